@@ -1,0 +1,64 @@
+#' Apply calibration coefficients to raw samples
+#'
+#' Replaces the `x`, `y`, `z` columns by their calibrated values
+#' `a = K (v + offset) + (T - meantemp) * tempoffset`, the temperature term
+#' being used only when the fit has a non-zero `tempoffset` (and then `x` must
+#' have a `temperature` column). All other columns, the row order and the
+#' class of `x` (data frame, tibble, data.table or matrix) are kept; the
+#' caller's object is not modified.
+#'
+#' A fit whose status is not `"ok"` carries identity coefficients, so the
+#' samples come back unchanged.
+#'
+#' @param x Raw samples: a data frame or matrix with columns `x`, `y`, `z`
+#'   (case-insensitive), as given to [calibrate()].
+#' @param fit A `gravcal_fit` from [calibrate()], [fit_gradient()] or
+#'   `fit_icp()`.
+#' @return `x` with calibrated `x`, `y`, `z`.
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 12, sf = 10, seed = 3)
+#' fit <- calibrate(rec, sf = 10)
+#' cal <- apply_calibration(rec, fit)
+#' head(cal)
+apply_calibration <- function(x, fit) {
+  check_fit(fit)
+  s <- as_samples(x)
+  uses_temp <- any(fit$tempoffset != 0)
+  if (uses_temp) {
+    if (is.null(s$temperature)) {
+      abort("`fit` has a temperature offset, so `x` must have a ",
+            "`temperature` column.")
+    }
+    if (!is.finite(fit$meantemp)) {
+      abort("`fit` has a temperature offset but no finite `meantemp`.")
+    }
+  }
+  K <- fit$K
+  o <- fit$offset
+  ux <- s$x + o[[1]]
+  uy <- s$y + o[[2]]
+  uz <- s$z + o[[3]]
+  ax <- K[1, 1] * ux + K[1, 2] * uy + K[1, 3] * uz
+  ay <- K[2, 1] * ux + K[2, 2] * uy + K[2, 3] * uz
+  az <- K[3, 1] * ux + K[3, 2] * uy + K[3, 3] * uz
+  if (uses_temp) {
+    dt <- s$temperature - fit$meantemp
+    ax <- ax + dt * fit$tempoffset[[1]]
+    ay <- ay + dt * fit$tempoffset[[2]]
+    az <- az + dt * fit$tempoffset[[3]]
+  }
+  cols <- match(c("x", "y", "z"), tolower(colnames(x)))
+  if (is.matrix(x) && anyNA(cols)) cols <- 1:3
+  if (is.matrix(x)) {
+    x[, cols[1]] <- ax
+    x[, cols[2]] <- ay
+    x[, cols[3]] <- az
+    return(x)
+  }
+  nm <- names(x)
+  x[[nm[cols[1]]]] <- ax
+  x[[nm[cols[2]]]] <- ay
+  x[[nm[cols[3]]]] <- az
+  x
+}

@@ -1,0 +1,322 @@
+#' Auto-calibrate a triaxial accelerometer recording against gravity
+#'
+#' Finds the rest windows of a raw recording, selects calibration points and
+#' fits correction coefficients, so that the calibrated vector of every rest
+#' window has a norm of 1 g.
+#'
+#' With `method = "lightweight"` (Farago et al. 2024) the steps are
+#' [rest_windows()] (5 s windows, max - min below 0.12 g), [select_points()]
+#' (3 x 3 orientation bins, 2 points each) and [fit_gradient()] (9-parameter
+#' model, forward-difference gradient descent). Arguments of those functions
+#' can be given in `...`.
+#'
+#' The paper stops after 50 iterations, a budget for a microcontroller. On
+#' real point sets the slowest direction of the problem (a mix of one axis'
+#' scale, offset and cross terms) contracts by only 2-10 % per iteration with
+#' the paper's rates, so 50 iterations can leave a few mg of error. A
+#' computer can afford to finish: `calibrate()` runs the same descent until
+#' every parameter step is below `tol = 1e-10` (at most `max_iter = 5000`
+#' iterations, typically 100-700). Give `max_iter = 50, tol = 0` for the
+#' paper's budget, exactly as a device would run it.
+#'
+#' The rest windows that were not selected as calibration points are a
+#' held-out set, as in the paper's Table 3: the fit reports the error on them
+#' before and after calibration (`error_heldout_before`,
+#' `error_heldout_after`).
+#'
+#' Calibration that cannot be done is a status, not an error: the fit then
+#' carries identity coefficients (so [apply_calibration()] leaves the data
+#' unchanged) and a `status` code with a `message` for people:
+#'
+#' | status | meaning | what to do |
+#' |---|---|---|
+#' | `"ok"` | calibrated | |
+#' | `"too_short"` | fewer samples than one window | check `sf` and the file |
+#' | `"no_rest"` | no window met the rest criterion | check units (g) and `sf` |
+#' | `"bins_incomplete"` | rest not seen in enough orientations | use a longer recording, or lower `min_per_bin` / `min_distance` |
+#' | `"diverged"` | the optimizer left the finite range | report it; try `objective = "mean"` |
+#' | `"no_improvement"` | the fit did not lower the error | the data are likely already calibrated |
+#' | `"implausible"` | coefficients outside plausible ranges | inspect the rest points with `plot()` |
+#'
+#' @param x Raw samples: a data frame or matrix with numeric columns `x`, `y`,
+#'   `z` in g and optionally `temperature` and `time`; or the path of a file
+#'   that [read_recording()] reads.
+#' @param sf Sampling frequency in Hz (taken from the file when `x` is a path
+#'   and `sf` is missing).
+#' @param method `"lightweight"` (Farago et al. 2024). The GGIR method
+#'   (van Hees et al. 2014) is planned and not available in this version.
+#' @param ggir_compat Reserved for the GGIR method.
+#' @param ... Arguments passed on to [rest_windows()] (`window`, `max_range`,
+#'   `axes`, `skip_zero`, `chunk_size`, `progress`), [select_points()]
+#'   (`per_bin`, `min_per_bin`, `min_distance`) and [fit_gradient()]
+#'   (`arithmetic`, `max_iter`, `rates`, `h`, `objective`, `use_sqrt`, `tol`,
+#'   `trace`).
+#' @return A `gravcal_fit`: a list with
+#'   * `K` (3 x 3) and `offset` (3), `tempoffset` (3) and `meantemp`, so that
+#'     the calibrated vector is `a = K (v + offset) + (T - meantemp) *
+#'     tempoffset`;
+#'   * `points`: the rest windows the fit used; `windows`: all rest windows;
+#'   * `error_before`, `error_after`: mean `| |a| - 1 |` over `points`, in g;
+#'     `error_heldout_before`, `error_heldout_after`: the same over the rest
+#'     windows not used for the fit (NA when there are none);
+#'   * `iterations`, `converged`, `status`, `message`, `method`, `call`, and
+#'     for the lightweight method `params` (the nine parameters).
+#' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 12, sf = 10, seed = 3)
+#' fit <- calibrate(rec, sf = 10)
+#' fit
+#' summary(fit)
+#' calibrated <- apply_calibration(rec, fit)
+calibrate <- function(x, sf, method = c("lightweight", "ggir"),
+                      ggir_compat = FALSE, ...) {
+  call <- match.call()
+  method <- match.arg(method)
+  check_flag(ggir_compat, "ggir_compat")
+  if (is.character(x)) {
+    rec <- read_recording(x)
+    if (missing(sf)) sf <- rec$sf
+    x <- rec$data
+  } else if (missing(sf)) {
+    abort("`sf` (sampling frequency in Hz) is missing.")
+  }
+  if (method == "ggir") {
+    abort("`method = \"ggir\"` is not available in this version of gravcal; ",
+          "use `method = \"lightweight\"`.")
+  }
+  args <- split_dots(list(...), list(
+    rest_windows = c("window", "max_range", "axes", "skip_zero",
+                     "chunk_size", "progress"),
+    select_points = c("per_bin", "min_per_bin", "min_distance"),
+    fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
+                     "use_sqrt", "tol", "trace")))
+  w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method),
+                               args$rest_windows))
+  rest <- w[w$rest, , drop = FALSE]
+  attr(rest, "n_windows") <- nrow(w)
+  fail <- function(status, message, points = rest[0, , drop = FALSE]) {
+    f <- new_fit(points = points, method = method, status = status,
+                 message = message, call = call)
+    finish_fit(f, rest)
+  }
+  if (nrow(w) == 0) {
+    return(fail("too_short", sprintf(paste0(
+      "recording too short: %d samples, fewer than one %g s window at %g Hz"),
+      NROW(x), attr(w, "window"), sf)))
+  }
+  if (nrow(rest) == 0) {
+    return(fail("no_rest", sprintf(paste0(
+      "no rest: none of the %d windows met the rest criterion; are the ",
+      "samples in g and is sf right?"), nrow(w))))
+  }
+  pts <- do.call(select_points, c(list(w = rest), args$select_points))
+  if (!isTRUE(attr(pts, "complete"))) {
+    return(fail("bins_incomplete", paste0(
+      "not enough rest points on all sides of the sphere: ",
+      nrow(rest), " rest windows, bins short of points: ",
+      missing_bins(pts)), points = pts))
+  }
+  fargs <- utils::modifyList(list(max_iter = 5000, tol = 1e-10),
+                             args$fit_gradient)
+  fit <- do.call(fit_gradient, c(list(pts = pts), fargs))
+  fit$call <- call
+  fit <- guard_fit(fit)
+  finish_fit(fit, rest)
+}
+
+# Route `...` to the functions that take each argument; unknown names fail.
+split_dots <- function(dots, table) {
+  nms <- names(dots)
+  if (length(dots) && (is.null(nms) || any(nms == ""))) {
+    abort("All arguments in `...` must be named.")
+  }
+  known <- unlist(table, use.names = FALSE)
+  bad <- setdiff(nms, known)
+  if (length(bad)) {
+    abort("Unknown argument", if (length(bad) > 1) "s", " in `...`: ",
+          paste0("`", bad, "`", collapse = ", "), ". Known: ",
+          paste(known, collapse = ", "), ".")
+  }
+  lapply(table, function(keep) dots[intersect(nms, keep)])
+}
+
+# Plausible coefficient ranges; wider than those seen across devices
+# (scale 0.83-1.13, offset -0.13 to 0.41 g; METHODS.md, van Hees 2014).
+plausible <- list(scale = c(0.7, 1.3), cross = 0.2, offset = 0.6)
+
+# A fit that does not lower the error or whose coefficients are implausible
+# is not applied: identity coefficients and a status that says why.
+guard_fit <- function(fit) {
+  if (fit$status != "ok") return(fit)
+  identity <- function(status, message) {
+    fit$K[] <- diag(3)
+    fit$offset[] <- 0
+    fit$tempoffset[] <- 0
+    if (!is.null(fit$params)) fit$params[] <- c(1, 1, 1, 0, 0, 0, 0, 0, 0)
+    fit$status <- status
+    fit$message <- message
+    fit <- refresh_errors(fit)
+    fit
+  }
+  before <- fit$error_before
+  after <- fit$error_after
+  if (!(after < before)) {
+    return(identity("no_improvement", sprintf(paste0(
+      "calibration not applied: it does not lower the error on the rest ",
+      "points (%.2f mg before, %.2f mg after)"), 1000 * before,
+      1000 * after)))
+  }
+  K <- fit$K
+  off <- abs(K[lower.tri(K)])
+  if (any(diag(K) < plausible$scale[1] | diag(K) > plausible$scale[2]) ||
+      any(off > plausible$cross) || any(abs(fit$offset) > plausible$offset)) {
+    return(identity("implausible", paste0(
+      "calibration not applied: coefficients outside plausible ranges ",
+      "(scale ", plausible$scale[1], "-", plausible$scale[2],
+      ", |cross-axis| <= ", plausible$cross, ", |offset| <= ",
+      plausible$offset, " g)")))
+  }
+  fit
+}
+
+# Attach the rest windows and held-out errors.
+finish_fit <- function(fit, rest) {
+  fit$windows <- rest
+  fit$n_windows <- attr(rest, "n_windows")
+  used <- if (is.null(fit$points$row)) integer(0) else fit$points$row
+  held <- rest[setdiff(seq_len(nrow(rest)), used), , drop = FALSE]
+  fit$error_heldout_before <- NA_real_
+  fit$error_heldout_after <- NA_real_
+  if (nrow(held) > 0) {
+    v <- point_matrix(held, "held")
+    fit$error_heldout_before <- sphere_error(v)
+    fit$error_heldout_after <- sphere_error(calibrate_points(fit, v,
+                                                             held$temperature))
+  }
+  fit
+}
+
+# Constructor of the one fit class both methods return.
+new_fit <- function(K = diag(3), offset = c(0, 0, 0), tempoffset = c(0, 0, 0),
+                    meantemp = NA_real_, points = NULL, method, iterations = 0L,
+                    converged = FALSE, status = "ok", message = "", call = NULL) {
+  dimnames(K) <- list(c("x", "y", "z"), c("x", "y", "z"))
+  fit <- list(K = K, offset = stats::setNames(as.double(offset), c("x", "y", "z")),
+              tempoffset = stats::setNames(as.double(tempoffset),
+                                           c("x", "y", "z")),
+              meantemp = meantemp, points = points,
+              iterations = as.integer(iterations), converged = converged,
+              status = status, message = message, method = method, call = call)
+  class(fit) <- "gravcal_fit"
+  refresh_errors(fit)
+}
+
+refresh_errors <- function(fit) {
+  fit$error_before <- NA_real_
+  fit$error_after <- NA_real_
+  if (!is.null(fit$points) && nrow(fit$points) > 0) {
+    v <- point_matrix(fit$points, "points")
+    fit$error_before <- sphere_error(v)
+    fit$error_after <- sphere_error(calibrate_points(fit, v,
+                                                     fit$points$temperature))
+  }
+  fit
+}
+
+# Mean | |v| - 1 | over the rows of an n x 3 matrix.
+sphere_error <- function(v) {
+  mean(abs(sqrt(rowSums(v^2)) - 1))
+}
+
+# Calibrated n x 3 matrix: a = K (v + offset) + (T - meantemp) tempoffset.
+calibrate_points <- function(fit, v, temperature = NULL) {
+  u <- sweep(v, 2, fit$offset, `+`)
+  a <- u %*% t(fit$K)
+  if (any(fit$tempoffset != 0) && !is.null(temperature)) {
+    a <- a + outer(temperature - fit$meantemp, fit$tempoffset)
+  }
+  unname(a)
+}
+
+#' @export
+coef.gravcal_fit <- function(object, ...) {
+  K <- object$K
+  stats::setNames(c(diag(K), K[2, 1], K[3, 1], K[3, 2], object$offset,
+                    object$tempoffset),
+                  c(param_names(), "t_x", "t_y", "t_z"))
+}
+
+#' @export
+print.gravcal_fit <- function(x, digits = 5, ...) {
+  cat("<gravcal_fit> ", x$method, " method, status: ", x$status, "\n",
+      sep = "")
+  if (nzchar(x$message)) cat("  ", x$message, "\n", sep = "")
+  np <- if (is.null(x$points)) 0L else nrow(x$points)
+  nw <- if (is.null(x$windows)) NA else nrow(x$windows)
+  cat(sprintf("  points: %d", np))
+  if (!is.na(nw)) {
+    cat(sprintf(" of %d rest windows (%s windows in all)", nw,
+                format(x$n_windows)))
+  }
+  cat("\n")
+  if (is.finite(x$error_before)) {
+    cat(sprintf("  error on fitting points: %.2f mg -> %.2f mg\n",
+                1000 * x$error_before, 1000 * x$error_after))
+  }
+  if (isTRUE(is.finite(x$error_heldout_before))) {
+    cat(sprintf("  error on held-out rest:  %.2f mg -> %.2f mg\n",
+                1000 * x$error_heldout_before, 1000 * x$error_heldout_after))
+  }
+  cat("  K (a = K (v + offset)):\n")
+  K <- format(round(x$K, digits), nsmall = digits)
+  cat(paste0("    ", apply(K, 1, paste, collapse = "  "), collapse = "\n"),
+      "\n")
+  cat("  offset (g):", format(round(x$offset, digits), nsmall = digits), "\n")
+  if (any(x$tempoffset != 0)) {
+    cat("  tempoffset (g/degree C):",
+        format(signif(x$tempoffset, digits)), "\n")
+    cat("  meantemp (degree C):", format(x$meantemp), "\n")
+  }
+  invisible(x)
+}
+
+#' @export
+summary.gravcal_fit <- function(object, ...) {
+  co <- coef(object)
+  err <- data.frame(
+    set = c("fitting points", "held-out rest windows"),
+    n = c(NROW(object$points),
+          NROW(object$windows) - NROW(object$points)),
+    before_mg = 1000 * c(object$error_before, object$error_heldout_before),
+    after_mg = 1000 * c(object$error_after, object$error_heldout_after))
+  err$improvement <- err$before_mg / err$after_mg
+  bins <- NULL
+  if (!is.null(object$points$bin)) bins <- table(object$points$bin)
+  structure(list(method = object$method, status = object$status,
+                 message = object$message, coefficients = co, errors = err,
+                 bins = bins, iterations = object$iterations,
+                 converged = object$converged),
+            class = "summary.gravcal_fit")
+}
+
+#' @export
+print.summary.gravcal_fit <- function(x, ...) {
+  cat("gravcal calibration (", x$method, " method)\n", sep = "")
+  cat("status: ", x$status, if (nzchar(x$message)) paste0(" - ", x$message),
+      "\n\n", sep = "")
+  cat("Coefficients:\n")
+  print(round(x$coefficients, 6))
+  cat("\nError | |a| - 1 | (mg):\n")
+  e <- x$errors
+  e$before_mg <- round(e$before_mg, 2)
+  e$after_mg <- round(e$after_mg, 2)
+  e$improvement <- round(e$improvement, 2)
+  print(e, row.names = FALSE)
+  if (!is.null(x$bins)) {
+    cat("\nPoints per orientation bin:\n")
+    print(x$bins)
+  }
+  cat("\niterations:", x$iterations, "\n")
+  invisible(x)
+}

@@ -1,0 +1,131 @@
+# Argument validation. Every message names the argument, what was expected
+# and what was given.
+
+abort <- function(...) {
+  stop(paste0(...), call. = FALSE)
+}
+
+describe <- function(x) {
+  if (is.null(x)) return("NULL")
+  if (is.data.frame(x)) return(sprintf("a data frame with %d rows", nrow(x)))
+  if (length(x) == 1 && is.atomic(x)) {
+    return(if (is.character(x)) sprintf('"%s"', x) else format(x))
+  }
+  sprintf("a %s of length %d", class(x)[1], length(x))
+}
+
+check_number <- function(x, arg, min = -Inf, max = Inf, min_inclusive = TRUE,
+                         integer = FALSE) {
+  ok <- is.numeric(x) && length(x) == 1 && !is.na(x) && is.finite(x)
+  if (ok) ok <- if (min_inclusive) x >= min else x > min
+  if (ok) ok <- x <= max
+  if (ok && integer) ok <- x == round(x)
+  if (!ok) {
+    what <- if (integer) "a whole number" else "a number"
+    range <- if (is.finite(min) && is.finite(max)) {
+      sprintf(" in [%s, %s]", format(min), format(max))
+    } else if (is.finite(min)) {
+      sprintf(" %s %s", if (min_inclusive) ">=" else ">", format(min))
+    } else if (is.finite(max)) {
+      sprintf(" <= %s", format(max))
+    } else ""
+    abort("`", arg, "` must be ", what, range, ", not ", describe(x), ".")
+  }
+  invisible(x)
+}
+
+check_flag <- function(x, arg) {
+  if (!(is.logical(x) && length(x) == 1 && !is.na(x))) {
+    abort("`", arg, "` must be TRUE or FALSE, not ", describe(x), ".")
+  }
+  invisible(x)
+}
+
+check_sf <- function(sf) {
+  check_number(sf, "sf", min = 0, min_inclusive = FALSE)
+}
+
+# Raw samples: a data frame or matrix with numeric columns x, y, z (any case),
+# optional temperature and time. Returns a list of plain numeric vectors that
+# point at the caller's memory (no copy for double columns).
+as_samples <- function(x, arg = "x") {
+  if (is.matrix(x)) {
+    if (is.null(colnames(x))) {
+      if (ncol(x) != 3) {
+        abort("`", arg, "` must have columns named x, y, z, or exactly 3 ",
+              "unnamed columns, not ", ncol(x), " unnamed columns.")
+      }
+      colnames(x) <- c("x", "y", "z")
+    }
+    x <- as.data.frame(x, stringsAsFactors = FALSE)
+  }
+  if (!is.data.frame(x)) {
+    abort("`", arg, "` must be a data frame or matrix of raw samples with ",
+          "columns x, y, z (in g), not ", describe(x), ".")
+  }
+  nm <- tolower(names(x))
+  col <- function(name, required = TRUE) {
+    i <- match(name, nm)
+    if (is.na(i)) {
+      if (required) {
+        abort("`", arg, "` must have a column `", name, "` (acceleration in ",
+              "g); it has columns: ", paste(names(x), collapse = ", "), ".")
+      }
+      return(NULL)
+    }
+    v <- x[[i]]
+    if (!is.numeric(v) || is.object(v)) {
+      abort("Column `", names(x)[i], "` of `", arg, "` must be numeric, not ",
+            class(v)[1], ".")
+    }
+    if (!is.double(v)) v <- as.double(v)
+    v
+  }
+  xs <- col("x")
+  ys <- col("y")
+  zs <- col("z")
+  temp <- col("temperature", required = FALSE)
+  ti <- match("time", nm)
+  time <- if (is.na(ti)) NULL else x[[ti]]
+  list(x = xs, y = ys, z = zs, temperature = temp, time = time, n = length(xs))
+}
+
+# Epochs (window table) or points: needs mean_x, mean_y, mean_z.
+as_epochs <- function(w, arg = "w", need = c("mean_x", "mean_y", "mean_z")) {
+  if (is.matrix(w)) w <- as.data.frame(w)
+  if (!is.data.frame(w)) {
+    abort("`", arg, "` must be a data frame of windows with columns ",
+          paste(need, collapse = ", "), ", not ", describe(w), ".")
+  }
+  missing <- setdiff(need, names(w))
+  if (length(missing)) {
+    abort("`", arg, "` must have columns ", paste(need, collapse = ", "),
+          "; missing: ", paste(missing, collapse = ", "), ".")
+  }
+  for (nm in need) {
+    if (!is.numeric(w[[nm]])) {
+      abort("Column `", nm, "` of `", arg, "` must be numeric, not ",
+            class(w[[nm]])[1], ".")
+    }
+  }
+  w
+}
+
+check_fit <- function(fit, arg = "fit") {
+  if (!inherits(fit, "gravcal_fit")) {
+    abort("`", arg, "` must be a gravcal_fit (from calibrate(), ",
+          "fit_gradient() or fit_icp()), not ", describe(fit), ".")
+  }
+  K <- fit$K
+  ok <- is.numeric(K) && is.matrix(K) && all(dim(K) == 3) && all(is.finite(K))
+  ok <- ok && is.numeric(fit$offset) && length(fit$offset) == 3 &&
+    all(is.finite(fit$offset))
+  ok <- ok && is.numeric(fit$tempoffset) && length(fit$tempoffset) == 3 &&
+    all(is.finite(fit$tempoffset))
+  ok <- ok && is.numeric(fit$meantemp) && length(fit$meantemp) == 1
+  if (!ok) {
+    abort("`", arg, "` is not a valid gravcal_fit: it needs a finite 3 x 3 ",
+          "`K`, finite `offset` and `tempoffset` of length 3 and a `meantemp`.")
+  }
+  invisible(fit)
+}

@@ -1,0 +1,102 @@
+#' Names of the nine orientation bins
+#'
+#' Bin `"x-"` holds points whose x coordinate lies in \[-1.25, -0.75\] g,
+#' `"x0"` in \[-0.25, 0.25\] g, `"x+"` in \[0.75, 1.25\] g; likewise for y and
+#' z (Farago et al. 2024, Eq. 10).
+#' @return A character vector of the nine bin names, in the core's order.
+#' @export
+#' @examples
+#' bin_names()
+bin_names <- function() {
+  paste0(rep(c("x", "y", "z"), each = 3), c("-", "0", "+"))
+}
+
+#' Select calibration points in 3 x 3 orientation bins
+#'
+#' Offers the rest windows, in time order, to the lightweight method's point
+#' selector (Farago et al. 2024, Sec. II-B-1 and Fig. 6), exactly as a device
+#' streaming its rest segments would. Each axis has three intervals,
+#' negative \[-1.25, -0.75\], zero \[-0.25, 0.25\] and positive
+#' \[0.75, 1.25\] g, giving nine bins. A rest mean is kept when
+#' 1. it lies in at least one bin that still has room (fewer than `per_bin`
+#'    points), and
+#' 2. it is at least `min_distance` g (Euclidean) from every point kept so far.
+#'
+#' A point can lie in up to three bins (one per axis); it counts for exactly
+#' one: its negative or positive bin when that bin has room (those caps cover
+#' an eighth of the sphere each, the zero bands a quarter, so points that can
+#' fill them should), otherwise the open zero bin whose axis coordinate is
+#' nearest to 0, ties going to the earlier bin in [bin_names()] order. A
+#' device lying flat on +z fills `z+` first, then `x0` or `y0`. Selection
+#' stops when every bin is full; the fit may start once every bin holds
+#' `min_per_bin` points.
+#'
+#' The paper does not print its novelty threshold; gravcal's default of 0.1 g
+#' (about 6 degrees of tilt) keeps repeated rests in one posture from taking
+#' two places of a bin, while leaving room for the 18 points on a device that
+#' rests in only a handful of postures.
+#'
+#' @param w Windows from [rest_windows()], or any data frame with numeric
+#'   columns `mean_x`, `mean_y`, `mean_z` (and optionally a logical `rest`
+#'   column; only rest rows are offered when it is present).
+#' @param per_bin Maximum number of points per bin (paper: 2, so 18 points).
+#' @param min_per_bin Points each bin needs before fitting (paper: 2).
+#' @param min_distance Novelty threshold in g: the smallest distance from a new
+#'   point to every kept point.
+#' @return The selected rows of `w` (all its columns), in the order they were
+#'   kept, with two more columns: `bin` (a factor with levels [bin_names()])
+#'   and `row` (the row of `w` the point came from). Attributes: `counts`
+#'   (points per bin), `complete` (every bin has `min_per_bin`), `per_bin`,
+#'   `min_per_bin`, `min_distance`, `offered` (rest rows considered).
+#' @seealso [fit_gradient()]
+#' @export
+#' @examples
+#' set.seed(1)
+#' cand <- simulate_points(500, noise = 0.001)
+#' pts <- select_points(cand)
+#' table(pts$bin)
+#' attr(pts, "complete")
+select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
+                          min_distance = 0.1) {
+  w <- as_epochs(w)
+  check_number(per_bin, "per_bin", min = 1, max = 64, integer = TRUE)
+  check_number(min_per_bin, "min_per_bin", min = 1, max = per_bin,
+               integer = TRUE)
+  check_number(min_distance, "min_distance", min = 0)
+  rows <- seq_len(nrow(w))
+  if ("rest" %in% names(w)) {
+    if (!is.logical(w$rest)) {
+      abort("Column `rest` of `w` must be logical, not ", class(w$rest)[1],
+            ".")
+    }
+    rows <- rows[!is.na(w$rest) & w$rest]
+  }
+  ok <- is.finite(w$mean_x[rows]) & is.finite(w$mean_y[rows]) &
+    is.finite(w$mean_z[rows])
+  rows <- rows[ok]
+  sel <- gc_select_points(w$mean_x[rows], w$mean_y[rows], w$mean_z[rows],
+                          as.integer(min_per_bin), as.integer(per_bin),
+                          min_distance)
+  kept <- which(!is.na(sel$bin) & sel$bin >= 0)
+  pts <- w[rows[kept], , drop = FALSE]
+  pts$bin <- factor(bin_names()[sel$bin[kept] + 1], levels = bin_names())
+  pts$row <- rows[kept]
+  rownames(pts) <- NULL
+  counts <- stats::setNames(sel$counts, bin_names())
+  attr(pts, "counts") <- counts
+  attr(pts, "complete") <- sel$complete
+  attr(pts, "per_bin") <- per_bin
+  attr(pts, "min_per_bin") <- min_per_bin
+  attr(pts, "min_distance") <- min_distance
+  attr(pts, "offered") <- length(rows)
+  pts
+}
+
+# Which bins lack points, as a readable string.
+missing_bins <- function(pts) {
+  counts <- attr(pts, "counts")
+  need <- attr(pts, "min_per_bin")
+  short <- counts < need
+  paste(sprintf("%s (%d of %d)", names(counts)[short], counts[short], need),
+        collapse = ", ")
+}

@@ -1,0 +1,237 @@
+#' Draw random sensor errors as in Farago et al. (2024)
+#'
+#' Sensitivities `S` uniform in (0.9, 1.1), non-orthogonalities `T` in
+#' (-0.05, 0.05) and offsets `O` in (-0.1, 0.1) g (paper Eq. 17), combined
+#' into the nine parameters `k_xx = S_x`, `k_yy = S_y`, `k_zz = S_z`,
+#' `k_xy = S_y T_xy`, `k_xz = S_z T_xz`, `k_yz = S_z T_yz`, `o = O` (Eq. 18).
+#' Uses R's random number generator, so `set.seed()` reproduces the draw.
+#' @param scale,misalignment,offset Half-widths of the uniform ranges.
+#' @return A named vector of the nine parameters ([param_names()]).
+#' @export
+#' @examples
+#' set.seed(1)
+#' random_params()
+random_params <- function(scale = 0.1, misalignment = 0.05, offset = 0.1) {
+  u <- function(n, half) 2 * (stats::runif(n) - 0.5) * half
+  S <- 1 + u(3, scale)
+  Tm <- u(3, misalignment)
+  O <- u(3, offset)
+  stats::setNames(c(S, S[2] * Tm[1], S[3] * Tm[2], S[3] * Tm[3], O),
+                  param_names())
+}
+
+#' Distort true acceleration vectors by the 9-parameter model
+#'
+#' The inverse of calibration: the measurement `v = K^-1 a - o` that a sensor
+#' with parameters `params` gives for the true vector `a`. This is the exact
+#' inverse of the model; the paper's Eq. 19 has sign slips in its second and
+#' third lines.
+#' @param a An n x 3 matrix of true vectors (g).
+#' @param params The nine parameters ([param_names()] order).
+#' @return An n x 3 matrix of measured vectors.
+#' @export
+#' @examples
+#' p <- c(1.05, 0.97, 1.02, 0.01, -0.02, 0.03, 0.05, -0.03, 0.02)
+#' v <- distort(diag(3), p)
+#' v
+distort <- function(a, params) {
+  a <- matrix(as.double(a), ncol = 3)
+  p <- unname(params)
+  ux <- a[, 1] / p[1]
+  uy <- (a[, 2] - p[4] * ux) / p[2]
+  uz <- (a[, 3] - p[5] * ux - p[6] * uy) / p[3]
+  cbind(ux - p[7], uy - p[8], uz - p[9])
+}
+
+#' Simulate calibration points as in Farago et al. (2024)
+#'
+#' The paper's simulation (Sec. III-A, Eq. 17-20): random unit vectors
+#' (uniform on the sphere), distorted by the inverse model with parameters
+#' drawn by [random_params()] (or given), plus Gaussian noise of standard
+#' deviation `noise` on each axis. The result is the candidate stream that
+#' [select_points()] picks from.
+#'
+#' @param n Number of candidate points.
+#' @param noise Noise standard deviation in g (paper: 0.001 and 0.005).
+#' @param params The true parameters; drawn by [random_params()] when NULL.
+#' @return A data frame with columns `mean_x`, `mean_y`, `mean_z` and
+#'   attributes `params` (the truth) and `noise`.
+#' @export
+#' @examples
+#' set.seed(2)
+#' cand <- simulate_points(300, noise = 0.005)
+#' fit <- fit_gradient(select_points(cand))
+#' round(fit$params - attr(cand, "params"), 4)
+simulate_points <- function(n = 1000, noise = 0.001, params = NULL) {
+  check_number(n, "n", min = 1, integer = TRUE)
+  check_number(noise, "noise", min = 0)
+  if (is.null(params)) params <- random_params()
+  check_params(params)
+  a <- random_unit_vectors(n)
+  v <- distort(a, params) + matrix(stats::rnorm(3 * n, sd = noise), ncol = 3)
+  out <- data.frame(mean_x = v[, 1], mean_y = v[, 2], mean_z = v[, 3])
+  attr(out, "params") <- stats::setNames(unname(params), param_names())
+  attr(out, "noise") <- noise
+  out
+}
+
+random_unit_vectors <- function(n) {
+  g <- matrix(stats::rnorm(3 * n), ncol = 3)
+  g / sqrt(rowSums(g^2))
+}
+
+check_params <- function(params) {
+  if (!is.numeric(params) || length(params) != 9 || !all(is.finite(params)) ||
+      any(params[1:3] <= 0)) {
+    abort("`params` must be 9 finite numbers (", paste(param_names(),
+          collapse = ", "), ") with positive scales, not ",
+          describe(params), ".")
+  }
+}
+
+#' Simulate a raw accelerometer recording with known calibration errors
+#'
+#' A wrist-worn-like recording: bouts of rest in varied postures (long ones at
+#' night, short ones by day) alternate with bouts of movement, in which the
+#' device turns between postures while shaking at 1-3 Hz. The true signal is
+#' distorted by the 9-parameter model ([distort()]), by a temperature offset
+#' when `tempoffset` is non-zero, and by Gaussian noise, then rounded to the
+#' sensor's resolution.
+#'
+#' @param hours Duration in hours.
+#' @param sf Sampling frequency in Hz.
+#' @param params True parameters of the 9-parameter model; drawn by
+#'   [random_params()] when NULL.
+#' @param noise Sample noise standard deviation in g.
+#' @param resolution Quantisation step in g (0 for none).
+#' @param temperature Add a `temperature` column (a daily cycle of +-3
+#'   degrees C around 28 plus a slow drift).
+#' @param tempoffset Temperature offset per axis in g per degree C, so that
+#'   the true acceleration is `K (v + o) + (T - meantemp) * tempoffset`.
+#' @param rest_fraction Fraction of daytime spent in rest bouts.
+#' @param start Start time (POSIXct).
+#' @param seed Optional seed; the caller's RNG state is restored afterwards.
+#' @return A data frame with columns `time`, `x`, `y`, `z` and (optionally)
+#'   `temperature`, and an attribute `truth`: a list with `params`, `K`,
+#'   `offset`, `tempoffset`, `meantemp` and `sf`.
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 1, sf = 10, seed = 1)
+#' str(rec)
+#' attr(rec, "truth")$params
+simulate_recording <- function(hours = 72, sf = 30, params = NULL,
+                               noise = 0.003, resolution = 1 / 256,
+                               temperature = TRUE,
+                               tempoffset = c(0, 0, 0), rest_fraction = 0.4,
+                               start = as.POSIXct("2024-01-01 00:00:00",
+                                                  tz = "UTC"),
+                               seed = NULL) {
+  check_number(hours, "hours", min = 0, min_inclusive = FALSE)
+  check_sf(sf)
+  check_number(noise, "noise", min = 0)
+  check_number(resolution, "resolution", min = 0)
+  check_flag(temperature, "temperature")
+  check_number(rest_fraction, "rest_fraction", min = 0, max = 1)
+  if (!is.numeric(tempoffset) || length(tempoffset) != 3 ||
+      !all(is.finite(tempoffset))) {
+    abort("`tempoffset` must be 3 finite numbers (g per degree C), not ",
+          describe(tempoffset), ".")
+  }
+  if (any(tempoffset != 0) && !temperature) {
+    abort("`tempoffset` needs `temperature = TRUE`.")
+  }
+  if (!is.null(seed)) {
+    check_number(seed, "seed", integer = TRUE)
+    old <- if (exists(".Random.seed", envir = globalenv())) {
+      get(".Random.seed", envir = globalenv())
+    }
+    on.exit({
+      if (is.null(old)) rm(".Random.seed", envir = globalenv())
+      else assign(".Random.seed", old, envir = globalenv())
+    }, add = TRUE)
+    set.seed(seed)
+  }
+  if (is.null(params)) params <- random_params()
+  check_params(params)
+  n <- as.integer(round(hours * 3600 * sf))
+  tsec <- (seq_len(n) - 1) / sf
+
+  # Bouts: rest (a posture) and movement (turning to the next posture).
+  postures <- simulated_postures(200)
+  bouts <- simulate_bouts(hours * 3600, rest_fraction)
+  nb <- nrow(bouts)
+  pidx <- sample.int(nrow(postures), nb + 1, replace = TRUE,
+                     prob = attr(postures, "prob"))
+  # each rest bout holds the posture of its index; movement goes from the
+  # previous rest posture to the next one
+  edges <- c(0, cumsum(bouts$duration))
+  bout_of <- findInterval(tsec, edges, rightmost.closed = TRUE)
+  bout_of[bout_of > nb] <- nb
+  from <- postures[pidx[bout_of], , drop = FALSE]
+  to <- postures[pidx[bout_of + 1], , drop = FALSE]
+  frac <- (tsec - edges[bout_of]) / bouts$duration[bout_of]
+  moving <- !bouts$rest[bout_of]
+  g <- from
+  if (any(moving)) {
+    w <- frac[moving]
+    g[moving, ] <- from[moving, ] * (1 - w) + to[moving, ] * w
+    g[moving, ] <- g[moving, ] / sqrt(rowSums(g[moving, , drop = FALSE]^2))
+  }
+  a <- g
+  if (any(moving)) {
+    f <- bouts$freq[bout_of[moving]]
+    amp <- bouts$amp[bout_of[moving]]
+    tm <- tsec[moving]
+    a[moving, 1] <- a[moving, 1] + amp * sin(2 * pi * f * tm)
+    a[moving, 2] <- a[moving, 2] + 0.7 * amp * sin(2 * pi * f * tm + 1)
+    a[moving, 3] <- a[moving, 3] + 0.5 * amp * sin(2 * pi * 1.3 * f * tm + 2)
+  }
+  temp <- NULL
+  meantemp <- NA_real_
+  if (temperature) {
+    temp <- 28 + 3 * sin(2 * pi * (tsec / 86400 - 0.3)) +
+      0.5 * tsec / max(tsec[n], 1)
+    meantemp <- mean(temp)
+    if (any(tempoffset != 0)) {
+      a <- a - outer(temp - meantemp, tempoffset)
+    }
+  }
+  v <- distort(a, params) + matrix(stats::rnorm(3 * n, sd = noise), ncol = 3)
+  if (resolution > 0) v <- round(v / resolution) * resolution
+  out <- data.frame(time = start + tsec, x = v[, 1], y = v[, 2], z = v[, 3])
+  if (temperature) out$temperature <- round(temp, 2)
+  attr(out, "truth") <- list(
+    params = stats::setNames(unname(params), param_names()),
+    K = params_to_K(params), offset = unname(params[7:9]),
+    tempoffset = tempoffset, meantemp = meantemp, sf = sf)
+  out
+}
+
+# Unit vectors of typical postures (lying, sitting, arm hanging, ...) with
+# uneven weights, plus random ones so that every side of the sphere is seen.
+simulated_postures <- function(n_random) {
+  base <- rbind(c(0, 0, 1), c(0, 0, -1), c(1, 0, 0), c(-1, 0, 0),
+                c(0, 1, 0), c(0, -1, 0), c(0.7, 0, 0.7), c(0, -0.7, 0.7),
+                c(-0.6, 0.6, 0.5))
+  tilt <- base + matrix(stats::rnorm(length(base), sd = 0.08), ncol = 3)
+  rnd <- random_unit_vectors(n_random)
+  p <- rbind(tilt, rnd)
+  p <- p / sqrt(rowSums(p^2))
+  attr(p, "prob") <- c(rep(3, nrow(tilt)), rep(1, n_random))
+  p
+}
+
+# Alternating rest / movement bouts covering `total` seconds.
+simulate_bouts <- function(total, rest_fraction) {
+  est <- ceiling(total / 60) + 10
+  rest <- rep(c(TRUE, FALSE), length.out = est)
+  dur <- ifelse(rest, stats::rexp(est, 1 / (120 * rest_fraction + 1)) + 20,
+                stats::rexp(est, 1 / (120 * (1 - rest_fraction) + 1)) + 10)
+  keep <- cumsum(dur) - dur < total
+  dur <- dur[keep]
+  rest <- rest[keep]
+  dur[length(dur)] <- total - sum(dur[-length(dur)])
+  data.frame(rest = rest, duration = dur,
+             freq = stats::runif(length(dur), 1, 3),
+             amp = stats::runif(length(dur), 0.1, 0.6))
+}

@@ -1,0 +1,170 @@
+#' Find rest windows in raw accelerometer samples
+#'
+#' Cuts the recording into consecutive, non-overlapping windows of fixed
+#' duration and computes, per window, the mean, standard deviation and range
+#' of each axis, the mean vector norm and the mean temperature, in one
+#' streaming pass in C++. Each window is then classed as rest or not by the
+#' chosen method's criterion.
+#'
+#' * `method = "lightweight"` (Farago et al. 2024): 5 s windows; rest when
+#'   max - min is below `max_range` (0.12 g) on every axis in `axes`. The
+#'   paper watches a single axis of a worn device; gravcal watches all three
+#'   by default, which costs nothing on a computer and rejects motion that
+#'   happens to spare one axis.
+#' * `method = "ggir"` (van Hees et al. 2014): 10 s windows; rest when the
+#'   standard deviation is below `max_sd` (13 mg) and the absolute mean below
+#'   `max_abs_mean` (2 g) on all three axes.
+#'
+#' Samples are fed to the core in chunks of `chunk_size`; the result does not
+#' depend on the chunk size (the segmenter carries the open window across
+#' chunks). A trailing incomplete window is dropped. Samples with x, y and z
+#' all exactly 0 (ActiGraph idle sleep) are skipped when `skip_zero` is TRUE.
+#' Samples with a non-finite value (NA, NaN, Inf) are left out of the window
+#' statistics and make their window ineligible as rest, with a warning.
+#'
+#' @param x Raw samples: a data frame or matrix with numeric columns `x`, `y`,
+#'   `z` in g (case-insensitive), and optionally `temperature` (degrees C) and
+#'   `time` (used for the `start` column).
+#' @param sf Sampling frequency in Hz, a positive number.
+#' @param method `"lightweight"` or `"ggir"`: which rest criterion and which
+#'   defaults to use.
+#' @param window Window duration in seconds; default 5 (lightweight) or 10
+#'   (ggir). Must hold at least 2 samples.
+#' @param max_range Lightweight rest threshold on max - min, in g (paper: 0.12).
+#' @param axes Lightweight: the axes whose range is checked, any of `"x"`,
+#'   `"y"`, `"z"` (default all three).
+#' @param max_sd GGIR rest threshold on each axis' standard deviation, in g
+#'   (13 mg).
+#' @param max_abs_mean GGIR clipping guard on each axis' absolute mean, in g
+#'   (2 g).
+#' @param skip_zero Skip samples that are exactly zero on all three axes.
+#' @param chunk_size Number of samples passed to the core at a time.
+#' @param progress Show a progress bar (default: in interactive sessions, for
+#'   recordings of more than 20 chunks).
+#' @return A data frame, one row per complete window: `start` (time of the
+#'   first sample, from `time` when given, else seconds from the start), `n`
+#'   (samples), `mean_x`, `mean_y`, `mean_z`, `sd_x`, `sd_y`, `sd_z`,
+#'   `range_x`, `range_y`, `range_z`, `mean_norm`, `temperature` (NA without
+#'   a temperature column), `n_invalid` (non-finite samples) and `rest`
+#'   (logical). Attributes record `sf`, `method`, `window` and the criterion.
+#' @references
+#' Farago D, Maczak B, Gingl Z (2024). Enhancing accuracy in actigraphic
+#' measurements: a lightweight calibration method for triaxial
+#' accelerometers. IEEE Access.
+#'
+#' van Hees VT, Fang Z, Langford J, et al. (2014). Autocalibration of
+#' accelerometer data for free-living physical activity assessment using
+#' local gravity and temperature: an evaluation on four continents. Journal
+#' of Applied Physiology 117(7), 738-744. \doi{10.1152/jappphysiol.00421.2014}
+#' @seealso [select_points()], [calibrate()]
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 2, sf = 10, seed = 1)
+#' w <- rest_windows(rec, sf = 10)
+#' head(w)
+#' mean(w$rest)
+rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
+                         window = NULL, max_range = 0.12,
+                         axes = c("x", "y", "z"), max_sd = 0.013,
+                         max_abs_mean = 2, skip_zero = TRUE,
+                         chunk_size = 1e6, progress = NULL) {
+  method <- match.arg(method)
+  s <- as_samples(x)
+  check_sf(sf)
+  if (is.null(window)) window <- if (method == "lightweight") 5 else 10
+  check_number(window, "window", min = 0, min_inclusive = FALSE)
+  if (window * sf < 2) {
+    abort("`window` * `sf` must give at least 2 samples per window, not ",
+          format(window * sf), " (window = ", format(window), " s, sf = ",
+          format(sf), " Hz).")
+  }
+  check_flag(skip_zero, "skip_zero")
+  check_number(chunk_size, "chunk_size", min = 1)
+  if (method == "lightweight") {
+    check_number(max_range, "max_range", min = 0, min_inclusive = FALSE)
+    if (!is.character(axes) || !length(axes) ||
+        !all(axes %in% c("x", "y", "z"))) {
+      abort("`axes` must name one or more of \"x\", \"y\", \"z\", not ",
+            describe(axes), ".")
+    }
+    rule <- 0L
+    par <- c(max_range, sum(c(x = 1, y = 2, z = 4)[unique(axes)]))
+  } else {
+    check_number(max_sd, "max_sd", min = 0, min_inclusive = FALSE)
+    check_number(max_abs_mean, "max_abs_mean", min = 0, min_inclusive = FALSE)
+    rule <- 1L
+    par <- c(max_sd, max_abs_mean)
+  }
+  if (!is.null(s$time) && length(s$time) != s$n) {
+    abort("Column `time` of `x` must have one value per sample.")
+  }
+  seg <- gc_segmenter_new(window * sf, skip_zero)
+  out <- segment_chunks(seg, s, rule, par, chunk_size, progress)
+  w <- windows_frame(out, s, sf)
+  state <- gc_segmenter_state(seg)
+  attr(w, "sf") <- sf
+  attr(w, "method") <- method
+  attr(w, "window") <- window
+  attr(w, "criterion") <- if (method == "lightweight") {
+    list(max_range = max_range, axes = unique(axes))
+  } else {
+    list(max_sd = max_sd, max_abs_mean = max_abs_mean)
+  }
+  attr(w, "samples") <- s$n
+  attr(w, "skipped_zero") <- unname(state["skipped_zero"])
+  attr(w, "dropped_tail") <- unname(state["pending"])
+  n_bad <- sum(w$n_invalid)
+  if (n_bad > 0) {
+    warning(sprintf(paste0("`x` has %d non-finite samples (NA, NaN or Inf) ",
+                           "in %d windows; those windows are not used as ",
+                           "rest."), n_bad, sum(w$n_invalid > 0)),
+            call. = FALSE)
+  }
+  w
+}
+
+# Push the samples through the segmenter chunk by chunk; returns the list of
+# per-chunk column lists.
+segment_chunks <- function(seg, s, rule, par, chunk_size, progress) {
+  n <- s$n
+  starts <- seq(0, max(n - 1, 0), by = chunk_size)
+  if (n == 0) starts <- numeric(0)
+  if (is.null(progress)) progress <- interactive() && length(starts) > 20
+  bar <- NULL
+  if (isTRUE(progress) && length(starts) > 1) {
+    bar <- utils::txtProgressBar(min = 0, max = length(starts), style = 3)
+    on.exit(close(bar), add = TRUE)
+  }
+  out <- vector("list", length(starts))
+  for (i in seq_along(starts)) {
+    to <- min(starts[i] + chunk_size, n)
+    out[[i]] <- gc_segmenter_push(seg, s$x, s$y, s$z, s$temperature,
+                                  starts[i], to, rule, par)
+    if (!is.null(bar)) utils::setTxtProgressBar(bar, i)
+  }
+  out
+}
+
+windows_frame <- function(chunks, s, sf) {
+  col <- function(name) {
+    v <- unlist(lapply(chunks, `[[`, name), use.names = FALSE)
+    if (is.null(v)) numeric(0) else v
+  }
+  first <- col("first")
+  start <- if (is.null(s$time)) first / sf else s$time[first + 1]
+  w <- data.frame(
+    start = start,
+    n = as.integer(col("n")),
+    mean_x = col("mean_x"), mean_y = col("mean_y"), mean_z = col("mean_z"),
+    sd_x = col("sd_x"), sd_y = col("sd_y"), sd_z = col("sd_z"),
+    range_x = col("max_x") - col("min_x"),
+    range_y = col("max_y") - col("min_y"),
+    range_z = col("max_z") - col("min_z"),
+    mean_norm = col("mean_norm"),
+    temperature = col("temperature"),
+    n_invalid = as.integer(col("n_invalid")),
+    rest = as.logical(col("rest"))
+  )
+  if (!length(first)) w$rest <- logical(0)
+  w
+}

@@ -1,0 +1,224 @@
+// Rcpp glue for the segmenter, the bin selector and the gradient fit.
+// Converts, checks shapes, calls the core in inst/include/gravcal. No
+// algorithm lives here, and R's memory is only read.
+#include <Rcpp.h>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gravcal/gravcal.hpp"
+
+using gravcal::Segmenter;
+using gravcal::WindowStats;
+
+namespace {
+
+struct WindowTable {
+  std::vector<double> start, mean[3], sd[3], min[3], max[3], norm, temp;
+  std::vector<int> n, n_invalid;
+  std::vector<double> index;
+  std::vector<int> rest;
+
+  void add(const WindowStats& s, bool is_rest) {
+    index.push_back(static_cast<double>(s.index));
+    start.push_back(static_cast<double>(s.first));
+    n.push_back(s.n);
+    n_invalid.push_back(s.n_invalid);
+    for (int a = 0; a < 3; ++a) {
+      mean[a].push_back(s.mean[a]);
+      sd[a].push_back(s.sd[a]);
+      min[a].push_back(s.min[a]);
+      max[a].push_back(s.max[a]);
+    }
+    norm.push_back(s.mean_norm);
+    temp.push_back(s.temperature);
+    rest.push_back(is_rest ? 1 : 0);
+  }
+
+  Rcpp::List to_list() const {
+    Rcpp::LogicalVector r(rest.begin(), rest.end());
+    return Rcpp::List::create(
+        Rcpp::Named("window") = Rcpp::wrap(index),
+        Rcpp::Named("first") = Rcpp::wrap(start),
+        Rcpp::Named("n") = Rcpp::wrap(n),
+        Rcpp::Named("n_invalid") = Rcpp::wrap(n_invalid),
+        Rcpp::Named("mean_x") = Rcpp::wrap(mean[0]),
+        Rcpp::Named("mean_y") = Rcpp::wrap(mean[1]),
+        Rcpp::Named("mean_z") = Rcpp::wrap(mean[2]),
+        Rcpp::Named("sd_x") = Rcpp::wrap(sd[0]),
+        Rcpp::Named("sd_y") = Rcpp::wrap(sd[1]),
+        Rcpp::Named("sd_z") = Rcpp::wrap(sd[2]),
+        Rcpp::Named("min_x") = Rcpp::wrap(min[0]),
+        Rcpp::Named("min_y") = Rcpp::wrap(min[1]),
+        Rcpp::Named("min_z") = Rcpp::wrap(min[2]),
+        Rcpp::Named("max_x") = Rcpp::wrap(max[0]),
+        Rcpp::Named("max_y") = Rcpp::wrap(max[1]),
+        Rcpp::Named("max_z") = Rcpp::wrap(max[2]),
+        Rcpp::Named("mean_norm") = Rcpp::wrap(norm),
+        Rcpp::Named("temperature") = Rcpp::wrap(temp),
+        Rcpp::Named("rest") = r);
+  }
+};
+
+}  // namespace
+
+// [[Rcpp::export(rng = false)]]
+SEXP gc_segmenter_new(double samples_per_window, bool skip_zero) {
+  if (!(samples_per_window >= 1.0)) Rcpp::stop("samples_per_window must be >= 1");
+  Rcpp::XPtr<Segmenter> p(new Segmenter(samples_per_window, skip_zero), true);
+  return p;
+}
+
+// Push samples [from, to) (0-based) of the given columns. rule: 0 = range
+// rule (lightweight; par = max_range, axes mask), 1 = sd rule (GGIR; par =
+// max_sd, max_abs_mean). Returns the windows this chunk completed.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
+                             const Rcpp::NumericVector& y,
+                             const Rcpp::NumericVector& z,
+                             Rcpp::Nullable<Rcpp::NumericVector> temp,
+                             double from, double to, int rule,
+                             Rcpp::NumericVector par) {
+  Rcpp::XPtr<Segmenter> s(seg);
+  const R_xlen_t n = x.size();
+  if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
+  const double* t = nullptr;
+  Rcpp::NumericVector tv;
+  if (temp.isNotNull()) {
+    tv = Rcpp::NumericVector(temp.get());
+    if (tv.size() != n) Rcpp::stop("temperature length differs");
+    t = tv.begin();
+  }
+  if (from < 0 || to > static_cast<double>(n) || from > to)
+    Rcpp::stop("chunk bounds out of range");
+  if (par.size() < 2) Rcpp::stop("par must have 2 values");
+  const std::size_t i0 = static_cast<std::size_t>(from);
+  const std::size_t len = static_cast<std::size_t>(to) - i0;
+
+  gravcal::RangeRestRule range_rule;
+  range_rule.max_range = par[0];
+  range_rule.axes = static_cast<unsigned>(par[1]);
+  gravcal::SdRestRule sd_rule;
+  sd_rule.max_sd = par[0];
+  sd_rule.max_abs_mean = par[1];
+
+  WindowTable out;
+  s->push(x.begin() + i0, y.begin() + i0, z.begin() + i0,
+          t ? t + i0 : nullptr, len, [&](const WindowStats& w) {
+            const bool r = rule == 0 ? gravcal::is_rest(w, range_rule)
+                                     : gravcal::is_rest(w, sd_rule);
+            out.add(w, r);
+          });
+  return out.to_list();
+}
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector gc_segmenter_state(SEXP seg) {
+  Rcpp::XPtr<Segmenter> s(seg);
+  return Rcpp::NumericVector::create(
+      Rcpp::Named("windows") = static_cast<double>(s->windows()),
+      Rcpp::Named("retained") = static_cast<double>(s->retained()),
+      Rcpp::Named("skipped_zero") = static_cast<double>(s->skipped_zero()),
+      Rcpp::Named("pending") = static_cast<double>(s->pending()));
+}
+
+// Offer rest means in order until the bins are full. Returns, per row, the
+// bin it was counted for (0..8) or the negative reason, NA for rows not
+// offered because the bins were already full.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_select_points(const Rcpp::NumericVector& x,
+                            const Rcpp::NumericVector& y,
+                            const Rcpp::NumericVector& z, int min_per_bin,
+                            int max_per_bin, double min_distance) {
+  typedef gravcal::BinSelector<double, 9 * 64> Selector;
+  gravcal::BinConfig cfg;
+  cfg.min_per_bin = min_per_bin;
+  cfg.max_per_bin = max_per_bin;
+  cfg.min_distance = min_distance;
+  std::unique_ptr<Selector> sel(new Selector(cfg));
+  if (!sel->valid()) Rcpp::stop("invalid bin configuration");
+  const R_xlen_t n = x.size();
+  Rcpp::IntegerVector res(n, NA_INTEGER);
+  for (R_xlen_t i = 0; i < n && !sel->full(); ++i) {
+    res[i] = sel->offer(gravcal::Vec3<double>{x[i], y[i], z[i]});
+  }
+  Rcpp::IntegerVector counts(9);
+  for (int b = 0; b < 9; ++b) counts[b] = sel->count(b);
+  return Rcpp::List::create(Rcpp::Named("bin") = res,
+                            Rcpp::Named("counts") = counts,
+                            Rcpp::Named("complete") = sel->complete());
+}
+
+namespace {
+
+template <typename T>
+Rcpp::List run_gradient(const Rcpp::NumericVector& x,
+                        const Rcpp::NumericVector& y,
+                        const Rcpp::NumericVector& z,
+                        const Rcpp::NumericVector& p0, int max_iter, double h,
+                        const Rcpp::NumericVector& rates, bool use_sqrt,
+                        bool sum_scale, double tol, bool trace) {
+  const int n = static_cast<int>(x.size());
+  std::vector<T> xs(n), ys(n), zs(n);
+  for (int i = 0; i < n; ++i) {
+    xs[i] = T(x[i]);
+    ys[i] = T(y[i]);
+    zs[i] = T(z[i]);
+  }
+  gravcal::GradientConfig<T> cfg;
+  cfg.max_iter = max_iter;
+  cfg.h = T(h);
+  for (int i = 0; i < gravcal::NPARAM; ++i) cfg.rate[i] = T(rates[i]);
+  cfg.use_sqrt = use_sqrt;
+  cfg.scale = sum_scale ? gravcal::SCALE_SUM : gravcal::SCALE_MEAN;
+  cfg.tol = T(tol);
+  T p[gravcal::NPARAM];
+  for (int i = 0; i < gravcal::NPARAM; ++i) p[i] = T(p0[i]);
+  std::vector<double> tr;
+  if (trace) tr.reserve(static_cast<std::size_t>(max_iter) * 10);
+  gravcal::GradientResult r = gravcal::fit_gradient(
+      p, xs.data(), ys.data(), zs.data(), n, cfg,
+      [&](int, const T* q, const T& f) {
+        if (!trace) return;
+        for (int i = 0; i < gravcal::NPARAM; ++i)
+          tr.push_back(static_cast<double>(q[i]));
+        tr.push_back(static_cast<double>(f));
+      });
+  Rcpp::NumericVector pout(gravcal::NPARAM);
+  for (int i = 0; i < gravcal::NPARAM; ++i) pout[i] = static_cast<double>(p[i]);
+  const double fend = static_cast<double>(gravcal::gradient_objective(
+      p, xs.data(), ys.data(), zs.data(), n, use_sqrt, cfg.scale));
+  Rcpp::NumericMatrix tm(10, static_cast<int>(tr.size() / 10));
+  std::copy(tr.begin(), tr.end(), tm.begin());
+  return Rcpp::List::create(Rcpp::Named("p") = pout,
+                            Rcpp::Named("iterations") = r.iterations,
+                            Rcpp::Named("converged") = r.converged,
+                            Rcpp::Named("finite") = r.finite,
+                            Rcpp::Named("objective") = fend,
+                            Rcpp::Named("trace") = tm);
+}
+
+}  // namespace
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x,
+                           const Rcpp::NumericVector& y,
+                           const Rcpp::NumericVector& z,
+                           const Rcpp::NumericVector& p0, int max_iter,
+                           double h, const Rcpp::NumericVector& rates,
+                           bool use_sqrt, bool sum_scale, double tol,
+                           bool trace, std::string arithmetic) {
+  if (y.size() != x.size() || z.size() != x.size())
+    Rcpp::stop("x, y, z lengths differ");
+  if (p0.size() != gravcal::NPARAM || rates.size() != gravcal::NPARAM)
+    Rcpp::stop("p0 and rates must have 9 values");
+  if (arithmetic == "double")
+    return run_gradient<double>(x, y, z, p0, max_iter, h, rates, use_sqrt,
+                                sum_scale, tol, trace);
+  if (arithmetic == "float")
+    return run_gradient<float>(x, y, z, p0, max_iter, h, rates, use_sqrt,
+                               sum_scale, tol, trace);
+  Rcpp::stop("unknown arithmetic");
+}

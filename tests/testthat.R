@@ -1,0 +1,4 @@
+library(testthat)
+library(gravcal)
+
+test_check("gravcal")

@@ -1,0 +1,26 @@
+# Real recordings live in ../shared/data beside the repository (never in the
+# package). The Makefile passes their absolute path as GRAVCAL_SHARED_DATA;
+# from a source checkout they are found relative to tests/testthat.
+shared_data <- function(...) {
+  roots <- c(Sys.getenv("GRAVCAL_SHARED_DATA"),
+             file.path("..", "..", "..", "shared", "data"),
+             file.path("..", "..", "..", "..", "shared", "data"))
+  for (r in roots[nzchar(roots)]) {
+    p <- file.path(r, ...)
+    if (file.exists(p)) return(normalizePath(p))
+  }
+  NULL
+}
+
+skip_if_no_shared <- function(...) {
+  p <- shared_data(...)
+  if (is.null(p)) {
+    skip(paste0("shared data file ", file.path(...), " not found ",
+                "(set GRAVCAL_SHARED_DATA to ../shared/data)"))
+  }
+  p
+}
+
+# Mean | |v| - 1 | of an n x 3 matrix: an independent restatement of the
+# calibration error for checks.
+err_mg <- function(v) 1000 * mean(abs(sqrt(rowSums(v^2)) - 1))

@@ -1,0 +1,95 @@
+test_that("calibrate() lowers the held-out error to the noise floor", {
+  rec <- simulate_recording(hours = 36, sf = 10, seed = 41)
+  fit <- calibrate(rec, sf = 10)
+  expect_s3_class(fit, "gravcal_fit")
+  expect_equal(fit$status, "ok")
+  expect_equal(nrow(fit$points), 18)
+  # held-out rest windows: not used for the fit (paper's Table 3 protocol)
+  held <- fit$windows[-fit$points$row, ]
+  expect_equal(nrow(held), nrow(fit$windows) - 18)
+  v <- as.matrix(held[c("mean_x", "mean_y", "mean_z")])
+  expect_equal(fit$error_heldout_before, err_mg(v) / 1000)
+  expect_gt(fit$error_heldout_before, 0.02)
+  # the noise floor: the same windows calibrated with the true parameters
+  tr <- attr(rec, "truth")
+  a_true <- t(tr$K %*% (t(v) + tr$offset))
+  floor_mg <- err_mg(a_true)
+  expect_lt(1000 * fit$error_heldout_after, floor_mg + 1)
+})
+
+test_that("calibrate() statuses: too short, no rest, bins incomplete", {
+  short <- data.frame(x = 0, y = 0, z = rep(1, 30))
+  f <- calibrate(short, sf = 10)
+  expect_equal(f$status, "too_short")
+  expect_equal(unname(f$K), diag(3))
+  expect_match(f$message, "30 samples")
+
+  set.seed(42)
+  n <- 3000
+  moving <- data.frame(x = rnorm(n, sd = 0.3), y = rnorm(n, sd = 0.3),
+                       z = 1 + rnorm(n, sd = 0.3))
+  f <- calibrate(moving, sf = 10)
+  expect_equal(f$status, "no_rest")
+  expect_match(f$message, "none of the 60 windows")
+
+  flat <- data.frame(x = rnorm(n, sd = 0.002), y = rnorm(n, sd = 0.002),
+                     z = 1.02 + rnorm(n, sd = 0.002))
+  f <- calibrate(flat, sf = 10)
+  expect_equal(f$status, "bins_incomplete")
+  expect_match(f$message, "x- \\(0 of 2\\)")
+  expect_equal(unname(coef(f)), c(1, 1, 1, rep(0, 9)))
+  expect_identical(apply_calibration(flat, f), flat)
+})
+
+test_that("calibrate() routes ... and rejects unknown arguments", {
+  rec <- simulate_recording(hours = 12, sf = 10, seed = 43)
+  f <- calibrate(rec, sf = 10, per_bin = 3, max_iter = 80, tol = 0,
+                 window = 4)
+  expect_equal(nrow(f$points), 27)
+  expect_equal(f$iterations, 80L)
+  expect_equal(f$settings$max_iter, 80)
+  # by default the descent runs to convergence
+  f2 <- calibrate(rec, sf = 10)
+  expect_true(f2$converged)
+  expect_gt(f2$iterations, 50L)
+  expect_error(calibrate(rec, sf = 10, perbin = 3), "Unknown argument.*perbin")
+  expect_error(calibrate(rec, 10, "lightweight", FALSE, 3), "must be named")
+  expect_error(calibrate(rec), "`sf`")
+  expect_error(calibrate(rec, sf = 10, method = "ggir"), "not available")
+})
+
+test_that("a fit that does not lower the error is not applied", {
+  set.seed(44)
+  # rest points exactly on the unit sphere: nothing to improve
+  a <- gravcal:::random_unit_vectors(3000)
+  w <- data.frame(mean_x = a[, 1], mean_y = a[, 2], mean_z = a[, 3])
+  fit <- fit_gradient(select_points(w))
+  g <- gravcal:::guard_fit(fit)
+  expect_true(g$status %in% c("ok", "no_improvement"))
+  fit$error_after <- fit$error_before + 1e-3
+  g <- gravcal:::guard_fit(fit)
+  expect_equal(g$status, "no_improvement")
+  expect_equal(unname(g$K), diag(3))
+  big <- fit_gradient(select_points(w))
+  big$K[1, 1] <- 2
+  big$error_after <- 0
+  expect_equal(gravcal:::guard_fit(big)$status, "implausible")
+})
+
+test_that("calibrate() on a real ActiGraph set on all six faces", {
+  path <- skip_if_no_shared("ggir", "actigraph_testfile.gt3x")
+  skip_if_not_installed("read.gt3x")
+  rec <- read_recording(path)
+  expect_equal(rec$sf, 30)
+  fit <- calibrate(rec$data, sf = rec$sf)
+  w <- fit$windows
+  m <- as.matrix(w[c("mean_x", "mean_y", "mean_z")])
+  # rests found on all six faces: some rest mean within 25 degrees of each
+  for (axis in 1:3) for (sgn in c(-1, 1)) {
+    expect_true(any(sgn * m[, axis] > 0.9), info = paste(axis, sgn))
+  }
+  expect_equal(fit$status, "ok")
+  expect_gt(nrow(fit$windows), nrow(fit$points))
+  expect_gt(fit$error_heldout_before, 0.02)
+  expect_lt(fit$error_heldout_after, fit$error_heldout_before / 2)
+})

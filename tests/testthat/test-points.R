@@ -1,0 +1,71 @@
+pt <- function(...) {
+  m <- rbind(...)
+  data.frame(mean_x = m[, 1], mean_y = m[, 2], mean_z = m[, 3])
+}
+
+test_that("bins follow the paper's intervals (Eq. 10)", {
+  expect_equal(bin_names(), c("x-", "x0", "x+", "y-", "y0", "y+", "z-",
+                              "z0", "z+"))
+  p <- pt(c(0, 0, 1), c(0, 0, 0.75), c(0, 0, 1.25), c(0, 0, 1.26),
+          c(0, 0, 0.74), c(0.5, 0.5, 0.5))
+  s <- select_points(p, per_bin = 5, min_distance = 0)
+  # 1.26, 0.74 (z) lie in x0 and y0 only (tie: x0); (0.5, 0.5, 0.5) in none
+  expect_equal(as.character(s$bin), c("z+", "z+", "z+", "x0", "x0"))
+  expect_equal(s$row, 1:5)
+})
+
+test_that("a point counts for its pole bin first, else the nearest zero bin", {
+  # (0.2, 0, 0.95) lies in x0, y0 and z+ -> z+
+  # (0.2, 0.05, 0.6) lies in x0 (|x| = 0.2) and y0 (|y| = 0.05) -> y0
+  p <- pt(c(0.2, 0, 0.95), c(0.2, 0.05, 0.6))
+  s <- select_points(p, per_bin = 2, min_distance = 0)
+  expect_equal(as.character(s$bin), c("z+", "y0"))
+  # when the pole bin is full, the nearest open zero bin takes the point
+  p2 <- pt(c(0, 0, 1), c(0, 0.01, 0.99), c(0.02, 0, 1), c(0.01, 0, 1))
+  s2 <- select_points(p2, per_bin = 2, min_distance = 0)
+  expect_equal(as.character(s2$bin), c("z+", "z+", "y0", "y0"))
+})
+
+test_that("the novelty threshold rejects points too close to kept ones", {
+  p <- pt(c(0, 0, 1), c(0, 0.05, 1), c(0, 0.11, 0.99))
+  s <- select_points(p, min_distance = 0.1)
+  expect_equal(s$row, c(1L, 3L))
+  expect_equal(nrow(select_points(p, min_distance = 0)), 3)
+})
+
+test_that("selection stops when bins are full; complete needs every minimum", {
+  set.seed(8)
+  cand <- simulate_points(2000, noise = 0.001)
+  s <- select_points(cand)
+  expect_equal(nrow(s), 18)
+  expect_true(attr(s, "complete"))
+  expect_equal(unname(attr(s, "counts")), rep(2L, 9))
+  expect_equal(as.vector(table(s$bin)), rep(2L, 9))
+  # kept points are at least min_distance apart
+  d <- as.matrix(dist(s[c("mean_x", "mean_y", "mean_z")]))
+  expect_true(min(d[upper.tri(d)]) >= 0.1)
+  s3 <- select_points(cand, per_bin = 3, min_per_bin = 1)
+  expect_equal(nrow(s3), 27)
+  few <- select_points(pt(c(0, 0, 1), c(0, 0, -1), c(1, 0, 0)))
+  expect_false(attr(few, "complete"))
+  expect_match(gravcal:::missing_bins(few), "x- \\(0 of 2\\)")
+})
+
+test_that("only rest windows with finite means are offered", {
+  p <- pt(c(0, 0, 1), c(0, 0, -1), c(NA, 0, 1))
+  p$rest <- c(FALSE, TRUE, TRUE)
+  s <- select_points(p)
+  expect_equal(s$row, 2L)
+  p$rest <- c("yes", "no", "no")
+  expect_error(select_points(p), "`rest` of `w` must be logical")
+})
+
+test_that("bad arguments are named", {
+  p <- pt(c(0, 0, 1))
+  expect_error(select_points(p, per_bin = 0), "`per_bin` must be a whole")
+  expect_error(select_points(p, per_bin = 2, min_per_bin = 3),
+               "`min_per_bin` must be a whole number in \\[1, 2\\]")
+  expect_error(select_points(p, min_distance = -1), "`min_distance`")
+  expect_error(select_points(data.frame(a = 1)), "missing: mean_x")
+  expect_error(select_points("x"), "must be a data frame of windows")
+})

@@ -1,0 +1,17 @@
+# The README's first command: calibrate the bundled example recording.
+library(gravcal)
+rec <- read_recording(gravcal_example())
+cat(sprintf("Example recording: %d samples at %g Hz (%.1f h)\n\n",
+            nrow(rec$data), rec$sf, nrow(rec$data) / rec$sf / 3600))
+fit <- calibrate(rec$data, sf = rec$sf)
+print(fit)
+cat("\n")
+print(summary(fit))
+truth <- attr(rec$data, "truth")$params
+cat("\nTrue parameters of the simulated sensor, and the fit's:\n")
+print(round(rbind(truth = truth, fit = fit$params), 5))
+out <- "gravcal-example.png"
+grDevices::png(out, width = 1000, height = 900, res = 110)
+plot(fit)
+invisible(grDevices::dev.off())
+cat("\nSphere before and after calibration written to", out, "\n")

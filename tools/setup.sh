@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs what gravcal needs to build, check and test, when it is missing.
+# Debian's prebuilt r-cran-* packages when we are root on Debian (fast), then
+# anything still missing from CRAN. Safe to run again: it skips what is there.
+set -euo pipefail
+
+cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
+
+deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
+r-cran-rmarkdown pandoc qpdf tidy"
+
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+  missing=""
+  for p in $deb_pkgs; do
+    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+  done
+  if [ -n "$missing" ]; then
+    echo "setup: installing Debian packages:$missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >/dev/null
+    apt-get install -y -qq --no-install-recommends $missing >/dev/null
+  fi
+fi
+
+# CRAN packages: the Imports and LinkingTo, and the Suggests so that every
+# test runs (tests skip only when a Suggests package is really absent).
+Rscript --vanilla - "$cran" <<'RSCRIPT'
+cran <- commandArgs(TRUE)[1]
+need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x")
+have <- rownames(installed.packages())
+miss <- setdiff(need, have)
+if (length(miss)) {
+  message("setup: installing from CRAN: ", paste(miss, collapse = ", "))
+  install.packages(miss, repos = cran, Ncpus = 2, quiet = TRUE)
+}
+still <- setdiff(need, rownames(installed.packages()))
+if (length(still)) stop("setup: could not install ", paste(still, collapse = ", "))
+RSCRIPT
