@@ -12,7 +12,7 @@ TARBALL := gravcal_$(VERSION).tar.gz
 # R CMD check on a machine without general network access: skip the parts
 # that must reach servers other than CRAN (current-time lookup) and CRAN's
 # incoming checks that need its database.
-CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE \
+CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE \
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 

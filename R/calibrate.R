@@ -6,7 +6,9 @@
 #'
 #' With `method = "lightweight"` (Farago et al. 2024) the steps are
 #' [rest_windows()] (5 s windows, max - min below 0.12 g), [select_points()]
-#' (3 x 3 orientation bins, 2 points each) and [fit_gradient()] (9-parameter
+#' (3 x 3 orientation bins, 2 points each, novelty threshold 0.3 g, or 0.1
+#' and then 0.03 g when the bins cannot be filled otherwise) and
+#' [fit_gradient()] (9-parameter
 #' model, forward-difference gradient descent). Arguments of those functions
 #' can be given in `...`.
 #'
@@ -110,7 +112,16 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
       "no rest: none of the %d windows met the rest criterion; are the ",
       "samples in g and is sf right?"), nrow(w))))
   }
-  pts <- do.call(select_points, c(list(w = rest), args$select_points))
+  # the novelty threshold falls back to smaller values when the recording
+  # has too few distinct postures for the default (unless the user set it)
+  sargs <- args$select_points
+  thresholds <- if (is.null(sargs$min_distance)) c(0.3, 0.1, 0.03) else
+    sargs$min_distance
+  for (md in thresholds) {
+    sargs$min_distance <- md
+    pts <- do.call(select_points, c(list(w = rest), sargs))
+    if (isTRUE(attr(pts, "complete"))) break
+  }
   if (!isTRUE(attr(pts, "complete"))) {
     return(fail("bins_incomplete", paste0(
       "not enough rest points on all sides of the sphere: ",
@@ -283,7 +294,7 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
 
 #' @export
 summary.gravcal_fit <- function(object, ...) {
-  co <- coef(object)
+  co <- stats::coef(object)
   err <- data.frame(
     set = c("fitting points", "held-out rest windows"),
     n = c(NROW(object$points),

@@ -26,7 +26,8 @@ fi
 # test runs (tests skip only when a Suggests package is really absent).
 Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
-need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x")
+need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
+          "tibble")
 have <- rownames(installed.packages())
 miss <- setdiff(need, have)
 if (length(miss)) {

@@ -93,3 +93,30 @@ test_that("calibrate() on a real ActiGraph set on all six faces", {
   expect_gt(fit$error_heldout_before, 0.02)
   expect_lt(fit$error_heldout_after, fit$error_heldout_before / 2)
 })
+
+test_that("calibrate() lowers the novelty threshold when postures are few", {
+  # rests in 24 postures: each pole and four tilts of 0.12 g around it, all
+  # within 0.3 g of each other, so no bin can get 2 points 0.3 g apart
+  set.seed(45)
+  poles <- rbind(diag(3), -diag(3))
+  post <- do.call(rbind, lapply(1:6, function(i) {
+    e <- poles[i, ]
+    o <- diag(3)[-which(e != 0), ]
+    rbind(e + 0.12 * o[1, ], e - 0.12 * o[1, ], e + 0.12 * o[2, ],
+          e - 0.12 * o[2, ])
+  }))
+  post <- post / sqrt(rowSums(post^2))
+  p <- c(1.02, 0.98, 1.01, 0.01, -0.01, 0.02, 0.03, -0.02, 0.01)
+  v <- distort(post[rep(seq_len(nrow(post)), each = 500), ], p)
+  n <- nrow(v)
+  x <- data.frame(x = v[, 1] + rnorm(n, sd = 0.002),
+                  y = v[, 2] + rnorm(n, sd = 0.002),
+                  z = v[, 3] + rnorm(n, sd = 0.002))
+  strict <- select_points(rest_windows(x, sf = 10))
+  expect_false(attr(strict, "complete"))
+  fit <- calibrate(x, sf = 10)
+  expect_equal(fit$status, "ok")
+  expect_lt(attr(fit$points, "min_distance"), 0.3)
+  expect_equal(calibrate(x, sf = 10, min_distance = 0.3)$status,
+               "bins_incomplete")
+})

@@ -43,7 +43,7 @@ test_that("selection stops when bins are full; complete needs every minimum", {
   expect_equal(as.vector(table(s$bin)), rep(2L, 9))
   # kept points are at least min_distance apart
   d <- as.matrix(dist(s[c("mean_x", "mean_y", "mean_z")]))
-  expect_true(min(d[upper.tri(d)]) >= 0.1)
+  expect_true(min(d[upper.tri(d)]) >= 0.3)
   s3 <- select_points(cand, per_bin = 3, min_per_bin = 1)
   expect_equal(nrow(s3), 27)
   few <- select_points(pt(c(0, 0, 1), c(0, 0, -1), c(1, 0, 0)))
