@@ -1,6 +1,7 @@
 # gravcal: the README's commands.
 #   make demo   set up, install, calibrate the bundled example recording
-#   make test   set up, R CMD build + R CMD check --as-cran (all tests)
+#   make test   set up, R CMD build + R CMD check --as-cran (all tests),
+#               then the standalone C++ core tests
 R ?= R
 RSCRIPT ?= Rscript
 BUILD := build
@@ -16,7 +17,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 
-.PHONY: setup install demo test check document bench clean
+.PHONY: setup install demo test check core document bench clean
 
 setup:
 	bash tools/setup.sh
@@ -28,7 +29,11 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check
+test: check core
+
+# the header-only core alone, without R, with -Wall -Wextra -Werror
+core:
+	$(MAKE) -C tests/cpp test
 
 check: setup
 	mkdir -p $(BUILD)

@@ -1,0 +1,136 @@
+// Standalone tests of the header-only core, built without R:
+//   make -C tests/cpp
+// Checks the model round trip, chunk invariance of the segmenter, the bin
+// rules and recovery of known parameters by the gradient fit, in double and
+// float.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "gravcal/gravcal.hpp"
+
+static int failures = 0;
+#define CHECK(cond)                                                   \
+  do {                                                                \
+    if (!(cond)) {                                                    \
+      std::printf("FAIL %s:%d: %s\n", __FILE__, __LINE__, #cond);     \
+      ++failures;                                                     \
+    }                                                                 \
+  } while (0)
+
+using gravcal::Vec3;
+
+static void test_model() {
+  const double p[9] = {1.05, 0.95, 1.02, 0.03, -0.04, 0.02, 0.08, -0.06, 0.05};
+  const Vec3<double> a{0.3, 0.5, std::sqrt(1 - 0.34)};
+  const Vec3<double> v = gravcal::invert_model(p, a);
+  const Vec3<double> b = gravcal::apply_model(p, v);
+  CHECK(std::fabs(b.x - a.x) < 1e-15 && std::fabs(b.y - a.y) < 1e-15 &&
+        std::fabs(b.z - a.z) < 1e-15);
+}
+
+struct Collect {
+  std::vector<gravcal::WindowStats>* out;
+  void operator()(const gravcal::WindowStats& s) const { out->push_back(s); }
+};
+
+static void test_segmenter() {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const std::size_t n = 20000;
+  std::vector<double> x(n), y(n), z(n), t(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = 0.1 + noise(rng);
+    y[i] = -0.2 + noise(rng);
+    z[i] = 0.97 + noise(rng);
+    t[i] = 25.0 + 0.001 * static_cast<double>(i);
+  }
+  x[50] = y[50] = z[50] = 0.0;  // idle-sleep sample
+  std::vector<gravcal::WindowStats> whole, parts;
+  gravcal::Segmenter s1(428.5, true);
+  s1.push(x.data(), y.data(), z.data(), t.data(), n, Collect{&whole});
+  gravcal::Segmenter s2(428.5, true);
+  std::uniform_int_distribution<int> len(1, 997);
+  for (std::size_t i = 0; i < n;) {
+    std::size_t k = static_cast<std::size_t>(len(rng));
+    if (i + k > n) k = n - i;
+    s2.push(x.data() + i, y.data() + i, z.data() + i, t.data() + i, k,
+            Collect{&parts});
+    i += k;
+  }
+  CHECK(whole.size() == parts.size());
+  CHECK(whole.size() == 46);
+  CHECK(s1.skipped_zero() == 1);
+  bool same = whole.size() == parts.size();
+  for (std::size_t i = 0; same && i < whole.size(); ++i)
+    same = std::memcmp(&whole[i], &parts[i], sizeof(gravcal::WindowStats)) == 0;
+  CHECK(same);
+  CHECK(std::fabs(whole[1].mean[2] - 0.97) < 0.005);
+  CHECK(std::fabs(whole[1].sd[0] - 0.01) < 0.002);
+  gravcal::RangeRestRule rr;
+  CHECK(gravcal::is_rest(whole[1], rr));
+  gravcal::SdRestRule sr;
+  CHECK(gravcal::is_rest(whole[1], sr));
+}
+
+static void test_bins() {
+  gravcal::BinConfig cfg;
+  gravcal::BinSelector<double> sel(cfg);
+  CHECK(sel.valid());
+  CHECK(sel.offer(Vec3<double>{0, 0, 1}) == 8);          // z+
+  CHECK(sel.offer(Vec3<double>{0, 0.05, 1}) == gravcal::BIN_TOO_CLOSE);
+  CHECK(sel.offer(Vec3<double>{0.5, 0.5, 0.5}) == gravcal::BIN_OUTSIDE);
+  CHECK(sel.offer(Vec3<double>{0.2, 0.05, 0.6}) == 4);   // y0
+  CHECK(!sel.complete());
+}
+
+template <typename T>
+static void test_gradient(double tol_param) {
+  const double truth[9] = {0.96, 1.04, 1.01, 0.02, -0.03, 0.01,
+                           0.05, -0.04, 0.02};
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  gravcal::BinSelector<T> sel(gravcal::BinConfig{});
+  for (int i = 0; i < 5000 && !sel.full(); ++i) {
+    Vec3<double> a{g(rng), g(rng), g(rng)};
+    const double r = std::sqrt(gravcal::norm2(a));
+    a = Vec3<double>{a.x / r, a.y / r, a.z / r};
+    const Vec3<double> v = gravcal::invert_model(truth, a);
+    sel.offer(Vec3<T>{T(v.x), T(v.y), T(v.z)});
+  }
+  CHECK(sel.complete());
+  const int n = sel.size();
+  std::vector<T> x(n), y(n), z(n);
+  for (int i = 0; i < n; ++i) {
+    x[i] = sel.point(i).x;
+    y[i] = sel.point(i).y;
+    z[i] = sel.point(i).z;
+  }
+  T p[9];
+  gravcal::identity_params(p);
+  gravcal::GradientConfig<T> cfg;
+  cfg.max_iter = 5000;
+  gravcal::GradientResult r =
+      gravcal::fit_gradient(p, x.data(), y.data(), z.data(), n, cfg);
+  CHECK(r.finite);
+  double worst = 0;
+  for (int i = 0; i < 9; ++i) {
+    const double d = std::fabs(static_cast<double>(p[i]) - truth[i]);
+    if (d > worst) worst = d;
+  }
+  std::printf("gradient (%s): max |p - truth| = %.2e after %d iterations\n",
+              sizeof(T) == 8 ? "double" : "float", worst, r.iterations);
+  CHECK(worst < tol_param);
+}
+
+int main() {
+  test_model();
+  test_segmenter();
+  test_bins();
+  test_gradient<double>(1e-4);
+  test_gradient<float>(5e-3);
+  std::printf("core: %s\n", failures ? "FAILED" : "all checks passed");
+  return failures ? 1 : 0;
+}
