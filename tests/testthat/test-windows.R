@@ -119,7 +119,7 @@ test_that("bad input gets errors that name the argument", {
 
 test_that("rest_windows() does not change the caller's data", {
   rec <- simulate_recording(hours = 0.1, sf = 10, seed = 24)
-  copy <- rlang_copy <- rec
+  copy <- rec
   rest_windows(rec, sf = 10)
   expect_identical(rec, copy)
   m <- as.matrix(rec[c("x", "y", "z")])
