@@ -98,7 +98,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   if (!is.null(s$time) && length(s$time) != s$n) {
     abort("Column `time` of `x` must have one value per sample.")
   }
-  seg <- gc_segmenter_new(window * sf, skip_zero)
+  seg <- gc_segmenter_new(window * sf, skip_zero, FALSE)
   out <- segment_chunks(seg, s, rule, par, chunk_size, progress)
   w <- windows_frame(out, s, sf)
   state <- gc_segmenter_state(seg)

@@ -11,14 +11,44 @@ Rcpp::Rostream<true>&  Rcpp::Rcout = Rcpp::Rcpp_cout_get();
 Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
+// gc_fit_icp
+Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, int stop_rule, int max_iter, double tol, double max_weight, bool trace);
+RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP stop_ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temp(tempSEXP);
+    Rcpp::traits::input_parameter< bool >::type use_temp(use_tempSEXP);
+    Rcpp::traits::input_parameter< int >::type stop_rule(stop_ruleSEXP);
+    Rcpp::traits::input_parameter< int >::type max_iter(max_iterSEXP);
+    Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
+    Rcpp::traits::input_parameter< double >::type max_weight(max_weightSEXP);
+    Rcpp::traits::input_parameter< bool >::type trace(traceSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fit_icp(x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_weight, trace));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_segmenter_new
-SEXP gc_segmenter_new(double samples_per_window, bool skip_zero);
-RcppExport SEXP _gravcal_gc_segmenter_new(SEXP samples_per_windowSEXP, SEXP skip_zeroSEXP) {
+SEXP gc_segmenter_new(double samples_per_window, bool skip_zero, bool r_arithmetic);
+RcppExport SEXP _gravcal_gc_segmenter_new(SEXP samples_per_windowSEXP, SEXP skip_zeroSEXP, SEXP r_arithmeticSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< double >::type samples_per_window(samples_per_windowSEXP);
     Rcpp::traits::input_parameter< bool >::type skip_zero(skip_zeroSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_segmenter_new(samples_per_window, skip_zero));
+    Rcpp::traits::input_parameter< bool >::type r_arithmetic(r_arithmeticSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_segmenter_new(samples_per_window, skip_zero, r_arithmetic));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_segmenter_new_block
+bool gc_segmenter_new_block(SEXP seg);
+RcppExport SEXP _gravcal_gc_segmenter_new_block(SEXP segSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_segmenter_new_block(seg));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -88,7 +118,9 @@ END_RCPP
 }
 
 static const R_CallMethodDef CallEntries[] = {
-    {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 2},
+    {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
+    {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
+    {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 6},

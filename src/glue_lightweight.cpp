@@ -4,6 +4,7 @@
 #include <Rcpp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,13 +63,36 @@ struct WindowTable {
   }
 };
 
+// A segmenter together with the window buffer it borrows in R-compatible
+// arithmetic (the core allocates nothing itself).
+struct SegmenterBox {
+  SegmenterBox(double L, bool skip_zero) : seg(L, skip_zero) {}
+  std::vector<double> buffer;
+  Segmenter seg;
+};
+
 }  // namespace
 
+// r_arithmetic: window statistics as GGIR gets them in R (see segmenter.hpp).
 // [[Rcpp::export(rng = false)]]
-SEXP gc_segmenter_new(double samples_per_window, bool skip_zero) {
-  if (!(samples_per_window >= 1.0)) Rcpp::stop("samples_per_window must be >= 1");
-  Rcpp::XPtr<Segmenter> p(new Segmenter(samples_per_window, skip_zero), true);
+SEXP gc_segmenter_new(double samples_per_window, bool skip_zero,
+                      bool r_arithmetic) {
+  if (!(samples_per_window >= 1.0 && samples_per_window < 1e7))
+    Rcpp::stop("samples_per_window must be in [1, 1e7)");
+  Rcpp::XPtr<SegmenterBox> p(new SegmenterBox(samples_per_window, skip_zero), true);
+  if (r_arithmetic) {
+    p->buffer.assign(3 * (static_cast<std::size_t>(std::ceil(samples_per_window)) + 1), 0.0);
+    if (!p->seg.use_r_arithmetic(p->buffer.data(), p->buffer.size()))
+      Rcpp::stop("could not set up the window buffer");
+  }
   return p;
+}
+
+// Restart GGIR's cumulative sums (a new block); only between windows.
+// [[Rcpp::export(rng = false)]]
+bool gc_segmenter_new_block(SEXP seg) {
+  Rcpp::XPtr<SegmenterBox> s(seg);
+  return s->seg.new_block();
 }
 
 // Push samples [from, to) (0-based) of the given columns. rule: 0 = range
@@ -81,7 +105,8 @@ Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
                              Rcpp::Nullable<Rcpp::NumericVector> temp,
                              double from, double to, int rule,
                              Rcpp::NumericVector par) {
-  Rcpp::XPtr<Segmenter> s(seg);
+  Rcpp::XPtr<SegmenterBox> box(seg);
+  Segmenter* s = &box->seg;
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
   const double* t = nullptr;
@@ -116,7 +141,8 @@ Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
 
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector gc_segmenter_state(SEXP seg) {
-  Rcpp::XPtr<Segmenter> s(seg);
+  Rcpp::XPtr<SegmenterBox> box(seg);
+  const Segmenter* s = &box->seg;
   return Rcpp::NumericVector::create(
       Rcpp::Named("windows") = static_cast<double>(s->windows()),
       Rcpp::Named("retained") = static_cast<double>(s->retained()),

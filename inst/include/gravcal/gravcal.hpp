@@ -1,5 +1,6 @@
 // gravcal: auto-calibration of triaxial accelerometers against gravity.
-// The header-only core; includes only standard headers (and Eigen in icp.hpp).
+// The header-only core, standard headers only (no Eigen, no heap): what a
+// microcontroller needs. The GGIR fit, which uses Eigen, is icp.hpp.
 #ifndef GRAVCAL_GRAVCAL_HPP
 #define GRAVCAL_GRAVCAL_HPP
 

@@ -14,9 +14,20 @@
 // right duration on average. Samples whose x, y and z are all exactly zero
 // (ActiGraph idle sleep) can be skipped before counting, as GGIR does.
 //
-// Sums are taken about the first valid sample of the window (shifted data
-// algorithm), which keeps the variance exact to rounding for the small
-// variances of rest windows without a division per sample.
+// Two arithmetics give the statistics:
+// - streaming (the default): sums about the first valid sample of the window
+//   (shifted data algorithm), exact to rounding for the small variances of
+//   rest windows, with no storage beyond a few sums; what a microcontroller
+//   runs.
+// - R-compatible (use_r_arithmetic()): the numbers GGIR gets in R, to the
+//   last bit, so that GGIR's exact-equality rules (its duplicate-window
+//   filter) and thresholds decide the same way. Means are differences of a
+//   running cumulative sum kept in long double and rounded to double at each
+//   window boundary (R's cumsum() followed by diff()), restarted by
+//   new_block() where GGIR restarts its cumsum (each block it reads); the sd
+//   is R's var(): a two-pass mean with a correction pass, then the sum of
+//   squared deviations, all in long double. The caller lends the buffer that
+//   holds the open window's samples, so the core still allocates nothing.
 //
 // Header-only, standard headers only, no heap.
 #ifndef GRAVCAL_SEGMENTER_HPP
@@ -53,7 +64,35 @@ class Segmenter {
     reset();
   }
 
+  // Switch to R-compatible arithmetic (see above). `buffer` must hold
+  // 3 * (ceil(L) + 1) doubles and outlive the segmenter; call before the
+  // first push. Returns false (and changes nothing) when it is too small.
+  bool use_r_arithmetic(double* buffer, std::size_t capacity) {
+    const std::size_t per_axis =
+        static_cast<std::size_t>(std::ceil(L_)) + 1u;
+    if (buffer == nullptr || capacity < 3u * per_axis) return false;
+    rbuf_ = buffer;
+    rcap_ = per_axis;
+    return true;
+  }
+  bool r_arithmetic() const { return rbuf_ != nullptr; }
+
+  // Restart the cumulative sums, as GGIR does at each block it reads. Only at
+  // a window boundary (no open window); returns false otherwise.
+  bool new_block() {
+    if (n_ != 0) return false;
+    for (int c = 0; c < 5; ++c) {
+      csum_[c] = 0.0L;
+      cprev_[c] = 0.0;
+    }
+    return true;
+  }
+
   void reset() {
+    for (int c = 0; c < 5; ++c) {
+      csum_[c] = 0.0L;
+      cprev_[c] = 0.0;
+    }
     window_ = 0;
     retained_ = 0;
     seen_ = 0;
@@ -117,6 +156,7 @@ class Segmenter {
     ++n_;
     if (std::isfinite(ti)) {
       sum_temp_ += ti;
+      csum_[4] += ti;
       ++n_temp_;
     }
     if (!(std::isfinite(xi) && std::isfinite(yi) && std::isfinite(zi))) {
@@ -124,6 +164,15 @@ class Segmenter {
       return;
     }
     const double v[3] = {xi, yi, zi};
+    if (rbuf_ != nullptr) {
+      for (int a = 0; a < 3; ++a) {
+        rbuf_[static_cast<std::size_t>(a) * rcap_ + n_valid_] = v[a];
+        csum_[a] += v[a];
+      }
+      // R: sqrt(Gx^2 + Gy^2 + Gz^2), each operation rounded to double.
+      const double sq = xi * xi + yi * yi;
+      csum_[3] += std::sqrt(sq + zi * zi);
+    }
     if (n_valid_ == 0) {
       for (int a = 0; a < 3; ++a) shift_[a] = v[a];
     }
@@ -165,13 +214,58 @@ class Segmenter {
     }
     s.mean_norm = n_valid_ > 0 ? sum_norm_ / nv : NAN;
     s.temperature = n_temp_ > 0 ? sum_temp_ / static_cast<double>(n_temp_) : NAN;
+    if (rbuf_ != nullptr) close_r(s);
     ++window_;
     next_boundary_ = boundary(window_ + 1);
     clear_window();
   }
 
+  // Means from the rounded cumulative sums, sds as R's var() computes them.
+  void close_r(WindowStats& s) {
+    double c[5];
+    for (int k = 0; k < 5; ++k) c[k] = static_cast<double>(csum_[k]);
+    if (n_valid_ > 0) {
+      const double nv = static_cast<double>(n_valid_);
+      for (int a = 0; a < 3; ++a) s.mean[a] = (c[a] - cprev_[a]) / nv;
+      s.mean_norm = (c[3] - cprev_[3]) / nv;
+    }
+    if (n_temp_ > 0) {
+      s.temperature = (c[4] - cprev_[4]) / static_cast<double>(n_temp_);
+    }
+    for (int k = 0; k < 5; ++k) cprev_[k] = c[k];
+    for (int a = 0; a < 3; ++a) {
+      s.sd[a] = n_valid_ > 1
+                    ? r_sd(rbuf_ + static_cast<std::size_t>(a) * rcap_, n_valid_)
+                    : NAN;
+    }
+  }
+
+  static double r_sd(const double* v, std::int64_t n) {
+    const long double ln = static_cast<long double>(n);
+    long double sum = 0.0L;
+    for (std::int64_t k = 0; k < n; ++k) sum += v[k];
+    long double m = sum / ln;
+    if (std::isfinite(static_cast<double>(m))) {
+      sum = 0.0L;
+      for (std::int64_t k = 0; k < n; ++k) sum += (v[k] - m);
+      m = m + sum / ln;
+    }
+    const long double mean = static_cast<double>(m);
+    long double ss = 0.0L;
+    for (std::int64_t k = 0; k < n; ++k) {
+      const long double d = v[k] - mean;
+      ss += d * d;
+    }
+    const double var = static_cast<double>(ss / static_cast<long double>(n - 1));
+    return std::sqrt(var);
+  }
+
   double L_;
   bool skip_zero_;
+  double* rbuf_ = nullptr;
+  std::size_t rcap_ = 0;
+  long double csum_[5];
+  double cprev_[5];
   std::int64_t window_, retained_, seen_, skipped_zero_, next_boundary_, first_;
   std::int64_t n_, n_invalid_, n_valid_, n_temp_;
   double shift_[3], sum_[3], sumsq_[3], min_[3], max_[3];

@@ -1,0 +1,218 @@
+// gravcal: the GGIR auto-calibration fit (van Hees et al. 2014), iterative
+// closest point with weights and a temperature term.
+//
+// Model, per axis k:  a_k = (v_k + offset_k) * scale_k + t * tempoffset_k,
+// t = temperature - mean temperature of the fitted windows.
+//
+// One iteration: project the current calibrated points onto the unit sphere
+// (their closest points); per axis, weighted least squares of the closest
+// point on [1, current value, t]; compose the small correction into offset,
+// scale and tempoffset; new weights min(1 / |residual|, max_weight).
+//
+// Stopping. GGIR stops when its statistic
+//   res = sum_i w_i |a_i - p_i|^2 / (n * sum_i w_i)
+// changes by less than `tol` (1e-10) between iterations. The statistic is
+// divided by the sum of the weights, so it is tiny and this rule usually
+// fires after 5-10 iterations, well before the parameters have settled
+// (GGIR-compatible mode, StopRule::ggir). gravcal's own rule
+// (StopRule::parameters) stops when no parameter moves by more than `tol`
+// (tempoffset measured over the temperature range), which is convergence.
+//
+// The arithmetic follows GGIR's R code where that decides a bit: the
+// calibrated value is (v + o) / (1 / s) + t / (1 / to), as R's scale()
+// computes it. The per-axis least squares use a Householder QR of the
+// weighted design (R's lm.wfit uses a Householder QR too).
+//
+// Uses Eigen (header-only); no R.
+#ifndef GRAVCAL_ICP_HPP
+#define GRAVCAL_ICP_HPP
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+namespace gravcal {
+
+enum class StopRule { ggir, parameters };
+
+struct IcpConfig {
+  int max_iter = 1000;        // GGIR: 1000
+  double tol = 1e-10;         // GGIR: 1e-10
+  double max_weight = 100.0;  // GGIR: 1 / 0.01
+  bool use_temp = true;
+  StopRule stop = StopRule::ggir;
+};
+
+struct IcpResult {
+  double offset[3] = {0.0, 0.0, 0.0};
+  double scale[3] = {1.0, 1.0, 1.0};
+  double tempoffset[3] = {0.0, 0.0, 0.0};
+  double meantemp = 0.0;
+  int iterations = 0;
+  bool converged = false;
+  bool finite = true;
+  bool temp_used = false;  // false when asked but the temperature of the
+                           // points does not vary (rank deficient)
+  double statistic = 0.0;  // last value of GGIR's res
+};
+
+// R's mean(): long double sum, then a correction pass.
+inline double r_mean(const double* v, std::size_t n) {
+  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  const long double ln = static_cast<long double>(n);
+  long double s = 0.0L;
+  for (std::size_t i = 0; i < n; ++i) s += v[i];
+  long double m = s / ln;
+  if (std::isfinite(static_cast<double>(m))) {
+    long double t = 0.0L;
+    for (std::size_t i = 0; i < n; ++i) t += (v[i] - m);
+    m += t / ln;
+  }
+  return static_cast<double>(m);
+}
+
+// The calibrated value, in GGIR's operation order.
+inline double icp_apply(double v, double o, double s, double t, double to) {
+  return (v + o) / (1.0 / s) + t / (1.0 / to);
+}
+
+// x, y, z: the n window means; temp: their temperatures (may be null, or
+// ignored when cfg.use_temp is false). Observer is called after each
+// iteration as obs(iteration, result-so-far).
+template <class Observer>
+IcpResult fit_icp(const double* x, const double* y, const double* z,
+                  const double* temp, std::size_t n, const IcpConfig& cfg,
+                  Observer&& obs) {
+  IcpResult r;
+  if (n < 3) {
+    r.finite = false;
+    return r;
+  }
+  const double* in[3] = {x, y, z};
+  std::vector<double> t(n, 0.0);
+  bool use_temp = cfg.use_temp && temp != nullptr;
+  if (use_temp) {
+    r.meantemp = r_mean(temp, n);
+    for (std::size_t i = 0; i < n; ++i) t[i] = temp[i] - r.meantemp;
+    double tmin = t[0], tmax = t[0];
+    for (std::size_t i = 1; i < n; ++i) {
+      if (t[i] < tmin) tmin = t[i];
+      if (t[i] > tmax) tmax = t[i];
+    }
+    if (!(tmax > tmin)) use_temp = false;  // constant: no temperature term
+    r.temp_used = use_temp;
+  }
+  double trange = 0.0;
+  if (use_temp) {
+    double tmin = t[0], tmax = t[0];
+    for (std::size_t i = 1; i < n; ++i) {
+      if (t[i] < tmin) tmin = t[i];
+      if (t[i] > tmax) tmax = t[i];
+    }
+    trange = tmax - tmin;
+  }
+
+  const Eigen::Index N = static_cast<Eigen::Index>(n);
+  const int ncol = use_temp ? 3 : 2;
+  Eigen::MatrixXd cur(N, 3), cp(N, 3);
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(N);
+  Eigen::MatrixXd X(N, ncol);
+  Eigen::VectorXd b(N), sw(N);
+  double res_prev = std::numeric_limits<double>::infinity();
+
+  for (int it = 1; it <= cfg.max_iter; ++it) {
+    for (Eigen::Index i = 0; i < N; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        cur(i, k) = icp_apply(in[k][i], r.offset[k], r.scale[k],
+                              use_temp ? t[static_cast<std::size_t>(i)] : 0.0,
+                              use_temp ? r.tempoffset[k] : 0.0);
+      }
+      const double nrm = std::sqrt(cur(i, 0) * cur(i, 0) + cur(i, 1) * cur(i, 1) +
+                                   cur(i, 2) * cur(i, 2));
+      for (int k = 0; k < 3; ++k) cp(i, k) = cur(i, k) / nrm;
+    }
+    if (!cp.allFinite()) {
+      r.finite = false;
+      break;
+    }
+    for (Eigen::Index i = 0; i < N; ++i) sw(i) = std::sqrt(w(i));
+    double d_off[3], d_scale[3], d_temp[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; ++k) {
+      for (Eigen::Index i = 0; i < N; ++i) {
+        X(i, 0) = sw(i);
+        X(i, 1) = sw(i) * cur(i, k);
+        if (use_temp) X(i, 2) = sw(i) * t[static_cast<std::size_t>(i)];
+        b(i) = sw(i) * cp(i, k);
+      }
+      const Eigen::VectorXd beta = X.householderQr().solve(b);
+      d_off[k] = beta(0);
+      d_scale[k] = beta(1);
+      if (use_temp) d_temp[k] = beta(2);
+      for (Eigen::Index i = 0; i < N; ++i) {
+        double f = beta(0) + beta(1) * cur(i, k);
+        if (use_temp) f += beta(2) * t[static_cast<std::size_t>(i)];
+        cur(i, k) = f;
+      }
+    }
+    double change = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double o_new = r.offset[k] + d_off[k] / (r.scale[k] * d_scale[k]);
+      const double s_new = r.scale[k] * d_scale[k];
+      const double t_new = use_temp ? r.tempoffset[k] * d_scale[k] + d_temp[k] : 0.0;
+      change = std::fmax(change, std::fabs(o_new - r.offset[k]));
+      change = std::fmax(change, std::fabs(s_new - r.scale[k]));
+      change = std::fmax(change, std::fabs(t_new - r.tempoffset[k]) * trange);
+      r.offset[k] = o_new;
+      r.scale[k] = s_new;
+      r.tempoffset[k] = t_new;
+    }
+    // GGIR's statistic, with the weights of this iteration; then new weights.
+    long double num = 0.0L, wsum = 0.0L;
+    for (Eigen::Index i = 0; i < N; ++i) wsum += w(i);
+    for (Eigen::Index i = 0; i < N; ++i) {
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = cur(i, k) - cp(i, k);
+        d2 += d * d;
+      }
+      num += w(i) * d2;
+      const double wi = 1.0 / std::sqrt(d2);
+      w(i) = wi < cfg.max_weight ? wi : cfg.max_weight;
+    }
+    const double res = static_cast<double>(num / (static_cast<long double>(n) * wsum));
+    r.iterations = it;
+    r.statistic = res;
+    obs(it, static_cast<const IcpResult&>(r));
+    bool finite = std::isfinite(res);
+    for (int k = 0; k < 3; ++k) {
+      finite = finite && std::isfinite(r.offset[k]) && std::isfinite(r.scale[k]) &&
+               std::isfinite(r.tempoffset[k]);
+    }
+    if (!finite) {
+      r.finite = false;
+      break;
+    }
+    if (cfg.stop == StopRule::ggir) {
+      if (std::fabs(res - res_prev) < cfg.tol) {
+        r.converged = true;
+        break;
+      }
+    } else if (change < cfg.tol) {
+      r.converged = true;
+      break;
+    }
+    res_prev = res;
+  }
+  return r;
+}
+
+inline IcpResult fit_icp(const double* x, const double* y, const double* z,
+                         const double* temp, std::size_t n, const IcpConfig& cfg) {
+  return fit_icp(x, y, z, temp, n, cfg, [](int, const IcpResult&) {});
+}
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_ICP_HPP
