@@ -7,8 +7,13 @@
 #' class of `x` (data frame, tibble, data.table or matrix) are kept; the
 #' caller's object is not modified.
 #'
-#' A fit whose status is not `"ok"` carries identity coefficients, so the
-#' samples come back unchanged.
+#' A fit of GGIR's model (`method = "ggir"`) is applied exactly as GGIR's
+#' `g.getmeta()` applies its coefficients, `(v + offset) / (1 / scale) + (T -
+#' meantemp) / (1 / tempoffset)` per axis, so the calibrated samples are
+#' GGIR's to the last bit.
+#'
+#' A fit whose status says it could not calibrate carries identity
+#' coefficients, so the samples come back unchanged.
 #'
 #' @param x Raw samples: a data frame or matrix with columns `x`, `y`, `z`
 #'   (case-insensitive), as given to [calibrate()].
@@ -36,17 +41,32 @@ apply_calibration <- function(x, fit) {
   }
   K <- fit$K
   o <- fit$offset
-  ux <- s$x + o[[1]]
-  uy <- s$y + o[[2]]
-  uz <- s$z + o[[3]]
-  ax <- K[1, 1] * ux + K[1, 2] * uy + K[1, 3] * uz
-  ay <- K[2, 1] * ux + K[2, 2] * uy + K[2, 3] * uz
-  az <- K[3, 1] * ux + K[3, 2] * uy + K[3, 3] * uz
-  if (uses_temp) {
-    dt <- s$temperature - fit$meantemp
-    ax <- ax + dt * fit$tempoffset[[1]]
-    ay <- ay + dt * fit$tempoffset[[2]]
-    az <- az + dt * fit$tempoffset[[3]]
+  to <- fit$tempoffset
+  if (identical(fit$method, "ggir") && all(K[row(K) != col(K)] == 0)) {
+    # GGIR's model, in GGIR's operation order (g.getmeta): the same bits
+    s3 <- diag(K)
+    ax <- (s$x + o[[1]]) / (1 / s3[1])
+    ay <- (s$y + o[[2]]) / (1 / s3[2])
+    az <- (s$z + o[[3]]) / (1 / s3[3])
+    if (uses_temp) {
+      dt <- s$temperature - fit$meantemp
+      ax <- ax + dt / (1 / to[[1]])
+      ay <- ay + dt / (1 / to[[2]])
+      az <- az + dt / (1 / to[[3]])
+    }
+  } else {
+    ux <- s$x + o[[1]]
+    uy <- s$y + o[[2]]
+    uz <- s$z + o[[3]]
+    ax <- K[1, 1] * ux + K[1, 2] * uy + K[1, 3] * uz
+    ay <- K[2, 1] * ux + K[2, 2] * uy + K[2, 3] * uz
+    az <- K[3, 1] * ux + K[3, 2] * uy + K[3, 3] * uz
+    if (uses_temp) {
+      dt <- s$temperature - fit$meantemp
+      ax <- ax + dt * to[[1]]
+      ay <- ay + dt * to[[2]]
+      az <- az + dt * to[[3]]
+    }
   }
   cols <- match(c("x", "y", "z"), tolower(colnames(x)))
   if (is.matrix(x) && anyNA(cols)) cols <- 1:3

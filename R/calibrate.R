@@ -76,16 +76,16 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   call <- match.call()
   method <- match.arg(method)
   check_flag(ggir_compat, "ggir_compat")
+  if (method == "ggir") {
+    return(calibrate_ggir(x, if (missing(sf)) NULL else sf, ggir_compat,
+                          list(...), call))
+  }
   if (is.character(x)) {
     rec <- read_recording(x)
     if (missing(sf)) sf <- rec$sf
     x <- rec$data
   } else if (missing(sf)) {
     abort("`sf` (sampling frequency in Hz) is missing.")
-  }
-  if (method == "ggir") {
-    abort("`method = \"ggir\"` is not available in this version of gravcal; ",
-          "use `method = \"lightweight\"`.")
   }
   args <- split_dots(list(...), list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",

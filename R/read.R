@@ -85,3 +85,216 @@ sf_from_time <- function(time) {
 gravcal_example <- function() {
   system.file("extdata", "example.rds", package = "gravcal", mustWork = TRUE)
 }
+
+# ---------------------------------------------------------------------------
+# Block readers. A source is a list with `format`, `sf`, `filename`,
+# `temperature` (does it carry a temperature column) and `read(i)`, which
+# returns block i (1, 2, ... in order) as list(data = data frame with x, y, z
+# and maybe temperature, last = logical), or NULL when there is nothing more.
+# Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
+# file where GGIR does: `chunksize` scales them (1 = about 12 hours).
+
+# Samples per block for formats GGIR reads by rows (csv, and data frames).
+ggir_rows_per_block <- function(sf, chunksize) {
+  round((14512 * (sf / 50)) * (chunksize * 0.5)) * 300
+}
+
+open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile") {
+  if (is.data.frame(datafile) || is.matrix(datafile)) {
+    return(source_frame(datafile, sf, chunksize, arg))
+  }
+  if (!is.character(datafile) || length(datafile) != 1 || is.na(datafile)) {
+    abort("`", arg, "` must be a file path or a data frame of raw samples, ",
+          "not ", describe(datafile), ".")
+  }
+  if (!file.exists(datafile) || dir.exists(datafile)) {
+    abort("`", arg, "` does not exist: \"", datafile, "\".")
+  }
+  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(datafile)))
+  src <- switch(ext,
+    csv = , "csv.gz" = source_csv(datafile, sf, chunksize),
+    rds = {
+      rec <- read_recording(datafile, sf)
+      source_frame(rec$data, rec$sf, chunksize, arg)
+    },
+    gt3x = source_gt3x(datafile, chunksize),
+    cwa = source_cwa(datafile, chunksize),
+    bin = source_geneactiv(datafile, chunksize),
+    abort("`", arg, "` has an unsupported extension \".", ext, "\"; gravcal ",
+          "reads .csv (ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, ",
+          ".cwa and GENEActiv .bin."))
+  src$filename <- basename(datafile)
+  src
+}
+
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
+source_frame <- function(x, sf, chunksize, arg) {
+  s <- as_samples(x, arg)
+  if (is.null(sf)) sf <- attr(x, "sf")
+  if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
+  if (is.null(sf)) abort("The sampling frequency of `", arg, "` is unknown: give `sf`.")
+  check_sf(sf)
+  B <- ggir_rows_per_block(sf, chunksize)
+  n <- s$n
+  list(format = "data.frame", sf = sf, filename = NA_character_,
+       temperature = !is.null(s$temperature), n = n,
+       read = function(i) {
+         from <- (i - 1) * B + 1
+         if (from > n) return(NULL)
+         to <- min(i * B, n)
+         idx <- from:to
+         d <- data.frame(x = s$x[idx], y = s$y[idx], z = s$z[idx])
+         if (!is.null(s$temperature)) d$temperature <- s$temperature[idx]
+         list(data = d, last = to >= n)
+       })
+}
+
+# ActiGraph csv export (10 header lines, optional column-name line, then
+# [timestamp,] x, y, z) or a plain csv with a header line naming x, y, z.
+source_csv <- function(file, sf, chunksize) {
+  head <- readLines(file, n = 12, warn = FALSE)
+  if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
+  actigraph <- grepl("ActiGraph", head[1], ignore.case = TRUE)
+  if (!actigraph) {
+    rec <- read_recording(file, sf)
+    src <- source_frame(rec$data, rec$sf, chunksize, "datafile")
+    src$format <- "csv"
+    return(src)
+  }
+  hz <- regmatches(head[1], regexpr("[0-9.]+ *Hz", head[1]))
+  if (is.null(sf)) {
+    if (!length(hz)) abort("No sampling frequency (\"at N Hz\") in the header of \"", file, "\": give `sf`.")
+    sf <- as.numeric(sub(" *Hz", "", hz))
+  }
+  check_sf(sf)
+  skip0 <- 10L
+  if (length(head) >= 11) {
+    first <- strsplit(head[11], ",")[[1]][1]
+    if (is.na(suppressWarnings(as.numeric(first)))) skip0 <- 11L
+  }
+  B <- ggir_rows_per_block(sf, chunksize)
+  read_rows <- function(skip, nrows) {
+    d <- tryCatch({
+      if (requireNamespace("data.table", quietly = TRUE)) {
+        data.table::fread(file, skip = skip, nrows = nrows, header = FALSE,
+                          showProgress = FALSE, data.table = FALSE)
+      } else {
+        utils::read.csv(file, skip = skip, nrows = nrows, header = FALSE)
+      }
+    }, error = function(e) NULL)
+    if (is.null(d) || !nrow(d) || ncol(d) < 3) return(NULL)
+    if (ncol(d) > 3) d <- d[, 2:4]
+    names(d) <- c("x", "y", "z")
+    for (v in c("x", "y", "z")) {
+      if (!is.numeric(d[[v]])) abort("Corrupt file \"", file, "\": column ", v, " is not numeric.")
+    }
+    d
+  }
+  list(format = "actigraph_csv", sf = sf, temperature = FALSE,
+       read = function(i) {
+         d <- read_rows(skip0 + (i - 1) * B, B)
+         if (is.null(d)) return(NULL)
+         list(data = d, last = nrow(d) < B)
+       })
+}
+
+source_gt3x <- function(file, chunksize) {
+  if (!requireNamespace("read.gt3x", quietly = TRUE)) {
+    abort("Reading .gt3x files needs the read.gt3x package: install.packages(\"read.gt3x\").")
+  }
+  hdr <- tryCatch(read.gt3x::parse_gt3x_info(file),
+                  error = function(e) abort("Corrupt .gt3x file \"", file, "\": ", conditionMessage(e)))
+  sf <- as.numeric(hdr[["Sample Rate"]])
+  B <- (12 * 3600) * chunksize
+  list(format = "gt3x", sf = sf, temperature = FALSE,
+       read = function(i) {
+         from <- B * (i - 1) + 1
+         d <- tryCatch(read.gt3x::read.gt3x(file, batch_begin = from,
+                                            batch_end = from + B - 1,
+                                            asDataFrame = TRUE, verbose = FALSE),
+                       error = function(e) NULL)
+         if (is.null(d) || !nrow(d)) return(NULL)
+         out <- data.frame(x = as.numeric(d$X), y = as.numeric(d$Y), z = as.numeric(d$Z))
+         list(data = out, last = FALSE)
+       })
+}
+
+need_ggirread <- function(what) {
+  if (!requireNamespace("GGIRread", quietly = TRUE)) {
+    abort("Reading ", what, " files needs the GGIRread package: install.packages(\"GGIRread\").")
+  }
+}
+
+source_cwa <- function(file, chunksize) {
+  need_ggirread("Axivity .cwa")
+  first <- tryCatch(GGIRread::readAxivity(file, start = 0, end = 1, progressBar = FALSE),
+                    error = function(e) NULL)
+  if (is.null(first) || is.null(first$header$frequency)) {
+    abort("Corrupt or unreadable .cwa file \"", file, "\".")
+  }
+  sf <- first$header$frequency
+  B <- round(12 * 3600 * sf / 80 * chunksize)
+  list(format = "cwa", sf = sf, temperature = TRUE,
+       read = function(i) {
+         start <- B * (i - 1)
+         P <- tryCatch(GGIRread::readAxivity(file, start = start, end = start + B,
+                                             progressBar = FALSE, frequency_tol = 0.1),
+                       error = function(e) NULL)
+         if (is.null(P) || is.null(P$data) || !nrow(P$data)) return(NULL)
+         d <- P$data[, intersect(c("x", "y", "z", "temperature"), names(P$data))]
+         list(data = d, last = FALSE)
+       })
+}
+
+source_geneactiv <- function(file, chunksize) {
+  need_ggirread("GENEActiv .bin")
+  first <- tryCatch(GGIRread::readGENEActiv(file, start = 1, end = 2),
+                    error = function(e) NULL)
+  if (is.null(first) || is.null(first$header$SampleRate)) {
+    abort("Corrupt or unreadable GENEActiv .bin file \"", file, "\".")
+  }
+  sf <- round(first$header$SampleRate)
+  B <- round((14512 * (sf / 50)) * (chunksize * 0.5))
+  list(format = "geneactiv", sf = sf, temperature = TRUE,
+       read = function(i) {
+         start <- B * (i - 1) + 1
+         P <- tryCatch(GGIRread::readGENEActiv(file, start = start, end = start + B - 1),
+                       error = function(e) NULL)
+         if (is.null(P) || is.null(P$data.out) || !nrow(P$data.out)) return(NULL)
+         d <- P$data.out[, intersect(c("x", "y", "z", "temperature"), names(P$data.out))]
+         list(data = d, last = nrow(d) < B * 300)
+       })
+}
+
+# Write raw samples as an ActiGraph csv export (ActiLife layout: 10 header
+# lines, a column-name line, then x, y, z in g). Used by the tests to hand
+# the same samples to GGIR and to gravcal.
+write_actigraph_csv <- function(x, file, sf, start = "2023-05-11 09:00:00") {
+  s <- as_samples(x)
+  t0 <- as.POSIXct(start, tz = "UTC")
+  t1 <- t0 + s$n / sf
+  hdr <- c(
+    paste0("------------ Data File Created By ActiGraph GT3X+ ActiLife v6.13.4 ",
+           "Firmware v3.2.1 date format M/d/yyyy at ", format(sf), " Hz  ",
+           "Filter Normal -----------"),
+    "Serial Number: MOS2E00000000",
+    paste("Start Time", format(t0, "%H:%M:%S")),
+    paste("Start Date", format(t0, "%m/%d/%Y")),
+    "Epoch Period (hh:mm:ss) 00:00:00",
+    paste("Download Time", format(t1, "%H:%M:%S")),
+    paste("Download Date", format(t1, "%m/%d/%Y")),
+    "Current Memory Address: 0",
+    "Current Battery Voltage: 4.20     Mode = 12",
+    "--------------------------------------------------",
+    "Accelerometer X,Accelerometer Y,Accelerometer Z")
+  writeLines(hdr, file)
+  d <- data.frame(x = s$x, y = s$y, z = s$z)
+  if (requireNamespace("data.table", quietly = TRUE)) {
+    data.table::fwrite(d, file, append = TRUE, col.names = FALSE)
+  } else {
+    utils::write.table(d, file, append = TRUE, sep = ",", row.names = FALSE,
+                       col.names = FALSE)
+  }
+  invisible(file)
+}
