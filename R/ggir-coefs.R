@@ -80,7 +80,7 @@ ggir_coef_row <- function(f, name) {
     g <- f$ggir
     start <- if (!is.null(g)) num1(g$cal.error.start) else f$error_before
     end <- if (!is.null(g)) num1(g$cal.error.end) else f$error_after
-    qc <- f$message
+    qc <- if (!is.null(f$QCmessage)) f$QCmessage else f$message
     npts <- if (!is.null(g)) num1(g$npoints) else NROW(f$points)
     hours <- if (!is.null(g)) num1(g$nhoursused) else NA_real_
     use_temp <- isTRUE(f$use_temp) && any(to != 0)

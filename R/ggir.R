@@ -315,9 +315,15 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
   src <- open_source(datafile, sf = sf, chunksize = pr$chunksize)
+  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor)
+  sdcriter <- if (identical(src$format, "csv") && !is.null(pr$rmc.noise)) {
+    pr$rmc.noise * 1.2
+  } else {
+    0.013
+  }
   out <- ggir_run(src, compat = TRUE, spherecrit = pr$spherecrit,
                   minloadcrit = pr$minloadcrit,
-                  sdcriter = pr$sdcriter, verbose = verbose,
+                  sdcriter = sdcriter, verbose = verbose,
                   printsummary = pr$printsummary)
   attr(out, "gravcal") <- NULL
   invisible(out)
@@ -346,10 +352,8 @@ ggir_params <- function(params_rawdata, dots) {
   check_number(p$spherecrit, "spherecrit", min = 0)
   check_number(p$minloadcrit, "minloadcrit", min = 0)
   check_flag(p$printsummary, "printsummary")
-  p$sdcriter <- 0.013
   if (!is.null(p$rmc.noise)) {
     check_number(p$rmc.noise, "rmc.noise", min = 0, min_inclusive = FALSE)
-    p$sdcriter <- p$rmc.noise * 1.2
   }
   p
 }
@@ -419,7 +423,7 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
   if (!is.null(icp) && !isTRUE(icp$finite)) status <- "diverged"
   detail <- switch(status,
     ok = if (identical(key, "attempted")) sprintf(
-      "calibrated on all %g hours of the recording (fewer than minloadcrit = %g)",
+      "calibrated on all %g hours of the recording (fewer than minloadcrit = %g hours)",
       res$nhoursused, minloadcrit) else "",
     high_error = sprintf(paste0(
       "coefficients kept, as GGIR applies them, but the error after ",
@@ -435,9 +439,10 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
     points = pts, method = "ggir",
     iterations = if (is.null(icp)) 0L else icp$iterations,
     converged = !is.null(icp) && isTRUE(icp$converged), status = status,
-    message = if (nzchar(detail)) paste0(qc, " (", detail, ")") else qc,
+    message = if (nzchar(detail)) paste0(detail, " [GGIR: ", qc, "]") else qc,
     call = call)
   fit$ggir <- res
+  fit$QCmessage <- qc
   fit$ggir_compat <- compat
   fit$use_temp <- isTRUE(res$use.temp)
   fit$n_windows <- info$windows

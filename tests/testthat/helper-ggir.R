@@ -1,0 +1,59 @@
+# Run GGIR's g.calibrate and gravcal's on the same file, quietly.
+run_both <- function(file, params = list()) {
+  pr <- GGIR::load_params()$params_rawdata
+  pr <- utils::modifyList(pr, params)
+  quiet <- function(expr) {
+    out <- NULL
+    utils::capture.output(out <- suppressWarnings(expr))
+    out
+  }
+  I <- quiet(GGIR::g.inspectfile(file, params_rawdata = pr))
+  R <- quiet(GGIR::g.calibrate(file, params_rawdata = pr,
+                               inspectfileobject = I, verbose = FALSE))
+  G <- quiet(gravcal::g.calibrate(file, params_rawdata = pr, verbose = FALSE))
+  list(ggir = R, gravcal = G)
+}
+
+# gravcal's result has GGIR's structure and numbers: names, classes and
+# lengths of every element, spheredata's columns and rows, coefficients
+# within 1e-8, identical counts and QC message, errors to 5 digits.
+expect_same_as_ggir <- function(b) {
+  R <- b$ggir
+  G <- b$gravcal
+  expect_identical(names(G), names(R))
+  for (nm in setdiff(names(R), "bsc_qc")) {
+    expect_identical(class(G[[nm]]), class(R[[nm]]), label = nm)
+    expect_identical(length(G[[nm]]), length(R[[nm]]), label = nm)
+  }
+  expect_identical(names(G$bsc_qc), names(R$bsc_qc))
+  expect_identical(nrow(G$bsc_qc), nrow(R$bsc_qc))
+  expect_identical(sapply(G$bsc_qc, class), sapply(R$bsc_qc, class))
+  for (nm in c("scale", "offset", "tempoffset", "meantempcal")) {
+    if (length(R[[nm]])) expect_lt(max(abs(G[[nm]] - R[[nm]])), 1e-8)
+  }
+  for (nm in c("npoints", "nhoursused", "QCmessage", "use.temp",
+               "cal.error.start", "cal.error.end")) {
+    expect_identical(G[[nm]], R[[nm]], label = nm)
+  }
+  if (length(R$spheredata)) {
+    expect_identical(names(G$spheredata), names(R$spheredata))
+    expect_identical(dim(G$spheredata), dim(R$spheredata))
+    expect_identical(as.integer(rownames(G$spheredata)),
+                     as.integer(rownames(R$spheredata)))
+    expect_lt(max(abs(as.matrix(G$spheredata) - as.matrix(R$spheredata))), 1e-10)
+  }
+}
+
+known_params <- function() {
+  c(k_xx = 1.02, k_yy = 0.98, k_zz = 1.01, k_xy = 0, k_xz = 0, k_yz = 0,
+    o_x = 0.03, o_y = -0.02, o_z = 0.015)
+}
+
+# An ad hoc csv (x, y, z, temperature) and the GGIR parameters to read it.
+write_adhoc <- function(rec, file, sf) {
+  utils::write.csv(rec[, c("x", "y", "z", "temperature")], file,
+                   row.names = FALSE)
+  list(rmc.firstrow.acc = 2, rmc.col.acc = 1:3, rmc.col.temp = 4,
+       rmc.sf = sf, rmc.noise = 0.013 / 1.2, rmc.unit.acc = "g",
+       rmc.unit.temp = "C")
+}

@@ -1,0 +1,245 @@
+# The GGIR procedure: gravcal::g.calibrate against GGIR::g.calibrate on the
+# same input, gravcal's own mode against known truth, GGIR's coefficient
+# file, and bad input.
+
+test_that("g.calibrate matches today's GGIR on the agcounts recording", {
+  skip_if_not_installed("GGIR")
+  d <- skip_if_no_shared("agcounts", "calibrationXaxis.RData")
+  d <- dirname(d)
+  env <- new.env()
+  for (v in c("X", "Y", "Z")) {
+    load(file.path(d, paste0("calibration", v, "axis.RData")), envir = env)
+  }
+  load(file.path(d, "ggirCalibrate.RData"), envir = env)
+  samples <- data.frame(x = env$X, y = env$Y, z = env$Z)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_actigraph_csv(samples, f, sf = 30)
+  b <- run_both(f)
+  expect_same_as_ggir(b)
+  # the same samples as a data frame: the same answer
+  G2 <- gravcal::g.calibrate(samples, sf = 30, verbose = FALSE)
+  expect_lt(max(abs(G2$offset - b$ggir$offset)), 1e-8)
+  expect_identical(G2$npoints, b$ggir$npoints)
+  # Against the result stored with the samples (bhelsel/agcounts
+  # inst/extdata/ggirCalibrate.RData, made by a 2023 GGIR): GGIR itself has
+  # moved since by up to 6e-4 in offset and 3 in npoints.
+  ref <- env$C
+  expect_lt(max(abs(b$gravcal$offset - ref$offset)), 1e-3)
+  expect_lt(abs(b$gravcal$npoints - ref$npoints), 5)
+  expect_identical(b$gravcal$QCmessage, ref$QCmessage)
+})
+
+test_that("g.calibrate matches GGIR on synthetic ActiGraph csv files", {
+  skip_if_not_installed("GGIR")
+  rec <- simulate_recording(hours = 26, sf = 20, seed = 41,
+                            params = known_params(), temperature = FALSE)
+  # idle sleep: a run of zeros inside the recording and one at the end of
+  # the first block
+  rec[c(300001:320000, 1306190:1306199), c("x", "y", "z")] <- 0
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_actigraph_csv(rec, f, sf = 20)
+  # default minloadcrit (168 h): all data used, "attempted"
+  b <- run_both(f)
+  expect_same_as_ggir(b)
+  expect_match(b$gravcal$QCmessage, "attempted with all available data")
+  # minloadcrit 12 h: accepted after the second block, loading stops early
+  b12 <- run_both(f, list(minloadcrit = 12))
+  expect_same_as_ggir(b12)
+  expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
+  expect_equal(nrow(b12$gravcal$bsc_qc), 2L)
+})
+
+test_that("g.calibrate matches GGIR with temperature (ad hoc csv)", {
+  skip_if_not_installed("GGIR")
+  rec <- simulate_recording(hours = 26, sf = 20, seed = 42,
+                            params = known_params(),
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- write_adhoc(rec, f, 20)
+  b <- run_both(f, pr)
+  expect_same_as_ggir(b)
+  expect_true(b$gravcal$use.temp)
+  expect_identical(names(b$gravcal$spheredata)[8], "temperature")
+  b12 <- run_both(f, c(pr, list(minloadcrit = 12)))
+  expect_same_as_ggir(b12)
+  expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
+})
+
+test_that("g.calibrate matches GGIR when it cannot calibrate", {
+  skip_if_not_installed("GGIR")
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  # too little rest: the wearer never keeps still
+  moving <- simulate_recording(hours = 3, sf = 20, seed = 43, noise = 0.05,
+                               rest_fraction = 0, temperature = FALSE)
+  gravcal:::write_actigraph_csv(moving, f, sf = 20)
+  b <- run_both(f)
+  expect_same_as_ggir(b)
+  expect_identical(b$gravcal$QCmessage,
+                   "recalibration not done because no non-movement data available")
+  # one orientation only: the sphere is not covered
+  n <- 3 * 3600 * 20
+  set.seed(44)
+  flat <- data.frame(x = round(rnorm(n, 0.02, 0.003), 3),
+                     y = round(rnorm(n, -0.01, 0.003), 3),
+                     z = round(rnorm(n, 1.01, 0.003), 3))
+  gravcal:::write_actigraph_csv(flat, f, sf = 20)
+  b <- run_both(f)
+  expect_same_as_ggir(b)
+  expect_identical(b$gravcal$QCmessage, paste0(
+    "recalibration not done because not enough points on all sides of the ",
+    "sphere"))
+  # a very short file (1.5 h: under GGIR's two hours for a first block)
+  short <- simulate_recording(hours = 1.5, sf = 20, seed = 45,
+                              temperature = FALSE)
+  gravcal:::write_actigraph_csv(short, f, sf = 20)
+  b <- run_both(f)
+  expect_same_as_ggir(b)
+  expect_identical(b$gravcal$QCmessage, paste0(
+    "recalibration not done because not enough data in the file or because ",
+    "file is corrupt"))
+  expect_null(b$gravcal$spheredata)
+})
+
+test_that("gravcal's own mode is 10 times closer to the truth than GGIR's", {
+  rec <- simulate_recording(hours = 48, sf = 10, seed = 21,
+                            params = known_params(),
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  tr <- attr(rec, "truth")
+  compat <- calibrate(rec, sf = 10, method = "ggir", ggir_compat = TRUE)
+  own <- calibrate(rec, sf = 10, method = "ggir")
+  expect_equal(c(compat$status, own$status), c("ok", "ok"))
+  # truth in GGIR's parametrisation: the fit's meantemp moves the offset by
+  # (meantemp - true meantemp) * tempoffset / scale
+  err <- function(f) {
+    off <- tr$offset + (f$meantemp - tr$meantemp) * tr$tempoffset / diag(tr$K)
+    c(offset = max(abs(f$offset - off)),
+      tempoffset = max(abs(f$tempoffset - tr$tempoffset)))
+  }
+  e_compat <- err(compat)
+  e_own <- err(own)
+  expect_lt(e_own[["offset"]], e_compat[["offset"]] / 10)
+  expect_lt(e_own[["tempoffset"]], e_compat[["tempoffset"]] / 10)
+  # the compatible mode is GGIR's answer on the same windows
+  expect_equal(compat$ggir$QCmessage, own$ggir$QCmessage)
+  expect_true(own$converged)
+})
+
+test_that("calibrate(method = 'ggir') gives a usable gravcal_fit", {
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 46,
+                            params = known_params(),
+                            tempoffset = c(0.001, 0, -0.001))
+  fit <- calibrate(rec, sf = 10, method = "ggir")
+  expect_s3_class(fit, "gravcal_fit")
+  expect_equal(fit$status, "ok")
+  expect_true(all(fit$K[row(fit$K) != col(fit$K)] == 0))
+  expect_output(print(fit), "ggir")
+  expect_lt(fit$error_after, fit$error_before / 10)
+  cal <- apply_calibration(rec, fit)
+  w <- rest_windows(cal, sf = 10, method = "ggir")
+  expect_lt(err_mg(as.matrix(w[w$rest, c("mean_x", "mean_y", "mean_z")])), 1)
+  # GGIR's per-sample formula, written out independently
+  s <- diag(fit$K)
+  gx <- (rec$x + fit$offset[[1]]) * s[1] +
+    (rec$temperature - fit$meantemp) * fit$tempoffset[[1]]
+  expect_equal(cal$x, gx, tolerance = 1e-12)
+  # failures: identity coefficients, status and GGIR's message
+  short <- simulate_recording(hours = 1, sf = 10, seed = 47)
+  f0 <- calibrate(short, sf = 10, method = "ggir")
+  expect_equal(f0$status, "too_short")
+  expect_equal(unname(f0$K), diag(3))
+  expect_identical(apply_calibration(short, f0)$x, short$x)
+  expect_error(calibrate(rec, sf = 10, method = "ggir", bogus = 1), "bogus")
+})
+
+test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
+  skip_if_not_installed("GGIR")
+  dir <- tempfile("ggir")
+  dir.create(file.path(dir, "data"), recursive = TRUE)
+  dir.create(file.path(dir, "out"))
+  on.exit(unlink(dir, recursive = TRUE))
+  rec <- simulate_recording(hours = 26, sf = 20, seed = 31,
+                            params = known_params(), temperature = FALSE)
+  f <- file.path(dir, "data", "rec01.csv")
+  gravcal:::write_actigraph_csv(rec, f, sf = 20)
+  fit <- calibrate(f, method = "ggir")   # gravcal's converged fit
+  coefs <- file.path(dir, "coefs.csv")
+  out <- write_ggir_coefs(fit, coefs)
+  expect_identical(out$filename, "rec01.csv")
+  expect_identical(names(out)[1:10], c(
+    "filename", "scale.x", "scale.y", "scale.z", "offset.x", "offset.y",
+    "offset.z", "temperature.offset.x", "temperature.offset.y",
+    "temperature.offset.z"))
+  utils::capture.output(suppressWarnings(GGIR::GGIR(
+    datadir = file.path(dir, "data"), outputdir = file.path(dir, "out"),
+    mode = 1:2, do.report = 2, backup.cal.coef = coefs, overwrite = TRUE,
+    do.parallel = FALSE, verbose = FALSE)))
+  rep <- list.files(file.path(dir, "out"), "data_quality_report.csv",
+                    recursive = TRUE, full.names = TRUE)
+  expect_length(rep, 1)
+  q <- utils::read.csv(rep)
+  expect_equal(q$scale.x, unname(diag(fit$K))[1], tolerance = 1e-12)
+  expect_equal(q$offset.z, unname(fit$offset)[3], tolerance = 1e-12)
+  # GGIR's own early-stopping fit differs from it, so the report shows ours
+  own <- gravcal::g.calibrate(f, verbose = FALSE)
+  expect_gt(abs(q$offset.x - own$offset[1]), 1e-7)
+  # a g.calibrate result needs a name; lightweight fits are refused
+  expect_error(write_ggir_coefs(own, coefs), "named")
+  expect_silent(write_ggir_coefs(list(rec01.csv = own), coefs))
+  lw <- calibrate(rec, sf = 20)
+  expect_error(write_ggir_coefs(list(a.csv = lw), coefs), "cross-axis")
+  expect_error(write_ggir_coefs(fit, NA), "file")
+})
+
+test_that("bad input: clear errors or GGIR's QC outcome, never a crash", {
+  expect_error(g.calibrate("no/such/file.bin", verbose = FALSE), "does not exist")
+  expect_error(g.calibrate(42, verbose = FALSE), "file path or a data frame")
+  f <- tempfile(fileext = ".xyz")
+  writeLines("a", f)
+  expect_error(g.calibrate(f, verbose = FALSE), "unsupported extension")
+  junk <- tempfile(fileext = ".csv")
+  writeLines(c("------------ Data File Created By ActiGraph at 30 Hz", rep("junk", 30)), junk)
+  C <- g.calibrate(junk, verbose = FALSE)
+  expect_match(C$QCmessage, "not enough data in the file or because file is corrupt")
+  empty <- tempfile(fileext = ".csv")
+  file.create(empty)
+  expect_error(g.calibrate(empty, verbose = FALSE), "empty")
+  if (requireNamespace("GGIRread", quietly = TRUE)) {
+    bad <- tempfile(fileext = ".cwa")
+    writeBin(as.raw(sample(0:255, 5000, TRUE)), bad)
+    expect_error(suppressWarnings(g.calibrate(bad, verbose = FALSE)), "cwa")
+  }
+  on.exit(unlink(c(f, junk, empty)))
+  # data frames: no sf, non-numeric columns, bad parameters
+  rec <- simulate_recording(hours = 3, sf = 10, seed = 48)
+  expect_error(g.calibrate(rec[, c("x", "y", "z")], verbose = FALSE), "sf")
+  expect_error(g.calibrate(rec, sf = 10, chunksize = 2, verbose = FALSE),
+               "chunksize")
+  expect_error(g.calibrate(rec, sf = 10, params_rawdata = "x"), "params_rawdata")
+  expect_warning(g.calibrate(rec, sf = 10, nonsense = 1, verbose = FALSE),
+                 "nonsense")
+  # temperature constant, or absurd: not used, with a warning
+  r2 <- simulate_recording(hours = 26, sf = 10, seed = 49,
+                           params = known_params())
+  r2$temperature <- 25
+  expect_warning(C <- g.calibrate(r2, sf = 10, minloadcrit = 12, verbose = FALSE),
+                 "does not vary")
+  expect_false(C$use.temp)
+  expect_identical(C$QCmessage, "recalibration done, but temperature values not used")
+  r2$temperature <- 400
+  expect_warning(C <- g.calibrate(r2, sf = 10, verbose = FALSE), "120")
+  expect_false(C$use.temp)
+  # clipped data: windows with |mean| >= 2 g are not rest; no crash
+  r3 <- simulate_recording(hours = 26, sf = 10, seed = 50)
+  r3$x <- pmin(r3$x * 3, 2.5)
+  C <- g.calibrate(r3, sf = 10, verbose = FALSE)
+  expect_type(C$QCmessage, "character")
+  expect_true(all(abs(C$spheredata$meanx) < 2))
+  # NA samples: windows with them are not rest
+  r4 <- simulate_recording(hours = 3, sf = 10, seed = 51)
+  r4$x[1000:5000] <- NA
+  expect_type(g.calibrate(r4, sf = 10, verbose = FALSE)$QCmessage, "character")
+})

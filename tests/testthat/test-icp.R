@@ -1,0 +1,85 @@
+# fit_icp() and the R-compatible window arithmetic behind GGIR mode.
+
+test_that("fit_icp reproduces GGIR's stored fit on data.calibrate (1e-8)", {
+  f <- skip_if_no_shared("ggir", "data.calibrate.RData")
+  env <- new.env()
+  load(f, envir = env)
+  C <- env$data.calibrate
+  # Reference: GGIR's own g.calibrate output stored with the windows
+  # (wadpac/GGIR data/data.calibrate.RData, v3.3-7; METHODS.md section 3).
+  fit <- fit_icp(C$spheredata, ggir_compat = TRUE)
+  expect_s3_class(fit, "gravcal_fit")
+  expect_equal(fit$status, "ok")
+  expect_lt(max(abs(diag(fit$K) - C$scale)), 1e-8)
+  expect_lt(max(abs(fit$offset - C$offset)), 1e-8)
+  expect_lt(max(abs(fit$tempoffset - C$tempoffset)), 1e-8)
+  expect_equal(fit$iterations, 5L)
+  # this stored result keeps the errors unrounded
+  expect_lt(abs(fit$error_before - C$cal.error.start), 1e-8)
+  expect_lt(abs(fit$error_after - C$cal.error.end), 1e-8)
+  expect_equal(fit$meantemp, mean(C$spheredata$temperature))
+  expect_true(all(fit$K[row(fit$K) != col(fit$K)] == 0))
+})
+
+test_that("gravcal's own stopping rule converges past GGIR's", {
+  rec <- simulate_recording(hours = 30, sf = 10, seed = 5,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  w <- rest_windows(rec, sf = 10, method = "ggir")
+  ggir <- fit_icp(w, ggir_compat = TRUE, trace = TRUE)
+  own <- fit_icp(w, trace = TRUE)
+  expect_true(own$converged)
+  expect_gt(own$iterations, ggir$iterations)
+  # converged: another run started from the result would not move; check
+  # that the last step of the trace is below the tolerance
+  tr <- as.matrix(own$trace[, 1:9])
+  expect_lt(max(abs(tr[nrow(tr), ] - tr[nrow(tr) - 1, ])), 1e-9)
+  expect_lte(own$error_after, ggir$error_after + 1e-6)
+  expect_equal(nrow(own$trace), own$iterations)
+})
+
+test_that("fit_icp handles missing or constant temperature", {
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 6)
+  w <- rest_windows(rec, sf = 10, method = "ggir")
+  w0 <- w
+  w0$temperature <- 25
+  f0 <- fit_icp(w0)
+  expect_equal(f0$status, "ok")
+  expect_equal(unname(f0$tempoffset), c(0, 0, 0))
+  expect_match(f0$message, "does not vary")
+  f1 <- fit_icp(w, use_temp = FALSE)
+  expect_equal(unname(f1$tempoffset), c(0, 0, 0))
+  expect_equal(unname(f1$offset), unname(f0$offset), tolerance = 1e-12)
+  w2 <- w
+  w2$temperature[3] <- NA
+  expect_error(fit_icp(w2), "temperature")
+  expect_equal(fit_icp(w[w$rest, ][1:5, ])$status, "no_rest")
+  expect_error(fit_icp(w, max_iter = 0), "max_iter")
+  expect_error(fit_icp(list(1)), "data frame")
+})
+
+test_that("R-compatible windows are R's own numbers, bit for bit", {
+  set.seed(3)
+  n <- 3 * 600
+  x <- round(rnorm(n, 0.3, 0.01), 3)
+  y <- round(rnorm(n, -0.2, 0.01), 3)
+  z <- round(rnorm(n, 0.9, 0.01), 3)
+  tt <- 25 + cumsum(rnorm(n, 0, 0.001))
+  L <- 600
+  seg <- gravcal:::gc_segmenter_new(L, FALSE, TRUE)
+  gravcal:::gc_segmenter_new_block(seg)
+  w <- gravcal:::gc_segmenter_push(seg, x, y, z, tt, 0, n, 1L, c(0.013, 2))
+  # GGIR's rollMean (cumsum then diff) and rollSD (sd per column)
+  rmean <- function(v) diff(cumsum(c(0, v))[seq(1, n + 1, by = L)]) / L
+  rsd <- function(v) apply(matrix(v, L), 2, stats::sd)
+  expect_identical(w$mean_x, rmean(x))
+  expect_identical(w$mean_z, rmean(z))
+  expect_identical(w$sd_x, rsd(x))
+  expect_identical(w$sd_y, rsd(y))
+  expect_identical(w$mean_norm, rmean(sqrt(x^2 + y^2 + z^2)))
+  expect_identical(w$temperature, rmean(tt))
+  # a new block restarts the cumulative sums
+  expect_true(gravcal:::gc_segmenter_new_block(seg))
+  w2 <- gravcal:::gc_segmenter_push(seg, x, y, z, tt, 0, 150, 1L, c(0.013, 2))
+  expect_false(gravcal:::gc_segmenter_new_block(seg))
+  expect_length(w2$mean_x, 0)
+})
