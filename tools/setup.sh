@@ -7,7 +7,7 @@ set -euo pipefail
 cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
 deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
-r-cran-rmarkdown pandoc qpdf tidy"
+r-cran-rmarkdown r-cran-data.table pandoc qpdf tidy"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""
@@ -27,7 +27,7 @@ fi
 Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
 need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
-          "tibble")
+          "tibble", "data.table")
 have <- rownames(installed.packages())
 miss <- setdiff(need, have)
 if (length(miss)) {
@@ -37,3 +37,7 @@ if (length(miss)) {
 still <- setdiff(need, rownames(installed.packages()))
 if (length(still)) stop("setup: could not install ", paste(still, collapse = ", "))
 RSCRIPT
+
+# GGIR and GGIRread (Suggests): the reference implementation the tests
+# compare against; see tools/install-ggir.sh for why it is installed that way.
+bash "$(dirname "$0")/install-ggir.sh"
