@@ -5,7 +5,7 @@ gc_fit_icp <- function(x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_we
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_weight, trace)
 }
 
-gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic) {
+gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic = FALSE) {
     .Call(`_gravcal_gc_segmenter_new`, samples_per_window, skip_zero, r_arithmetic)
 }
 

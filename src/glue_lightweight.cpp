@@ -76,7 +76,7 @@ struct SegmenterBox {
 // r_arithmetic: window statistics as GGIR gets them in R (see segmenter.hpp).
 // [[Rcpp::export(rng = false)]]
 SEXP gc_segmenter_new(double samples_per_window, bool skip_zero,
-                      bool r_arithmetic) {
+                      bool r_arithmetic = false) {
   if (!(samples_per_window >= 1.0 && samples_per_window < 1e7))
     Rcpp::stop("samples_per_window must be in [1, 1e7)");
   Rcpp::XPtr<SegmenterBox> p(new SegmenterBox(samples_per_window, skip_zero), true);

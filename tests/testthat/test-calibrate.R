@@ -55,7 +55,7 @@ test_that("calibrate() routes ... and rejects unknown arguments", {
   expect_error(calibrate(rec, sf = 10, perbin = 3), "Unknown argument.*perbin")
   expect_error(calibrate(rec, 10, "lightweight", FALSE, 3), "must be named")
   expect_error(calibrate(rec), "`sf`")
-  expect_error(calibrate(rec, sf = 10, method = "ggir"), "not available")
+  expect_error(calibrate(rec, sf = 10, method = "ggir", per_bin = 2), "Unknown argument.*per_bin")
 })
 
 test_that("a fit that does not lower the error is not applied", {
