@@ -5,6 +5,18 @@ gc_fit_icp <- function(x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_we
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_weight, trace)
 }
 
+gc_count_zero <- function(x, y, z, from, to) {
+    .Call(`_gravcal_gc_count_zero`, x, y, z, from, to)
+}
+
+gc_sd_below <- function(v, from, to, limit, threshold) {
+    .Call(`_gravcal_gc_sd_below`, v, from, to, limit, threshold)
+}
+
+gc_r_mean_sd <- function(v, from, to, limit) {
+    .Call(`_gravcal_gc_r_mean_sd`, v, from, to, limit)
+}
+
 gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic = FALSE) {
     .Call(`_gravcal_gc_segmenter_new`, samples_per_window, skip_zero, r_arithmetic)
 }
@@ -27,5 +39,9 @@ gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance) {
 
 gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic) {
     .Call(`_gravcal_gc_fit_gradient`, x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic)
+}
+
+gc_read_once <- function(cols) {
+    .Call(`_gravcal_gc_read_once`, cols)
 }
 

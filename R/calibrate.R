@@ -124,9 +124,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                           list(...), call))
   }
   if (is.character(x)) {
-    rec <- read_recording(x)
-    if (missing(sf)) sf <- rec$sf
-    x <- rec$data
+    # a file: read block by block by rest_windows()
+    if (missing(sf)) sf <- NULL
   } else if (missing(sf)) {
     abort("`sf` (sampling frequency in Hz) is missing.")
   }
@@ -148,7 +147,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   if (nrow(w) == 0) {
     return(fail("too_short", sprintf(paste0(
       "recording too short: %d samples, fewer than one %g s window at %g Hz"),
-      NROW(x), attr(w, "window"), sf)))
+      attr(w, "samples"), attr(w, "window"), attr(w, "sf"))))
   }
   if (nrow(rest) == 0) {
     return(fail("no_rest", sprintf(paste0(

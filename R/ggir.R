@@ -40,6 +40,113 @@ drop_zero_samples <- function(m, compat) {
   m
 }
 
+# The procedure handles a block as a list of "pieces": ranges [from, to)
+# (0-based) of columns x, y, z and t (temperature, or NULL) that stay where
+# they are (the caller's vectors for data in memory, the reader's for files),
+# so that no sample is copied on the way to the segmenter. Only the samples
+# carried from one block to the next (less than an hour) are copied.
+piece <- function(x, y, z, t, from, to) {
+  list(x = x, y = y, z = z, t = t, from = from, to = to)
+}
+
+pieces_n <- function(P) {
+  n <- 0
+  for (p in P) n <- n + (p$to - p$from)
+  n
+}
+
+# The first n rows.
+pieces_head <- function(P, n) {
+  out <- list()
+  for (p in P) {
+    if (n <= 0) break
+    k <- min(n, p$to - p$from)
+    p$to <- p$from + k
+    out[[length(out) + 1]] <- p
+    n <- n - k
+  }
+  out
+}
+
+# All but the first n rows.
+pieces_drop <- function(P, n) {
+  out <- list()
+  for (p in P) {
+    len <- p$to - p$from
+    if (n >= len) {
+      n <- n - len
+      next
+    }
+    p$from <- p$from + n
+    n <- 0
+    out[[length(out) + 1]] <- p
+  }
+  out
+}
+
+pieces_col <- function(P, col) {
+  v <- lapply(P, function(p) p[[col]][seq.int(p$from + 1, length.out = p$to - p$from)])
+  as.double(unlist(v, use.names = FALSE))
+}
+
+# One piece holding copies of the rows.
+pieces_own <- function(P) {
+  if (!length(P)) return(list())
+  temp <- !is.null(P[[1]]$t)
+  list(piece(pieces_col(P, "x"), pieces_col(P, "y"), pieces_col(P, "z"),
+             if (temp) pieces_col(P, "t"), 0, pieces_n(P)))
+}
+
+pieces_matrix <- function(P) {
+  temp <- length(P) && !is.null(P[[1]]$t)
+  m <- cbind(pieces_col(P, "x"), pieces_col(P, "y"), pieces_col(P, "z"))
+  if (temp) m <- cbind(m, pieces_col(P, "t"))
+  m
+}
+
+pieces_zeros <- function(P) {
+  n <- 0
+  for (p in P) n <- n + gc_count_zero(p$x, p$y, p$z, p$from, p$to)
+  n
+}
+
+# c(mean, sd, n) of the temperature of the first `limit` rows, as R's mean()
+# and sd() with na.rm = TRUE give them.
+pieces_temp_stats <- function(P, limit) {
+  gc_r_mean_sd(lapply(P, `[[`, "t"), vapply(P, `[[`, 0, "from"),
+               vapply(P, `[[`, 0, "to"), limit)
+}
+
+# Is the sd of the temperature of the first `limit` rows below `threshold`
+# (R's sd(, na.rm = TRUE) decides)? NA with fewer than 2 values.
+pieces_sd_below <- function(P, limit, threshold) {
+  gc_sd_below(lapply(P, `[[`, "t"), vapply(P, `[[`, 0, "from"),
+              vapply(P, `[[`, 0, "to"), limit, threshold)
+}
+
+# A block from a source as a piece (see open_source() for the two forms).
+block_piece <- function(blk, temp) {
+  if (!is.null(blk$cols)) {
+    cl <- blk$cols
+    return(piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, blk$from, blk$to))
+  }
+  d <- blk$data
+  col <- function(v) {
+    if (!is.numeric(v)) abort("The recording has a non-numeric acceleration or temperature column.")
+    as.double(v)
+  }
+  piece(col(d$x), col(d$y), col(d$z), if (temp) col(d$temperature), 0, nrow(d))
+}
+
+block_rows <- function(blk) {
+  if (!is.null(blk$cols)) blk$to - blk$from else NROW(blk$data)
+}
+
+block_has_temp <- function(blk) {
+  if (!is.null(blk$cols)) !is.null(blk$cols$temperature) else
+    "temperature" %in% names(blk$data)
+}
+
 ggir_feature_names <- function(temp) {
   c("Euclidean Norm", "meanx", "meany", "meanz", "sdx", "sdy", "sdz",
     if (temp) "temperature")
@@ -53,7 +160,7 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
   sf <- src$sf
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
-  S <- NULL
+  S <- list()
   feats <- list()
   n_feat <- 0
   use.temp <- temp.available <- FALSE
@@ -64,16 +171,18 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
   nhoursused <- 0
   QC <- NULL
   ft <- NULL
+  ft_id <- integer(0)
   bsc_qc <- data.frame()
   icp <- NULL
   meantemp <- 0
   blocks <- 0
+  pending <- FALSE
   i <- 1
   repeat {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     blk <- src$read(i)
     if (!is.null(blk)) {
-      nr <- NROW(blk$data)
+      nr <- block_rows(blk)
       if (nr == 0) {
         blk <- NULL
       } else if (nr < per_hour * 2 + 1) {
@@ -85,91 +194,123 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
     }
     last <- is.null(blk) || isTRUE(blk$last)
     if (i == 1) {
-      use.temp <- temp.available <- !is.null(blk) &&
-        "temperature" %in% names(blk$data)
+      use.temp <- temp.available <- !is.null(blk) && block_has_temp(blk)
     }
     added <- FALSE
     if (!is.null(blk)) {
-      cols <- c("x", "y", "z", if (temp.available) "temperature")
-      m <- as.matrix(blk$data[, cols])
-      storage.mode(m) <- "double"
-      if (!is.null(S)) m <- rbind(S, m)
-      m <- drop_zero_samples(m, compat)
-      LD <- nrow(m)
+      P <- c(S, list(block_piece(blk, temp.available)))
+      if (pieces_zeros(P) > 0) {
+        # idle-sleep samples: GGIR's removal, on a copy of this block
+        m <- drop_zero_samples(pieces_matrix(P), compat)
+        P <- list(piece(m[, 1], m[, 2], m[, 3],
+                        if (temp.available) m[, 4], 0, nrow(m)))
+        rm(m)
+      }
+      LD <- pieces_n(P)
       use <- floor(LD / per_hour) * per_hour
       if (use > 0) {
         if (use != LD) {
-          S <- m[(use + 1):LD, , drop = FALSE]
+          S <- pieces_own(pieces_drop(P, use))
         } else if (!compat) {
-          S <- NULL
+          S <- list()
         }
-        m <- m[seq_len(use), , drop = FALSE]
+        P <- pieces_head(P, use)
         if (use.temp) {
-          if (mean(m[1:10, 4], na.rm = TRUE) > 120) {
+          first10 <- pieces_temp_stats(P, 10)[1]
+          if (isTRUE(first10 > 120)) {
             warning("temperature not used for calibration: its first values ",
                     "exceed 120 (not degrees C?)", call. = FALSE)
             use.temp <- FALSE
-          } else if (stats::sd(m[, 4], na.rm = TRUE) < 0.01) {
-            warning("temperature not used for calibration: it does not vary ",
-                    "(sd < 0.01)", call. = FALSE)
-            use.temp <- FALSE
+          } else {
+            flat <- pieces_sd_below(P, use, 0.01)
+            if (is.na(flat)) {
+              warning("temperature not used for calibration: it has fewer ",
+                      "than 2 values", call. = FALSE)
+              use.temp <- FALSE
+            } else if (flat) {
+              warning("temperature not used for calibration: it does not vary ",
+                      "(sd < 0.01)", call. = FALSE)
+              use.temp <- FALSE
+            }
           }
         }
         gc_segmenter_new_block(seg)
-        w <- gc_segmenter_push(seg, m[, 1], m[, 2], m[, 3],
-                               if (use.temp) m[, 4] else NULL, 0, use, 1L,
-                               c(sdcriter, 2))
-        f <- data.frame(w$mean_norm, w$mean_x, w$mean_y, w$mean_z, w$sd_x,
-                        w$sd_y, w$sd_z)
-        if (temp.available) f[[8]] <- if (use.temp) w$temperature else 99999
-        names(f) <- paste0("V.", seq_along(f))
+        ws <- lapply(P, function(p) {
+          gc_segmenter_push(seg, p$x, p$y, p$z, if (use.temp) p$t, p$from,
+                            p$to, 1L, c(sdcriter, 2))
+        })
+        wcol <- function(name) unlist(lapply(ws, `[[`, name), use.names = FALSE)
+        f <- cbind(wcol("mean_norm"), wcol("mean_x"), wcol("mean_y"),
+                   wcol("mean_z"), wcol("sd_x"), wcol("sd_y"), wcol("sd_z"))
+        if (temp.available) {
+          f <- cbind(f, if (use.temp) wcol("temperature") else 99999)
+        }
+        rm(ws, P)
         n_feat <- n_feat + nrow(f)
         feats[[length(feats) + 1]] <- f
         added <- TRUE
         blocks <- blocks + 1
-        mem <- gc()[2, 2]
+        # memory in use after the block, as GGIR records it (a minor
+        # collection: GGIR's full one costs more than the block itself)
+        mem <- gc(full = FALSE)[2, 2]
         bsc_qc <- rbind(bsc_qc, data.frame(time = format(Sys.time()),
                                            size = mem,
                                            stringsAsFactors = FALSE))
       } else if (!compat) {
-        S <- m
+        S <- pieces_own(P)
       }
     }
     stop_loading <- FALSE
-    if (added || i == 1) {
+    # GGIR fits after every block, but only the fit after the last block, or
+    # one that can stop the loading (more than minloadcrit hours), decides
+    # the result: the others are skipped (the window table only grows, so
+    # the last fit is the same either way).
+    due <- added || i == 1
+    if (due && !last && n_feat * 10 / 3600 <= minloadcrit) {
+      pending <- TRUE
+      due <- FALSE
+    }
+    if (last && pending) due <- TRUE
+    if (due) {
+      pending <- FALSE
       spherepopulated <- FALSE
-      ft <- if (length(feats)) do.call(rbind, feats) else NULL
-      if (is.null(ft)) {
-        ft <- as.data.frame(matrix(numeric(0), 0, if (temp.available) 8 else 7))
-      }
-      # row names: the window's number in the recording, as in GGIR
-      attr(ft, "row.names") <- seq_len(nrow(ft))
-      ft <- ft[!is.na(ft[[4]]) & !is.na(ft[[1]]), , drop = FALSE]
+      ft <- if (length(feats)) do.call(rbind, feats) else
+        matrix(numeric(0), 0, if (temp.available) 8 else 7)
+      # ft_id: the window's number in the recording (GGIR's row names)
+      ft_id <- seq_len(nrow(ft))
+      keep <- !is.na(ft[, 4]) & !is.na(ft[, 1])
+      ft <- ft[keep, , drop = FALSE]
+      ft_id <- ft_id[keep]
       n <- nrow(ft)
       if (n > 1) {
-        same <- rowSums(ft[1:(n - 1), 2:7] == ft[2:n, 2:7])
+        same <- rowSums(ft[1:(n - 1), 2:7, drop = FALSE] == ft[2:n, 2:7, drop = FALSE])
         cut <- which(same == if (compat) 3 else 6)
-        if (length(cut)) ft <- ft[-cut, , drop = FALSE]
+        if (length(cut)) {
+          ft <- ft[-cut, , drop = FALSE]
+          ft_id <- ft_id[-cut]
+        }
       }
       nhoursused <- 0
       enough <- if (compat) nrow(ft) > (minloadcrit - 21) else nrow(ft) >= 360
       if (enough) {
         nhoursused <- (nrow(ft) * 10) / 3600
         ft <- ft[-1, , drop = FALSE]
-        nomovement <- which(ft[[5]] < sdcriter & ft[[6]] < sdcriter &
-                              ft[[7]] < sdcriter & abs(ft[[2]]) < 2 &
-                              abs(ft[[3]]) < 2 & abs(ft[[4]]) < 2)
+        ft_id <- ft_id[-1]
+        nomovement <- which(ft[, 5] < sdcriter & ft[, 6] < sdcriter &
+                              ft[, 7] < sdcriter & abs(ft[, 2]) < 2 &
+                              abs(ft[, 3]) < 2 & abs(ft[, 4]) < 2)
         if (length(nomovement) < 10) {
           QC <- ggir_messages[["no_rest"]]
           ft <- NULL
         } else {
           ft <- ft[nomovement, , drop = FALSE]
+          ft_id <- ft_id[nomovement]
           npoints <- nrow(ft)
-          e <- sqrt(ft[[2]]^2 + ft[[3]]^2 + ft[[4]]^2)
+          e <- sqrt(ft[, 2]^2 + ft[, 3]^2 + ft[, 4]^2)
           cal.error.start <- round(mean(abs(e - 1)), digits = 5)
           tel <- 0
           for (a in 2:4) {
-            if (min(ft[[a]]) < -spherecrit && max(ft[[a]]) > spherecrit) tel <- tel + 1
+            if (min(ft[, a]) < -spherecrit && max(ft[, a]) > spherecrit) tel <- tel + 1
           }
           spherepopulated <- tel == 3
           if (!spherepopulated) QC <- ggir_messages[["no_sphere"]]
@@ -178,9 +319,8 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
         QC <- ggir_messages[["no_data"]]
       }
       if (spherepopulated) {
-        temp <- if (use.temp) as.numeric(ft[[8]]) else NULL
-        icp <- gc_fit_icp(as.numeric(ft[[2]]), as.numeric(ft[[3]]),
-                          as.numeric(ft[[4]]), temp, use.temp,
+        temp <- if (use.temp) ft[, 8] else NULL
+        icp <- gc_fit_icp(ft[, 2], ft[, 3], ft[, 4], temp, use.temp,
                           if (compat) 0L else 1L, as.integer(max_iter), tol,
                           100, FALSE)
         scale <- icp$scale
@@ -188,7 +328,7 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
         tempoffset <- icp$tempoffset
         meantemp <- if (use.temp) icp$meantemp else 0
         a <- lapply(1:3, function(k) {
-          v <- (as.numeric(ft[[k + 1]]) + offset[k]) / (1 / scale[k])
+          v <- (ft[, k + 1] + offset[k]) / (1 / scale[k])
           if (use.temp) v <- v + (temp - meantemp) / (1 / tempoffset[k])
           v
         })
@@ -216,7 +356,8 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
   }
   spheredata <- NULL
   if (!is.null(ft) && nrow(ft) > 0 && ncol(ft) > 0) {
-    spheredata <- ft
+    spheredata <- as.data.frame(unname(ft))
+    attr(spheredata, "row.names") <- ft_id
     nm <- ggir_feature_names(use.temp)
     names(spheredata) <- c(nm, rep(NA_character_, ncol(ft) - length(nm)))
   }
@@ -393,7 +534,8 @@ drop_temperature <- function(read) {
   force(read)
   function(i) {
     b <- read(i)
-    if (!is.null(b)) b$data$temperature <- NULL
+    if (!is.null(b$cols)) b$cols$temperature <- NULL
+    if (!is.null(b$data)) b$data$temperature <- NULL
     b
   }
 }

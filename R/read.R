@@ -89,8 +89,11 @@ gravcal_example <- function() {
 # ---------------------------------------------------------------------------
 # Block readers. A source is a list with `format`, `sf`, `filename`,
 # `temperature` (does it carry a temperature column) and `read(i)`, which
-# returns block i (1, 2, ... in order) as list(data = data frame with x, y, z
-# and maybe temperature, last = logical), or NULL when there is nothing more.
+# returns block i (1, 2, ... in order), or NULL when there is nothing more,
+# in one of two forms: list(data = data frame with x, y, z and maybe
+# temperature, last = logical) for blocks read from a file, or list(cols =
+# list of double vectors x, y, z and maybe temperature, from, to, last) for
+# rows [from, to) (0-based) of data held in memory.
 # Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
 # file where GGIR does: `chunksize` scales them (1 = about 12 hours).
 
@@ -140,13 +143,11 @@ source_frame <- function(x, sf, chunksize, arg) {
   list(format = "data.frame", sf = sf, filename = NA_character_,
        temperature = !is.null(s$temperature), n = n,
        read = function(i) {
-         from <- (i - 1) * B + 1
-         if (from > n) return(NULL)
+         from <- (i - 1) * B
+         if (from >= n) return(NULL)
          to <- min(i * B, n)
-         idx <- from:to
-         d <- data.frame(x = s$x[idx], y = s$y[idx], z = s$z[idx])
-         if (!is.null(s$temperature)) d$temperature <- s$temperature[idx]
-         list(data = d, last = to >= n)
+         # the block as a range of the caller's columns: nothing is copied
+         list(cols = s, from = from, to = to, last = to >= n)
        })
 }
 

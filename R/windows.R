@@ -24,8 +24,11 @@
 #'
 #' @param x Raw samples: a data frame or matrix with numeric columns `x`, `y`,
 #'   `z` in g (case-insensitive), and optionally `temperature` (degrees C) and
-#'   `time` (used for the `start` column).
-#' @param sf Sampling frequency in Hz, a positive number.
+#'   `time` (used for the `start` column); or the path of a recording in a
+#'   format [calibrate()] reads, which is read block by block (about 12 hours
+#'   at a time), so that memory holds one block and the window table.
+#' @param sf Sampling frequency in Hz, a positive number (for a file: only
+#'   when the file does not give it).
 #' @param method `"lightweight"` or `"ggir"`: which rest criterion and which
 #'   defaults to use.
 #' @param window Window duration in seconds; default 5 (lightweight) or 10
@@ -69,7 +72,14 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          max_abs_mean = 2, skip_zero = TRUE,
                          chunk_size = 1e6, progress = NULL) {
   method <- match.arg(method)
-  s <- as_samples(x)
+  src <- NULL
+  if (is.character(x)) {
+    src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x")
+    sf <- src$sf
+    s <- list(n = 0, time = NULL)
+  } else {
+    s <- as_samples(x)
+  }
   check_sf(sf)
   if (is.null(window)) window <- if (method == "lightweight") 5 else 10
   check_number(window, "window", min = 0, min_inclusive = FALSE)
@@ -99,7 +109,12 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     abort("Column `time` of `x` must have one value per sample.")
   }
   seg <- gc_segmenter_new(window * sf, skip_zero, FALSE)
-  out <- segment_chunks(seg, s, rule, par, chunk_size, progress)
+  if (is.null(src)) {
+    out <- segment_chunks(seg, s, rule, par, chunk_size, progress)
+  } else {
+    out <- segment_source(seg, src, rule, par, progress)
+    s$n <- attr(out, "samples")
+  }
   w <- windows_frame(out, s, sf)
   state <- gc_segmenter_state(seg)
   attr(w, "sf") <- sf
@@ -142,6 +157,32 @@ segment_chunks <- function(seg, s, rule, par, chunk_size, progress) {
                                   starts[i], to, rule, par)
     if (!is.null(bar)) utils::setTxtProgressBar(bar, i)
   }
+  out
+}
+
+# The same for a file source (open_source()), one block at a time.
+segment_source <- function(seg, src, rule, par, progress) {
+  if (is.null(progress)) progress <- interactive()
+  out <- list()
+  n <- 0
+  i <- 1
+  repeat {
+    blk <- src$read(i)
+    if (is.null(blk)) break
+    p <- block_piece(blk, block_has_temp(blk))
+    last <- isTRUE(blk$last)
+    out[[i]] <- gc_segmenter_push(seg, p$x, p$y, p$z, p$t, p$from, p$to,
+                                  rule, par)
+    n <- n + (p$to - p$from)
+    if (isTRUE(progress)) {
+      cat(sprintf("\rblock %d: %.1f hours read", i, n / src$sf / 3600))
+    }
+    rm(blk, p)
+    if (last) break
+    i <- i + 1
+  }
+  if (isTRUE(progress)) cat("\n")
+  attr(out, "samples") <- n
   out
 }
 

@@ -30,6 +30,47 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_count_zero
+double gc_count_zero(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, double from, double to);
+RcppExport SEXP _gravcal_gc_count_zero(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP fromSEXP, SEXP toSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type to(toSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_count_zero(x, y, z, from, to));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_sd_below
+Rcpp::LogicalVector gc_sd_below(const Rcpp::List& v, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, double limit, double threshold);
+RcppExport SEXP _gravcal_gc_sd_below(SEXP vSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP limitSEXP, SEXP thresholdSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type to(toSEXP);
+    Rcpp::traits::input_parameter< double >::type limit(limitSEXP);
+    Rcpp::traits::input_parameter< double >::type threshold(thresholdSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_sd_below(v, from, to, limit, threshold));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_r_mean_sd
+Rcpp::NumericVector gc_r_mean_sd(const Rcpp::List& v, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, double limit);
+RcppExport SEXP _gravcal_gc_r_mean_sd(SEXP vSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP limitSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type to(toSEXP);
+    Rcpp::traits::input_parameter< double >::type limit(limitSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_r_mean_sd(v, from, to, limit));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_segmenter_new
 SEXP gc_segmenter_new(double samples_per_window, bool skip_zero, bool r_arithmetic);
 RcppExport SEXP _gravcal_gc_segmenter_new(SEXP samples_per_windowSEXP, SEXP skip_zeroSEXP, SEXP r_arithmeticSEXP) {
@@ -116,15 +157,29 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_read_once
+double gc_read_once(const Rcpp::List& cols);
+RcppExport SEXP _gravcal_gc_read_once(SEXP colsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type cols(colsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_read_once(cols));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
+    {"_gravcal_gc_count_zero", (DL_FUNC) &_gravcal_gc_count_zero, 5},
+    {"_gravcal_gc_sd_below", (DL_FUNC) &_gravcal_gc_sd_below, 5},
+    {"_gravcal_gc_r_mean_sd", (DL_FUNC) &_gravcal_gc_r_mean_sd, 4},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 6},
     {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 12},
+    {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},
     {NULL, NULL, 0}
 };
 

@@ -248,3 +248,28 @@ Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x,
                                sum_scale, tol, trace);
   Rcpp::stop("unknown arithmetic");
 }
+
+// The memory-bandwidth floor for bench/: reads every sample of the given
+// columns once (four independent sums per column, so that the loop is bound
+// by memory, not by the latency of one chain of additions). Not exported to
+// users; the benchmark compares the segmenter with it.
+// [[Rcpp::export(rng = false)]]
+double gc_read_once(const Rcpp::List& cols) {
+  double total = 0.0;
+  for (R_xlen_t c = 0; c < cols.size(); ++c) {
+    Rcpp::NumericVector v(cols[c]);
+    const double* p = v.begin();
+    const R_xlen_t n = v.size();
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    R_xlen_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+      a0 += p[i];
+      a1 += p[i + 1];
+      a2 += p[i + 2];
+      a3 += p[i + 3];
+    }
+    for (; i < n; ++i) a0 += p[i];
+    total += (a0 + a1) + (a2 + a3);
+  }
+  return total;
+}

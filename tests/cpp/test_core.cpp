@@ -50,6 +50,8 @@ static void test_segmenter() {
     t[i] = 25.0 + 0.001 * static_cast<double>(i);
   }
   x[50] = y[50] = z[50] = 0.0;  // idle-sleep sample
+  y[3000] = NAN;                // an invalid sample
+  t[7000] = NAN;                // a missing temperature
   std::vector<gravcal::WindowStats> whole, parts;
   gravcal::Segmenter s1(428.5, true);
   s1.push(x.data(), y.data(), z.data(), t.data(), n, Collect{&whole});
@@ -65,6 +67,8 @@ static void test_segmenter() {
   CHECK(whole.size() == parts.size());
   CHECK(whole.size() == 46);
   CHECK(s1.skipped_zero() == 1);
+  CHECK(whole[6].n_invalid == 1 && whole[5].n_invalid == 0);
+  CHECK(!std::isnan(whole[16].temperature));
   bool same = whole.size() == parts.size();
   for (std::size_t i = 0; same && i < whole.size(); ++i)
     same = std::memcmp(&whole[i], &parts[i], sizeof(gravcal::WindowStats)) == 0;
@@ -171,18 +175,24 @@ static void test_r_arithmetic() {
   std::mt19937 rng(9);
   std::normal_distribution<double> nd(0.0, 0.01);
   const std::size_t n = 5000;
-  std::vector<double> x(n), y(n), z(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = 0.1 + nd(rng), y[i] = nd(rng), z[i] = 1 + nd(rng);
+  std::vector<double> x(n), y(n), z(n), t(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = 0.1 + nd(rng), y[i] = nd(rng), z[i] = 1 + nd(rng);
+    t[i] = 20 + 1e-3 * static_cast<double>(i);
+  }
+  z[777] = NAN;  // window 7 goes through the sample-by-sample path
+  t[1234] = NAN;
   std::vector<gravcal::WindowStats> a, b;
   std::vector<double> buf1(3 * 102), buf2(3 * 102);
   gravcal::Segmenter s1(100, false), s2(100, false);
   CHECK(s1.use_r_arithmetic(buf1.data(), buf1.size()));
   CHECK(s2.use_r_arithmetic(buf2.data(), buf2.size()));
   CHECK(!s1.use_r_arithmetic(buf1.data(), 10));
-  s1.push(x.data(), y.data(), z.data(), nullptr, n, [&](const gravcal::WindowStats& w) { a.push_back(w); });
+  // whole windows at once (the one-pass path) against 37-sample chunks
+  s1.push(x.data(), y.data(), z.data(), t.data(), n, [&](const gravcal::WindowStats& w) { a.push_back(w); });
   for (std::size_t i = 0; i < n; i += 37) {
     const std::size_t m = std::min<std::size_t>(37, n - i);
-    s2.push(x.data() + i, y.data() + i, z.data() + i, nullptr, m,
+    s2.push(x.data() + i, y.data() + i, z.data() + i, t.data() + i, m,
             [&](const gravcal::WindowStats& w) { b.push_back(w); });
   }
   CHECK(a.size() == 50 && b.size() == 50);
@@ -191,8 +201,10 @@ static void test_r_arithmetic() {
     for (int c = 0; c < 3; ++c) {
       same = same && a[k].mean[c] == b[k].mean[c] && a[k].sd[c] == b[k].sd[c];
     }
+    same = same && std::memcmp(&a[k], &b[k], sizeof(gravcal::WindowStats)) == 0;
   }
   CHECK(same);
+  CHECK(a[7].n_invalid == 1 && std::isnan(a[7].mean[2]) == false);
 }
 
 int main() {

@@ -37,6 +37,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#if defined(__GNUC__)
+#define GRAVCAL_NOINLINE __attribute__((noinline))
+#else
+#define GRAVCAL_NOINLINE
+#endif
+
 namespace gravcal {
 
 // Per-window results.
@@ -103,24 +109,32 @@ class Segmenter {
 
   // Push a chunk of n samples. t may be null (no temperature). sink(stats) is
   // called once for every window completed by this chunk, in order.
+  //
+  // A window that lies whole inside the chunk is computed by one tight loop
+  // over the caller's arrays (whole_window()); it falls back to the
+  // sample-by-sample path when the window holds a skipped zero or a
+  // non-finite value. Both paths add the same numbers in the same order, so
+  // the results do not depend on which one ran, nor on the chunking.
   template <class Sink>
   void push(const double* x, const double* y, const double* z,
             const double* t, std::size_t n, Sink&& sink) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const double xi = x[i], yi = y[i], zi = z[i];
-      const std::int64_t at = seen_++;
-      if (skip_zero_ && xi == 0.0 && yi == 0.0 && zi == 0.0) {
-        ++skipped_zero_;
-        continue;
+    std::size_t i = 0;
+    bool try_whole = true;
+    while (i < n) {
+      if (n_ == 0 && try_whole) {
+        const std::int64_t need = next_boundary_ - retained_;
+        if (need > 0 && static_cast<std::uint64_t>(need) <= n - i) {
+          const std::size_t m = static_cast<std::size_t>(need);
+          if (whole_window(x + i, y + i, z + i, t ? t + i : nullptr, m,
+                           sink)) {
+            i += m;
+            continue;
+          }
+          try_whole = false;  // until this window closes
+        }
       }
-      if (n_ == 0) first_ = at;
-      add(xi, yi, zi, t ? t[i] : NAN);
-      ++retained_;
-      if (retained_ == next_boundary_) {
-        WindowStats s;
-        close(s);
-        sink(s);
-      }
+      if (step(x[i], y[i], z[i], t ? t[i] : NAN, sink)) try_whole = true;
+      ++i;
     }
   }
 
@@ -133,6 +147,197 @@ class Segmenter {
  private:
   std::int64_t boundary(std::int64_t k) const {
     return static_cast<std::int64_t>(std::llround(static_cast<double>(k) * L_));
+  }
+
+  // One sample; returns true when it completed a window.
+  template <class Sink>
+  bool step(double xi, double yi, double zi, double ti, Sink& sink) {
+    const std::int64_t at = seen_++;
+    if (skip_zero_ && xi == 0.0 && yi == 0.0 && zi == 0.0) {
+      ++skipped_zero_;
+      return false;
+    }
+    if (n_ == 0) first_ = at;
+    add(xi, yi, zi, ti);
+    ++retained_;
+    if (retained_ != next_boundary_) return false;
+    WindowStats s;
+    close(s, nullptr);
+    sink(s);
+    return true;
+  }
+
+  // A whole window of m samples at x, y, z (t may be null) in one pass, with
+  // the same operations in the same order as add(). Changes nothing and
+  // returns false if the window needs the sample-by-sample path (a sample to
+  // skip, or a non-finite value).
+  template <class Sink>
+  bool whole_window(const double* x, const double* y, const double* z,
+                    const double* t, std::size_t m, Sink& sink) {
+    const double h0 = x[0], h1 = y[0], h2 = z[0];
+    StreamScan a;
+    RScan r;
+    if (rbuf_ == nullptr) {
+      scan_stream(x, y, z, t, m, a);
+      if ((skip_zero_ && a.zero) ||
+          !std::isfinite(a.s[0] + a.s[1] + a.s[2] + a.q[0] + a.q[1] + a.q[2] +
+                         a.nrm) ||
+          (t != nullptr && !std::isfinite(a.st))) {
+        return false;
+      }
+    } else {
+      for (int k = 0; k < 5; ++k) r.c[k] = csum_[k];
+      scan_r(x, y, z, t, m, r);
+      // the running sums stay finite through windows of finite samples
+      // (add() leaves out non-finite ones), so a non-finite sum here means
+      // this window holds a non-finite value
+      if ((skip_zero_ && r.zero) ||
+          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3])) ||
+          (t != nullptr && !std::isfinite(static_cast<double>(r.c[4])))) {
+        return false;
+      }
+      for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
+      for (int k = 0; k < 3; ++k) {
+        wsum_[k] = r.w[k];
+        a.s[k] = a.q[k] = 0.0;  // replaced by close_r()
+        a.lo[k] = r.lo[k];
+        a.hi[k] = r.hi[k];
+      }
+      a.nrm = a.st = 0.0;
+    }
+    first_ = seen_;
+    seen_ += static_cast<std::int64_t>(m);
+    retained_ += static_cast<std::int64_t>(m);
+    n_ = n_valid_ = static_cast<std::int64_t>(m);
+    n_invalid_ = 0;
+    n_temp_ = t != nullptr ? static_cast<std::int64_t>(m) : 0;
+    shift_[0] = h0;
+    shift_[1] = h1;
+    shift_[2] = h2;
+    for (int k = 0; k < 3; ++k) {
+      sum_[k] = a.s[k];
+      sumsq_[k] = a.q[k];
+      min_[k] = a.lo[k];
+      max_[k] = a.hi[k];
+    }
+    sum_norm_ = a.nrm;
+    sum_temp_ = a.st;
+    const double* cols[3] = {x, y, z};
+    WindowStats s;
+    close(s, cols);
+    sink(s);
+    return true;
+  }
+
+  // The one-pass loops of whole_window(), kept out of line so that their
+  // code does not depend on the caller's.
+  struct StreamScan {
+    double s[3], q[3], lo[3], hi[3], nrm, st;
+    bool zero;
+  };
+  struct RScan {
+    long double c[5], w[3];
+    double lo[3], hi[3];
+    bool zero;
+  };
+
+  // Streaming sums about the first sample (add()'s arithmetic, same order).
+  GRAVCAL_NOINLINE static void scan_stream(const double* x, const double* y,
+                                           const double* z, const double* t,
+                                           std::size_t m, StreamScan& o) {
+    const double h0 = x[0], h1 = y[0], h2 = z[0];
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, q0 = 0.0, q1 = 0.0, q2 = 0.0;
+    double lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+    double nrm = 0.0, st = 0.0;
+    bool zero = false;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double xi = x[k], yi = y[k], zi = z[k];
+      zero |= (xi == 0.0) & (yi == 0.0) & (zi == 0.0);
+      const double d0 = xi - h0, d1 = yi - h1, d2 = zi - h2;
+      s0 += d0;
+      s1 += d1;
+      s2 += d2;
+      q0 += d0 * d0;
+      q1 += d1 * d1;
+      q2 += d2 * d2;
+      lo0 = xi < lo0 ? xi : lo0;
+      lo1 = yi < lo1 ? yi : lo1;
+      lo2 = zi < lo2 ? zi : lo2;
+      hi0 = xi > hi0 ? xi : hi0;
+      hi1 = yi > hi1 ? yi : hi1;
+      hi2 = zi > hi2 ? zi : hi2;
+      nrm += std::sqrt(xi * xi + yi * yi + zi * zi);
+    }
+    if (t != nullptr) {
+      for (std::size_t k = 0; k < m; ++k) st += t[k];
+    }
+    o.s[0] = s0;
+    o.s[1] = s1;
+    o.s[2] = s2;
+    o.q[0] = q0;
+    o.q[1] = q1;
+    o.q[2] = q2;
+    o.lo[0] = lo0;
+    o.lo[1] = lo1;
+    o.lo[2] = lo2;
+    o.hi[0] = hi0;
+    o.hi[1] = hi1;
+    o.hi[2] = hi2;
+    o.nrm = nrm;
+    o.st = st;
+    o.zero = zero;
+  }
+
+  // R's cumsum(), one column at a time, continuing o.c, and the norm as
+  // add() forms it; the window's own long double sums (the first pass of
+  // R's sd) ride along. Scalar accumulators, so that they stay in x87
+  // registers; min, max and temperature in a second loop.
+  GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
+                                      const double* z, const double* t,
+                                      std::size_t m, RScan& o) {
+    long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
+    long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
+    for (std::size_t k = 0; k < m; ++k) {
+      const double xi = x[k], yi = y[k], zi = z[k];
+      c0 += xi;
+      c1 += yi;
+      c2 += zi;
+      w0 += xi;
+      w1 += yi;
+      w2 += zi;
+      const double sq = xi * xi + yi * yi;
+      c3 += std::sqrt(sq + zi * zi);
+    }
+    o.c[0] = c0;
+    o.c[1] = c1;
+    o.c[2] = c2;
+    o.c[3] = c3;
+    o.w[0] = w0;
+    o.w[1] = w1;
+    o.w[2] = w2;
+    const double h0 = x[0], h1 = y[0], h2 = z[0];
+    double lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+    bool zero = false;
+    long double c4 = o.c[4];
+    for (std::size_t k = 0; k < m; ++k) {
+      const double xi = x[k], yi = y[k], zi = z[k];
+      zero |= (xi == 0.0) & (yi == 0.0) & (zi == 0.0);
+      lo0 = xi < lo0 ? xi : lo0;
+      lo1 = yi < lo1 ? yi : lo1;
+      lo2 = zi < lo2 ? zi : lo2;
+      hi0 = xi > hi0 ? xi : hi0;
+      hi1 = yi > hi1 ? yi : hi1;
+      hi2 = zi > hi2 ? zi : hi2;
+      if (t != nullptr) c4 += t[k];
+    }
+    o.c[4] = c4;
+    o.lo[0] = lo0;
+    o.lo[1] = lo1;
+    o.lo[2] = lo2;
+    o.hi[0] = hi0;
+    o.hi[1] = hi1;
+    o.hi[2] = hi2;
+    o.zero = zero;
   }
 
   void clear_window() {
@@ -187,7 +392,9 @@ class Segmenter {
     sum_norm_ += std::sqrt(xi * xi + yi * yi + zi * zi);
   }
 
-  void close(WindowStats& s) {
+  // cols: the window's samples per axis (whole_window()), or null for the
+  // lent buffer.
+  void close(WindowStats& s, const double* const* cols) {
     s.index = window_;
     s.first = first_;
     s.n = static_cast<std::int32_t>(n_);
@@ -214,14 +421,14 @@ class Segmenter {
     }
     s.mean_norm = n_valid_ > 0 ? sum_norm_ / nv : NAN;
     s.temperature = n_temp_ > 0 ? sum_temp_ / static_cast<double>(n_temp_) : NAN;
-    if (rbuf_ != nullptr) close_r(s);
+    if (rbuf_ != nullptr) close_r(s, cols);
     ++window_;
     next_boundary_ = boundary(window_ + 1);
     clear_window();
   }
 
   // Means from the rounded cumulative sums, sds as R's var() computes them.
-  void close_r(WindowStats& s) {
+  void close_r(WindowStats& s, const double* const* cols) {
     double c[5];
     for (int k = 0; k < 5; ++k) c[k] = static_cast<double>(csum_[k]);
     if (n_valid_ > 0) {
@@ -233,31 +440,72 @@ class Segmenter {
       s.temperature = (c[4] - cprev_[4]) / static_cast<double>(n_temp_);
     }
     for (int k = 0; k < 5; ++k) cprev_[k] = c[k];
-    for (int a = 0; a < 3; ++a) {
-      s.sd[a] = n_valid_ > 1
-                    ? r_sd(rbuf_ + static_cast<std::size_t>(a) * rcap_, n_valid_)
-                    : NAN;
+    if (n_valid_ > 1) {
+      const double* v[3];
+      for (int a = 0; a < 3; ++a) {
+        v[a] = cols != nullptr ? cols[a]
+                               : rbuf_ + static_cast<std::size_t>(a) * rcap_;
+      }
+      r_sd3(v, static_cast<std::size_t>(n_valid_), cols != nullptr ? wsum_ : nullptr,
+            s.sd);
+    } else {
+      for (int a = 0; a < 3; ++a) s.sd[a] = NAN;
     }
   }
 
-  static double r_sd(const double* v, std::int64_t n) {
+  // R's sd() of three columns of n (>= 2) values: the mean with R's
+  // correction pass, then the sum of squared deviations, in long double. The
+  // three columns go through each pass together (independent sums, so the
+  // result is that of three separate calls). sum1: the first pass's sums
+  // when the caller has them already, or null.
+  static void r_sd3(const double* const* v, std::size_t n,
+                    const long double* sum1, double* out) {
     const long double ln = static_cast<long double>(n);
-    long double sum = 0.0L;
-    for (std::int64_t k = 0; k < n; ++k) sum += v[k];
-    long double m = sum / ln;
-    if (std::isfinite(static_cast<double>(m))) {
-      sum = 0.0L;
-      for (std::int64_t k = 0; k < n; ++k) sum += (v[k] - m);
-      m = m + sum / ln;
+    const double* a = v[0];
+    const double* b = v[1];
+    const double* c = v[2];
+    long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
+    if (sum1 != nullptr) {
+      sa = sum1[0];
+      sb = sum1[1];
+      sc = sum1[2];
+    } else {
+      for (std::size_t k = 0; k < n; ++k) {
+        sa += a[k];
+        sb += b[k];
+        sc += c[k];
+      }
     }
-    const long double mean = static_cast<double>(m);
-    long double ss = 0.0L;
-    for (std::int64_t k = 0; k < n; ++k) {
-      const long double d = v[k] - mean;
-      ss += d * d;
+    long double m[3] = {sa / ln, sb / ln, sc / ln};
+    const bool fin[3] = {std::isfinite(static_cast<double>(m[0])),
+                         std::isfinite(static_cast<double>(m[1])),
+                         std::isfinite(static_cast<double>(m[2]))};
+    sa = sb = sc = 0.0L;
+    {
+      const long double m0 = m[0], m1 = m[1], m2 = m[2];
+      for (std::size_t k = 0; k < n; ++k) {
+        sa += (a[k] - m0);
+        sb += (b[k] - m1);
+        sc += (c[k] - m2);
+      }
     }
-    const double var = static_cast<double>(ss / static_cast<long double>(n - 1));
-    return std::sqrt(var);
+    if (fin[0]) m[0] = m[0] + sa / ln;
+    if (fin[1]) m[1] = m[1] + sb / ln;
+    if (fin[2]) m[2] = m[2] + sc / ln;
+    const long double ma = static_cast<double>(m[0]);
+    const long double mb = static_cast<double>(m[1]);
+    const long double mc = static_cast<double>(m[2]);
+    sa = sb = sc = 0.0L;
+    for (std::size_t k = 0; k < n; ++k) {
+      const long double da = a[k] - ma, db = b[k] - mb, dc = c[k] - mc;
+      sa += da * da;
+      sb += db * db;
+      sc += dc * dc;
+    }
+    const long double d = static_cast<long double>(n - 1);
+    out[0] = std::sqrt(static_cast<double>(sa / d));
+    out[1] = std::sqrt(static_cast<double>(sb / d));
+    out[2] = std::sqrt(static_cast<double>(sc / d));
   }
 
   double L_;
@@ -265,6 +513,7 @@ class Segmenter {
   double* rbuf_ = nullptr;
   std::size_t rcap_ = 0;
   long double csum_[5];
+  long double wsum_[3] = {0.0L, 0.0L, 0.0L};  // see whole_window()
   double cprev_[5];
   std::int64_t window_, retained_, seen_, skipped_zero_, next_boundary_, first_;
   std::int64_t n_, n_invalid_, n_valid_, n_temp_;
