@@ -17,7 +17,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 
-.PHONY: setup install demo test check core document bench clean
+.PHONY: setup install demo test check core document bench bench-speed clean
 
 setup:
 	bash tools/setup.sh
@@ -46,6 +46,10 @@ document:
 
 bench: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/table2.R
+
+# speed and memory against GGIR (about 25 minutes; results in bench/results)
+bench-speed: install
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/speed.R
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png

@@ -5,7 +5,37 @@
 #include <cmath>
 #include <vector>
 
+#include <R_ext/Applic.h>
+
 #include "gravcal/icp.hpp"
+
+namespace {
+
+// Weighted least squares by R's own LINPACK routine dqrls, with lm.wfit's
+// tolerance and its handling of aliased columns: the numbers GGIR's lm.wfit
+// calls get, to the last bit (see icp.hpp, IcpConfig::r_arithmetic).
+struct RLeastSquares {
+  mutable std::vector<double> qty, qraux, work, b;
+  mutable std::vector<int> jpvt;
+  void operator()(double* X, const double* y, std::size_t n, int p,
+                  double* coef, double* rsd) const {
+    int nn = static_cast<int>(n), pp = p, ny = 1, rank = 0;
+    double tol = 1e-7;
+    qty.assign(n, 0.0);
+    qraux.assign(static_cast<std::size_t>(p), 0.0);
+    work.assign(2 * static_cast<std::size_t>(p), 0.0);
+    b.assign(static_cast<std::size_t>(p), 0.0);
+    jpvt.resize(static_cast<std::size_t>(p));
+    for (int j = 0; j < p; ++j) jpvt[static_cast<std::size_t>(j)] = j + 1;
+    std::vector<double> yy(y, y + n);
+    F77_CALL(dqrls)(X, &nn, &pp, yy.data(), &ny, &tol, b.data(), rsd,
+                    qty.data(), &rank, jpvt.data(), qraux.data(), work.data());
+    for (int j = 0; j < p; ++j) coef[j] = NA_REAL;
+    for (int j = 0; j < rank; ++j) coef[jpvt[static_cast<std::size_t>(j)] - 1] = b[static_cast<std::size_t>(j)];
+  }
+};
+
+}  // namespace
 
 // x, y, z: window means; temp: their temperatures or NULL. stop_rule: 0 =
 // GGIR's statistic rule, 1 = parameter convergence.
@@ -30,6 +60,8 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
   cfg.max_weight = max_weight;
   cfg.use_temp = use_temp && t != nullptr;
   cfg.stop = stop_rule == 0 ? gravcal::StopRule::ggir : gravcal::StopRule::parameters;
+  // GGIR's rule: GGIR's arithmetic and R's least squares, bit for bit
+  cfg.r_arithmetic = stop_rule == 0;
   std::vector<double> tr;
   const gravcal::IcpResult r = gravcal::fit_icp(
       x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), cfg,
@@ -39,7 +71,7 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
         for (int k = 0; k < 3; ++k) tr.push_back(q.offset[k]);
         for (int k = 0; k < 3; ++k) tr.push_back(q.tempoffset[k]);
         tr.push_back(q.statistic);
-      });
+      }, RLeastSquares());
   Rcpp::NumericMatrix tm(10, static_cast<int>(tr.size() / 10));
   std::copy(tr.begin(), tr.end(), tm.begin());
   return Rcpp::List::create(

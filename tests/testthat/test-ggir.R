@@ -49,6 +49,16 @@ test_that("g.calibrate matches GGIR on synthetic ActiGraph csv files", {
   expect_same_as_ggir(b12)
   expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
   expect_equal(nrow(b12$gravcal$bsc_qc), 2L)
+  # the same samples held in memory (blocks as ranges of the caller's
+  # columns, idle-sleep blocks through the copying path): GGIR's answer
+  samples <- rec[, c("x", "y", "z")]
+  before <- unserialize(serialize(samples, NULL))
+  G <- gravcal::g.calibrate(samples, sf = 20, verbose = FALSE)
+  for (nm in c("scale", "offset")) expect_identical(G[[nm]], b$ggir[[nm]])
+  expect_identical(G$npoints, b$ggir$npoints)
+  expect_identical(G$QCmessage, b$ggir$QCmessage)
+  expect_identical(rownames(G$spheredata), rownames(b$gravcal$spheredata))
+  expect_identical(samples, before)
 })
 
 test_that("g.calibrate matches GGIR with temperature (ad hoc csv)", {
@@ -66,6 +76,50 @@ test_that("g.calibrate matches GGIR with temperature (ad hoc csv)", {
   b12 <- run_both(f, c(pr, list(minloadcrit = 12)))
   expect_same_as_ggir(b12)
   expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
+})
+
+test_that("the block scans agree with R", {
+  set.seed(5)
+  n <- 20000
+  x <- stats::rnorm(n)
+  y <- stats::rnorm(n)
+  z <- stats::rnorm(n)
+  zero <- c(1, 4096, 4097, 8192, 12000, n)
+  x[zero] <- y[zero] <- z[zero] <- 0
+  x[100] <- y[100] <- 0  # not idle sleep: z is not zero
+  z[200] <- NA
+  x[200] <- y[200] <- 0
+  iz <- function(a, b) as.numeric(sum(x[a:b] == 0 & y[a:b] == 0 & z[a:b] == 0, na.rm = TRUE))
+  expect_identical(gravcal:::gc_count_zero(x, y, z, 0, n), iz(1, n))
+  expect_identical(gravcal:::gc_count_zero(x, y, z, 1, 8192), iz(2, 8192))
+  expect_identical(gravcal:::gc_count_zero(x, y, z, 5, 5), 0)
+  expect_error(gravcal:::gc_count_zero(x, y, z, 0, n + 1), "range")
+  # temperature: mean and sd as R's, over pieces, NA removed
+  t <- 25 + cumsum(stats::rnorm(n, sd = 0.01))
+  t[c(3, 500)] <- NA
+  P <- list(gravcal:::piece(x, y, z, t, 10, 5000),
+            gravcal:::piece(x, y, z, t, 100, 900))
+  v <- c(t[11:5000], t[101:900])
+  r <- gravcal:::pieces_temp_stats(P, 5500)
+  expect_identical(r[1], mean(v[1:5500], na.rm = TRUE))
+  expect_identical(r[2], stats::sd(v[1:5500], na.rm = TRUE))
+  expect_identical(r[3], as.numeric(sum(!is.na(v[1:5500]))))
+  # sd below a threshold: the fast pass, and R's exact arithmetic when the
+  # sd is within rounding of the threshold
+  s0 <- stats::sd(v, na.rm = TRUE)
+  for (th in c(s0 * (1 + 1e-3), s0 * (1 - 1e-3), s0, s0 * (1 + 1e-15), s0 * (1 - 1e-15))) {
+    expect_identical(gravcal:::pieces_sd_below(P, length(v), th),
+                     stats::sd(v, na.rm = TRUE) < th)
+  }
+  expect_identical(gravcal:::pieces_sd_below(P, 1, 1), NA)
+  # pieces: head, drop and copies
+  Q <- gravcal:::pieces_drop(P, 4000)
+  expect_identical(gravcal:::pieces_n(Q), 4990 + 800 - 4000)
+  expect_identical(gravcal:::pieces_col(Q, "t"), v[4001:5790])
+  H <- gravcal:::pieces_head(P, 5000)
+  expect_identical(gravcal:::pieces_col(H, "x"), c(x[11:5000], x[101:110]))
+  O <- gravcal:::pieces_own(P)
+  expect_identical(O[[1]]$z, c(z[11:5000], z[101:900]))
 })
 
 test_that("g.calibrate matches GGIR when it cannot calibrate", {

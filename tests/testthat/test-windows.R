@@ -127,3 +127,48 @@ test_that("rest_windows() does not change the caller's data", {
   rest_windows(m, sf = 10)
   expect_identical(m, m2)
 })
+
+test_that("a file is windowed block by block as the same data in memory", {
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 8, temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_actigraph_csv(rec, f, sf = 10)
+  wf <- rest_windows(f, progress = FALSE)
+  wm <- rest_windows(rec[, c("x", "y", "z")], sf = 10)
+  expect_identical(attr(wf, "samples"), as.numeric(nrow(rec)))
+  cols <- c("mean_x", "mean_y", "mean_z", "sd_x", "sd_y", "sd_z", "rest")
+  expect_identical(wf[cols], wm[cols])
+  expect_identical(wf$start, wm$start)
+  fit_f <- calibrate(f, progress = FALSE)
+  fit_m <- calibrate(rec[, c("x", "y", "z")], sf = 10)
+  expect_identical(coef(fit_f), coef(fit_m))
+})
+
+test_that("R-compatible windows do not depend on the chunking", {
+  set.seed(12)
+  n <- 25000
+  x <- stats::rnorm(n, 0.1, 0.01)
+  y <- stats::rnorm(n, 0, 0.01)
+  z <- stats::rnorm(n, 1, 0.01)
+  t <- 25 + stats::rnorm(n, 0, 0.1)
+  x[3333] <- NaN  # this window takes the sample-by-sample path
+  one <- function(r, cuts) {
+    s <- gravcal:::gc_segmenter_new(1000, FALSE, r)
+    out <- lapply(seq_len(length(cuts) - 1), function(i) {
+      gravcal:::gc_segmenter_push(s, x, y, z, t, cuts[i], cuts[i + 1], 1L,
+                                  c(0.013, 2))
+    })
+    do.call(rbind, lapply(out, as.data.frame))
+  }
+  for (r in c(TRUE, FALSE)) {
+    a <- one(r, c(0, n))
+    b <- one(r, c(0, 17, 999, 1000, 4321, 4322, 12000, n))
+    expect_identical(a, b)
+  }
+  # and they are R's own numbers (GGIR computes them with cumsum and sd)
+  a <- one(TRUE, c(0, n))
+  k <- 3
+  idx <- (k - 1) * 1000 + 1:1000
+  expect_identical(a$sd_y[k], stats::sd(y[idx]))
+  expect_identical(a$mean_y[k], diff(cumsum(c(0, y))[c(1, 1001) + (k - 1) * 1000]) / 1000)
+})

@@ -21,7 +21,12 @@
 // The arithmetic follows GGIR's R code where that decides a bit: the
 // calibrated value is (v + o) / (1 / s) + t / (1 / to), as R's scale()
 // computes it. The per-axis least squares use a Householder QR of the
-// weighted design (R's lm.wfit uses a Householder QR too).
+// weighted design (R's lm.wfit uses a Householder QR too). With
+// IcpConfig::r_arithmetic every other step is done as GGIR's R code does it
+// too (row sums and means in long double, fitted values from the weighted
+// residuals, the statistic element by element), so that a solver computing
+// what R's lm.wfit computes (the caller may pass one: the R glue passes R's
+// own LINPACK routine) gives GGIR's coefficients to the last bit.
 //
 // Uses Eigen (header-only); no R.
 #ifndef GRAVCAL_ICP_HPP
@@ -43,6 +48,7 @@ struct IcpConfig {
   double max_weight = 100.0;  // GGIR: 1 / 0.01
   bool use_temp = true;
   StopRule stop = StopRule::ggir;
+  bool r_arithmetic = false;  // GGIR's R arithmetic, step by step (above)
 };
 
 struct IcpResult {
@@ -73,19 +79,157 @@ inline double r_mean(const double* v, std::size_t n) {
   return static_cast<double>(m);
 }
 
+// Weighted least squares by Householder QR. X: n x p, column-major, rows
+// already multiplied by sqrt(weight); y likewise. Writes the p coefficients
+// (NaN for a column that adds nothing, as R gives NA) and the weighted
+// residuals y - X coef. May overwrite X.
+struct EigenLeastSquares {
+  void operator()(double* X, const double* y, std::size_t n, int p,
+                  double* coef, double* rsd) const {
+    const Eigen::Index N = static_cast<Eigen::Index>(n);
+    Eigen::Map<Eigen::MatrixXd> A(X, N, p);
+    Eigen::Map<const Eigen::VectorXd> b(y, N);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    qr.setThreshold(1e-7);
+    Eigen::VectorXd beta = qr.solve(b);
+    Eigen::Map<Eigen::VectorXd> r(rsd, N);
+    r = b - A * beta;
+    const Eigen::Index rank = qr.rank();
+    for (int j = 0; j < p; ++j) coef[j] = beta(j);
+    // columns beyond the rank, in pivot order, are aliased
+    for (Eigen::Index j = rank; j < p; ++j) {
+      coef[qr.colsPermutation().indices()(j)] =
+          std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+};
+
 // The calibrated value, in GGIR's operation order.
 inline double icp_apply(double v, double o, double s, double t, double to) {
   return (v + o) / (1.0 / s) + t / (1.0 / to);
 }
 
+// GGIR's loop with R's arithmetic (IcpConfig::r_arithmetic). As GGIR: the
+// design always has the temperature column (zeros without temperature), a
+// temperature that does not vary gives NA coefficients (reported as not
+// finite), the statistic is 3 * mean(w * (a - p)^2 / sum(w)) over all 3n
+// elements, the weights min(1 / sqrt(rowSums((a - p)^2)), max_weight).
+template <class Observer, class Solver>
+IcpResult fit_icp_r(const double* x, const double* y, const double* z,
+                    const double* temp, std::size_t n, const IcpConfig& cfg,
+                    Observer& obs, const Solver& solve) {
+  IcpResult r;
+  if (n < 3) {
+    r.finite = false;
+    return r;
+  }
+  const double* in[3] = {x, y, z};
+  const bool use_temp = cfg.use_temp && temp != nullptr;
+  std::vector<double> t(n, 0.0);
+  if (use_temp) {
+    r.meantemp = r_mean(temp, n);
+    for (std::size_t i = 0; i < n; ++i) t[i] = temp[i] - r.meantemp;
+    r.temp_used = true;
+  }
+  std::vector<double> cur(3 * n), cp(3 * n), w(n, 1.0), sw(n), X(3 * n), yw(n),
+      rsd(n), e(3 * n);
+  double res_prev = std::numeric_limits<double>::infinity();
+  for (int it = 1; it <= cfg.max_iter; ++it) {
+    for (int k = 0; k < 3; ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        cur[k * n + i] = icp_apply(in[k][i], r.offset[k], r.scale[k], t[i],
+                                   r.tempoffset[k]);
+      }
+    }
+    // closest points: curr / sqrt(rowSums(curr^2))
+    for (std::size_t i = 0; i < n; ++i) {
+      long double ss = 0.0L;
+      for (int k = 0; k < 3; ++k) {
+        const double c = cur[k * n + i];
+        ss += c * c;
+      }
+      const double nrm = std::sqrt(static_cast<double>(ss));
+      for (int k = 0; k < 3; ++k) cp[k * n + i] = cur[k * n + i] / nrm;
+    }
+    for (std::size_t i = 0; i < n; ++i) sw[i] = std::sqrt(w[i]);
+    double d_off[3], d_scale[3], d_temp[3] = {0.0, 0.0, 0.0};
+    bool finite = true;
+    for (int k = 0; k < 3; ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        X[i] = 1.0 * sw[i];
+        X[n + i] = cur[k * n + i] * sw[i];
+        X[2 * n + i] = t[i] * sw[i];
+        yw[i] = cp[k * n + i] * sw[i];
+        finite = finite && std::isfinite(X[n + i]) && std::isfinite(yw[i]);
+      }
+      if (!finite) break;
+      double coef[3];
+      solve(X.data(), yw.data(), n, 3, coef, rsd.data());
+      d_off[k] = coef[0];
+      d_scale[k] = coef[1];
+      if (use_temp) d_temp[k] = coef[2];
+      for (std::size_t i = 0; i < n; ++i) {
+        cur[k * n + i] = cp[k * n + i] - rsd[i] / sw[i];
+      }
+    }
+    if (!finite) {
+      r.finite = false;
+      break;
+    }
+    for (int k = 0; k < 3; ++k) {
+      r.offset[k] = r.offset[k] + d_off[k] / (r.scale[k] * d_scale[k]);
+      if (use_temp) r.tempoffset[k] = r.tempoffset[k] * d_scale[k] + d_temp[k];
+      r.scale[k] = r.scale[k] * d_scale[k];
+    }
+    long double wsum_l = 0.0L;
+    for (std::size_t i = 0; i < n; ++i) wsum_l += w[i];
+    const double wsum = static_cast<double>(wsum_l);
+    for (int k = 0; k < 3; ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const double d = cur[k * n + i] - cp[k * n + i];
+        e[k * n + i] = w[i] * (d * d) / wsum;
+      }
+    }
+    const double res = 3.0 * r_mean(e.data(), 3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      long double ss = 0.0L;
+      for (int k = 0; k < 3; ++k) {
+        const double d = cur[k * n + i] - cp[k * n + i];
+        ss += d * d;
+      }
+      const double wi = 1.0 / std::sqrt(static_cast<double>(ss));
+      w[i] = wi < cfg.max_weight ? wi : cfg.max_weight;
+    }
+    r.iterations = it;
+    r.statistic = res;
+    obs(it, static_cast<const IcpResult&>(r));
+    finite = std::isfinite(res);
+    for (int k = 0; k < 3; ++k) {
+      finite = finite && std::isfinite(r.offset[k]) && std::isfinite(r.scale[k]) &&
+               std::isfinite(r.tempoffset[k]);
+    }
+    if (!finite) {
+      r.finite = false;
+      break;
+    }
+    if (std::fabs(res - res_prev) < cfg.tol) {
+      r.converged = true;
+      break;
+    }
+    res_prev = res;
+  }
+  return r;
+}
+
 // x, y, z: the n window means; temp: their temperatures (may be null, or
 // ignored when cfg.use_temp is false). Observer is called after each
 // iteration as obs(iteration, result-so-far).
-template <class Observer>
+template <class Observer, class Solver = EigenLeastSquares>
 IcpResult fit_icp(const double* x, const double* y, const double* z,
                   const double* temp, std::size_t n, const IcpConfig& cfg,
-                  Observer&& obs) {
+                  Observer&& obs, const Solver& solve = Solver()) {
   IcpResult r;
+  if (cfg.r_arithmetic) return fit_icp_r(x, y, z, temp, n, cfg, obs, solve);
   if (n < 3) {
     r.finite = false;
     return r;
