@@ -45,3 +45,7 @@ gc_read_once <- function(cols) {
     .Call(`_gravcal_gc_read_once`, cols)
 }
 
+gc_release_memory <- function() {
+    .Call(`_gravcal_gc_release_memory`)
+}
+

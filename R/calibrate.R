@@ -73,8 +73,10 @@
 #' `"too_short"` and `"diverged"`, the last five with identity
 #' coefficients.
 #'
-#' With `ggir_compat = TRUE` the numbers are GGIR's (within 1e-8 of
-#' `GGIR::g.calibrate()` 3.3 on the same samples). gravcal's default differs
+#' With `ggir_compat = TRUE` the numbers are GGIR's: coefficients, errors
+#' and window statistics identical, to the last bit, to those of
+#' `GGIR::g.calibrate()` 3.3 on the same samples (the window statistics use
+#' R's arithmetic, the fit R's own least-squares routine). gravcal's default differs
 #' from GGIR in four places, each where GGIR's behaviour is an accident:
 #' 1. The fit runs to convergence (no parameter moves by more than `tol`).
 #'    GGIR stops when its residual statistic, divided by the sum of the

@@ -167,6 +167,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_release_memory
+bool gc_release_memory();
+RcppExport SEXP _gravcal_gc_release_memory() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(gc_release_memory());
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
@@ -180,6 +189,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 6},
     {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 12},
     {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},
+    {"_gravcal_gc_release_memory", (DL_FUNC) &_gravcal_gc_release_memory, 0},
     {NULL, NULL, 0}
 };
 

@@ -273,3 +273,20 @@ double gc_read_once(const Rcpp::List& cols) {
   }
   return total;
 }
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+// For bench/: hand memory that malloc keeps after R freed it back to the
+// system (glibc only), so that a peak measured next starts from what is in
+// use. Returns whether it could.
+// [[Rcpp::export(rng = false)]]
+bool gc_release_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+  return true;
+#else
+  return false;
+#endif
+}

@@ -6,6 +6,7 @@
 // window arithmetic is also chunk invariant.
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -207,7 +208,31 @@ static void test_r_arithmetic() {
   CHECK(a[7].n_invalid == 1 && std::isnan(a[7].mean[2]) == false);
 }
 
-int main() {
+// A digest of the windows of a fixed stream, printed so that the Makefile
+// can check that the SSE2 and the portable builds give the same bits.
+static void print_digest() {
+  std::mt19937 rng(77);
+  std::normal_distribution<double> nd(0.0, 0.02);
+  const std::size_t n = 100003;
+  std::vector<double> x(n), y(n), z(n), t(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = 0.3 + nd(rng), y[i] = -0.5 + nd(rng), z[i] = 0.8 + nd(rng);
+    t[i] = 30 + nd(rng);
+  }
+  std::uint64_t h = 1469598103934665603ull;
+  gravcal::Segmenter s(85.7 * 5, false);
+  s.push(x.data(), y.data(), z.data(), t.data(), n, [&](const gravcal::WindowStats& w) {
+    const unsigned char* p = reinterpret_cast<const unsigned char*>(&w);
+    for (std::size_t i = 0; i < sizeof(w); ++i) h = (h ^ p[i]) * 1099511628211ull;
+  });
+  std::printf("digest %016llx\n", static_cast<unsigned long long>(h));
+}
+
+int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "--digest") == 0) {
+    print_digest();
+    return 0;
+  }
   test_icp();
   test_r_arithmetic();
   test_model();

@@ -18,7 +18,10 @@
 // - streaming (the default): sums about the first valid sample of the window
 //   (shifted data algorithm), exact to rounding for the small variances of
 //   rest windows, with no storage beyond a few sums; what a microcontroller
-//   runs.
+//   runs. Each sum is kept in four lanes by the sample's position in the
+//   window (position mod 4) and the lanes are added as (0 + 1) + (2 + 3) when
+//   the window closes, so that whole windows can be summed two samples per
+//   instruction (SSE2) with the same result as sample by sample.
 // - R-compatible (use_r_arithmetic()): the numbers GGIR gets in R, to the
 //   last bit, so that GGIR's exact-equality rules (its duplicate-window
 //   filter) and thresholds decide the same way. Means are differences of a
@@ -36,6 +39,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+// GRAVCAL_NO_SIMD: the portable loop only (the results are the same bits)
+#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
+#define GRAVCAL_SSE2 1
+#include <emmintrin.h>
+#endif
 
 #if defined(__GNUC__)
 #define GRAVCAL_NOINLINE __attribute__((noinline))
@@ -179,10 +187,10 @@ class Segmenter {
     RScan r;
     if (rbuf_ == nullptr) {
       scan_stream(x, y, z, t, m, a);
-      if ((skip_zero_ && a.zero) ||
-          !std::isfinite(a.s[0] + a.s[1] + a.s[2] + a.q[0] + a.q[1] + a.q[2] +
-                         a.nrm) ||
-          (t != nullptr && !std::isfinite(a.st))) {
+      double all = lanes(a.nrm);
+      for (int k = 0; k < 3; ++k) all += lanes(a.s[k]) + lanes(a.q[k]);
+      if ((skip_zero_ && a.zero) || !std::isfinite(all) ||
+          (t != nullptr && !std::isfinite(lanes(a.st)))) {
         return false;
       }
     } else {
@@ -197,13 +205,12 @@ class Segmenter {
         return false;
       }
       for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
+      a = StreamScan();  // sums replaced by close_r()
       for (int k = 0; k < 3; ++k) {
         wsum_[k] = r.w[k];
-        a.s[k] = a.q[k] = 0.0;  // replaced by close_r()
         a.lo[k] = r.lo[k];
         a.hi[k] = r.hi[k];
       }
-      a.nrm = a.st = 0.0;
     }
     first_ = seen_;
     seen_ += static_cast<std::int64_t>(m);
@@ -215,13 +222,17 @@ class Segmenter {
     shift_[1] = h1;
     shift_[2] = h2;
     for (int k = 0; k < 3; ++k) {
-      sum_[k] = a.s[k];
-      sumsq_[k] = a.q[k];
+      for (int l = 0; l < 4; ++l) {
+        sum_[k][l] = a.s[k][l];
+        sumsq_[k][l] = a.q[k][l];
+      }
       min_[k] = a.lo[k];
       max_[k] = a.hi[k];
     }
-    sum_norm_ = a.nrm;
-    sum_temp_ = a.st;
+    for (int l = 0; l < 4; ++l) {
+      sum_norm_[l] = a.nrm[l];
+      sum_temp_[l] = a.st[l];
+    }
     const double* cols[3] = {x, y, z};
     WindowStats s;
     close(s, cols);
@@ -232,8 +243,9 @@ class Segmenter {
   // The one-pass loops of whole_window(), kept out of line so that their
   // code does not depend on the caller's.
   struct StreamScan {
-    double s[3], q[3], lo[3], hi[3], nrm, st;
-    bool zero;
+    double s[3][4] = {}, q[3][4] = {}, lo[3] = {}, hi[3] = {}, nrm[4] = {},
+           st[4] = {};
+    bool zero = false;
   };
   struct RScan {
     long double c[5], w[3];
@@ -241,50 +253,120 @@ class Segmenter {
     bool zero;
   };
 
-  // Streaming sums about the first sample (add()'s arithmetic, same order).
+  // Streaming sums about the first sample, in lanes by position (add()'s
+  // arithmetic): with SSE2, lanes 0 and 1 in one register and 2 and 3 in
+  // another; otherwise one lane at a time. Either way every lane adds its
+  // own samples in order, so the results are the same bits.
   GRAVCAL_NOINLINE static void scan_stream(const double* x, const double* y,
                                            const double* z, const double* t,
                                            std::size_t m, StreamScan& o) {
-    const double h0 = x[0], h1 = y[0], h2 = z[0];
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, q0 = 0.0, q1 = 0.0, q2 = 0.0;
-    double lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
-    double nrm = 0.0, st = 0.0;
+    const double h[3] = {x[0], y[0], z[0]};
+    const double* col[3] = {x, y, z};
+    std::size_t k = 0;
+    double lo[3] = {h[0], h[1], h[2]}, hi[3] = {h[0], h[1], h[2]};
     bool zero = false;
-    for (std::size_t k = 0; k < m; ++k) {
+#if defined(GRAVCAL_SSE2)
+    {
+      // named registers, not arrays, so that all of them stay in registers;
+      // suffix a: lanes 0 and 1 (samples k, k + 1), b: lanes 2 and 3
+      const __m128d zr = _mm_setzero_pd();
+      const __m128d h0 = _mm_set1_pd(h[0]), h1 = _mm_set1_pd(h[1]),
+                    h2 = _mm_set1_pd(h[2]);
+      __m128d s0a = zr, s0b = zr, s1a = zr, s1b = zr, s2a = zr, s2b = zr;
+      __m128d q0a = zr, q0b = zr, q1a = zr, q1b = zr, q2a = zr, q2b = zr;
+      __m128d na = zr, nb = zr, ta = zr, tb = zr, zacc = zr;
+      __m128d lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+      for (; k + 4 <= m; k += 4) {
+        const __m128d xa = _mm_loadu_pd(x + k), xb = _mm_loadu_pd(x + k + 2);
+        const __m128d ya = _mm_loadu_pd(y + k), yb = _mm_loadu_pd(y + k + 2);
+        const __m128d za = _mm_loadu_pd(z + k), zb = _mm_loadu_pd(z + k + 2);
+        __m128d d = _mm_sub_pd(xa, h0);
+        s0a = _mm_add_pd(s0a, d);
+        q0a = _mm_add_pd(q0a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(xb, h0);
+        s0b = _mm_add_pd(s0b, d);
+        q0b = _mm_add_pd(q0b, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(ya, h1);
+        s1a = _mm_add_pd(s1a, d);
+        q1a = _mm_add_pd(q1a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(yb, h1);
+        s1b = _mm_add_pd(s1b, d);
+        q1b = _mm_add_pd(q1b, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(za, h2);
+        s2a = _mm_add_pd(s2a, d);
+        q2a = _mm_add_pd(q2a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(zb, h2);
+        s2b = _mm_add_pd(s2b, d);
+        q2b = _mm_add_pd(q2b, _mm_mul_pd(d, d));
+        lo0 = _mm_min_pd(lo0, _mm_min_pd(xa, xb));
+        hi0 = _mm_max_pd(hi0, _mm_max_pd(xa, xb));
+        lo1 = _mm_min_pd(lo1, _mm_min_pd(ya, yb));
+        hi1 = _mm_max_pd(hi1, _mm_max_pd(ya, yb));
+        lo2 = _mm_min_pd(lo2, _mm_min_pd(za, zb));
+        hi2 = _mm_max_pd(hi2, _mm_max_pd(za, zb));
+        na = _mm_add_pd(na, _mm_sqrt_pd(_mm_add_pd(
+                                _mm_add_pd(_mm_mul_pd(xa, xa), _mm_mul_pd(ya, ya)),
+                                _mm_mul_pd(za, za))));
+        nb = _mm_add_pd(nb, _mm_sqrt_pd(_mm_add_pd(
+                                _mm_add_pd(_mm_mul_pd(xb, xb), _mm_mul_pd(yb, yb)),
+                                _mm_mul_pd(zb, zb))));
+        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(xa, zr),
+                                                     _mm_cmpeq_pd(ya, zr)),
+                                          _mm_cmpeq_pd(za, zr)));
+        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(xb, zr),
+                                                     _mm_cmpeq_pd(yb, zr)),
+                                          _mm_cmpeq_pd(zb, zr)));
+        if (t != nullptr) {
+          ta = _mm_add_pd(ta, _mm_loadu_pd(t + k));
+          tb = _mm_add_pd(tb, _mm_loadu_pd(t + k + 2));
+        }
+      }
+      _mm_storeu_pd(o.s[0], s0a);
+      _mm_storeu_pd(o.s[0] + 2, s0b);
+      _mm_storeu_pd(o.s[1], s1a);
+      _mm_storeu_pd(o.s[1] + 2, s1b);
+      _mm_storeu_pd(o.s[2], s2a);
+      _mm_storeu_pd(o.s[2] + 2, s2b);
+      _mm_storeu_pd(o.q[0], q0a);
+      _mm_storeu_pd(o.q[0] + 2, q0b);
+      _mm_storeu_pd(o.q[1], q1a);
+      _mm_storeu_pd(o.q[1] + 2, q1b);
+      _mm_storeu_pd(o.q[2], q2a);
+      _mm_storeu_pd(o.q[2] + 2, q2b);
+      _mm_storeu_pd(o.nrm, na);
+      _mm_storeu_pd(o.nrm + 2, nb);
+      _mm_storeu_pd(o.st, ta);
+      _mm_storeu_pd(o.st + 2, tb);
+      const __m128d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
+      for (int c = 0; c < 3; ++c) {
+        double e[2];
+        _mm_storeu_pd(e, lov[c]);
+        lo[c] = e[0] < e[1] ? e[0] : e[1];
+        _mm_storeu_pd(e, hiv[c]);
+        hi[c] = e[0] > e[1] ? e[0] : e[1];
+      }
+      zero = _mm_movemask_pd(zacc) != 0;
+    }
+#endif
+    for (; k < m; ++k) {
+      const int l = static_cast<int>(k & 3);
       const double xi = x[k], yi = y[k], zi = z[k];
-      zero |= (xi == 0.0) & (yi == 0.0) & (zi == 0.0);
-      const double d0 = xi - h0, d1 = yi - h1, d2 = zi - h2;
-      s0 += d0;
-      s1 += d1;
-      s2 += d2;
-      q0 += d0 * d0;
-      q1 += d1 * d1;
-      q2 += d2 * d2;
-      lo0 = xi < lo0 ? xi : lo0;
-      lo1 = yi < lo1 ? yi : lo1;
-      lo2 = zi < lo2 ? zi : lo2;
-      hi0 = xi > hi0 ? xi : hi0;
-      hi1 = yi > hi1 ? yi : hi1;
-      hi2 = zi > hi2 ? zi : hi2;
-      nrm += std::sqrt(xi * xi + yi * yi + zi * zi);
+      zero = zero || (xi == 0.0 && yi == 0.0 && zi == 0.0);
+      for (int a = 0; a < 3; ++a) {
+        const double v = col[a][k];
+        const double d = v - h[a];
+        o.s[a][l] += d;
+        o.q[a][l] += d * d;
+        lo[a] = v < lo[a] ? v : lo[a];
+        hi[a] = v > hi[a] ? v : hi[a];
+      }
+      o.nrm[l] += std::sqrt(xi * xi + yi * yi + zi * zi);
+      if (t != nullptr) o.st[l] += t[k];
     }
-    if (t != nullptr) {
-      for (std::size_t k = 0; k < m; ++k) st += t[k];
+    for (int a = 0; a < 3; ++a) {
+      o.lo[a] = lo[a];
+      o.hi[a] = hi[a];
     }
-    o.s[0] = s0;
-    o.s[1] = s1;
-    o.s[2] = s2;
-    o.q[0] = q0;
-    o.q[1] = q1;
-    o.q[2] = q2;
-    o.lo[0] = lo0;
-    o.lo[1] = lo1;
-    o.lo[2] = lo2;
-    o.hi[0] = hi0;
-    o.hi[1] = hi1;
-    o.hi[2] = hi2;
-    o.nrm = nrm;
-    o.st = st;
     o.zero = zero;
   }
 
@@ -345,13 +427,17 @@ class Segmenter {
     n_invalid_ = 0;
     n_valid_ = 0;
     n_temp_ = 0;
-    sum_norm_ = 0.0;
-    sum_temp_ = 0.0;
+    for (int l = 0; l < 4; ++l) {
+      sum_norm_[l] = 0.0;
+      sum_temp_[l] = 0.0;
+    }
     first_ = -1;
     for (int a = 0; a < 3; ++a) {
       shift_[a] = 0.0;
-      sum_[a] = 0.0;
-      sumsq_[a] = 0.0;
+      for (int l = 0; l < 4; ++l) {
+        sum_[a][l] = 0.0;
+        sumsq_[a][l] = 0.0;
+      }
       min_[a] = INFINITY;
       max_[a] = -INFINITY;
     }
@@ -360,7 +446,7 @@ class Segmenter {
   void add(double xi, double yi, double zi, double ti) {
     ++n_;
     if (std::isfinite(ti)) {
-      sum_temp_ += ti;
+      sum_temp_[n_temp_ & 3] += ti;
       csum_[4] += ti;
       ++n_temp_;
     }
@@ -381,16 +467,19 @@ class Segmenter {
     if (n_valid_ == 0) {
       for (int a = 0; a < 3; ++a) shift_[a] = v[a];
     }
+    const int lane = static_cast<int>(n_valid_ & 3);
     ++n_valid_;
     for (int a = 0; a < 3; ++a) {
       const double d = v[a] - shift_[a];
-      sum_[a] += d;
-      sumsq_[a] += d * d;
+      sum_[a][lane] += d;
+      sumsq_[a][lane] += d * d;
       if (v[a] < min_[a]) min_[a] = v[a];
       if (v[a] > max_[a]) max_[a] = v[a];
     }
-    sum_norm_ += std::sqrt(xi * xi + yi * yi + zi * zi);
+    sum_norm_[lane] += std::sqrt(xi * xi + yi * yi + zi * zi);
   }
+
+  static double lanes(const double* v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
   // cols: the window's samples per axis (whole_window()), or null for the
   // lent buffer.
@@ -402,7 +491,7 @@ class Segmenter {
     const double nv = static_cast<double>(n_valid_);
     for (int a = 0; a < 3; ++a) {
       if (n_valid_ > 0) {
-        const double m = sum_[a] / nv;
+        const double m = lanes(sum_[a]) / nv;
         s.mean[a] = shift_[a] + m;
         s.min[a] = min_[a];
         s.max[a] = max_[a];
@@ -412,15 +501,17 @@ class Segmenter {
         s.max[a] = NAN;
       }
       if (n_valid_ > 1) {
-        double ss = sumsq_[a] - sum_[a] * sum_[a] / nv;
+        const double sa = lanes(sum_[a]);
+        double ss = lanes(sumsq_[a]) - sa * sa / nv;
         if (ss < 0.0) ss = 0.0;
         s.sd[a] = std::sqrt(ss / (nv - 1.0));
       } else {
         s.sd[a] = NAN;
       }
     }
-    s.mean_norm = n_valid_ > 0 ? sum_norm_ / nv : NAN;
-    s.temperature = n_temp_ > 0 ? sum_temp_ / static_cast<double>(n_temp_) : NAN;
+    s.mean_norm = n_valid_ > 0 ? lanes(sum_norm_) / nv : NAN;
+    s.temperature =
+        n_temp_ > 0 ? lanes(sum_temp_) / static_cast<double>(n_temp_) : NAN;
     if (rbuf_ != nullptr) close_r(s, cols);
     ++window_;
     next_boundary_ = boundary(window_ + 1);
@@ -517,8 +608,8 @@ class Segmenter {
   double cprev_[5];
   std::int64_t window_, retained_, seen_, skipped_zero_, next_boundary_, first_;
   std::int64_t n_, n_invalid_, n_valid_, n_temp_;
-  double shift_[3], sum_[3], sumsq_[3], min_[3], max_[3];
-  double sum_norm_, sum_temp_;
+  double shift_[3], min_[3], max_[3];
+  double sum_[3][4], sumsq_[3][4], sum_norm_[4], sum_temp_[4];  // lanes
 };
 
 // Rest rule of the lightweight method (Farago et al. 2024, Sec. II-B-1):
