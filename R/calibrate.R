@@ -141,9 +141,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                                args$rest_windows))
   rest <- w[w$rest, , drop = FALSE]
   attr(rest, "n_windows") <- nrow(w)
+  hours <- attr(w, "samples") / attr(w, "sf") / 3600
   fail <- function(status, message, points = rest[0, , drop = FALSE]) {
     f <- new_fit(points = points, method = method, status = status,
                  message = message, call = call)
+    f$hours <- hours
+    if (is.character(x)) f$file <- basename(x)
     finish_fit(f, rest)
   }
   if (nrow(w) == 0) {
@@ -177,6 +180,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   fit <- do.call(fit_gradient, c(list(pts = pts), fargs))
   fit$call <- call
   fit <- guard_fit(fit)
+  fit$hours <- hours
+  if (is.character(x)) fit$file <- basename(x)
   finish_fit(fit, rest)
 }
 

@@ -597,5 +597,6 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
   fit$ggir_compat <- compat
   fit$use_temp <- isTRUE(res$use.temp)
   fit$n_windows <- info$windows
+  fit$hours <- info$windows * 10 / 3600
   fit
 }

@@ -4,7 +4,8 @@
 #   1. end to end on a 7-day, 100 Hz recording with temperature held in
 #      memory: GGIR::g.calibrate (fed from memory, see ggir_from_memory()),
 #      gravcal::g.calibrate (GGIR-compatible), calibrate(method = "ggir"),
-#      calibrate(method = "lightweight"); wall time (median of `runs`),
+#      calibrate(method = "lightweight"); wall time (median of 5 runs taken
+#      in turns),
 #      ratio to GGIR, peak memory above the input, and the coefficients
 #      compared;
 #   2. the same from an ActiGraph csv file (a format GGIR reads), reader
@@ -16,7 +17,8 @@
 #      against stats::optim and GGIR's algorithm written as an R loop.
 #
 # Run from the package root with gravcal and GGIR installed:
-#   Rscript bench/speed.R          (about 25 minutes; `make bench-speed`)
+#   Rscript bench/speed.R          (about 30 minutes; `make bench-speed`)
+# The segmenter and the fits are measured first, in a fresh process.
 #   GRAVCAL_BENCH_QUICK=1 Rscript bench/speed.R   (a 2-minute smoke run)
 # Writes bench/results/speed.md and speed.csv.
 #
@@ -159,98 +161,6 @@ coefs <- function(v) {
   }
 }
 
-# --- 1. end to end, in memory ------------------------------------------------
-
-say("input: ", days_main, " days at ", sf, " Hz")
-rec <- recording(days_main)
-input_mb <- as.numeric(utils::object.size(rec)) / 2^20
-res_mem <- list()
-for (nm in names(cs <- contenders_memory(rec))) {
-  say("in memory: ", nm)
-  res_mem[[nm]] <- repeat_measure(cs[[nm]])
-}
-g_ref <- res_mem[["GGIR::g.calibrate"]]$value
-for (nm in names(res_mem)) {
-  r <- res_mem[[nm]]
-  v <- r$value
-  d <- max(abs(coefs(v) - coefs(g_ref)))
-  record(part = "in memory", days = days_main, contender = nm,
-         time_s = r$time, runs = paste(format(r$times, nsmall = 2), collapse = " "),
-         speedup = res_mem[["GGIR::g.calibrate"]]$time / r$time,
-         peak_mb = r$peak_mb, input_mb = input_mb,
-         max_coef_diff = d,
-         identical = if (nm == "gravcal::g.calibrate") identical(v$scale, g_ref$scale) &&
-           identical(v$offset, g_ref$offset) && identical(v$tempoffset, g_ref$tempoffset) else NA)
-}
-rm(res_mem)
-
-# --- 2. from a file (ActiGraph csv, no temperature) ---------------------------
-
-csv <- tempfile(fileext = ".csv")
-say("writing ", csv)
-gravcal:::write_actigraph_csv(rec[, c("x", "y", "z")], csv, sf = sf)
-file_mb <- file.size(csv) / 2^20
-rm(rec)
-pr <- GGIR::load_params()$params_rawdata
-I <- quiet(GGIR::g.inspectfile(csv, params_rawdata = pr))
-cf <- list(
-  "GGIR::g.calibrate" = function() {
-    quiet(GGIR::g.calibrate(csv, params_rawdata = pr, inspectfileobject = I,
-                            verbose = FALSE))
-  },
-  "gravcal::g.calibrate" = function() {
-    quiet(gravcal::g.calibrate(csv, params_rawdata = pr, verbose = FALSE))
-  },
-  "calibrate(method = \"ggir\")" = function() quiet(calibrate(csv, method = "ggir")),
-  "calibrate(method = \"lightweight\")" = function() quiet(calibrate(csv, method = "lightweight")))
-res_file <- list()
-file_runs <- if (quick) 1L else 2L
-for (nm in names(cf)) {
-  say("file: ", nm)
-  res_file[[nm]] <- repeat_measure(cf[[nm]], file_runs)
-}
-g_ref <- res_file[["GGIR::g.calibrate"]]$value
-for (nm in names(res_file)) {
-  r <- res_file[[nm]]
-  record(part = "csv file", days = days_main, contender = nm, time_s = r$time,
-         runs = paste(format(r$times, nsmall = 2), collapse = " "),
-         speedup = res_file[["GGIR::g.calibrate"]]$time / r$time,
-         peak_mb = r$peak_mb, input_mb = file_mb,
-         max_coef_diff = max(abs(coefs(r$value) - coefs(g_ref))),
-         identical = if (nm == "gravcal::g.calibrate") identical(r$value$scale, g_ref$scale) &&
-           identical(r$value$offset, g_ref$offset) else NA)
-}
-unlink(csv)
-rm(res_file)
-
-# --- 3. scaling ------------------------------------------------------------------
-
-# Default parameters: GGIR (and the compatible mode) stop reading once more
-# than minloadcrit = 168 hours calibrate well. "whole recording" rows raise
-# minloadcrit above the recording's length, so that every sample is used.
-for (days in days_scaling) {
-  rec <- recording(days)
-  input_mb <- as.numeric(utils::object.size(rec)) / 2^20
-  cs <- contenders_memory(rec)
-  cs[["calibrate(method = \"ggir\"), whole recording"]] <- function() {
-    quiet(calibrate(rec, sf = sf, method = "ggir", minloadcrit = 24 * days + 1))
-  }
-  for (nm in names(cs)) {
-    say("scaling: ", days, " days: ", nm)
-    n <- if (grepl("^GGIR", nm)) 1L else runs
-    r <- tryCatch(repeat_measure(cs[[nm]], n),
-                  error = function(e) list(time = NA_real_, times = NA_real_,
-                                           peak_mb = NA_real_,
-                                           value = conditionMessage(e)))
-    record(part = "scaling", days = days, contender = nm, time_s = r$time,
-           runs = paste(format(r$times, nsmall = 2), collapse = " "),
-           speedup = NA_real_, peak_mb = r$peak_mb, input_mb = input_mb,
-           max_coef_diff = NA_real_,
-           identical = if (is.character(r$value)) r$value else NA)
-  }
-  rm(rec, cs)
-}
-
 # --- 4. segmenter against the read-once floor ------------------------------------
 
 rec <- recording(days_main)
@@ -357,6 +267,111 @@ for (nm in names(res_fit)) {
          identical = NA)
 }
 
+# --- 1. end to end, in memory ------------------------------------------------
+
+say("input: ", days_main, " days at ", sf, " Hz")
+rec <- recording(days_main)
+input_mb <- as.numeric(utils::object.size(rec)) / 2^20
+# the contenders take turns, run after run, so that a slow spell of the
+# machine does not fall on one of them only
+cs <- contenders_memory(rec)
+runs_main <- if (quick) 1L else 5L
+meas <- list()
+for (k in seq_len(runs_main)) {
+  for (nm in names(cs)) {
+    say("in memory, run ", k, ": ", nm)
+    meas[[nm]][[k]] <- measure(cs[[nm]])
+  }
+}
+res_mem <- lapply(meas, function(m) {
+  list(time = stats::median(vapply(m, `[[`, 0, "time")),
+       times = vapply(m, `[[`, 0, "time"),
+       peak_mb = max(vapply(m, `[[`, 0, "peak_mb")),
+       value = m[[length(m)]]$value)
+})
+rm(meas)
+g_ref <- res_mem[["GGIR::g.calibrate"]]$value
+for (nm in names(res_mem)) {
+  r <- res_mem[[nm]]
+  v <- r$value
+  d <- max(abs(coefs(v) - coefs(g_ref)))
+  record(part = "in memory", days = days_main, contender = nm,
+         time_s = r$time, runs = paste(format(r$times, nsmall = 2), collapse = " "),
+         speedup = res_mem[["GGIR::g.calibrate"]]$time / r$time,
+         peak_mb = r$peak_mb, input_mb = input_mb,
+         max_coef_diff = d,
+         identical = if (nm == "gravcal::g.calibrate") identical(v$scale, g_ref$scale) &&
+           identical(v$offset, g_ref$offset) && identical(v$tempoffset, g_ref$tempoffset) else NA)
+}
+rm(res_mem)
+
+# --- 2. from a file (ActiGraph csv, no temperature) ---------------------------
+
+csv <- tempfile(fileext = ".csv")
+say("writing ", csv)
+gravcal:::write_actigraph_csv(rec[, c("x", "y", "z")], csv, sf = sf)
+file_mb <- file.size(csv) / 2^20
+rm(rec)
+pr <- GGIR::load_params()$params_rawdata
+I <- quiet(GGIR::g.inspectfile(csv, params_rawdata = pr))
+cf <- list(
+  "GGIR::g.calibrate" = function() {
+    quiet(GGIR::g.calibrate(csv, params_rawdata = pr, inspectfileobject = I,
+                            verbose = FALSE))
+  },
+  "gravcal::g.calibrate" = function() {
+    quiet(gravcal::g.calibrate(csv, params_rawdata = pr, verbose = FALSE))
+  },
+  "calibrate(method = \"ggir\")" = function() quiet(calibrate(csv, method = "ggir")),
+  "calibrate(method = \"lightweight\")" = function() quiet(calibrate(csv, method = "lightweight")))
+res_file <- list()
+file_runs <- if (quick) 1L else 2L
+for (nm in names(cf)) {
+  say("file: ", nm)
+  res_file[[nm]] <- repeat_measure(cf[[nm]], file_runs)
+}
+g_ref <- res_file[["GGIR::g.calibrate"]]$value
+for (nm in names(res_file)) {
+  r <- res_file[[nm]]
+  record(part = "csv file", days = days_main, contender = nm, time_s = r$time,
+         runs = paste(format(r$times, nsmall = 2), collapse = " "),
+         speedup = res_file[["GGIR::g.calibrate"]]$time / r$time,
+         peak_mb = r$peak_mb, input_mb = file_mb,
+         max_coef_diff = max(abs(coefs(r$value) - coefs(g_ref))),
+         identical = if (nm == "gravcal::g.calibrate") identical(r$value$scale, g_ref$scale) &&
+           identical(r$value$offset, g_ref$offset) else NA)
+}
+unlink(csv)
+rm(res_file)
+
+# --- 3. scaling ------------------------------------------------------------------
+
+# Default parameters: GGIR (and the compatible mode) stop reading once more
+# than minloadcrit = 168 hours calibrate well. "whole recording" rows raise
+# minloadcrit above the recording's length, so that every sample is used.
+for (days in days_scaling) {
+  rec <- recording(days)
+  input_mb <- as.numeric(utils::object.size(rec)) / 2^20
+  cs <- contenders_memory(rec)
+  cs[["calibrate(method = \"ggir\"), whole recording"]] <- function() {
+    quiet(calibrate(rec, sf = sf, method = "ggir", minloadcrit = 24 * days + 1))
+  }
+  for (nm in names(cs)) {
+    say("scaling: ", days, " days: ", nm)
+    n <- if (grepl("^GGIR", nm)) 1L else runs
+    r <- tryCatch(repeat_measure(cs[[nm]], n),
+                  error = function(e) list(time = NA_real_, times = NA_real_,
+                                           peak_mb = NA_real_,
+                                           value = conditionMessage(e)))
+    record(part = "scaling", days = days, contender = nm, time_s = r$time,
+           runs = paste(format(r$times, nsmall = 2), collapse = " "),
+           speedup = NA_real_, peak_mb = r$peak_mb, input_mb = input_mb,
+           max_coef_diff = NA_real_,
+           identical = if (is.character(r$value)) r$value else NA)
+  }
+  rm(rec, cs)
+}
+
 # --- results -------------------------------------------------------------------
 
 tab <- do.call(rbind, rows)
@@ -385,9 +400,11 @@ part_table <- function(part, header, cols) {
 }
 md <- c(md, part_table("in memory", sprintf(paste0(
   "## 1. End to end, %g days at %d Hz with temperature, in memory (%.0f MB)\n\n",
-  "Median of %d runs. Peak: resident memory above the input during the call. ",
-  "Coefficient difference: largest |difference| from GGIR's scale and offset."),
-  days_main, sf, tab$input_mb[tab$part == "in memory"][1], runs), list(
+  "Median of %d runs, the contenders taking turns. Peak: resident memory ",
+  "above the input during the call. Coefficient difference: largest ",
+  "|difference| from GGIR's scale and offset; identical: `identical()` on ",
+  "scale, offset and tempoffset."),
+  days_main, sf, tab$input_mb[tab$part == "in memory"][1], runs_main), list(
     contender = function(r) r$contender, "time (s)" = function(r) fmt(r$time_s),
     "x faster than GGIR" = function(r) fmt(r$speedup, 1),
     "peak (MB)" = function(r) fmt(r$peak_mb, 0),

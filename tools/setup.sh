@@ -7,7 +7,8 @@ set -euo pipefail
 cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
 deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
-r-cran-rmarkdown r-cran-data.table pandoc qpdf tidy"
+r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
+r-cran-progressr pandoc qpdf tidy"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""
@@ -27,7 +28,7 @@ fi
 Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
 need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
-          "tibble", "data.table")
+          "tibble", "data.table", "future", "future.apply", "progressr")
 have <- rownames(installed.packages())
 miss <- setdiff(need, have)
 if (length(miss)) {

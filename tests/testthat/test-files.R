@@ -1,0 +1,123 @@
+# calibrate_files(): a folder of recordings in two formats, sequential and in
+# parallel, a corrupt file, resumption after a killed run; cli().
+
+cohort_dir <- function() {
+  dir <- tempfile("cohort")
+  dir.create(dir)
+  p <- c(k_xx = 1.02, k_yy = 0.98, k_zz = 1.01, k_xy = 0, k_xz = 0, k_yz = 0,
+         o_x = 0.03, o_y = -0.02, o_z = 0.015)
+  for (i in 1:2) {
+    rec <- simulate_recording(hours = 26, sf = 10, seed = 100 + i, params = p)
+    utils::write.csv(rec, file.path(dir, sprintf("p%02d.csv", i)), row.names = FALSE)
+  }
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 103, params = p,
+                            temperature = FALSE)
+  gravcal:::write_actigraph_csv(rec, file.path(dir, "p03_actigraph.csv"), sf = 10)
+  saveRDS(simulate_recording(hours = 26, sf = 10, seed = 104, params = p),
+          file.path(dir, "p04.rds"))
+  writeLines(c("x,y,z", "a,b,c", "1,2"), file.path(dir, "p05_corrupt.csv"))
+  dir
+}
+
+test_that("calibrate_files() calibrates a folder, one row per recording", {
+  dir <- cohort_dir()
+  on.exit(unlink(dir, recursive = TRUE))
+  out <- file.path(dir, "out")
+  tab <- calibrate_files(dir, outdir = out, sf = 10)
+  expect_identical(tab$file, c("p01.csv", "p02.csv", "p03_actigraph.csv",
+                               "p04.rds", "p05_corrupt.csv"))
+  # each row is calibrate() on that file
+  for (i in 1:4) {
+    f <- calibrate(file.path(dir, tab$file[i]), sf = 10, method = "ggir")
+    expect_equal(unname(unlist(tab[i, c(param_names(), "t_x", "t_y", "t_z")])),
+                 unname(coef(f)), tolerance = 0, label = tab$file[i])
+    expect_identical(tab$status[i], f$status)
+  }
+  expect_identical(tab$status[5], "failed")
+  expect_match(tab$error[5], "numeric|column|corrupt", ignore.case = TRUE)
+  expect_true(all(tab$error[1:4] == ""))
+  expect_true(all(tab$error_after_mg[1:4] < tab$error_before_mg[1:4]))
+  expect_equal(tab$hours[1], 26, tolerance = 0.01)
+  # files written: the table and GGIR's coefficient file, nothing half-done
+  written <- utils::read.csv(file.path(out, "calibration.csv"), stringsAsFactors = FALSE)
+  expect_identical(written$file, tab$file)
+  expect_equal(written$o_x, tab$o_x)
+  coefs <- utils::read.csv(file.path(out, "calibration_ggir_coefs.csv"))
+  expect_identical(sort(coefs$filename), sort(tab$file[tab$status %in% c("ok", "high_error")]))
+  expect_length(list.files(out, pattern = "tmp$", recursive = TRUE, all.files = TRUE), 0)
+  # the lightweight method too
+  tl <- calibrate_files(file.path(dir, c("p01.csv", "p04.rds")),
+                        method = "lightweight", outdir = out, sf = 10)
+  expect_identical(unname(unlist(tl[1, param_names()])),
+                   unname(coef(calibrate(file.path(dir, "p01.csv"), sf = 10))[1:9]))
+  expect_false(file.exists(file.path(out, "calibration_lightweight.csv")))
+})
+
+test_that("in parallel (multisession, 2 workers) the table is the same", {
+  skip_if_not_installed("future")
+  skip_if_not_installed("future.apply")
+  skip_on_os("windows")
+  dir <- cohort_dir()
+  on.exit(unlink(dir, recursive = TRUE))
+  seq_tab <- calibrate_files(dir, outdir = file.path(dir, "seq"), sf = 10)
+  old <- future::plan(future::multisession, workers = 2)
+  on.exit(future::plan(old), add = TRUE)
+  par_tab <- calibrate_files(dir, outdir = file.path(dir, "par"), sf = 10)
+  drop <- c("seconds")
+  expect_identical(par_tab[setdiff(names(par_tab), drop)],
+                   seq_tab[setdiff(names(seq_tab), drop)])
+})
+
+test_that("an interrupted run resumes without redoing finished recordings", {
+  skip_on_os("windows")  # fork
+  dir <- cohort_dir()
+  on.exit(unlink(dir, recursive = TRUE))
+  out <- file.path(dir, "out")
+  full <- calibrate_files(dir, outdir = file.path(dir, "full"), sf = 10)
+  # a run killed after its first recordings: a forked R process, killed
+  # as soon as two results are saved
+  job <- parallel::mcparallel(calibrate_files(dir, outdir = out, sf = 10),
+                              silent = TRUE)
+  store <- file.path(out, ".gravcal")
+  t0 <- Sys.time()
+  while (length(list.files(store, pattern = "rds$")) < 2 &&
+         difftime(Sys.time(), t0, units = "secs") < 120) Sys.sleep(0.05)
+  tools::pskill(job$pid, tools::SIGKILL)
+  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
+  saved <- list.files(store, pattern = "rds$", full.names = TRUE)
+  expect_gte(length(saved), 2)
+  expect_lt(length(saved), 5)  # stopped before the end
+  stamp <- file.mtime(saved)
+  tab <- calibrate_files(dir, outdir = out, sf = 10)
+  # finished recordings were not redone, and the table is the same
+  expect_identical(file.mtime(saved), stamp)
+  expect_identical(tab[setdiff(names(tab), "seconds")],
+                   full[setdiff(names(full), "seconds")])
+  expect_length(list.files(out, pattern = "tmp$", recursive = TRUE, all.files = TRUE), 0)
+})
+
+test_that("calibrate_files() and cli() reject bad input clearly", {
+  expect_error(calibrate_files(character(0), outdir = tempdir()), "`files`")
+  expect_error(calibrate_files(tempfile(), outdir = tempdir()), "do not exist")
+  d <- tempfile("empty")
+  dir.create(d)
+  expect_error(calibrate_files(d, outdir = tempdir()), "no recordings")
+  expect_error(calibrate_files(gravcal_example()), "`outdir`")
+  expect_error(calibrate_files(gravcal_example(), "ggir", tempdir(), 3), "named")
+  expect_output(cli("--help"), "Usage")
+  expect_error(cli(c("--out")), "needs a value")
+  expect_error(cli(c("--bogus", "x")), "unknown option")
+  expect_error(cli(c("--out", tempdir())), "no recordings")
+  expect_error(cli(c("--out", tempdir(), "--method", "x", gravcal_example())), "ggir or lightweight")
+})
+
+test_that("cli() calibrates files given on the command line", {
+  dir <- cohort_dir()
+  on.exit(unlink(dir, recursive = TRUE))
+  out <- file.path(dir, "cli")
+  expect_message(tab <- cli(c("--", "--method", "lightweight", "--sf", "10", "--out", out,
+                              file.path(dir, "p01.csv"), file.path(dir, "p05_corrupt.csv"))),
+                 "1 calibrated, 0 not calibrated, 1 failed")
+  expect_identical(tab$file, c("p01.csv", "p05_corrupt.csv"))
+  expect_true(file.exists(file.path(out, "calibration.csv")))
+})
