@@ -35,7 +35,7 @@
 #' @return A data frame, one row per recording, in the order of `files`:
 #'   `file`, `format`, `hours` (of samples read), `windows`, `rest_windows`,
 #'   `status` (see [calibrate()]), `k_xx` ... `o_z` (the model's nine
-#'   parameters, see [coef.gravcal_fit()]), `t_x`, `t_y`, `t_z`
+#'   parameters, as `coef()` of a fit gives them), `t_x`, `t_y`, `t_z`
 #'   (temperature terms), `meantemp`, `error_before_mg`, `error_after_mg`
 #'   (on the rest points used), `seconds` (time taken) and `error` (why a
 #'   recording failed, else empty). The fits are in `attr(, "fits")`.
@@ -45,10 +45,11 @@
 #' dir <- tempfile("cohort")
 #' dir.create(dir)
 #' for (i in 1:2) {
-#'   rec <- simulate_recording(hours = 26, sf = 10, seed = i)
-#'   write.csv(rec, file.path(dir, sprintf("p%02d.csv", i)), row.names = FALSE)
+#'   rec <- simulate_recording(hours = 12, sf = 10, seed = i)
+#'   saveRDS(rec, file.path(dir, sprintf("p%02d.rds", i)))
 #' }
-#' res <- calibrate_files(dir, outdir = file.path(dir, "out"))
+#' res <- calibrate_files(dir, method = "lightweight",
+#'                        outdir = file.path(dir, "out"))
 #' res[, c("file", "status", "error_before_mg", "error_after_mg")]
 #' list.files(file.path(dir, "out"))
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
@@ -158,7 +159,7 @@ calibrate_one <- function(file, method, args) {
 }
 
 cohort_row <- function(file, fit, err, seconds) {
-  cf <- if (is.null(fit)) rep(NA_real_, 12) else unname(coef(fit))
+  cf <- if (is.null(fit)) rep(NA_real_, 12) else unname(stats::coef(fit))
   names(cf) <- c(param_names(), "t_x", "t_y", "t_z")
   format <- tryCatch(open_source_format(file), error = function(e) NA_character_)
   data.frame(
