@@ -8,7 +8,12 @@
 #' * `.csv`, `.csv.gz`: a header line with columns `x`, `y`, `z` and
 #'   optionally `time` and `temperature`; `sf` from `time` or the argument;
 #' * `.gt3x`: ActiGraph, through the read.gt3x package (a Suggests package);
-#'   idle-sleep gaps come back as zeros, which [rest_windows()] skips.
+#'   idle-sleep gaps come back as zeros, which [rest_windows()] skips;
+#' * `.cwa` (Axivity) and `.bin` (GENEActiv), through the GGIRread package
+#'   (a Suggests package), with their temperature.
+#'
+#' To calibrate a long recording, give its path to [calibrate()] or
+#' [rest_windows()] instead: they read it block by block, in bounded memory.
 #'
 #' @param file Path of the file.
 #' @param sf Sampling frequency in Hz, when the file does not give it.
@@ -29,8 +34,9 @@ read_recording <- function(file, sf = NULL) {
     rds = readRDS(file),
     csv = , "csv.gz" = utils::read.csv(file, stringsAsFactors = FALSE),
     gt3x = read_gt3x_file(file),
+    cwa = , bin = read_blocks(file),
     abort("`file` has an unsupported extension \".", ext, "\"; gravcal ",
-          "reads .rds, .csv, .csv.gz and .gt3x."))
+          "reads .rds, .csv, .csv.gz, .gt3x, .cwa and .bin."))
   if (!is.data.frame(data)) {
     abort("`file` does not hold a data frame of samples: \"", file, "\".")
   }
@@ -45,6 +51,25 @@ read_recording <- function(file, sf = NULL) {
   }
   check_sf(sf)
   list(data = data, sf = sf)
+}
+
+# A whole .cwa or .bin file, from its blocks.
+read_blocks <- function(file) {
+  src <- open_source(file, arg = "file")
+  parts <- list()
+  i <- 1
+  repeat {
+    b <- src$read(i)
+    if (is.null(b)) break
+    parts[[i]] <- b$data
+    if (isTRUE(b$last)) break
+    i <- i + 1
+  }
+  if (!length(parts)) abort("`file` holds no samples: \"", file, "\".")
+  out <- do.call(rbind, parts)
+  rownames(out) <- NULL
+  attr(out, "sf") <- src$sf
+  out
 }
 
 read_gt3x_file <- function(file) {
@@ -243,6 +268,8 @@ source_cwa <- function(file, chunksize) {
                                              progressBar = FALSE, frequency_tol = 0.1),
                        error = function(e) NULL)
          if (is.null(P) || is.null(P$data) || !nrow(P$data)) return(NULL)
+         # GGIRread calls the temperature "temp" (GGIR renames it too)
+         names(P$data)[names(P$data) == "temp"] <- "temperature"
          d <- P$data[, intersect(c("x", "y", "z", "temperature"), names(P$data))]
          list(data = d, last = FALSE)
        })

@@ -22,6 +22,24 @@ struct WindowTable {
   std::vector<double> index;
   std::vector<int> rest;
 
+  // room for about `windows` windows, so that the vectors are allocated
+  // once rather than grown
+  void reserve(std::size_t windows) {
+    start.reserve(windows);
+    for (int a = 0; a < 3; ++a) {
+      mean[a].reserve(windows);
+      sd[a].reserve(windows);
+      min[a].reserve(windows);
+      max[a].reserve(windows);
+    }
+    norm.reserve(windows);
+    temp.reserve(windows);
+    n.reserve(windows);
+    n_invalid.reserve(windows);
+    index.reserve(windows);
+    rest.reserve(windows);
+  }
+
   void add(const WindowStats& s, bool is_rest) {
     index.push_back(static_cast<double>(s.index));
     start.push_back(static_cast<double>(s.first));
@@ -66,7 +84,9 @@ struct WindowTable {
 // A segmenter together with the window buffer it borrows in R-compatible
 // arithmetic (the core allocates nothing itself).
 struct SegmenterBox {
-  SegmenterBox(double L, bool skip_zero) : seg(L, skip_zero) {}
+  SegmenterBox(double samples_per_window, bool skip_zero)
+      : L(samples_per_window), seg(samples_per_window, skip_zero) {}
+  double L;
   std::vector<double> buffer;
   Segmenter seg;
 };
@@ -130,6 +150,7 @@ Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
   sd_rule.max_abs_mean = par[1];
 
   WindowTable out;
+  out.reserve(static_cast<std::size_t>(static_cast<double>(len) / box->L) + 2);
   s->push(x.begin() + i0, y.begin() + i0, z.begin() + i0,
           t ? t + i0 : nullptr, len, [&](const WindowStats& w) {
             const bool r = rule == 0 ? gravcal::is_rest(w, range_rule)

@@ -297,3 +297,13 @@ test_that("bad input: clear errors or GGIR's QC outcome, never a crash", {
   r4$x[1000:5000] <- NA
   expect_type(g.calibrate(r4, sf = 10, verbose = FALSE)$QCmessage, "character")
 })
+
+test_that("g.calibrate matches GGIR on the devices' own files (cwa, bin)", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  for (f in c(system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread"),
+              system.file("testfiles", "GENEActiv_testfile.bin", package = "GGIRread"))) {
+    b <- run_both(f)
+    expect_same_as_ggir(b)
+  }
+})
