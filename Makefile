@@ -4,7 +4,7 @@
 #               then the standalone C++ core tests
 R ?= R
 RSCRIPT ?= Rscript
-BUILD := build
+BUILD := _build
 LIB := $(BUILD)/lib
 SHARED_DATA ?= $(abspath ../shared/data)
 VERSION := $(shell sed -n 's/^Version: *//p' DESCRIPTION)
