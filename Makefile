@@ -47,7 +47,7 @@ document:
 bench: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/table2.R
 
-# speed and memory against GGIR (about 25 minutes; results in bench/results)
+# speed and memory against GGIR (about 30 minutes; results in bench/results)
 bench-speed: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/speed.R
 
