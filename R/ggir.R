@@ -406,7 +406,7 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
 #' The returned numbers are GGIR's to the last bit (the window statistics
 #' are computed in R's arithmetic, the fit with R's own least-squares
 #' routine); the work is one pass over the samples in C++, without copying
-#' them, so a week at 100 Hz held in memory takes about a second, some 70
+#' them, so a week at 100 Hz held in memory takes about a second, some 55
 #' times less than GGIR, and needs little memory beyond the input (the
 #' window table and at most an hour of samples carried between blocks);
 #' from a file, one block at a time. Figures: `bench/results/speed.md` in
