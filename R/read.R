@@ -200,17 +200,26 @@ source_csv <- function(file, sf, chunksize) {
     if (is.na(suppressWarnings(as.numeric(first)))) skip0 <- 11L
   }
   B <- ggir_rows_per_block(sf, chunksize)
+  # with a time stamp column first, x, y, z are columns 2 to 4; the time
+  # stamps are not read at all (as strings they would take more memory than
+  # the samples)
+  data_line <- head[skip0 + 1]
+  fields <- if (is.na(data_line)) 3L else length(strsplit(data_line, ",")[[1]])
+  cols <- if (fields > 3) 2:4 else 1:3
   read_rows <- function(skip, nrows) {
     d <- tryCatch({
       if (requireNamespace("data.table", quietly = TRUE)) {
         data.table::fread(file, skip = skip, nrows = nrows, header = FALSE,
-                          showProgress = FALSE, data.table = FALSE)
+                          select = cols, showProgress = FALSE,
+                          data.table = FALSE)
       } else {
-        utils::read.csv(file, skip = skip, nrows = nrows, header = FALSE)
+        cc <- rep("NULL", fields)
+        cc[cols] <- NA
+        utils::read.csv(file, skip = skip, nrows = nrows, header = FALSE,
+                        colClasses = cc)
       }
     }, error = function(e) NULL)
     if (is.null(d) || !nrow(d) || ncol(d) < 3) return(NULL)
-    if (ncol(d) > 3) d <- d[, 2:4]
     names(d) <- c("x", "y", "z")
     for (v in c("x", "y", "z")) {
       if (!is.numeric(d[[v]])) abort("Corrupt file \"", file, "\": column ", v, " is not numeric.")
@@ -232,7 +241,14 @@ source_gt3x <- function(file, chunksize) {
   hdr <- tryCatch(read.gt3x::parse_gt3x_info(file),
                   error = function(e) abort("Corrupt .gt3x file \"", file, "\": ", conditionMessage(e)))
   sf <- as.numeric(hdr[["Sample Rate"]])
+  # read.gt3x counts batches in seconds of stored data: idle-sleep periods,
+  # which the device does not store, are skipped, and batches come without
+  # the zeros that a whole read (imputeZeroes = TRUE) puts there. Put them
+  # back from the time stamps, so that a streamed file has the same samples
+  # at the same positions as the file read whole.
   B <- (12 * 3600) * chunksize
+  t0 <- NULL
+  next_i <- 0
   list(format = "gt3x", sf = sf, temperature = FALSE,
        read = function(i) {
          from <- B * (i - 1) + 1
@@ -241,7 +257,16 @@ source_gt3x <- function(file, chunksize) {
                                             asDataFrame = TRUE, verbose = FALSE),
                        error = function(e) NULL)
          if (is.null(d) || !nrow(d)) return(NULL)
-         out <- data.frame(x = as.numeric(d$X), y = as.numeric(d$Y), z = as.numeric(d$Z))
+         t <- as.numeric(d$time)
+         if (is.null(t0)) t0 <<- t[1]
+         pos <- round((t - t0) * sf) - next_i
+         keep <- pos >= 0 & !duplicated(pos)
+         n <- max(pos[keep]) + 1
+         out <- data.frame(x = numeric(n), y = numeric(n), z = numeric(n))
+         out$x[pos[keep] + 1] <- as.numeric(d$X[keep])
+         out$y[pos[keep] + 1] <- as.numeric(d$Y[keep])
+         out$z[pos[keep] + 1] <- as.numeric(d$Z[keep])
+         next_i <<- next_i + n
          list(data = out, last = FALSE)
        })
 }
@@ -297,8 +322,10 @@ source_geneactiv <- function(file, chunksize) {
 
 # Write raw samples as an ActiGraph csv export (ActiLife layout: 10 header
 # lines, a column-name line, then x, y, z in g). Used by the tests to hand
-# the same samples to GGIR and to gravcal.
-write_actigraph_csv <- function(x, file, sf, start = "2023-05-11 09:00:00") {
+# the same samples to GGIR and to gravcal. `timestamps = TRUE` adds ActiLife's
+# time stamp column (M/d/yyyy HH:MM:SS.fff) before x, y, z.
+write_actigraph_csv <- function(x, file, sf, start = "2023-05-11 09:00:00",
+                                timestamps = FALSE) {
   s <- as_samples(x)
   t0 <- as.POSIXct(start, tz = "UTC")
   t1 <- t0 + s$n / sf
@@ -315,14 +342,94 @@ write_actigraph_csv <- function(x, file, sf, start = "2023-05-11 09:00:00") {
     "Current Memory Address: 0",
     "Current Battery Voltage: 4.20     Mode = 12",
     "--------------------------------------------------",
-    "Accelerometer X,Accelerometer Y,Accelerometer Z")
+    paste0(if (timestamps) "Timestamp,", "Accelerometer X,Accelerometer Y,Accelerometer Z"))
   writeLines(hdr, file)
   d <- data.frame(x = s$x, y = s$y, z = s$z)
+  if (timestamps) {
+    t <- t0 + (seq_len(s$n) - 1) / sf
+    ms <- round((as.numeric(t) %% 1) * 1000)
+    stamp <- paste0(as.integer(format(t, "%m")), "/", as.integer(format(t, "%d")),
+                    format(t - ms / 1000, "/%Y %H:%M:%S"), sprintf(".%03d", ms))
+    d <- cbind(timestamp = stamp, d)
+  }
   if (requireNamespace("data.table", quietly = TRUE)) {
     data.table::fwrite(d, file, append = TRUE, col.names = FALSE)
   } else {
     utils::write.table(d, file, append = TRUE, sep = ",", row.names = FALSE,
                        col.names = FALSE)
+  }
+  invisible(file)
+}
+
+# Write raw samples as a GENEActiv .bin file (the device's text format: a
+# header, then pages of 300 samples, each page with its own header lines and
+# one line of 12 hex digits per sample: x, y, z as 12-bit two's complement
+# counts, then 10 bits of light and 2 status bits). Counts are
+# round((g * gain + offset) / 100), GENEActiv's calibration in reverse, and
+# clip at the 12-bit range (about +-8 g). A last part-page is left out.
+# Temperature, where given, is written per page (its mean, 0.1 degree).
+# Used by the tests and benchmarks to give gravcal and GGIR a device file.
+write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
+                                gain = c(25600, 25600, 25600),
+                                offset = c(0, 0, 0), pages_per_write = 2000) {
+  s <- as_samples(x)
+  pages <- s$n %/% 300
+  if (pages < 1) abort("`x` has fewer than 300 samples, one GENEActiv page.")
+  t0 <- as.POSIXct(start, tz = "UTC")
+  stamp <- function(t) {
+    ms <- round((as.numeric(t) %% 1) * 1000)
+    paste0(format(t - (ms / 1000), "%Y-%m-%d %H:%M:%S"), ":", sprintf("%03d", ms))
+  }
+  hz <- format(sf)
+  hdr <- c("Device Identity", "Device Unique Serial Code:000000",
+    "Device Type:GENEActiv", "Device Model:1.1",
+    "Device Firmware Version:Ver1.30 date 05Aug11",
+    paste0("Calibration Date:", stamp(t0)), "",
+    "Device Capabilities", "Accelerometer Range:-8 to 8",
+    "Accelerometer Resolution:0.0039", "Accelerometer Units:g",
+    "Light Meter Range:0 to 5000", "Light Meter Resolution:5",
+    "Light Meter Units:lux", "Temperature Sensor Range:0 to 70",
+    "Temperature Sensor Resolution:0.1", "Temperature Sensor Units:deg. C", "",
+    "Configuration Info", paste0("Measurement Frequency:", hz, " Hz"),
+    paste0("Measurement Period:", ceiling(pages * 300 / sf / 3600), " Hours"),
+    paste0("Start Time:", stamp(t0)), "Time Zone:GMT +00:00", "",
+    "Trial Info", "Study Centre:", "Study Code:", "Investigator ID:",
+    "Exercise Type:", "Config Operator ID:", paste0("Config Time:", stamp(t0)),
+    "Config Notes:", "Extract Operator ID:", paste0("Extract Time:", stamp(t0)),
+    "Extract Notes:", "", "Subject Info", "Device Location Code:",
+    "Subject Code:", "Date of Birth:", "Sex:", "Height:", "Weight:",
+    "Handedness Code:", "Subject Notes:", "", "Calibration Data",
+    paste0(c("x gain:", "x offset:", "y gain:", "y offset:", "z gain:",
+             "z offset:"), c(rbind(round(gain), round(offset)))),
+    "Volts:300", "Lux:800", "", "Memory Status",
+    paste0("Number of Pages:", pages), "")
+  con <- file(file, "wb")
+  on.exit(close(con))
+  writeLines(hdr, con)
+  counts <- function(v, a, from, to) {
+    r <- round((v[from:to] * gain[a] + offset[a]) / 100)
+    r <- pmin(pmax(r, -2048), 2047)
+    as.integer(r %% 4096)
+  }
+  for (p0 in seq(0, pages - 1, by = pages_per_write)) {
+    p1 <- min(p0 + pages_per_write, pages)
+    from <- p0 * 300 + 1
+    to <- p1 * 300
+    hi <- counts(s$x, 1, from, to) * 4096L + counts(s$y, 2, from, to)
+    lo <- counts(s$z, 3, from, to) * 4096L
+    hex <- paste(sprintf("%06X%06X", hi, lo), collapse = "")
+    np <- p1 - p0
+    lines <- substring(hex, (seq_len(np) - 1) * 3600 + 1, seq_len(np) * 3600)
+    temp <- if (is.null(s$temperature)) rep(20, np) else
+      colMeans(matrix(s$temperature[from:to], 300))
+    ptime <- stamp(t0 + (p0 + seq_len(np) - 1) * 300 / sf)
+    page <- rbind("Recorded Data", "Device Unique Serial Code:000000",
+                  paste0("Sequence Number:", p0 + seq_len(np) - 1),
+                  paste0("Page Time:", ptime), "Unassigned:",
+                  paste0("Temperature:", sprintf("%.1f", temp)),
+                  "Battery voltage:4.1", "Device Status:Recording",
+                  paste0("Measurement Frequency:", hz), lines)
+    writeLines(c(page), con)
   }
   invisible(file)
 }

@@ -307,3 +307,37 @@ test_that("g.calibrate matches GGIR on the devices' own files (cwa, bin)", {
     expect_same_as_ggir(b)
   }
 })
+
+test_that("g.calibrate matches GGIR on a GENEActiv .bin of several blocks", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # 30 hours at 20 Hz: GGIR reads a .bin in blocks of about 12 hours, so this
+  # crosses two block boundaries, with the carry-over between blocks
+  rec <- simulate_recording(hours = 30, sf = 20, seed = 21,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(rec, f, sf = 20)
+  b <- run_both(f)
+  expect_gt(b$ggir$npoints, 50)
+  expect_same_as_ggir(b)
+})
+
+test_that("an ActiGraph csv with a time stamp column gives the same calibration", {
+  skip_if_not_installed("GGIR")
+  rec <- simulate_recording(hours = 14, sf = 20, seed = 31)
+  f1 <- tempfile(fileext = ".csv")
+  f2 <- tempfile(fileext = ".csv")
+  on.exit(unlink(c(f1, f2)))
+  gravcal:::write_actigraph_csv(rec, f1, sf = 20)
+  gravcal:::write_actigraph_csv(rec, f2, sf = 20, timestamps = TRUE)
+  expect_match(readLines(f2, n = 12)[12], "^5/11/2023 09:00:00.000,")
+  a <- calibrate(f1, method = "ggir")
+  b <- calibrate(f2, method = "ggir")
+  expect_identical(coef(b), coef(a))
+  expect_identical(b$points, a$points)
+  expect_identical(b$n_windows, a$n_windows)
+  expect_identical(b$hours, a$hours)
+  # and GGIR agrees on the file with time stamps
+  expect_same_as_ggir(run_both(f2))
+})

@@ -65,3 +65,59 @@ test_that("ActiGraph .gt3x files read (read.gt3x's and GGIR's test files)", {
   expect_gt(nrow(rec$data), 1000)
   expect_true(all(abs(rec$data$x) <= 8))
 })
+
+test_that("a .gt3x file streamed in blocks gives the samples of a whole read", {
+  skip_if_not_installed("read.gt3x")
+  # read.gt3x's batches count stored seconds and leave out idle-sleep gaps;
+  # the block reader must put the gaps back as zeros where a whole read
+  # (imputeZeroes = TRUE) has them. Both files have idle-sleep gaps.
+  files <- c(system.file("extdata", "TAS1H30182785_2019-09-17.gt3x", package = "read.gt3x"),
+             shared_data("ggir", "actigraph_testfile.gt3x"))
+  files <- files[nzchar(files)]
+  for (f in files) {
+    whole <- read_recording(f)$data
+    expect_gt(sum(whole$x == 0 & whole$y == 0 & whole$z == 0), 1000)
+    src <- gravcal:::open_source(f, chunksize = 60 / 43200) # 60 s blocks
+    parts <- list()
+    repeat {
+      b <- src$read(length(parts) + 1)
+      if (is.null(b)) break
+      parts[[length(parts) + 1]] <- b$data
+    }
+    expect_gt(length(parts), 3)
+    s <- do.call(rbind, parts)
+    n <- nrow(s)
+    # the same samples at the same positions; a whole read also pads the
+    # idle time after the last stored sample with zeros
+    expect_identical(s$x, whole$x[seq_len(n)], label = basename(f))
+    expect_identical(s$z, whole$z[seq_len(n)], label = basename(f))
+    rest <- whole[-seq_len(n), ]
+    expect_true(all(rest$x == 0 & rest$y == 0 & rest$z == 0))
+  }
+})
+
+test_that("a GENEActiv .bin written by gravcal reads back through GGIRread", {
+  skip_if_not_installed("GGIRread")
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 7, resolution = 0)
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(rec, f, sf = 10, gain = c(25875, 25734, 25538),
+                                offset = c(439, -662, -3056))
+  back <- read_recording(f)
+  expect_identical(back$sf, 10)
+  n <- nrow(back$data)
+  expect_identical(n, nrow(rec) %/% 300L * 300L)
+  # 12-bit counts: within half a count (100 / gain g) of the samples, plus
+  # single precision (GGIRread converts in float)
+  expect_lt(max(abs(back$data$x - rec$x[1:n])), 0.5 * 100 / 25875 + 1e-6)
+  expect_lt(max(abs(back$data$z - rec$z[1:n])), 0.5 * 100 / 25538 + 1e-6)
+  # temperature: one value per page of 300 samples, the page mean
+  page_mean <- rep(colMeans(matrix(rec$temperature[1:n], 300)), each = 300)
+  expect_lt(max(abs(back$data$temperature - page_mean)), 0.05 + 1e-6)
+  # 26 hours at 10 Hz are 3 of GGIR's GENEActiv blocks: streamed windows are
+  # the windows of the whole recording
+  w1 <- rest_windows(f, progress = FALSE)
+  w2 <- rest_windows(back$data, sf = 10)
+  expect_identical(w1[c("mean_x", "sd_y", "temperature", "rest")],
+                   w2[c("mean_x", "sd_y", "temperature", "rest")])
+})
