@@ -5,8 +5,10 @@
 #' * `.rds`: a data frame as written by `saveRDS()` (for example the bundled
 #'   example, see [gravcal_example()]); `sf` from its `sf` attribute or its
 #'   `time` column;
-#' * `.csv`, `.csv.gz`: a header line with columns `x`, `y`, `z` and
-#'   optionally `time` and `temperature`; `sf` from `time` or the argument;
+#' * `.csv`, `.csv.gz`: an ActiGraph csv export (ActiLife's 10-line header,
+#'   with or without time stamps; `sf` from the header), or a header line with
+#'   columns `x`, `y`, `z` and optionally `time` and `temperature`; `sf` from
+#'   `time` or the argument;
 #' * `.gt3x`: ActiGraph, through the read.gt3x package (a Suggests package);
 #'   idle-sleep gaps come back as zeros, which [rest_windows()] skips;
 #' * `.cwa` (Axivity) and `.bin` (GENEActiv), through the GGIRread package
@@ -32,7 +34,8 @@ read_recording <- function(file, sf = NULL) {
   ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(file)))
   data <- switch(ext,
     rds = readRDS(file),
-    csv = , "csv.gz" = utils::read.csv(file, stringsAsFactors = FALSE),
+    csv = , "csv.gz" = if (is_actigraph_csv(file)) read_blocks(file, sf) else
+      utils::read.csv(file, stringsAsFactors = FALSE),
     gt3x = read_gt3x_file(file),
     cwa = , bin = read_blocks(file),
     abort("`file` has an unsupported extension \".", ext, "\"; gravcal ",
@@ -53,9 +56,13 @@ read_recording <- function(file, sf = NULL) {
   list(data = data, sf = sf)
 }
 
-# A whole .cwa or .bin file, from its blocks.
-read_blocks <- function(file) {
-  src <- open_source(file, arg = "file")
+is_actigraph_csv <- function(file) {
+  grepl("ActiGraph", readLines(file, n = 1, warn = FALSE)[1], ignore.case = TRUE)
+}
+
+# A whole .cwa, .bin or ActiGraph csv file, from its blocks.
+read_blocks <- function(file, sf = NULL) {
+  src <- open_source(file, sf = sf, arg = "file")
   parts <- list()
   i <- 1
   repeat {
@@ -88,13 +95,40 @@ read_gt3x_file <- function(file) {
   out
 }
 
-# Sampling frequency from time stamps: the median step, in Hz.
+# Sampling frequency from time stamps, in Hz: one over the median step; for
+# time stamps in whole seconds (as a csv of POSIXct times holds them), the
+# samples counted between the first and the last change of second. NULL when
+# the time stamps do not tell.
 sf_from_time <- function(time) {
-  t <- as.numeric(time)
-  if (length(t) < 2) return(NULL)
-  step <- stats::median(diff(t[seq_len(min(length(t), 10000))]))
-  if (!is.finite(step) || step <= 0) return(NULL)
-  signif(1 / step, 6)
+  t <- time_seconds(time[seq_len(min(length(time), 100000))])
+  if (is.null(t) || length(t) < 2) return(NULL)
+  d <- diff(t)
+  step <- stats::median(d)
+  if (is.finite(step) && step > 0) return(signif(1 / step, 6))
+  ch <- which(d > 0)
+  if (length(ch) < 2) return(NULL)
+  first <- ch[1]
+  last <- ch[length(ch)]
+  sf <- (last - first) / (t[last + 1] - t[first + 1])
+  if (!is.finite(sf) || sf <= 0) return(NULL)
+  signif(sf, 6)
+}
+
+# Time stamps as seconds: numbers and date-times as they are, text parsed as
+# a date-time in one of the usual layouts; NULL when that fails.
+time_seconds <- function(time) {
+  if (is.numeric(time) || inherits(time, "POSIXt")) {
+    t <- as.numeric(time)
+  } else if (is.character(time) || is.factor(time)) {
+    t <- tryCatch(as.numeric(as.POSIXct(as.character(time), tz = "UTC",
+      tryFormats = c("%Y-%m-%d %H:%M:%OS", "%Y/%m/%d %H:%M:%OS",
+                     "%Y-%m-%dT%H:%M:%OS", "%m/%d/%Y %H:%M:%OS"))),
+      error = function(e) NULL)
+  } else {
+    return(NULL)
+  }
+  if (is.null(t) || anyNA(t)) return(NULL)
+  t
 }
 
 #' Path of the bundled example recording
@@ -181,7 +215,7 @@ source_frame <- function(x, sf, chunksize, arg) {
 source_csv <- function(file, sf, chunksize) {
   head <- readLines(file, n = 12, warn = FALSE)
   if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
-  actigraph <- grepl("ActiGraph", head[1], ignore.case = TRUE)
+  actigraph <- is_actigraph_csv(file)
   if (!actigraph) {
     rec <- read_recording(file, sf)
     src <- source_frame(rec$data, rec$sf, chunksize, "datafile")

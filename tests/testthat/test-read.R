@@ -121,3 +121,38 @@ test_that("a GENEActiv .bin written by gravcal reads back through GGIRread", {
   expect_identical(w1[c("mean_x", "sd_y", "temperature", "rest")],
                    w2[c("mean_x", "sd_y", "temperature", "rest")])
 })
+
+test_that("read_recording() reads ActiGraph csv exports, with or without time stamps", {
+  rec <- simulate_recording(hours = 1, sf = 30, seed = 3, temperature = FALSE)
+  for (ts in c(FALSE, TRUE)) {
+    f <- tempfile(fileext = ".csv")
+    gravcal:::write_actigraph_csv(rec, f, sf = 30, timestamps = ts)
+    r <- read_recording(f)
+    unlink(f)
+    expect_identical(r$sf, 30)
+    expect_identical(names(r$data), c("x", "y", "z"))
+    expect_identical(nrow(r$data), nrow(rec))
+    # fwrite writes the shortest decimal that reads back to the same double
+    expect_identical(r$data$y, rec$y)
+  }
+})
+
+test_that("sf comes from time stamps written as text, whole seconds included", {
+  rec <- simulate_recording(hours = 0.5, sf = 10, seed = 4)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  # write.csv() writes POSIXct times in whole seconds: 10 rows per stamp
+  utils::write.csv(rec, f, row.names = FALSE)
+  expect_match(readLines(f, n = 3)[3], "2024-01-01 00:00:00")
+  expect_identical(read_recording(f)$sf, 10)
+  # stamps with fractions of a second
+  rec$time <- format(rec$time, "%Y-%m-%d %H:%M:%OS3")
+  utils::write.csv(rec, f, row.names = FALSE)
+  expect_identical(read_recording(f)$sf, 10)
+  # unreadable time stamps: no guess, an error asking for sf
+  rec$time <- "soon"
+  utils::write.csv(rec, f, row.names = FALSE)
+  expect_error(read_recording(f), "unknown: give `sf`")
+  expect_identical(gravcal:::sf_from_time(c(5, 5, 5)), NULL)
+  expect_identical(gravcal:::sf_from_time(as.POSIXct("2024-01-01", tz = "UTC") + (0:99) / 25), 25)
+})
