@@ -8,8 +8,8 @@
 #' see the section below. With `method = "lightweight"` (Farago et al. 2024)
 #' the steps are
 #' [rest_windows()] (5 s windows, max - min below 0.12 g), [select_points()]
-#' (3 x 3 orientation bins, 2 points each, novelty threshold 0.3 g, or 0.1
-#' and then 0.03 g when the bins cannot be filled otherwise) and
+#' (3 x 3 orientation bins, 2 points each, novelty threshold 0.3 g; bins
+#' that cannot be filled so are filled with 0.1 g, then 0.03 g) and
 #' [fit_gradient()] (9-parameter
 #' model, forward-difference gradient descent). Arguments of those functions
 #' can be given in `...`.
@@ -159,16 +159,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
       "no rest: none of the %d windows met the rest criterion; are the ",
       "samples in g and is sf right?"), nrow(w))))
   }
-  # the novelty threshold falls back to smaller values when the recording
-  # has too few distinct postures for the default (unless the user set it)
+  # the bins that a 0.3 g novelty threshold cannot fill are filled with
+  # smaller thresholds, keeping the points already chosen (unless the user
+  # set the thresholds)
   sargs <- args$select_points
-  thresholds <- if (is.null(sargs$min_distance)) c(0.3, 0.1, 0.03) else
-    sargs$min_distance
-  for (md in thresholds) {
-    sargs$min_distance <- md
-    pts <- do.call(select_points, c(list(w = rest), sargs))
-    if (isTRUE(attr(pts, "complete"))) break
-  }
+  if (is.null(sargs$min_distance)) sargs$min_distance <- c(0.3, 0.1, 0.03)
+  pts <- do.call(select_points, c(list(w = rest), sargs))
   if (!isTRUE(attr(pts, "complete"))) {
     return(fail("bins_incomplete", paste0(
       "not enough rest points on all sides of the sphere: ",

@@ -35,8 +35,10 @@ bin_names <- function() {
 #' (about 17 degrees of tilt) spreads the points: on the paper's simulation it
 #' lowers the mean absolute errors after 50 iterations by a third against
 #' 0.1 g, because a spread set is better conditioned and the descent
-#' converges faster (`bench/results/table2.md`). [calibrate()] falls back to
-#' 0.1 and 0.03 g when a recording has too few distinct postures.
+#' converges faster (`bench/results/table2.md`). [calibrate()] gives
+#' `min_distance = c(0.3, 0.1, 0.03)`: when a recording has too few distinct
+#' postures for 0.3 g, the bins still short of points are filled with 0.1 g,
+#' then 0.03 g, keeping the points already chosen.
 #'
 #' @param w Windows from [rest_windows()], or any data frame with numeric
 #'   columns `mean_x`, `mean_y`, `mean_z` (and optionally a logical `rest`
@@ -44,12 +46,18 @@ bin_names <- function() {
 #' @param per_bin Maximum number of points per bin (paper: 2, so 18 points).
 #' @param min_per_bin Points each bin needs before fitting (paper: 2).
 #' @param min_distance Novelty threshold in g: the smallest distance from a new
-#'   point to every kept point.
+#'   point to every kept point. Several values, in decreasing order, make
+#'   successive passes: each keeps the points already chosen and fills only
+#'   the bins still short of points with the next, smaller threshold, so the
+#'   points stay spread (a single pass with a small threshold would pick
+#'   points close together everywhere, and a poorly spread set calibrates
+#'   worse; see `vignette("farago2024")`).
 #' @return The selected rows of `w` (all its columns), in the order they were
 #'   kept, with two more columns: `bin` (a factor with levels [bin_names()])
 #'   and `row` (the row of `w` the point came from). Attributes: `counts`
 #'   (points per bin), `complete` (every bin has `min_per_bin`), `per_bin`,
-#'   `min_per_bin`, `min_distance`, `offered` (rest rows considered).
+#'   `min_per_bin`, `min_distance` (the thresholds of the passes made),
+#'   `offered` (rest rows considered).
 #' @seealso [fit_gradient()]
 #' @export
 #' @examples
@@ -64,7 +72,12 @@ select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
   check_number(per_bin, "per_bin", min = 1, max = 64, integer = TRUE)
   check_number(min_per_bin, "min_per_bin", min = 1, max = per_bin,
                integer = TRUE)
-  check_number(min_distance, "min_distance", min = 0)
+  if (!is.numeric(min_distance) || !length(min_distance) ||
+      !all(is.finite(min_distance)) || any(min_distance < 0) ||
+      is.unsorted(rev(min_distance))) {
+    abort("`min_distance` must be one or more non-negative numbers in g, ",
+          "in decreasing order, not ", describe(min_distance), ".")
+  }
   rows <- seq_len(nrow(w))
   if ("rest" %in% names(w)) {
     if (!is.logical(w$rest)) {
@@ -76,20 +89,30 @@ select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
   ok <- is.finite(w$mean_x[rows]) & is.finite(w$mean_y[rows]) &
     is.finite(w$mean_z[rows])
   rows <- rows[ok]
-  sel <- gc_select_points(w$mean_x[rows], w$mean_y[rows], w$mean_z[rows],
-                          as.integer(min_per_bin), as.integer(per_bin),
-                          min_distance)
-  kept <- which(!is.na(sel$bin) & sel$bin >= 0)
-  pts <- w[rows[kept], , drop = FALSE]
-  pts$bin <- factor(bin_names()[sel$bin[kept] + 1], levels = bin_names())
-  pts$row <- rows[kept]
+  # One pass per threshold. A later pass first offers the points kept so far
+  # (the selector keeps them again, in the same bins: they are further apart
+  # than the smaller threshold), then the other windows in time order, so
+  # it only fills the bins still short of points.
+  kept_rows <- integer(0)
+  for (md in min_distance) {
+    offer <- c(kept_rows, setdiff(rows, kept_rows))
+    sel <- gc_select_points(w$mean_x[offer], w$mean_y[offer], w$mean_z[offer],
+                            as.integer(min_per_bin), as.integer(per_bin), md)
+    kept <- which(!is.na(sel$bin) & sel$bin >= 0)
+    kept_rows <- offer[kept]
+    kept_bins <- sel$bin[kept]
+    if (isTRUE(sel$complete)) break
+  }
+  pts <- w[kept_rows, , drop = FALSE]
+  pts$bin <- factor(bin_names()[kept_bins + 1], levels = bin_names())
+  pts$row <- kept_rows
   rownames(pts) <- NULL
   counts <- stats::setNames(sel$counts, bin_names())
   attr(pts, "counts") <- counts
   attr(pts, "complete") <- sel$complete
   attr(pts, "per_bin") <- per_bin
   attr(pts, "min_per_bin") <- min_per_bin
-  attr(pts, "min_distance") <- min_distance
+  attr(pts, "min_distance") <- min_distance[seq_len(match(md, min_distance))]
   attr(pts, "offered") <- length(rows)
   pts
 }

@@ -8,7 +8,7 @@ cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
 deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
 r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
-r-cran-progressr pandoc qpdf tidy"
+r-cran-progressr r-cran-deoptim pandoc qpdf tidy"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""
@@ -28,7 +28,8 @@ fi
 Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
 need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
-          "tibble", "data.table", "future", "future.apply", "progressr")
+          "tibble", "data.table", "future", "future.apply", "progressr",
+          "DEoptim", "signal")
 have <- rownames(installed.packages())
 miss <- setdiff(need, have)
 if (length(miss)) {

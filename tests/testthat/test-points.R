@@ -69,3 +69,37 @@ test_that("bad arguments are named", {
   expect_error(select_points(data.frame(a = 1)), "missing: mean_x")
   expect_error(select_points("x"), "must be a data frame of windows")
 })
+
+test_that("several thresholds top up the bins and keep the first pass's points", {
+  set.seed(46)
+  # postures clustered around the six poles, 0.12 g apart within a cluster:
+  # 0.3 g fills one point per bin at most where a cluster is the only source
+  poles <- rbind(diag(3), -diag(3))
+  post <- do.call(rbind, lapply(1:6, function(i) {
+    e <- poles[i, ]
+    o <- diag(3)[-which(e != 0), ]
+    rbind(e + 0.12 * o[1, ], e - 0.12 * o[1, ], e + 0.12 * o[2, ])
+  }))
+  post <- post / sqrt(rowSums(post^2))
+  w <- data.frame(mean_x = post[, 1], mean_y = post[, 2], mean_z = post[, 3])
+  w <- w[sample(nrow(w)), ]
+  one <- select_points(w, min_distance = 0.3)
+  expect_false(attr(one, "complete"))
+  two <- select_points(w, min_distance = c(0.3, 0.1))
+  expect_true(attr(two, "complete"))
+  expect_identical(attr(two, "min_distance"), c(0.3, 0.1))
+  # the first pass's points are all still there, in the same bins
+  m <- match(one$row, two$row)
+  expect_false(anyNA(m))
+  expect_identical(as.character(two$bin[m]), as.character(one$bin))
+  # a complete first pass makes no second pass
+  cand <- simulate_points(500, noise = 0.001)
+  a <- select_points(cand)
+  b <- select_points(cand, min_distance = c(0.3, 0.1, 0.03))
+  expect_true(attr(a, "complete"))
+  expect_identical(b$row, a$row)
+  expect_identical(attr(b, "min_distance"), 0.3)
+  expect_error(select_points(cand, min_distance = c(0.1, 0.3)), "decreasing order")
+  expect_error(select_points(cand, min_distance = -1), "non-negative")
+  expect_error(select_points(cand, min_distance = NA), "`min_distance`")
+})
