@@ -17,7 +17,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 
-.PHONY: setup install demo test check core document bench bench-speed bench-memory clean
+.PHONY: setup install demo test check core document bench bench-speed bench-memory refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -54,6 +54,10 @@ bench-speed: install
 # peak memory calibrating a 7-day device file, against GGIR (about 15 minutes)
 bench-memory: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/memory.R
+
+# recompute the vignettes' cached results (about 10 minutes)
+refresh-vignettes: install
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) tools/refresh-vignettes.R
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png
