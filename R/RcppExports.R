@@ -37,8 +37,8 @@ gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance) {
     .Call(`_gravcal_gc_select_points`, x, y, z, min_per_bin, max_per_bin, min_distance)
 }
 
-gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic) {
-    .Call(`_gravcal_gc_fit_gradient`, x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic)
+gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central = FALSE) {
+    .Call(`_gravcal_gc_fit_gradient`, x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central)
 }
 
 gc_read_once <- function(cols) {

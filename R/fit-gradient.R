@@ -39,19 +39,31 @@ param_names <- function() {
 #' @param pts Calibration points: the result of [select_points()], or any
 #'   data frame or matrix with numeric columns `mean_x`, `mean_y`, `mean_z`
 #'   (or `x`, `y`, `z`) in g. At least 9 points.
-#' @param arithmetic Number type the core computes in: `"double"` or
-#'   `"float"` (single precision, as on a microcontroller with an FPU).
+#' @param arithmetic Number type the core computes in: `"double"`,
+#'   `"float"` (single precision, as on a microcontroller with an FPU), or
+#'   fixed point as on one without: `"fixed32"` (Q3.29 in 32-bit integers,
+#'   64-bit intermediates) or `"fixed16"` (Q3.12 in 16-bit integers, 32-bit
+#'   intermediates), saturating on overflow. The points are rounded to the
+#'   arithmetic first. The result is bit for bit what the same header-only
+#'   core computes on a device (`inst/include/gravcal/fixed_point.hpp`; see
+#'   `vignette("firmware")`).
 #' @param max_iter Number of iterations M (paper: 50).
 #' @param rates Learning rates for the scale, misalignment and offset groups
 #'   (paper: 0.3, 0.8, 0.2), a named or unnamed vector of 3.
 #' @param h Finite-difference step (paper: 1e-5 for double, float and 32-bit
-#'   fixed point).
+#'   fixed point, 0.01 for 16-bit fixed point; the default follows
+#'   `arithmetic`).
 #' @param objective `"mean"` (default) or `"sum"` over points; see Details.
 #' @param use_sqrt Keep the square root in the objective.
 #' @param tol Stop early once every parameter step is below `tol`; 0 (the
 #'   paper's rule) always runs `max_iter` iterations.
 #' @param trace Keep the parameters after every iteration (for the paper's
 #'   Fig. 9); stored as `fit$trace`.
+#' @param difference `"forward"` (the paper's Eq. 13) or `"central"`
+#'   differences for the gradient. Central differences cost twice the
+#'   evaluations but remove the forward difference's bias of about `h / 2`
+#'   per parameter: negligible with `h = 1e-5`, about 5 mg with the 16-bit
+#'   step `h = 0.01` (`bench/results/fixed.md`).
 #' @return A `gravcal_fit` (see [calibrate()]) with `K` lower-triangular,
 #'   `offset`, zero `tempoffset`, `params` (the nine named parameters),
 #'   `objective`, and `trace` when asked for. Status `"ok"`, or `"diverged"`
@@ -66,14 +78,18 @@ param_names <- function() {
 #' cand <- simulate_points(500, noise = 0.001)
 #' fit <- fit_gradient(select_points(cand))
 #' rbind(truth = attr(cand, "params"), fit = fit$params)
-fit_gradient <- function(pts, arithmetic = c("double", "float"),
+fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
+                                              "fixed16"),
                          max_iter = 50, rates = c(scale = 0.3,
-                         misalignment = 0.8, offset = 0.2), h = 1e-5,
+                         misalignment = 0.8, offset = 0.2),
+                         h = if (arithmetic[1] == "fixed16") 0.01 else 1e-5,
                          objective = c("mean", "sum"), use_sqrt = FALSE,
-                         tol = 0, trace = FALSE) {
+                         tol = 0, trace = FALSE,
+                         difference = c("forward", "central")) {
   call <- match.call()
   arithmetic <- match.arg(arithmetic)
   objective <- match.arg(objective)
+  difference <- match.arg(difference)
   v <- point_matrix(pts, "pts")
   if (nrow(v) < 9) {
     abort("`pts` must hold at least 9 points to fit 9 parameters, not ",
@@ -93,14 +109,15 @@ fit_gradient <- function(pts, arithmetic = c("double", "float"),
   r <- gc_fit_gradient(v[, 1], v[, 2], v[, 3],
                        c(1, 1, 1, 0, 0, 0, 0, 0, 0), as.integer(max_iter), h,
                        rep(unname(rates), each = 3), use_sqrt,
-                       objective == "sum", tol, trace, arithmetic)
+                       objective == "sum", tol, trace, arithmetic,
+                       difference == "central")
   p <- stats::setNames(r$p, param_names())
   status <- "ok"
   message <- sprintf("fitted in %d iterations (%s arithmetic)", r$iterations,
                      arithmetic)
   f0 <- gc_fit_gradient(v[, 1], v[, 2], v[, 3], c(1, 1, 1, 0, 0, 0, 0, 0, 0),
                         0L, h, rep(1, 9), use_sqrt, objective == "sum", 0,
-                        FALSE, arithmetic)$objective
+                        FALSE, arithmetic, FALSE)$objective
   if (!r$finite || !all(is.finite(p)) || !is.finite(r$objective) ||
       r$objective > 10 * f0 + 1e-6) {
     status <- "diverged"
@@ -122,7 +139,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float"),
   fit$objective <- r$objective
   fit$settings <- list(arithmetic = arithmetic, max_iter = max_iter,
                        rates = rates, h = h, objective = objective,
-                       use_sqrt = use_sqrt, tol = tol)
+                       use_sqrt = use_sqrt, tol = tol, difference = difference)
   if (trace) {
     tr <- t(r$trace)
     colnames(tr) <- c(param_names(), "f")

@@ -137,8 +137,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_fit_gradient
-Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::NumericVector& p0, int max_iter, double h, const Rcpp::NumericVector& rates, bool use_sqrt, bool sum_scale, double tol, bool trace, std::string arithmetic);
-RcppExport SEXP _gravcal_gc_fit_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP p0SEXP, SEXP max_iterSEXP, SEXP hSEXP, SEXP ratesSEXP, SEXP use_sqrtSEXP, SEXP sum_scaleSEXP, SEXP tolSEXP, SEXP traceSEXP, SEXP arithmeticSEXP) {
+Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::NumericVector& p0, int max_iter, double h, const Rcpp::NumericVector& rates, bool use_sqrt, bool sum_scale, double tol, bool trace, std::string arithmetic, bool central);
+RcppExport SEXP _gravcal_gc_fit_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP p0SEXP, SEXP max_iterSEXP, SEXP hSEXP, SEXP ratesSEXP, SEXP use_sqrtSEXP, SEXP sum_scaleSEXP, SEXP tolSEXP, SEXP traceSEXP, SEXP arithmeticSEXP, SEXP centralSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -153,7 +153,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
     Rcpp::traits::input_parameter< bool >::type trace(traceSEXP);
     Rcpp::traits::input_parameter< std::string >::type arithmetic(arithmeticSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_fit_gradient(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic));
+    Rcpp::traits::input_parameter< bool >::type central(centralSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fit_gradient(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -187,7 +188,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 6},
-    {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 12},
+    {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 13},
     {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},
     {"_gravcal_gc_release_memory", (DL_FUNC) &_gravcal_gc_release_memory, 0},
     {NULL, NULL, 0}

@@ -206,7 +206,7 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
                         const Rcpp::NumericVector& z,
                         const Rcpp::NumericVector& p0, int max_iter, double h,
                         const Rcpp::NumericVector& rates, bool use_sqrt,
-                        bool sum_scale, double tol, bool trace) {
+                        bool sum_scale, double tol, bool trace, bool central) {
   const int n = static_cast<int>(x.size());
   std::vector<T> xs(n), ys(n), zs(n);
   for (int i = 0; i < n; ++i) {
@@ -221,6 +221,7 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
   cfg.use_sqrt = use_sqrt;
   cfg.scale = sum_scale ? gravcal::SCALE_SUM : gravcal::SCALE_MEAN;
   cfg.tol = T(tol);
+  cfg.central = central;
   T p[gravcal::NPARAM];
   for (int i = 0; i < gravcal::NPARAM; ++i) p[i] = T(p0[i]);
   std::vector<double> tr;
@@ -256,17 +257,24 @@ Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x,
                            const Rcpp::NumericVector& p0, int max_iter,
                            double h, const Rcpp::NumericVector& rates,
                            bool use_sqrt, bool sum_scale, double tol,
-                           bool trace, std::string arithmetic) {
+                           bool trace, std::string arithmetic,
+                           bool central = false) {
   if (y.size() != x.size() || z.size() != x.size())
     Rcpp::stop("x, y, z lengths differ");
   if (p0.size() != gravcal::NPARAM || rates.size() != gravcal::NPARAM)
     Rcpp::stop("p0 and rates must have 9 values");
   if (arithmetic == "double")
     return run_gradient<double>(x, y, z, p0, max_iter, h, rates, use_sqrt,
-                                sum_scale, tol, trace);
+                                sum_scale, tol, trace, central);
   if (arithmetic == "float")
     return run_gradient<float>(x, y, z, p0, max_iter, h, rates, use_sqrt,
-                               sum_scale, tol, trace);
+                               sum_scale, tol, trace, central);
+  if (arithmetic == "fixed32")
+    return run_gradient<gravcal::fixed32>(x, y, z, p0, max_iter, h, rates,
+                                          use_sqrt, sum_scale, tol, trace, central);
+  if (arithmetic == "fixed16")
+    return run_gradient<gravcal::fixed16>(x, y, z, p0, max_iter, h, rates,
+                                          use_sqrt, sum_scale, tol, trace, central);
   Rcpp::stop("unknown arithmetic");
 }
 
