@@ -31,9 +31,12 @@ demo: install
 
 test: check core
 
-# the header-only core alone, without R, with -Wall -Wextra -Werror
-core:
-	$(MAKE) -C tests/cpp test
+# the header-only core alone, without R, with -Wall -Wextra -Werror: unit
+# tests (double, float, fixed point), the Cortex-M4 build (no heap), the
+# instruction counts, and R's fit_gradient() against it bit for bit
+core: install
+	$(MAKE) -C tests/cpp test arm cost
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r
 
 check: setup
 	mkdir -p $(BUILD)

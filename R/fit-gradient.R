@@ -42,7 +42,7 @@ param_names <- function() {
 #' @param arithmetic Number type the core computes in: `"double"`,
 #'   `"float"` (single precision, as on a microcontroller with an FPU), or
 #'   fixed point as on one without: `"fixed32"` (Q3.29 in 32-bit integers,
-#'   64-bit intermediates) or `"fixed16"` (Q3.12 in 16-bit integers, 32-bit
+#'   64-bit intermediates) or `"fixed16"` (Q1.14 in 16-bit integers, 32-bit
 #'   intermediates), saturating on overflow. The points are rounded to the
 #'   arithmetic first. The result is bit for bit what the same header-only
 #'   core computes on a device (`inst/include/gravcal/fixed_point.hpp`; see

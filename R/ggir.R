@@ -180,6 +180,12 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
   i <- 1
   repeat {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
+    if (i > 1 && isTRUE(src$from_file)) {
+      # the previous block is garbage now: collect it before reading the
+      # next, so that memory stays at about one block
+      blk <- NULL
+      invisible(gc(full = TRUE))
+    }
     blk <- src$read(i)
     if (!is.null(blk)) {
       nr <- block_rows(blk)

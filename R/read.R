@@ -186,6 +186,11 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile") {
           "reads .csv (ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, ",
           ".cwa and GENEActiv .bin."))
   src$filename <- basename(datafile)
+  # blocks read from the file (not views of data already in memory): the
+  # block loops collect each one's garbage before reading the next, so that
+  # memory stays at about one block
+  src$from_file <- !identical(src$format, "data.frame") &&
+    !identical(src$format, "csv")
   src
 }
 

@@ -179,6 +179,7 @@ segment_source <- function(seg, src, rule, par, progress) {
     }
     rm(blk, p)
     if (last) break
+    if (isTRUE(src$from_file)) invisible(gc(full = TRUE))
     i <- i + 1
   }
   if (isTRUE(progress)) cat("\n")
