@@ -56,7 +56,7 @@
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
 #'   `chunk_size`, `progress`), [select_points()] (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
-#'   `h`, `objective`, `use_sqrt`, `tol`, `trace`). For the GGIR method:
+#'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`). For the GGIR method:
 #'   `use_temp` (fit the temperature term when there is one, default TRUE),
 #'   `spherecrit` (0.3 g), `minloadcrit` (168 h), `chunksize` (1, about 12 h
 #'   blocks), `max_sd` (0.013 g), `max_iter` (1000), `tol` (1e-10) and
@@ -119,7 +119,7 @@
 calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                       ggir_compat = FALSE, ...) {
   call <- match.call()
-  method <- match.arg(method)
+  method <- match_choice(method, "method")
   check_flag(ggir_compat, "ggir_compat")
   if (method == "ggir") {
     return(calibrate_ggir(x, if (missing(sf)) NULL else sf, ggir_compat,
@@ -136,7 +136,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                      "chunk_size", "progress"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
-                     "use_sqrt", "tol", "trace")))
+                     "use_sqrt", "tol", "trace", "difference")))
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method),
                                args$rest_windows))
   rest <- w[w$rest, , drop = FALSE]

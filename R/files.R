@@ -55,7 +55,7 @@
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
                             pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$") {
-  method <- match.arg(method)
+  method <- match_choice(method, "method")
   files <- cohort_files(files, pattern)
   if (missing(outdir) || !is.character(outdir) || length(outdir) != 1 ||
       is.na(outdir) || !nzchar(outdir)) {

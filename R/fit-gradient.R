@@ -87,9 +87,9 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          tol = 0, trace = FALSE,
                          difference = c("forward", "central")) {
   call <- match.call()
-  arithmetic <- match.arg(arithmetic)
-  objective <- match.arg(objective)
-  difference <- match.arg(difference)
+  arithmetic <- match_choice(arithmetic, "arithmetic")
+  objective <- match_choice(objective, "objective")
+  difference <- match_choice(difference, "difference")
   v <- point_matrix(pts, "pts")
   if (nrow(v) < 9) {
     abort("`pts` must hold at least 9 points to fit 9 parameters, not ",
@@ -102,6 +102,12 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
           "not ", describe(rates), ".")
   }
   check_number(h, "h", min = 0, min_inclusive = FALSE)
+  limit <- c(double = Inf, float = Inf, fixed32 = 4, fixed16 = 2)[[arithmetic]]
+  if (any(abs(v) >= limit)) {
+    abort("`pts` has coordinates beyond the range of ", arithmetic, " (+-",
+          limit, " g): ", sum(rowSums(abs(v) >= limit) > 0), " of ", nrow(v),
+          " points. Rest points lie within about 1.3 g; are they in g?")
+  }
   check_flag(use_sqrt, "use_sqrt")
   check_number(tol, "tol", min = 0)
   check_flag(trace, "trace")

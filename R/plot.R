@@ -21,7 +21,7 @@
 #' plot(fit)
 plot.gravcal_fit <- function(x, which = 1:4, set = c("windows", "points"),
                              theta = 35, phi = 20, ...) {
-  set <- match.arg(set)
+  set <- match_choice(set, "set")
   if (!is.numeric(which) || !length(which) || !all(which %in% 1:4)) {
     abort("`which` must be a subset of 1:4, not ", describe(which), ".")
   }

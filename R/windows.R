@@ -71,7 +71,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          axes = c("x", "y", "z"), max_sd = 0.013,
                          max_abs_mean = 2, skip_zero = TRUE,
                          chunk_size = 1e6, progress = NULL) {
-  method <- match.arg(method)
+  method <- match_choice(method, "method")
   src <- NULL
   if (is.character(x)) {
     src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x")

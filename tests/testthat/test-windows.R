@@ -107,7 +107,7 @@ test_that("bad input gets errors that name the argument", {
   expect_error(rest_windows(matrix(0, 3, 4), sf = 10), "exactly 3 unnamed")
   expect_error(rest_windows(x, sf = 0.2), "at least 2 samples per window")
   expect_error(rest_windows(x, sf = 10, axes = "w"), "`axes` must name")
-  expect_error(rest_windows(x, sf = 10, method = "other"), "should be one of")
+  expect_error(rest_windows(x, sf = 10, method = "other"), "`method` must be one of")
   # integer columns are accepted; a short recording gives no windows
   xi <- data.frame(x = 0L, y = 0L, z = rep(1L, 20))
   w <- rest_windows(xi, sf = 10)
