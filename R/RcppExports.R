@@ -33,8 +33,8 @@ gc_segmenter_state <- function(seg) {
     .Call(`_gravcal_gc_segmenter_state`, seg)
 }
 
-gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance) {
-    .Call(`_gravcal_gc_select_points`, x, y, z, min_per_bin, max_per_bin, min_distance)
+gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic = "double") {
+    .Call(`_gravcal_gc_select_points`, x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic)
 }
 
 gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central = FALSE) {

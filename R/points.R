@@ -52,6 +52,9 @@ bin_names <- function() {
 #'   points stay spread (a single pass with a small threshold would pick
 #'   points close together everywhere, and a poorly spread set calibrates
 #'   worse; see `vignette("farago2024")`).
+#' @param arithmetic Number type of the selector (see [fit_gradient()]):
+#'   the coordinates are rounded to it, as a device holding them in fixed
+#'   point would, so that R selects the points the device selects.
 #' @return The selected rows of `w` (all its columns), in the order they were
 #'   kept, with two more columns: `bin` (a factor with levels [bin_names()])
 #'   and `row` (the row of `w` the point came from). Attributes: `counts`
@@ -67,7 +70,10 @@ bin_names <- function() {
 #' table(pts$bin)
 #' attr(pts, "complete")
 select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
-                          min_distance = 0.3) {
+                          min_distance = 0.3,
+                          arithmetic = c("double", "float", "fixed32",
+                                         "fixed16")) {
+  arithmetic <- match_choice(arithmetic, "arithmetic")
   w <- as_epochs(w)
   check_number(per_bin, "per_bin", min = 1, max = 64, integer = TRUE)
   check_number(min_per_bin, "min_per_bin", min = 1, max = per_bin,
@@ -97,7 +103,8 @@ select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
   for (md in min_distance) {
     offer <- c(kept_rows, setdiff(rows, kept_rows))
     sel <- gc_select_points(w$mean_x[offer], w$mean_y[offer], w$mean_z[offer],
-                            as.integer(min_per_bin), as.integer(per_bin), md)
+                            as.integer(min_per_bin), as.integer(per_bin), md,
+                            arithmetic)
     kept <- which(!is.na(sel$bin) & sel$bin >= 0)
     kept_rows <- offer[kept]
     kept_bins <- sel$bin[kept]

@@ -122,8 +122,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_select_points
-Rcpp::List gc_select_points(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, int min_per_bin, int max_per_bin, double min_distance);
-RcppExport SEXP _gravcal_gc_select_points(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP min_per_binSEXP, SEXP max_per_binSEXP, SEXP min_distanceSEXP) {
+Rcpp::List gc_select_points(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, int min_per_bin, int max_per_bin, double min_distance, std::string arithmetic);
+RcppExport SEXP _gravcal_gc_select_points(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP min_per_binSEXP, SEXP max_per_binSEXP, SEXP min_distanceSEXP, SEXP arithmeticSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -132,7 +132,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< int >::type min_per_bin(min_per_binSEXP);
     Rcpp::traits::input_parameter< int >::type max_per_bin(max_per_binSEXP);
     Rcpp::traits::input_parameter< double >::type min_distance(min_distanceSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_select_points(x, y, z, min_per_bin, max_per_bin, min_distance));
+    Rcpp::traits::input_parameter< std::string >::type arithmetic(arithmeticSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_select_points(x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -187,7 +188,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},
-    {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 6},
+    {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 7},
     {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 13},
     {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},
     {"_gravcal_gc_release_memory", (DL_FUNC) &_gravcal_gc_release_memory, 0},

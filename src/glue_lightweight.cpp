@@ -174,12 +174,15 @@ Rcpp::NumericVector gc_segmenter_state(SEXP seg) {
 // Offer rest means in order until the bins are full. Returns, per row, the
 // bin it was counted for (0..8) or the negative reason, NA for rows not
 // offered because the bins were already full.
-// [[Rcpp::export(rng = false)]]
-Rcpp::List gc_select_points(const Rcpp::NumericVector& x,
-                            const Rcpp::NumericVector& y,
-                            const Rcpp::NumericVector& z, int min_per_bin,
-                            int max_per_bin, double min_distance) {
-  typedef gravcal::BinSelector<double, 9 * 64> Selector;
+namespace {
+
+// The bin selector in number type T: the coordinates are rounded to T as a
+// device would hold them.
+template <typename T>
+Rcpp::List run_select(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
+                      const Rcpp::NumericVector& z, int min_per_bin,
+                      int max_per_bin, double min_distance) {
+  typedef gravcal::BinSelector<T, 9 * 64> Selector;
   gravcal::BinConfig cfg;
   cfg.min_per_bin = min_per_bin;
   cfg.max_per_bin = max_per_bin;
@@ -189,13 +192,34 @@ Rcpp::List gc_select_points(const Rcpp::NumericVector& x,
   const R_xlen_t n = x.size();
   Rcpp::IntegerVector res(n, NA_INTEGER);
   for (R_xlen_t i = 0; i < n && !sel->full(); ++i) {
-    res[i] = sel->offer(gravcal::Vec3<double>{x[i], y[i], z[i]});
+    res[i] = sel->offer(gravcal::Vec3<T>{T(x[i]), T(y[i]), T(z[i])});
   }
   Rcpp::IntegerVector counts(9);
   for (int b = 0; b < 9; ++b) counts[b] = sel->count(b);
   return Rcpp::List::create(Rcpp::Named("bin") = res,
                             Rcpp::Named("counts") = counts,
                             Rcpp::Named("complete") = sel->complete());
+}
+
+}  // namespace
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_select_points(const Rcpp::NumericVector& x,
+                            const Rcpp::NumericVector& y,
+                            const Rcpp::NumericVector& z, int min_per_bin,
+                            int max_per_bin, double min_distance,
+                            std::string arithmetic = "double") {
+  if (arithmetic == "double")
+    return run_select<double>(x, y, z, min_per_bin, max_per_bin, min_distance);
+  if (arithmetic == "float")
+    return run_select<float>(x, y, z, min_per_bin, max_per_bin, min_distance);
+  if (arithmetic == "fixed32")
+    return run_select<gravcal::fixed32>(x, y, z, min_per_bin, max_per_bin,
+                                        min_distance);
+  if (arithmetic == "fixed16")
+    return run_select<gravcal::fixed16>(x, y, z, min_per_bin, max_per_bin,
+                                        min_distance);
+  Rcpp::stop("unknown arithmetic");
 }
 
 namespace {

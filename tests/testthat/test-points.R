@@ -103,3 +103,18 @@ test_that("several thresholds top up the bins and keep the first pass's points",
   expect_error(select_points(cand, min_distance = -1), "non-negative")
   expect_error(select_points(cand, min_distance = NA), "`min_distance`")
 })
+
+test_that("select_points() in a device's arithmetic rounds as the device does", {
+  # x = 0.75 - 1e-6 is outside [0.75, 1.25] in double, but rounds to 0.75 in
+  # Q1.14 (resolution 6.1e-5) and in Q3.29 stays below it
+  w <- data.frame(mean_x = 0.75 - 1e-6, mean_y = 0.5, mean_z = 0.5)
+  expect_identical(nrow(select_points(w)), 0L)
+  expect_identical(nrow(select_points(w, arithmetic = "fixed32")), 0L)
+  p16 <- select_points(w, arithmetic = "fixed16")
+  expect_identical(as.character(p16$bin), "x+")
+  set.seed(5)
+  cand <- simulate_points(500, noise = 0.002)
+  expect_identical(select_points(cand, arithmetic = "fixed32")$row,
+                   select_points(cand)$row)
+  expect_error(select_points(cand, arithmetic = "int8"), "`arithmetic` must be one of")
+})
