@@ -17,7 +17,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 
-.PHONY: setup install demo test check core document bench bench-speed bench-memory refresh-vignettes clean
+.PHONY: setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -29,7 +29,7 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check core
+test: check core sanitize valgrind fuzz-short
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
@@ -37,6 +37,34 @@ test: check core
 core: install
 	$(MAKE) -C tests/cpp test arm cost
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r
+
+# the whole test suite against the package built with AddressSanitizer and
+# UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not
+# instrumented, so the runtimes are preloaded. Any report fails.
+ASAN_RT = $(shell gcc -print-file-name=libasan.so) $(shell gcc -print-file-name=libubsan.so)
+sanitize: setup
+	mkdir -p $(BUILD)/asan
+	R_MAKEVARS_USER=$(abspath tools/sanitize.mk) $(R) CMD INSTALL --preclean --no-multiarch \
+	  --no-test-load -l $(BUILD)/asan . > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
+	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
+	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) ../../tools/run-tests.R \
+	  > ../../$(BUILD)/sanitize.log 2>&1 || (tail -60 ../../$(BUILD)/sanitize.log; exit 1)
+	@if grep -qE "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log; then \
+	  grep -E -A20 "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log | head -60; exit 1; fi
+	@tail -1 $(BUILD)/sanitize.log; echo "sanitize: ASan/UBSan clean"
+
+# the core's unit tests under valgrind
+valgrind:
+	$(MAKE) -C tests/cpp valgrind
+
+# libFuzzer harnesses (clang): FUZZ_SECONDS per harness
+fuzz:
+	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=$${FUZZ_SECONDS:-600}
+
+fuzz-short:
+	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=30
 
 check: setup
 	mkdir -p $(BUILD)

@@ -1,0 +1,11 @@
+# Runs the testthat suite of the installed gravcal from tests/testthat and
+# exits with status 1 on any failure (used by `make sanitize`).
+suppressPackageStartupMessages({
+  library(testthat)
+  library(gravcal)
+})
+res <- as.data.frame(test_dir(".", reporter = "summary", stop_on_failure = FALSE))
+bad <- sum(res$failed) + sum(res$error)
+cat(sprintf("\n%d tests in %d files, %d expectations; %d failed\n", nrow(res),
+            length(unique(res$file)), sum(res$nb), bad))
+if (bad > 0) quit(status = 1)
