@@ -46,6 +46,7 @@ sanitize: setup
 	mkdir -p $(BUILD)/asan
 	R_MAKEVARS_USER=$(abspath tools/sanitize.mk) $(R) CMD INSTALL --preclean --no-multiarch \
 	  --no-test-load -l $(BUILD)/asan . > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
+	rm -f src/*.o src/*.so
 	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
 	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" \

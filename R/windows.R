@@ -78,6 +78,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     sf <- src$sf
     s <- list(n = 0, time = NULL)
   } else {
+    if (missing(sf)) abort("`sf` (sampling frequency in Hz) is missing.")
     s <- as_samples(x)
   }
   check_sf(sf)
