@@ -65,7 +65,9 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
   std::vector<double> tr;
   const gravcal::IcpResult r = gravcal::fit_icp(
       x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), cfg,
-      [&](int, const gravcal::IcpResult& q) {
+      [&](int it, const gravcal::IcpResult& q) {
+        // Ctrl-C: the core's observer may throw (see icp.hpp)
+        if ((it & 15) == 0) Rcpp::checkUserInterrupt();
         if (!trace) return;
         for (int k = 0; k < 3; ++k) tr.push_back(q.scale[k]);
         for (int k = 0; k < 3; ++k) tr.push_back(q.offset[k]);

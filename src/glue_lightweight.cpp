@@ -252,7 +252,9 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
   if (trace) tr.reserve(static_cast<std::size_t>(max_iter) * 10);
   gravcal::GradientResult r = gravcal::fit_gradient(
       p, xs.data(), ys.data(), zs.data(), n, cfg,
-      [&](int, const T* q, const T& f) {
+      [&](int it, const T* q, const T& f) {
+        // Ctrl-C: the core's observer may throw (see gradient.hpp)
+        if ((it & 1023) == 0) Rcpp::checkUserInterrupt();
         if (!trace) return;
         for (int i = 0; i < gravcal::NPARAM; ++i)
           tr.push_back(static_cast<double>(q[i]));

@@ -82,7 +82,10 @@ struct NoObserver {
 
 // Fit p in place (p holds the start on entry, usually identity_params()).
 // observe(iteration, p, f) is called after every update, iteration from 1,
-// with f the objective before that update.
+// with f the objective before that update. It is also the way to stop a long
+// fit from outside: observe may throw, and since the core holds no resources
+// (no heap, no locks) the fit unwinds cleanly. The R glue does so on Ctrl-C
+// (Rcpp::checkUserInterrupt()); the core itself stays free of R.
 template <typename T, class Observer = NoObserver>
 inline GradientResult fit_gradient(T* p, const T* x, const T* y, const T* z,
                                    int n, const GradientConfig<T>& cfg,

@@ -223,7 +223,9 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
 
 // x, y, z: the n window means; temp: their temperatures (may be null, or
 // ignored when cfg.use_temp is false). Observer is called after each
-// iteration as obs(iteration, result-so-far).
+// iteration as obs(iteration, result-so-far). obs may throw to abandon the
+// fit (the R glue does on Ctrl-C); the Eigen matrices the fit allocated are
+// freed by their destructors on the way out.
 template <class Observer, class Solver = EigenLeastSquares>
 IcpResult fit_icp(const double* x, const double* y, const double* z,
                   const double* temp, std::size_t n, const IcpConfig& cfg,

@@ -1,0 +1,52 @@
+# A long fit stops on Ctrl-C (SIGINT) within moments, instead of when the C++
+# call returns: the glue checks for interrupts through the core's observer.
+# Starts `code` (which defines run()) in a separate R process, sends it
+# SIGINT `wait` seconds after run() started, and returns how long the process
+# took to stop after the signal, and whether run() finished.
+interrupt_after <- function(code, wait = 2) {
+  skip_on_os("windows")
+  out <- tempfile()
+  script <- tempfile(fileext = ".R")
+  writeLines(c(
+    "suppressPackageStartupMessages(library(gravcal))",
+    "set.seed(1)",
+    code,
+    sprintf("writeLines('ready', '%s')", out),
+    "run()",
+    sprintf("writeLines(c('ready', 'finished'), '%s')", out)),
+    script)
+  rscript <- file.path(R.home("bin"), "Rscript")
+  pidfile <- tempfile()
+  system2("bash", c("-c", shQuote(sprintf("exec '%s' '%s' > /dev/null 2>&1 & echo $! > '%s'",
+                                          rscript, script, pidfile))), wait = TRUE)
+  pid <- as.integer(readLines(pidfile))
+  alive <- function() isTRUE(tools::pskill(pid, 0L))
+  t0 <- Sys.time()
+  while (!file.exists(out) && Sys.time() - t0 < 60) Sys.sleep(0.05)
+  Sys.sleep(wait)
+  expect_true(alive())
+  tools::pskill(pid, tools::SIGINT)
+  t1 <- Sys.time()
+  while (alive() && Sys.time() - t1 < 120) Sys.sleep(0.05)
+  stopped <- as.numeric(difftime(Sys.time(), t1, units = "secs"))
+  if (alive()) tools::pskill(pid, tools::SIGKILL)
+  list(seconds = stopped, finished = length(readLines(out)) > 1)
+}
+
+test_that("Ctrl-C stops a long gradient fit", {
+  # a million iterations on 500 points: about 2 minutes without the interrupt
+  res <- interrupt_after(c(
+    "pts <- simulate_points(500, noise = 0.001)",
+    "run <- function() fit_gradient(pts, max_iter = 1e6, tol = 0)"))
+  expect_false(res$finished)
+  expect_lt(res$seconds, 3)
+})
+
+test_that("Ctrl-C stops a long ICP fit", {
+  # 20,000 windows, up to a million iterations with tol = 0
+  res <- interrupt_after(c(
+    "v <- simulate_points(20000, noise = 0.002)",
+    "run <- function() fit_icp(v, use_temp = FALSE, max_iter = 1e6, tol = 0)"))
+  expect_false(res$finished)
+  expect_lt(res$seconds, 3)
+})
