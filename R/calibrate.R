@@ -69,7 +69,9 @@
 #' "attempted with all available data" with an error after calibration
 #' below 10 mg: GGIR's pipeline applies these coefficients), `"high_error"`
 #' (attempted, error still 10 mg or more; coefficients kept, as GGIR keeps
-#' them), `"no_improvement"`, `"sphere_not_covered"`, `"no_rest"`,
+#' them), `"implausible"` (not applied: coefficients outside the ranges
+#' real devices show; not in compatible mode, which applies what GGIR
+#' applies), `"no_improvement"`, `"sphere_not_covered"`, `"no_rest"`,
 #' `"too_short"` and `"diverged"`, the last five with identity
 #' coefficients.
 #'
@@ -199,7 +201,10 @@ split_dots <- function(dots, table) {
 
 # Plausible coefficient ranges; wider than those seen across devices
 # (scale 0.83-1.13, offset -0.13 to 0.41 g; METHODS.md, van Hees 2014).
-plausible <- list(scale = c(0.7, 1.3), cross = 0.2, offset = 0.6)
+# Wider than what METHODS.md reports across real devices (scale 0.83-1.13,
+# offset -0.13 to 0.41 g, temperature -0.014 to 0.017 g per degree C), so
+# that only coefficients no real sensor needs are refused.
+plausible <- list(scale = c(0.7, 1.3), cross = 0.2, offset = 0.6, temp = 0.05)
 
 # A fit that does not lower the error or whose coefficients are implausible
 # is not applied: identity coefficients and a status that says why.

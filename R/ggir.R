@@ -556,6 +556,13 @@ drop_temperature <- function(read) {
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.
+ggir_plausible <- function(scale, offset, tempoffset) {
+  to <- if (length(tempoffset)) tempoffset else 0
+  all(is.finite(c(scale, offset, to))) &&
+    all(scale >= plausible$scale[1] & scale <= plausible$scale[2]) &&
+    all(abs(offset) <= plausible$offset) && all(abs(to) <= plausible$temp)
+}
+
 ggir_fit <- function(res, compat, call, minloadcrit) {
   info <- attr(res, "gravcal")
   attr(res, "gravcal") <- NULL
@@ -587,6 +594,16 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
       "calibration is %.2f mg (GGIR accepts < 10 mg)"), 1000 * res$cal.error.end),
     too_short = "fewer distinct 10 s windows than the procedure needs",
     diverged = "the fit did not stay finite", "")
+  # gravcal's own mode does not apply coefficients outside the ranges real
+  # devices show (GGIR, and so compatible mode, applies them)
+  if (!compat && status %in% c("ok", "high_error") &&
+      !ggir_plausible(res$scale, res$offset, res$tempoffset)) {
+    status <- "implausible"
+    detail <- paste0("calibration not applied: coefficients outside plausible ",
+                     "ranges (scale ", plausible$scale[1], "-", plausible$scale[2],
+                     ", |offset| <= ", plausible$offset, " g, |temperature offset| <= ",
+                     plausible$temp, " g per degree C)")
+  }
   applied <- status %in% c("ok", "high_error")
   fit <- new_fit(
     K = if (applied) diag(res$scale, 3) else diag(3),

@@ -240,3 +240,23 @@ test_that("write_ggir_coefs() refuses what GGIR cannot use", {
   expect_error(write_ggir_coefs(list(rec.csv = "x"), f), "gravcal_fit|g.calibrate")
   expect_false(file.exists(f))
 })
+
+test_that("GGIR method: implausible coefficients are not applied (gravcal's mode)", {
+  # a sensor whose x axis reads 1 / 1.4 of the truth: the fit needs a scale
+  # of 1.4, beyond what real devices show (METHODS.md: 0.83-1.13)
+  r <- simulate_recording(hours = 30, sf = 10, seed = 61,
+                          params = c(1.4, 1, 1, 0, 0, 0, 0, 0, 0))
+  f <- calibrate(r, sf = 10, method = "ggir")
+  expect_identity_fit(f, "implausible")
+  expect_match(f$message, "plausible ranges")
+  expect_identical(apply_calibration(r, f)$x, r$x)
+  # compatible mode applies what GGIR applies
+  fc <- calibrate(r, sf = 10, method = "ggir", ggir_compat = TRUE)
+  expect_true(fc$status %in% c("ok", "high_error"))
+  expect_gt(fc$K[1, 1], 1.3)
+  # the plausible ranges themselves
+  expect_true(gravcal:::ggir_plausible(c(1.1, 0.9, 1), c(0.4, -0.1, 0), c(0.01, 0, 0)))
+  expect_false(gravcal:::ggir_plausible(c(1, 1, 1), c(0.7, 0, 0), NULL))
+  expect_false(gravcal:::ggir_plausible(c(1, 1, 1), c(0, 0, 0), c(0, 0.06, 0)))
+  expect_false(gravcal:::ggir_plausible(c(1, NA, 1), c(0, 0, 0), NULL))
+})
