@@ -54,12 +54,13 @@
 #'   corrected procedure (`FALSE`, default).
 #' @param ... For the lightweight method, arguments passed on to
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
-#'   `chunk_size`, `progress`), [select_points()] (`per_bin`, `min_per_bin`,
+#'   `chunk_size`, `progress`, `reader`), [select_points()] (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
 #'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`). For the GGIR method:
 #'   `use_temp` (fit the temperature term when there is one, default TRUE),
 #'   `spherecrit` (0.3 g), `minloadcrit` (168 h), `chunksize` (1, about 12 h
-#'   blocks), `max_sd` (0.013 g), `max_iter` (1000), `tol` (1e-10) and
+#'   blocks), `max_sd` (0.013 g), `max_iter` (1000), `tol` (1e-10),
+#'   `reader` (`"native"` or `"reference"`, see [rest_windows()]) and
 #'   `verbose`.
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
@@ -79,7 +80,8 @@
 #' and window statistics identical, to the last bit, to those of
 #' `GGIR::g.calibrate()` 3.3 on the same samples (the window statistics use
 #' R's arithmetic, the fit R's own least-squares routine). gravcal's default differs
-#' from GGIR in four places, each where GGIR's behaviour is an accident:
+#' from GGIR in five places, each where GGIR's behaviour is an accident or
+#' costs time for nothing:
 #' 1. The fit runs to convergence (no parameter moves by more than `tol`).
 #'    GGIR stops when its residual statistic, divided by the sum of the
 #'    weights, changes by less than 1e-10, usually after 5-10 iterations;
@@ -96,6 +98,13 @@
 #'    idle-sleep zeros keeps its value. (GGIR re-reads stale leftovers when a
 #'    block ends exactly on an hour, drops a block shorter than an hour, and
 #'    overwrites that sample with the one before it.)
+#' 5. Time grows linearly with the recording. GGIR refits on all windows
+#'    after every block once it has `minloadcrit` hours, so a recording that
+#'    never reaches the error target costs time that grows with its square.
+#'    gravcal decides whether to read on with a fit that stops as GGIR's
+#'    does (a few iterations), refits only once the window table has grown
+#'    by a quarter, and fits to convergence for the result it returns; it
+#'    may therefore read up to a quarter more than GGIR before it stops.
 #'
 #' Window statistics in compatible mode are computed in GGIR's arithmetic
 #' (R's `cumsum()` and `sd()`, bit for bit) so that its exact-equality rules
@@ -135,7 +144,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   }
   args <- split_dots(list(...), list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
-                     "chunk_size", "progress"),
+                     "chunk_size", "progress", "reader"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
                      "use_sqrt", "tol", "trace", "difference")))
@@ -148,6 +157,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     f <- new_fit(points = points, method = method, status = status,
                  message = message, call = call)
     f$hours <- hours
+    f$input <- attr(w, "input")
     if (is.character(x)) f$file <- basename(x)
     finish_fit(f, rest)
   }
@@ -179,6 +189,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   fit$call <- call
   fit <- guard_fit(fit)
   fit$hours <- hours
+  fit$input <- attr(w, "input")
   if (is.character(x)) fit$file <- basename(x)
   finish_fit(fit, rest)
 }
@@ -313,6 +324,8 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
   cat("<gravcal_fit> ", x$method, " method, status: ", x$status, "\n",
       sep = "")
   if (nzchar(x$message)) cat("  ", x$message, "\n", sep = "")
+  inp <- format_input(x$input)
+  if (!is.null(inp)) cat("  input: ", inp, "\n", sep = "")
   np <- if (is.null(x$points)) 0L else nrow(x$points)
   nw <- if (is.null(x$windows)) NA else nrow(x$windows)
   cat(sprintf("  points: %d", np))

@@ -133,9 +133,11 @@ check_fit <- function(fit, arg = "fit") {
 # match.arg() with an error that names the argument and the choices: `x` is
 # the caller's argument `arg`, whose default in the caller's signature is the
 # vector of choices (the first is the default).
-match_choice <- function(x, arg) {
-  caller <- sys.function(sys.parent())
-  choices <- eval(formals(caller)[[arg]], envir = parent.frame())
+match_choice <- function(x, arg, choices = NULL) {
+  if (is.null(choices)) {
+    caller <- sys.function(sys.parent())
+    choices <- eval(formals(caller)[[arg]], envir = parent.frame())
+  }
   if (identical(x, choices)) return(choices[1])
   if (!is.character(x) || length(x) != 1 || is.na(x) || !x %in% choices) {
     abort("`", arg, "` must be one of ", paste0("\"", choices, "\"", collapse = ", "),

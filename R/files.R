@@ -37,8 +37,13 @@
 #'   `status` (see [calibrate()]), `k_xx` ... `o_z` (the model's nine
 #'   parameters, as `coef()` of a fit gives them), `t_x`, `t_y`, `t_z`
 #'   (temperature terms), `meantemp`, `error_before_mg`, `error_after_mg`
-#'   (on the rest points used), `seconds` (time taken) and `error` (why a
-#'   recording failed, else empty). The fits are in `attr(, "fits")`.
+#'   (on the rest points used); what the file's reader did: `reader`
+#'   (`"native"` or `"reference"`), `samples` read, `skipped` (units its
+#'   decoder could not use: damaged blocks, pages, records or lines),
+#'   `gaps` and `gap_seconds` (jumps in time), `truncated` and `read_notes`
+#'   (the first problems, where they were); `seconds` (time taken) and
+#'   `error` (why a recording failed, else empty). The fits are in
+#'   `attr(, "fits")`.
 #' @seealso [cli()] for batch scripts.
 #' @export
 #' @examples
@@ -161,7 +166,10 @@ calibrate_one <- function(file, method, args) {
 cohort_row <- function(file, fit, err, seconds) {
   cf <- if (is.null(fit)) rep(NA_real_, 12) else unname(stats::coef(fit))
   names(cf) <- c(param_names(), "t_x", "t_y", "t_z")
-  format <- tryCatch(open_source_format(file), error = function(e) NA_character_)
+  format <- tryCatch(file_format(file), error = function(e) NA_character_)
+  num <- function(v) if (is.null(v)) NA_real_ else as.numeric(v)
+  inp <- if (is.null(fit)) NULL else fit$input
+  rep <- inp$report
   data.frame(
     file = basename(file), format = format,
     hours = if (is.null(fit)) NA_real_ else fit_hours(fit),
@@ -172,17 +180,18 @@ cohort_row <- function(file, fit, err, seconds) {
     meantemp = if (is.null(fit)) NA_real_ else as.numeric(fit$meantemp),
     error_before_mg = if (is.null(fit)) NA_real_ else 1000 * fit$error_before,
     error_after_mg = if (is.null(fit)) NA_real_ else 1000 * fit$error_after,
+    # what the reader read and skipped (native decoders)
+    reader = if (is.null(inp$reader)) NA_character_ else inp$reader,
+    samples = num(inp$samples),
+    skipped = num(rep$skipped), gaps = num(rep$gaps),
+    gap_seconds = num(rep$gap_seconds),
+    truncated = if (is.null(rep)) NA else isTRUE(rep$truncated),
+    read_notes = if (length(rep$notes)) paste(rep$notes, collapse = "; ") else "",
     seconds = seconds, error = err, stringsAsFactors = FALSE)
 }
 
 fit_hours <- function(fit) {
   if (is.null(fit$hours)) NA_real_ else as.numeric(fit$hours)
-}
-
-open_source_format <- function(file) {
-  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(file)))
-  switch(ext, csv = , "csv.gz" = "csv", rds = "rds", gt3x = "ActiGraph gt3x",
-         cwa = "Axivity cwa", bin = "GENEActiv bin", ext)
 }
 
 # Run worker(i, progressor) for every i in todo: future.apply when

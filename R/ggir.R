@@ -15,6 +15,31 @@
 #      block, and the last sample before a run of idle-sleep zeros keeps its
 #      own value (GGIR overwrites it with the sample before it).
 
+# GGIR's constants, each with where it comes from (van Hees et al. 2014,
+# doi:10.1152/jappphysiol.00421.2014; GGIR 3.3 g.calibrate, g.part1 and
+# load_params). Every rule of the procedure takes its number from here.
+ggir_constants <- list(
+  window = 10,            # s, window length (paper; GGIR's calibEpochSize)
+  max_sd = 0.013,         # g, rest: sd of every axis below (paper: 13 mg)
+  max_abs_mean = 2,       # g, rest: |mean| of every axis below (clipping guard)
+  min_rest = 10,          # rest windows needed to try a fit (g.calibrate)
+  spherecrit = 0.3,       # g, each axis needs rest means beyond -+ this
+  minloadcrit = 168,      # h, read at least this much before stopping (load_params)
+  enough_offset = 21,     # GGIR's "enough data" test: windows > minloadcrit - 21
+  min_hours = 1,          # h, gravcal's own "enough data" (distinct windows)
+  max_error = 0.01,       # g, error after calibration accepted as done
+  error_digits = 5,       # errors rounded to 5 digits before comparing
+  temp_max_first = 120,   # temperature ignored when its first values exceed
+  temp_min_sd = 0.01,     # temperature ignored when its sd is below
+  temp_first_n = 10,      # how many first values are looked at
+  temp_missing = 99999,   # GGIR's fill for an unused temperature column
+  max_iter = 1000,        # ICP iterations (g.calibrate)
+  tol = 1e-10,            # ICP stopping tolerance (g.calibrate)
+  max_weight = 100,       # ICP weights capped at 1 / 0.01 (g.calibrate)
+  block_hours = 12,       # GGIR reads about 12 h per block (chunksize = 1)
+  refit_growth = 1.25     # gravcal's own mode: refit once the table grew by this
+)
+
 ggir_messages <- c(
   done = "recalibration done, no problems detected",
   done_no_temp = "recalibration done, but temperature values not used",
@@ -28,121 +53,58 @@ ggir_messages <- c(
                    "file or because file is corrupt")
 )
 
-# Remove idle-sleep samples (x = y = z = 0) from a block, as GGIR does.
-drop_zero_samples <- function(m, compat) {
-  z <- m[, 1] == 0 & m[, 2] == 0 & m[, 3] == 0
-  z[is.na(z)] <- FALSE
-  if (!any(z)) return(m)
-  last_zero <- z[length(z)]
-  m <- m[!z, , drop = FALSE]
-  n <- nrow(m)
-  if (compat && last_zero && n >= 2) m[n, 1:3] <- m[n - 1, 1:3]
-  m
+# GGIR's calibration error: mean | |a| - 1 | over the rest windows' means m
+# (n x 3) after calibration, in GGIR's arithmetic ((m + offset) / (1 /
+# scale), to the bit), rounded as GGIR rounds it.
+ggir_error <- function(m, scale, offset, tempoffset = NULL, temp = NULL,
+                       meantemp = 0) {
+  a <- lapply(1:3, function(k) {
+    v <- (m[, k] + offset[k]) / (1 / scale[k])
+    if (!is.null(temp)) v <- v + (temp - meantemp) / (1 / tempoffset[k])
+    v
+  })
+  e <- sqrt(a[[1]]^2 + a[[2]]^2 + a[[3]]^2)
+  round(mean(abs(e - 1)), digits = ggir_constants$error_digits)
 }
 
-# The procedure handles a block as a list of "pieces": ranges [from, to)
+# A block of samples is handled as a list of "pieces": ranges [from, to)
 # (0-based) of columns x, y, z and t (temperature, or NULL) that stay where
-# they are (the caller's vectors for data in memory, the reader's for files),
-# so that no sample is copied on the way to the segmenter. Only the samples
-# carried from one block to the next (less than an hour) are copied.
+# they are (the caller's vectors for data in memory, the reader's for
+# files), so that no sample is copied on the way to the core.
 piece <- function(x, y, z, t, from, to) {
   list(x = x, y = y, z = z, t = t, from = from, to = to)
 }
 
-pieces_n <- function(P) {
-  n <- 0
-  for (p in P) n <- n + (p$to - p$from)
-  n
-}
-
-# The first n rows.
-pieces_head <- function(P, n) {
-  out <- list()
-  for (p in P) {
-    if (n <= 0) break
-    k <- min(n, p$to - p$from)
-    p$to <- p$from + k
-    out[[length(out) + 1]] <- p
-    n <- n - k
+# A block from a source as a list of pieces (see open_source() for its
+# forms: parts read by a native decoder, columns in memory, or a data frame).
+block_pieces <- function(blk, temp) {
+  if (!is.null(blk$parts)) {
+    return(lapply(blk$parts, function(b) {
+      cl <- b$cols
+      piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, b$from, b$to)
+    }))
   }
-  out
-}
-
-# All but the first n rows.
-pieces_drop <- function(P, n) {
-  out <- list()
-  for (p in P) {
-    len <- p$to - p$from
-    if (n >= len) {
-      n <- n - len
-      next
-    }
-    p$from <- p$from + n
-    n <- 0
-    out[[length(out) + 1]] <- p
-  }
-  out
-}
-
-pieces_col <- function(P, col) {
-  v <- lapply(P, function(p) p[[col]][seq.int(p$from + 1, length.out = p$to - p$from)])
-  as.double(unlist(v, use.names = FALSE))
-}
-
-# One piece holding copies of the rows.
-pieces_own <- function(P) {
-  if (!length(P)) return(list())
-  temp <- !is.null(P[[1]]$t)
-  list(piece(pieces_col(P, "x"), pieces_col(P, "y"), pieces_col(P, "z"),
-             if (temp) pieces_col(P, "t"), 0, pieces_n(P)))
-}
-
-pieces_matrix <- function(P) {
-  temp <- length(P) && !is.null(P[[1]]$t)
-  m <- cbind(pieces_col(P, "x"), pieces_col(P, "y"), pieces_col(P, "z"))
-  if (temp) m <- cbind(m, pieces_col(P, "t"))
-  m
-}
-
-pieces_zeros <- function(P) {
-  n <- 0
-  for (p in P) n <- n + gc_count_zero(p$x, p$y, p$z, p$from, p$to)
-  n
-}
-
-# c(mean, sd, n) of the temperature of the first `limit` rows, as R's mean()
-# and sd() with na.rm = TRUE give them.
-pieces_temp_stats <- function(P, limit) {
-  gc_r_mean_sd(lapply(P, `[[`, "t"), vapply(P, `[[`, 0, "from"),
-               vapply(P, `[[`, 0, "to"), limit)
-}
-
-# Is the sd of the temperature of the first `limit` rows below `threshold`
-# (R's sd(, na.rm = TRUE) decides)? NA with fewer than 2 values.
-pieces_sd_below <- function(P, limit, threshold) {
-  gc_sd_below(lapply(P, `[[`, "t"), vapply(P, `[[`, 0, "from"),
-              vapply(P, `[[`, 0, "to"), limit, threshold)
-}
-
-# A block from a source as a piece (see open_source() for the two forms).
-block_piece <- function(blk, temp) {
   if (!is.null(blk$cols)) {
     cl <- blk$cols
-    return(piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, blk$from, blk$to))
+    return(list(piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, blk$from,
+                      blk$to)))
   }
   d <- blk$data
   col <- function(v) {
     if (!is.numeric(v)) abort("The recording has a non-numeric acceleration or temperature column.")
     as.double(v)
   }
-  piece(col(d$x), col(d$y), col(d$z), if (temp) col(d$temperature), 0, nrow(d))
+  list(piece(col(d$x), col(d$y), col(d$z), if (temp) col(d$temperature), 0,
+             nrow(d)))
 }
 
 block_rows <- function(blk) {
+  if (!is.null(blk$parts)) return(sum(vapply(blk$parts, `[[`, 0, "to")))
   if (!is.null(blk$cols)) blk$to - blk$from else NROW(blk$data)
 }
 
 block_has_temp <- function(blk) {
+  if (!is.null(blk$parts)) return(!is.null(blk$parts[[1]]$cols$temperature))
   if (!is.null(blk$cols)) !is.null(blk$cols$temperature) else
     "temperature" %in% names(blk$data)
 }
@@ -152,16 +114,36 @@ ggir_feature_names <- function(temp) {
     if (temp) "temperature")
 }
 
+# GGIR's temperature checks on a block's used samples (the block rules give
+# R's mean of the first 10 and sd of all): FALSE, with a warning, when the
+# temperature cannot be used.
+ggir_temperature_usable <- function(r) {
+  k <- ggir_constants
+  why <- if (isTRUE(r$first_mean > k$temp_max_first)) {
+    "its first values exceed 120 (not degrees C?)"
+  } else if (is.na(r$temp_sd)) {
+    "it has fewer than 2 values"
+  } else if (r$temp_sd < k$temp_min_sd) {
+    "it does not vary (sd < 0.01)"
+  }
+  if (is.null(why)) return(TRUE)
+  warning("temperature not used for calibration: ", why, call. = FALSE)
+  FALSE
+}
+
 # Run the procedure on a source (see open_source()). Returns GGIR's list plus,
 # in attribute "gravcal", what calibrate() needs.
-ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
-                     sdcriter = 0.013, verbose = FALSE, printsummary = FALSE,
-                     max_iter = 1000, tol = 1e-10) {
+ggir_run <- function(src, compat = TRUE,
+                     spherecrit = ggir_constants$spherecrit,
+                     minloadcrit = ggir_constants$minloadcrit,
+                     sdcriter = ggir_constants$max_sd, verbose = FALSE,
+                     printsummary = FALSE, max_iter = ggir_constants$max_iter,
+                     tol = ggir_constants$tol) {
   sf <- src$sf
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
-  S <- list()
   feats <- list()
+  rests <- list()  # the core's rest flag of each window (GGIR's rule)
   n_feat <- 0
   use.temp <- temp.available <- FALSE
   scale <- c(1, 1, 1)
@@ -177,116 +159,107 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
   meantemp <- 0
   blocks <- 0
   pending <- FALSE
+  next_fit <- 0
+  n_read <- 0
+  rule_par <- c(sdcriter, ggir_constants$max_abs_mean)
+  runner <- NULL
+  # The next block through GGIR's block rules (ggir_blocks.hpp) into the
+  # segmenter: from a native decoder without R vectors, else from the
+  # source's columns. NULL when the source has no more blocks.
+  feed <- function(i) {
+    if (!is.null(src$native)) {
+      temp <- isTRUE(src$temperature)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      r <- gc_blocks_decode(runner, src$native$ptr, src$block_units, 1L, rule_par)
+    } else {
+      blk <- src$read(i)
+      if (is.null(blk)) return(NULL)
+      temp <- block_has_temp(blk)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      P <- block_pieces(blk, temp)
+      r <- gc_blocks_columns(runner, lapply(P, `[[`, "x"), lapply(P, `[[`, "y"),
+                             lapply(P, `[[`, "z"), lapply(P, function(p) p$t),
+                             vapply(P, `[[`, 0, "from"), vapply(P, `[[`, 0, "to"),
+                             1L, rule_par)
+      r$done <- isTRUE(blk$last)
+    }
+    r$temperature <- temp
+    r
+  }
   i <- 1
   repeat {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
-    if (i > 1 && isTRUE(src$from_file)) {
+    if (i > 1 && isTRUE(src$from_file) && is.null(src$native)) {
       # the previous block is garbage now: collect it before reading the
       # next, so that memory stays at about one block
-      blk <- NULL
       invisible(gc(full = TRUE))
     }
-    blk <- src$read(i)
-    if (!is.null(blk)) {
-      nr <- block_rows(blk)
-      if (nr == 0) {
-        blk <- NULL
-      } else if (nr < per_hour * 2 + 1) {
+    r <- feed(i)
+    present <- !is.null(r) && r$rows > 0
+    last <- !present || isTRUE(r$done) ||
+      (!is.null(src$short_block) && src$short_block(r$rows))
+    if (present) {
+      n_read <- n_read + r$rows
+      if (r$rows < per_hour * 2 + 1) {
         # GGIR: a short block is the last one; a short first block means the
         # file is too short to use
-        blk$last <- TRUE
-        if (i == 1) blk <- NULL
+        last <- TRUE
+        if (i == 1) present <- FALSE
       }
     }
-    last <- is.null(blk) || isTRUE(blk$last)
-    if (i == 1) {
-      use.temp <- temp.available <- !is.null(blk) && block_has_temp(blk)
-    }
+    if (i == 1) use.temp <- temp.available <- present && r$temperature
     added <- FALSE
-    if (!is.null(blk)) {
-      P <- c(S, list(block_piece(blk, temp.available)))
-      if (pieces_zeros(P) > 0) {
-        # idle-sleep samples: GGIR's removal, on a copy of this block
-        m <- drop_zero_samples(pieces_matrix(P), compat)
-        P <- list(piece(m[, 1], m[, 2], m[, 3],
-                        if (temp.available) m[, 4], 0, nrow(m)))
-        rm(m)
+    if (present && r$used > 0) {
+      if (use.temp) use.temp <- ggir_temperature_usable(r)
+      w <- r$windows
+      f <- cbind(w$mean_norm, w$mean_x, w$mean_y, w$mean_z, w$sd_x, w$sd_y,
+                 w$sd_z)
+      if (temp.available) {
+        f <- cbind(f, if (use.temp) w$temperature else ggir_constants$temp_missing)
       }
-      LD <- pieces_n(P)
-      use <- floor(LD / per_hour) * per_hour
-      if (use > 0) {
-        if (use != LD) {
-          S <- pieces_own(pieces_drop(P, use))
-        } else if (!compat) {
-          S <- list()
-        }
-        P <- pieces_head(P, use)
-        if (use.temp) {
-          first10 <- pieces_temp_stats(P, 10)[1]
-          if (isTRUE(first10 > 120)) {
-            warning("temperature not used for calibration: its first values ",
-                    "exceed 120 (not degrees C?)", call. = FALSE)
-            use.temp <- FALSE
-          } else {
-            flat <- pieces_sd_below(P, use, 0.01)
-            if (is.na(flat)) {
-              warning("temperature not used for calibration: it has fewer ",
-                      "than 2 values", call. = FALSE)
-              use.temp <- FALSE
-            } else if (flat) {
-              warning("temperature not used for calibration: it does not vary ",
-                      "(sd < 0.01)", call. = FALSE)
-              use.temp <- FALSE
-            }
-          }
-        }
-        gc_segmenter_new_block(seg)
-        ws <- lapply(P, function(p) {
-          gc_segmenter_push(seg, p$x, p$y, p$z, if (use.temp) p$t, p$from,
-                            p$to, 1L, c(sdcriter, 2))
-        })
-        wcol <- function(name) unlist(lapply(ws, `[[`, name), use.names = FALSE)
-        f <- cbind(wcol("mean_norm"), wcol("mean_x"), wcol("mean_y"),
-                   wcol("mean_z"), wcol("sd_x"), wcol("sd_y"), wcol("sd_z"))
-        if (temp.available) {
-          f <- cbind(f, if (use.temp) wcol("temperature") else 99999)
-        }
-        rm(ws, P)
-        n_feat <- n_feat + nrow(f)
-        feats[[length(feats) + 1]] <- f
-        added <- TRUE
-        blocks <- blocks + 1
-        # memory in use after the block, as GGIR records it (a minor
-        # collection: GGIR's full one costs more than the block itself)
-        mem <- gc(full = FALSE)[2, 2]
-        bsc_qc <- rbind(bsc_qc, data.frame(time = format(Sys.time()),
-                                           size = mem,
-                                           stringsAsFactors = FALSE))
-      } else if (!compat) {
-        S <- pieces_own(P)
-      }
+      rests[[length(rests) + 1]] <- as.logical(w$rest)
+      n_feat <- n_feat + nrow(f)
+      feats[[length(feats) + 1]] <- f
+      added <- TRUE
+      blocks <- blocks + 1
+      # memory in use after the block, as GGIR records it (a minor
+      # collection: GGIR's full one costs more than the block itself)
+      mem <- gc(full = FALSE)[2, 2]
+      bsc_qc <- rbind(bsc_qc, data.frame(time = format(Sys.time()),
+                                         size = mem,
+                                         stringsAsFactors = FALSE))
     }
+    rm(r)
     stop_loading <- FALSE
     # GGIR fits after every block, but only the fit after the last block, or
     # one that can stop the loading (more than minloadcrit hours), decides
     # the result: the others are skipped (the window table only grows, so
     # the last fit is the same either way).
+    # gravcal's own mode refits before the last block only once the window
+    # table has grown by a quarter since the previous fit: the fits then
+    # cost a bounded multiple of the last one, so time grows linearly with
+    # the recording even when the error target is never reached (GGIR
+    # refits after every block, which grows with its square).
     due <- added || i == 1
-    if (due && !last && n_feat * 10 / 3600 <= minloadcrit) {
+    if (due && !last && (n_feat * 10 / 3600 <= minloadcrit ||
+                         (!compat && n_feat < next_fit))) {
       pending <- TRUE
       due <- FALSE
     }
     if (last && pending) due <- TRUE
     if (due) {
       pending <- FALSE
+      next_fit <- n_feat * ggir_constants$refit_growth
       spherepopulated <- FALSE
       ft <- if (length(feats)) do.call(rbind, feats) else
         matrix(numeric(0), 0, if (temp.available) 8 else 7)
       # ft_id: the window's number in the recording (GGIR's row names)
       ft_id <- seq_len(nrow(ft))
+      ft_rest <- unlist(rests, use.names = FALSE)
       keep <- !is.na(ft[, 4]) & !is.na(ft[, 1])
       ft <- ft[keep, , drop = FALSE]
       ft_id <- ft_id[keep]
+      ft_rest <- ft_rest[keep]
       n <- nrow(ft)
       if (n > 1) {
         same <- rowSums(ft[1:(n - 1), 2:7, drop = FALSE] == ft[2:n, 2:7, drop = FALSE])
@@ -294,26 +267,29 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
         if (length(cut)) {
           ft <- ft[-cut, , drop = FALSE]
           ft_id <- ft_id[-cut]
+          ft_rest <- ft_rest[-cut]
         }
       }
       nhoursused <- 0
-      enough <- if (compat) nrow(ft) > (minloadcrit - 21) else nrow(ft) >= 360
+      enough <- if (compat) {
+        nrow(ft) > (minloadcrit - ggir_constants$enough_offset)
+      } else {
+        nrow(ft) * ggir_constants$window >= ggir_constants$min_hours * 3600
+      }
       if (enough) {
         nhoursused <- (nrow(ft) * 10) / 3600
         ft <- ft[-1, , drop = FALSE]
         ft_id <- ft_id[-1]
-        nomovement <- which(ft[, 5] < sdcriter & ft[, 6] < sdcriter &
-                              ft[, 7] < sdcriter & abs(ft[, 2]) < 2 &
-                              abs(ft[, 3]) < 2 & abs(ft[, 4]) < 2)
-        if (length(nomovement) < 10) {
+        nomovement <- which(ft_rest[-1])
+        if (length(nomovement) < ggir_constants$min_rest) {
           QC <- ggir_messages[["no_rest"]]
           ft <- NULL
         } else {
           ft <- ft[nomovement, , drop = FALSE]
           ft_id <- ft_id[nomovement]
           npoints <- nrow(ft)
-          e <- sqrt(ft[, 2]^2 + ft[, 3]^2 + ft[, 4]^2)
-          cal.error.start <- round(mean(abs(e - 1)), digits = 5)
+          cal.error.start <- ggir_error(ft[, 2:4, drop = FALSE], c(1, 1, 1),
+                                        c(0, 0, 0))
           tel <- 0
           for (a in 2:4) {
             if (min(ft[, a]) < -spherecrit && max(ft[, a]) > spherecrit) tel <- tel + 1
@@ -326,22 +302,30 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
       }
       if (spherepopulated) {
         temp <- if (use.temp) ft[, 8] else NULL
-        icp <- gc_fit_icp(ft[, 2], ft[, 3], ft[, 4], temp, use.temp,
-                          if (compat) 0L else 1L, as.integer(max_iter), tol,
-                          100, FALSE)
+        fit_ft <- function(rule) {
+          r <- gc_fit_icp(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
+                          as.integer(max_iter), tol,
+                          ggir_constants$max_weight, FALSE)
+          r$meantemp <- if (use.temp) r$meantemp else 0
+          r$error <- ggir_error(ft[, 2:4, drop = FALSE], r$scale, r$offset,
+                                r$tempoffset, temp, r$meantemp)
+          r
+        }
+        judge <- function(r) {
+          r$error < cal.error.start && r$error < ggir_constants$max_error &&
+            nhoursused > minloadcrit
+        }
+        # compatible mode fits as GGIR does; gravcal's own mode decides
+        # whether to read on with GGIR's cheap early stop, and fits to
+        # convergence only for a result it keeps
+        icp <- fit_ft(if (compat) "ggir_r" else if (last) "converge" else "ggir")
+        if (!compat && !last && judge(icp)) icp <- fit_ft("converge")
         scale <- icp$scale
         offset <- icp$offset
         tempoffset <- icp$tempoffset
-        meantemp <- if (use.temp) icp$meantemp else 0
-        a <- lapply(1:3, function(k) {
-          v <- (ft[, k + 1] + offset[k]) / (1 / scale[k])
-          if (use.temp) v <- v + (temp - meantemp) / (1 / tempoffset[k])
-          v
-        })
-        e <- sqrt(a[[1]]^2 + a[[2]]^2 + a[[3]]^2)
-        cal.error.end <- round(mean(abs(e - 1)), digits = 5)
-        if (cal.error.end < cal.error.start && cal.error.end < 0.01 &&
-            nhoursused > minloadcrit) {
+        meantemp <- icp$meantemp
+        cal.error.end <- icp$error
+        if (judge(icp)) {
           QC <- if (use.temp == temp.available) ggir_messages[["done"]] else
             ggir_messages[["done_no_temp"]]
           stop_loading <- TRUE
@@ -357,6 +341,7 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
     if (last || stop_loading) break
     i <- i + 1
   }
+  check_source_read(src, n_read)
   if (length(cal.error.end) > 0 && cal.error.end > cal.error.start) {
     QC <- ggir_messages[["no_decrease"]]
   }
@@ -389,6 +374,7 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
               nhoursused = nhoursused, QCmessage = QC, use.temp = use.temp,
               meantempcal = meantempcal, bsc_qc = bsc_qc)
   attr(out, "gravcal") <- list(icp = icp, meantemp = meantemp, blocks = blocks,
+                               input = source_input(src, n_read),
                                temp.available = temp.available,
                                windows = n_feat)
   out
@@ -425,8 +411,12 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
 #' the sampling rate given as `sf = ` in `...` (or from a `time` column).
 #'
 #' Formats: ActiGraph csv exports, csv files with `x`, `y`, `z` columns,
-#' `.rds` data frames, ActiGraph `.gt3x` (package read.gt3x), Axivity `.cwa`
-#' and GENEActiv `.bin` (package GGIRread, the readers GGIR uses).
+#' `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
+#' `.bin`. They are read by gravcal's own decoders, which give what GGIR's
+#' readers give (GGIRread's resampling of `.cwa` included), block by block
+#' as GGIR reads them, in bounded memory; a damaged file keeps its good
+#' samples where GGIR's readers stop. `reader = "reference"` in `...` reads
+#' through GGIR's readers themselves (GGIRread, read.gt3x, data.table).
 #'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
@@ -439,8 +429,9 @@ ggir_run <- function(src, compat = TRUE, spherecrit = 0.3, minloadcrit = 168,
 #'   `sf` is used.
 #' @param verbose Print progress (the blocks read) as GGIR does.
 #' @param ... Legacy arguments that override the parameter lists, as in
-#'   GGIR (`chunksize`, `spherecrit`, `minloadcrit`, `printsummary`), and
-#'   `sf` for a data frame.
+#'   GGIR (`chunksize`, `spherecrit`, `minloadcrit`, `printsummary`), `sf`
+#'   for a data frame, and `reader` (`"native"`, the default, or
+#'   `"reference"`).
 #' @return GGIR's list: `scale`, `offset`, `tempoffset` (empty when no fit
 #'   ran), `cal.error.start`, `cal.error.end` (rounded to 5 digits),
 #'   `spheredata` (the rest windows: `Euclidean Norm, meanx, meany, meanz,
@@ -470,12 +461,13 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     sf <- inspectfileobject$sf
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
-  src <- open_source(datafile, sf = sf, chunksize = pr$chunksize)
+  src <- open_source(datafile, sf = sf, chunksize = pr$chunksize,
+                     reader = pr$reader, compat = TRUE)
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor)
   sdcriter <- if (identical(src$format, "csv") && !is.null(pr$rmc.noise)) {
     pr$rmc.noise * 1.2
   } else {
-    0.013
+    ggir_constants$max_sd
   }
   out <- ggir_run(src, compat = TRUE, spherecrit = pr$spherecrit,
                   minloadcrit = pr$minloadcrit,
@@ -487,8 +479,10 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
 
 # GGIR's parameters with defaults; legacy arguments in `dots` win.
 ggir_params <- function(params_rawdata, dots) {
-  p <- list(chunksize = 1, spherecrit = 0.3, minloadcrit = 168,
-            printsummary = FALSE, rmc.noise = NULL, rmc.sf = NULL)
+  p <- list(chunksize = 1, spherecrit = ggir_constants$spherecrit,
+            minloadcrit = ggir_constants$minloadcrit,
+            printsummary = FALSE, rmc.noise = NULL, rmc.sf = NULL,
+            reader = "native")
   if (length(params_rawdata)) {
     if (!is.list(params_rawdata)) {
       abort("`params_rawdata` must be a list (as from GGIR::load_params()), ",
@@ -518,10 +512,13 @@ ggir_params <- function(params_rawdata, dots) {
 calibrate_ggir <- function(x, sf, compat, dots, call) {
   args <- split_dots(dots, list(ggir = c(
     "use_temp", "spherecrit", "minloadcrit", "chunksize", "max_sd",
-    "max_iter", "tol", "verbose")))$ggir
-  a <- utils::modifyList(list(use_temp = TRUE, spherecrit = 0.3,
-                              minloadcrit = 168, chunksize = 1, max_sd = 0.013,
-                              max_iter = 1000, tol = 1e-10, verbose = FALSE),
+    "max_iter", "tol", "verbose", "reader")))$ggir
+  k <- ggir_constants
+  a <- utils::modifyList(list(use_temp = TRUE, spherecrit = k$spherecrit,
+                              minloadcrit = k$minloadcrit, chunksize = 1,
+                              max_sd = k$max_sd, max_iter = k$max_iter,
+                              tol = k$tol, verbose = FALSE,
+                              reader = "native"),
                          args)
   check_flag(a$use_temp, "use_temp")
   check_number(a$spherecrit, "spherecrit", min = 0)
@@ -535,8 +532,12 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
       !("time" %in% tolower(colnames(x)))) {
     abort("`sf` (sampling frequency in Hz) is missing.")
   }
-  src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x")
-  if (!a$use_temp) src$read <- drop_temperature(src$read)
+  src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
+                     reader = a$reader, compat = compat)
+  if (!a$use_temp) {
+    src$read <- drop_temperature(src$read)
+    src$temperature <- FALSE
+  }
   res <- ggir_run(src, compat = compat, spherecrit = a$spherecrit,
                   minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
                   verbose = a$verbose, max_iter = a$max_iter, tol = a$tol)
@@ -550,6 +551,7 @@ drop_temperature <- function(read) {
   function(i) {
     b <- read(i)
     if (!is.null(b$cols)) b$cols$temperature <- NULL
+    for (k in seq_along(b$parts)) b$parts[[k]]$cols$temperature <- NULL
     if (!is.null(b$data)) b$data$temperature <- NULL
     b
   }
@@ -579,7 +581,7 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
   icp <- info$icp
   status <- switch(key,
     done = , done_no_temp = "ok",
-    attempted = if (!is.null(res$cal.error.end) && res$cal.error.end < 0.01) "ok" else "high_error",
+    attempted = if (!is.null(res$cal.error.end) && res$cal.error.end < ggir_constants$max_error) "ok" else "high_error",
     no_decrease = "no_improvement",
     no_sphere = "sphere_not_covered",
     no_rest = "no_rest",
@@ -620,6 +622,7 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
   fit$ggir_compat <- compat
   fit$use_temp <- isTRUE(res$use.temp)
   fit$n_windows <- info$windows
+  fit$input <- info$input
   fit$hours <- info$windows * 10 / 3600
   fit
 }

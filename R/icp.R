@@ -87,7 +87,7 @@ fit_icp <- function(w, use_temp = TRUE, ggir_compat = FALSE, max_iter = 1000,
   }
   r <- gc_fit_icp(as.double(w$mean_x), as.double(w$mean_y),
                   as.double(w$mean_z), temp, use_temp,
-                  if (ggir_compat) 0L else 1L, as.integer(max_iter), tol,
+                  if (ggir_compat) "ggir_r" else "converge", as.integer(max_iter), tol,
                   max_weight, trace)
   if (use_temp && !r$temp_used) {
     msg <- "temperature does not vary over the windows, so the temperature term was not fitted"

@@ -9,37 +9,60 @@
 #'   with or without time stamps; `sf` from the header), or a header line with
 #'   columns `x`, `y`, `z` and optionally `time` and `temperature`; `sf` from
 #'   `time` or the argument;
-#' * `.gt3x`: ActiGraph, through the read.gt3x package (a Suggests package);
-#'   idle-sleep gaps come back as zeros, which [rest_windows()] skips;
-#' * `.cwa` (Axivity) and `.bin` (GENEActiv), through the GGIRread package
-#'   (a Suggests package), with their temperature.
+#' * `.gt3x` (ActiGraph; current `log.bin` and older `activity.bin`
+#'   devices): idle-sleep gaps come back as zeros, which [rest_windows()]
+#'   skips;
+#' * `.cwa` (Axivity AX3 and AX6) and `.bin` (GENEActiv), with their
+#'   temperature.
+#'
+#' gravcal reads these device formats with its own decoders (C++, one pass
+#' through a fixed buffer). They keep every good sample of a damaged file
+#' and say what they skipped (corrupt blocks, bad checksums, malformed
+#' lines, a truncated end, jumps in time): see `input$report`. The samples
+#' are those the device stored, at their own times; GGIR's readers
+#' (`reader = "reference"`: GGIRread, read.gt3x, data.table, Suggests
+#' packages) resample Axivity files onto a regular grid and round GENEActiv
+#' values to single precision. [g.calibrate()] and
+#' `calibrate(ggir_compat = TRUE)` read exactly what GGIR reads.
 #'
 #' To calibrate a long recording, give its path to [calibrate()] or
 #' [rest_windows()] instead: they read it block by block, in bounded memory.
 #'
 #' @param file Path of the file.
 #' @param sf Sampling frequency in Hz, when the file does not give it.
+#' @param reader `"native"` (default): gravcal's own decoders for `.cwa`,
+#'   `.bin`, `.gt3x` and csv, which give the samples as the device stored
+#'   them and count what they had to skip; `"reference"`: the readers GGIR
+#'   uses (GGIRread, read.gt3x, data.table).
 #' @return A list with `data` (a data frame with `x`, `y`, `z` and, where the
-#'   file has them, `time` and `temperature`) and `sf`.
+#'   file has them, `time` and `temperature`), `sf` and `input` (for the
+#'   native reader: the samples read and what was skipped, and why).
 #' @export
 #' @examples
 #' rec <- read_recording(gravcal_example())
 #' rec$sf
 #' head(rec$data)
-read_recording <- function(file, sf = NULL) {
+read_recording <- function(file, sf = NULL, reader = c("native", "reference")) {
   if (!is.character(file) || length(file) != 1 || is.na(file)) {
     abort("`file` must be a single file path, not ", describe(file), ".")
   }
-  if (!file.exists(file)) abort("`file` does not exist: \"", file, "\".")
-  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(file)))
-  data <- switch(ext,
-    rds = readRDS(file),
-    csv = , "csv.gz" = if (is_actigraph_csv(file)) read_blocks(file, sf) else
-      utils::read.csv(file, stringsAsFactors = FALSE),
-    gt3x = read_gt3x_file(file),
-    cwa = , bin = read_blocks(file),
-    abort("`file` has an unsupported extension \".", ext, "\"; gravcal ",
-          "reads .rds, .csv, .csv.gz, .gt3x, .cwa and .bin."))
+  if (!file.exists(file) || dir.exists(file)) {
+    abort("`file` does not exist: \"", file, "\".")
+  }
+  reader <- match_choice(reader, "reader")
+  format <- file_format(file)
+  data <- NULL
+  if (reader == "native" && format %in% names(native_block_units)) {
+    data <- read_native(file, format, sf)
+  }
+  if (is.null(data)) {
+    data <- switch(format,
+      rds = readRDS(file),
+      actigraph_csv = read_blocks(file, sf, reader),
+      csv = utils::read.csv(file, stringsAsFactors = FALSE),
+      gt3x = read_gt3x_file(file),
+      cwa = , geneactiv = read_blocks(file, sf, reader))
+  }
   if (!is.data.frame(data)) {
     abort("`file` does not hold a data frame of samples: \"", file, "\".")
   }
@@ -53,7 +76,33 @@ read_recording <- function(file, sf = NULL) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
   check_sf(sf)
-  list(data = data, sf = sf)
+  list(data = data, sf = sf, input = attr(data, "input"))
+}
+
+# A whole file through its native decoder (raw samples, not resampled), time
+# as POSIXct; NULL when this build has no decoder for the format.
+read_native <- function(file, format, sf) {
+  opts <- list(compat = 0)
+  # a whole .gt3x read gives idle-sleep periods as zeros at their times, as
+  # read.gt3x(imputeZeroes = TRUE) does, to its last sample time; calibration
+  # skips them
+  if (format == "gt3x") opts <- list(compat = 1, impute_zeroes = 1)
+  if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  h <- gc_decoder_open(path.expand(file), format, opts)
+  if (is.null(h$ptr)) {
+    if (isTRUE(h$unsupported)) return(NULL)
+    native_open_error(file, format, h$error, "file")
+  }
+  gc_decoder_close(h$ptr)
+  d <- native_read_all(file, format, opts, time = TRUE)
+  if (!is.null(d$time)) d$time <- as.POSIXct(d$time, origin = "1970-01-01", tz = "UTC")
+  if (isTRUE(is.finite(attr(d, "sf")) && attr(d, "sf") > 0)) sf <- attr(d, "sf")
+  attr(d, "sf") <- sf
+  attr(d, "input") <- list(source = basename(file), format = format,
+                           reader = "native",
+                           serial = attr(d, "info")$serial,
+                           samples = nrow(d), report = attr(d, "report"))
+  d
 }
 
 is_actigraph_csv <- function(file) {
@@ -61,8 +110,8 @@ is_actigraph_csv <- function(file) {
 }
 
 # A whole .cwa, .bin or ActiGraph csv file, from its blocks.
-read_blocks <- function(file, sf = NULL) {
-  src <- open_source(file, sf = sf, arg = "file")
+read_blocks <- function(file, sf = NULL, reader = "reference") {
+  src <- open_source(file, sf = sf, arg = "file", reader = reader)
   parts <- list()
   i <- 1
   repeat {
@@ -161,7 +210,8 @@ ggir_rows_per_block <- function(sf, chunksize) {
   round((14512 * (sf / 50)) * (chunksize * 0.5)) * 300
 }
 
-open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile") {
+open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
+                        reader = "native", compat = TRUE) {
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -172,19 +222,23 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile") {
   if (!file.exists(datafile) || dir.exists(datafile)) {
     abort("`", arg, "` does not exist: \"", datafile, "\".")
   }
-  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(datafile)))
-  src <- switch(ext,
-    csv = , "csv.gz" = source_csv(datafile, sf, chunksize),
-    rds = {
-      rec <- read_recording(datafile, sf)
-      source_frame(rec$data, rec$sf, chunksize, arg)
-    },
-    gt3x = source_gt3x(datafile, chunksize),
-    cwa = source_cwa(datafile, chunksize),
-    bin = source_geneactiv(datafile, chunksize),
-    abort("`", arg, "` has an unsupported extension \".", ext, "\"; gravcal ",
-          "reads .csv (ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, ",
-          ".cwa and GENEActiv .bin."))
+  reader <- match_choice(reader, "reader", c("native", "reference"))
+  format <- file_format(datafile, arg)
+  src <- NULL
+  if (reader == "native" && format %in% names(native_block_units)) {
+    src <- source_native(datafile, format, sf, chunksize, compat, arg)
+  }
+  if (is.null(src)) {
+    src <- switch(format,
+      actigraph_csv = , csv = source_csv(datafile, sf, chunksize),
+      rds = {
+        rec <- read_recording(datafile, sf)
+        source_frame(rec$data, rec$sf, chunksize, arg)
+      },
+      gt3x = source_gt3x(datafile, chunksize),
+      cwa = source_cwa(datafile, chunksize),
+      geneactiv = source_geneactiv(datafile, chunksize))
+  }
   src$filename <- basename(datafile)
   # blocks read from the file (not views of data already in memory): the
   # block loops collect each one's garbage before reading the next, so that
@@ -192,6 +246,140 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile") {
   src$from_file <- !identical(src$format, "data.frame") &&
     !identical(src$format, "csv")
   src
+}
+
+# What a fit was computed from: the source, the samples read and, from a
+# native decoder, its report of what it skipped (see decode.hpp's Report).
+source_input <- function(src, samples) {
+  if (is.null(src) || identical(src$format, "data.frame")) {
+    return(list(source = "memory", samples = samples))
+  }
+  rep <- if (is.null(src$report)) NULL else src$report()
+  list(source = src$filename, format = src$format,
+       reader = if (is.null(src$native)) "reference" else "native",
+       serial = if (is.null(src$info$serial)) NA_character_ else src$info$serial,
+       samples = samples, report = rep)
+}
+
+# A file whose reader found no sample at all, having skipped what it read,
+# cannot be read: an error naming it and the first problem.
+check_source_read <- function(src, samples) {
+  if (samples > 0 || is.null(src$report)) return(invisible())
+  r <- src$report()
+  if (r$skipped > 0 || isTRUE(r$read_error)) {
+    abort("Cannot read \"", src$filename, "\": no ", unit_name(src$format, 2),
+          " of it hold samples (", format(r$skipped), " skipped",
+          if (length(r$notes)) paste0("; first: ", r$notes[1]), ").")
+  }
+}
+
+# The decoder's reason a file could not be opened, in the package's words
+# where it is the missing sampling rate.
+native_open_error <- function(file, format, why, arg) {
+  if (grepl("sampling rate is unknown", why, fixed = TRUE)) {
+    abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
+  }
+  abort("Cannot read `", arg, "` \"", file, "\" as ", native_format_name(format),
+        ": ", why, ".")
+}
+
+# One line for print(): what was read and what was skipped.
+format_input <- function(input) {
+  if (is.null(input) || identical(input$source, "memory")) return(NULL)
+  s <- sprintf("%s samples from %s (%s reader)",
+               format(input$samples, big.mark = ","), input$source,
+               input$reader)
+  r <- input$report
+  if (!is.null(r)) {
+    lost <- c(if (r$skipped > 0) sprintf("%s unreadable %s skipped",
+                                          format(r$skipped, big.mark = ","),
+                                          unit_name(input$format, r$skipped)),
+              if (r$gaps > 0) sprintf("%d gap%s in time (%.1f s)", r$gaps,
+                                      if (r$gaps > 1) "s" else "", r$gap_seconds),
+              if (isTRUE(r$truncated)) "file truncated",
+              if (isTRUE(r$read_error)) "READ ERROR before the end of the file")
+    s <- paste0(s, if (length(lost)) paste0("; ", paste(lost, collapse = ", ")) else
+      "; nothing skipped")
+  }
+  s
+}
+
+unit_name <- function(format, n) {
+  u <- switch(format, cwa = "block", geneactiv = "page", gt3x = "record",
+              actigraph_csv = , csv = "line", "unit")
+  if (n == 1) u else paste0(u, "s")
+}
+
+# The format of a recording from its name (and, for csv, its first line).
+file_format <- function(file, arg = "file") {
+  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(file)))
+  switch(ext,
+    csv = , "csv.gz" = if (is_actigraph_csv(file)) "actigraph_csv" else "csv",
+    rds = "rds", gt3x = "gt3x", cwa = "cwa", bin = "geneactiv",
+    abort("`", arg, "` has an unsupported extension \".", ext, "\"; gravcal ",
+          "reads .csv (ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, ",
+          ".cwa and GENEActiv .bin."))
+}
+
+# Format units in one of GGIR's blocks (g.calibrate's blocksize, chunksize =
+# 1 is about 12 hours), per format: cwa 512-byte blocks, GENEActiv pages,
+# gt3x seconds, csv lines.
+native_block_units <- list(
+  cwa = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
+  geneactiv = function(sf, chunksize) round((14512 * (sf / 50)) * (chunksize * 0.5)),
+  gt3x = function(sf, chunksize) (12 * 3600) * chunksize,
+  actigraph_csv = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
+  csv = function(sf, chunksize) ggir_rows_per_block(sf, chunksize)
+)
+
+# A file read by gravcal's own decoder (decode_*.hpp). NULL when this build
+# has no decoder for the format. Blocks are GGIR's (in the format's units);
+# each block comes as one or more parts (list(cols, from, to)), which hold
+# the samples of GGIR's block together, however many samples that is.
+# `segment()` streams units straight into a segmenter, without R vectors.
+source_native <- function(file, format, sf, chunksize, compat, arg) {
+  opts <- list(compat = as.numeric(isTRUE(compat)))
+  if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
+  # it back as zeros where it was, as a whole read does
+  if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1
+  h <- gc_decoder_open(path.expand(file), format, opts)
+  if (is.null(h$ptr)) {
+    if (isTRUE(h$unsupported)) return(NULL)
+    native_open_error(file, format, h$error, arg)
+  }
+  if (is.null(sf) || format %in% c("cwa", "geneactiv", "gt3x")) sf <- h$info$sf
+  if (!isTRUE(is.finite(sf) && sf > 0)) {
+    abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
+  }
+  check_sf(sf)
+  B <- native_block_units[[format]](sf, chunksize)
+  per_unit <- gc_decoder_unit_samples(h$ptr)
+  cap <- max(1, min(B * per_unit, 2^28))
+  # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
+  # pages hold for the last one; after its resampling of a rate that rounds
+  # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
+  short <- if (format == "geneactiv" && isTRUE(compat)) {
+    function(rows) rows < B * 300
+  }
+  list(format = format, sf = sf, temperature = isTRUE(h$info$temperature),
+       info = h$info, native = h, block_units = B, short_block = short,
+       read = function(i) {
+         parts <- list()
+         units <- 0
+         repeat {
+           b <- native_block(h, B - units, cap, TRUE, FALSE)
+           if (b$to > 0) parts[[length(parts) + 1]] <- b
+           units <- units + b$units
+           if (b$done || units >= B || (b$to == 0 && b$units == 0)) break
+         }
+         if (!length(parts)) return(NULL)
+         list(parts = parts, last = b$done)
+       },
+       report = function() native_report(h),
+       segment = function(seg, rule, par, temperature = TRUE) {
+         gc_decoder_segment(h$ptr, seg, B, rule, par, temperature)
+       })
 }
 
 `%||%` <- function(a, b) if (is.null(a)) b else a
@@ -396,79 +584,6 @@ write_actigraph_csv <- function(x, file, sf, start = "2023-05-11 09:00:00",
   } else {
     utils::write.table(d, file, append = TRUE, sep = ",", row.names = FALSE,
                        col.names = FALSE)
-  }
-  invisible(file)
-}
-
-# Write raw samples as a GENEActiv .bin file (the device's text format: a
-# header, then pages of 300 samples, each page with its own header lines and
-# one line of 12 hex digits per sample: x, y, z as 12-bit two's complement
-# counts, then 10 bits of light and 2 status bits). Counts are
-# round((g * gain + offset) / 100), GENEActiv's calibration in reverse, and
-# clip at the 12-bit range (about +-8 g). A last part-page is left out.
-# Temperature, where given, is written per page (its mean, 0.1 degree).
-# Used by the tests and benchmarks to give gravcal and GGIR a device file.
-write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
-                                gain = c(25600, 25600, 25600),
-                                offset = c(0, 0, 0), pages_per_write = 2000) {
-  s <- as_samples(x)
-  pages <- s$n %/% 300
-  if (pages < 1) abort("`x` has fewer than 300 samples, one GENEActiv page.")
-  t0 <- as.POSIXct(start, tz = "UTC")
-  stamp <- function(t) {
-    ms <- round((as.numeric(t) %% 1) * 1000)
-    paste0(format(t - (ms / 1000), "%Y-%m-%d %H:%M:%S"), ":", sprintf("%03d", ms))
-  }
-  hz <- format(sf)
-  hdr <- c("Device Identity", "Device Unique Serial Code:000000",
-    "Device Type:GENEActiv", "Device Model:1.1",
-    "Device Firmware Version:Ver1.30 date 05Aug11",
-    paste0("Calibration Date:", stamp(t0)), "",
-    "Device Capabilities", "Accelerometer Range:-8 to 8",
-    "Accelerometer Resolution:0.0039", "Accelerometer Units:g",
-    "Light Meter Range:0 to 5000", "Light Meter Resolution:5",
-    "Light Meter Units:lux", "Temperature Sensor Range:0 to 70",
-    "Temperature Sensor Resolution:0.1", "Temperature Sensor Units:deg. C", "",
-    "Configuration Info", paste0("Measurement Frequency:", hz, " Hz"),
-    paste0("Measurement Period:", ceiling(pages * 300 / sf / 3600), " Hours"),
-    paste0("Start Time:", stamp(t0)), "Time Zone:GMT +00:00", "",
-    "Trial Info", "Study Centre:", "Study Code:", "Investigator ID:",
-    "Exercise Type:", "Config Operator ID:", paste0("Config Time:", stamp(t0)),
-    "Config Notes:", "Extract Operator ID:", paste0("Extract Time:", stamp(t0)),
-    "Extract Notes:", "", "Subject Info", "Device Location Code:",
-    "Subject Code:", "Date of Birth:", "Sex:", "Height:", "Weight:",
-    "Handedness Code:", "Subject Notes:", "", "Calibration Data",
-    paste0(c("x gain:", "x offset:", "y gain:", "y offset:", "z gain:",
-             "z offset:"), c(rbind(round(gain), round(offset)))),
-    "Volts:300", "Lux:800", "", "Memory Status",
-    paste0("Number of Pages:", pages), "")
-  con <- file(file, "wb")
-  on.exit(close(con))
-  writeLines(hdr, con)
-  counts <- function(v, a, from, to) {
-    r <- round((v[from:to] * gain[a] + offset[a]) / 100)
-    r <- pmin(pmax(r, -2048), 2047)
-    as.integer(r %% 4096)
-  }
-  for (p0 in seq(0, pages - 1, by = pages_per_write)) {
-    p1 <- min(p0 + pages_per_write, pages)
-    from <- p0 * 300 + 1
-    to <- p1 * 300
-    hi <- counts(s$x, 1, from, to) * 4096L + counts(s$y, 2, from, to)
-    lo <- counts(s$z, 3, from, to) * 4096L
-    hex <- paste(sprintf("%06X%06X", hi, lo), collapse = "")
-    np <- p1 - p0
-    lines <- substring(hex, (seq_len(np) - 1) * 3600 + 1, seq_len(np) * 3600)
-    temp <- if (is.null(s$temperature)) rep(20, np) else
-      colMeans(matrix(s$temperature[from:to], 300))
-    ptime <- stamp(t0 + (p0 + seq_len(np) - 1) * 300 / sf)
-    page <- rbind("Recorded Data", "Device Unique Serial Code:000000",
-                  paste0("Sequence Number:", p0 + seq_len(np) - 1),
-                  paste0("Page Time:", ptime), "Unassigned:",
-                  paste0("Temperature:", sprintf("%.1f", temp)),
-                  "Battery voltage:4.1", "Device Status:Recording",
-                  paste0("Measurement Frequency:", hz), lines)
-    writeLines(c(page), con)
   }
   invisible(file)
 }

@@ -44,12 +44,18 @@
 #' @param chunk_size Number of samples passed to the core at a time.
 #' @param progress Show a progress bar (default: in interactive sessions, for
 #'   recordings of more than 20 chunks).
+#' @param reader For a file: `"native"` (default), gravcal's own decoders
+#'   (Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x`, csv), which
+#'   stream the file in bounded memory and count what they skip; or
+#'   `"reference"`, the readers GGIR uses (GGIRread, read.gt3x,
+#'   data.table), block by block.
 #' @return A data frame, one row per complete window: `start` (time of the
 #'   first sample, from `time` when given, else seconds from the start), `n`
 #'   (samples), `mean_x`, `mean_y`, `mean_z`, `sd_x`, `sd_y`, `sd_z`,
 #'   `range_x`, `range_y`, `range_z`, `mean_norm`, `temperature` (NA without
 #'   a temperature column), `n_invalid` (non-finite samples) and `rest`
-#'   (logical). Attributes record `sf`, `method`, `window` and the criterion.
+#'   (logical). Attributes record `sf`, `method`, `window`, the criterion and
+#'   `input`: what was read and, for a file, what its reader skipped and why.
 #' @references
 #' Farago D, Maczak B, Gingl Z (2024). Enhancing accuracy in actigraphic
 #' measurements: a lightweight calibration method for triaxial
@@ -70,11 +76,14 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          window = NULL, max_range = 0.12,
                          axes = c("x", "y", "z"), max_sd = 0.013,
                          max_abs_mean = 2, skip_zero = TRUE,
-                         chunk_size = 1e6, progress = NULL) {
+                         chunk_size = 1e6, progress = NULL,
+                         reader = c("native", "reference")) {
   method <- match_choice(method, "method")
   src <- NULL
   if (is.character(x)) {
-    src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x")
+    reader <- match_choice(reader, "reader")
+    src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x",
+                       reader = reader, compat = FALSE)
     sf <- src$sf
     s <- list(n = 0, time = NULL)
   } else {
@@ -129,6 +138,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   attr(w, "samples") <- s$n
   attr(w, "skipped_zero") <- unname(state["skipped_zero"])
   attr(w, "dropped_tail") <- unname(state["pending"])
+  attr(w, "input") <- source_input(src, s$n)
   n_bad <- sum(w$n_invalid)
   if (n_bad > 0) {
     warning(sprintf(paste0("`x` has %d non-finite samples (NA, NaN or Inf) ",
@@ -168,22 +178,34 @@ segment_source <- function(seg, src, rule, par, progress) {
   n <- 0
   i <- 1
   repeat {
-    blk <- src$read(i)
-    if (is.null(blk)) break
-    p <- block_piece(blk, block_has_temp(blk))
-    last <- isTRUE(blk$last)
-    out[[i]] <- gc_segmenter_push(seg, p$x, p$y, p$z, p$t, p$from, p$to,
-                                  rule, par)
-    n <- n + (p$to - p$from)
+    if (!is.null(src$segment)) {
+      # a native decoder: the block goes from the file to the segmenter in
+      # C++, through a fixed buffer
+      r <- src$segment(seg, rule, par)
+      out[[i]] <- r$windows
+      n <- n + r$samples
+      last <- isTRUE(r$done) || (r$samples == 0 && r$units == 0)
+    } else {
+      blk <- src$read(i)
+      if (is.null(blk)) break
+      temp <- block_has_temp(blk)
+      for (p in block_pieces(blk, temp)) {
+        out[[length(out) + 1]] <- gc_segmenter_push(seg, p$x, p$y, p$z, p$t,
+                                                    p$from, p$to, rule, par)
+        n <- n + (p$to - p$from)
+      }
+      last <- isTRUE(blk$last)
+      rm(blk, p)
+    }
     if (isTRUE(progress)) {
       cat(sprintf("\rblock %d: %.1f hours read", i, n / src$sf / 3600))
     }
-    rm(blk, p)
     if (last) break
-    if (isTRUE(src$from_file)) invisible(gc(full = TRUE))
+    if (isTRUE(src$from_file) && is.null(src$segment)) invisible(gc(full = TRUE))
     i <- i + 1
   }
   if (isTRUE(progress)) cat("\n")
+  check_source_read(src, n)
   attr(out, "samples") <- n
   out
 }

@@ -11,9 +11,103 @@ Rcpp::Rostream<true>&  Rcpp::Rcout = Rcpp::Rcpp_cout_get();
 Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
+// gc_decoder_open
+Rcpp::List gc_decoder_open(const std::string& path, const std::string& format, const Rcpp::List& options);
+RcppExport SEXP _gravcal_gc_decoder_open(SEXP pathSEXP, SEXP formatSEXP, SEXP optionsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const std::string& >::type path(pathSEXP);
+    Rcpp::traits::input_parameter< const std::string& >::type format(formatSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type options(optionsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_open(path, format, options));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_decoder_read
+Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity, bool want_temperature, bool want_time);
+RcppExport SEXP _gravcal_gc_decoder_read(SEXP ptrSEXP, SEXP max_unitsSEXP, SEXP capacitySEXP, SEXP want_temperatureSEXP, SEXP want_timeSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< double >::type max_units(max_unitsSEXP);
+    Rcpp::traits::input_parameter< double >::type capacity(capacitySEXP);
+    Rcpp::traits::input_parameter< bool >::type want_temperature(want_temperatureSEXP);
+    Rcpp::traits::input_parameter< bool >::type want_time(want_timeSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_read(ptr, max_units, capacity, want_temperature, want_time));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_decoder_unit_samples
+double gc_decoder_unit_samples(SEXP ptr);
+RcppExport SEXP _gravcal_gc_decoder_unit_samples(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_unit_samples(ptr));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_decoder_report
+Rcpp::List gc_decoder_report(SEXP ptr);
+RcppExport SEXP _gravcal_gc_decoder_report(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_report(ptr));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_decoder_close
+void gc_decoder_close(SEXP ptr);
+RcppExport SEXP _gravcal_gc_decoder_close(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    gc_decoder_close(ptr);
+    return R_NilValue;
+END_RCPP
+}
+// gc_decoder_segment
+Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule, Rcpp::NumericVector par, bool use_temperature);
+RcppExport SEXP _gravcal_gc_decoder_segment(SEXP ptrSEXP, SEXP segSEXP, SEXP max_unitsSEXP, SEXP ruleSEXP, SEXP parSEXP, SEXP use_temperatureSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
+    Rcpp::traits::input_parameter< double >::type max_units(max_unitsSEXP);
+    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
+    Rcpp::traits::input_parameter< bool >::type use_temperature(use_temperatureSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_segment(ptr, seg, max_units, rule, par, use_temperature));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_blocks_decode
+Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule, Rcpp::NumericVector par);
+RcppExport SEXP _gravcal_gc_blocks_decode(SEXP blocksSEXP, SEXP ptrSEXP, SEXP max_unitsSEXP, SEXP ruleSEXP, SEXP parSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type blocks(blocksSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< double >::type max_units(max_unitsSEXP);
+    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_blocks_decode(blocks, ptr, max_units, rule, par));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_decoder_drain
+double gc_decoder_drain(SEXP ptr);
+RcppExport SEXP _gravcal_gc_decoder_drain(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_drain(ptr));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fit_icp
-Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, int stop_rule, int max_iter, double tol, double max_weight, bool trace);
-RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP stop_ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
+Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
+RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -21,53 +115,43 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
     Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temp(tempSEXP);
     Rcpp::traits::input_parameter< bool >::type use_temp(use_tempSEXP);
-    Rcpp::traits::input_parameter< int >::type stop_rule(stop_ruleSEXP);
+    Rcpp::traits::input_parameter< const std::string& >::type rule(ruleSEXP);
     Rcpp::traits::input_parameter< int >::type max_iter(max_iterSEXP);
     Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
     Rcpp::traits::input_parameter< double >::type max_weight(max_weightSEXP);
     Rcpp::traits::input_parameter< bool >::type trace(traceSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_fit_icp(x, y, z, temp, use_temp, stop_rule, max_iter, tol, max_weight, trace));
+    rcpp_result_gen = Rcpp::wrap(gc_fit_icp(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace));
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_count_zero
-double gc_count_zero(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, double from, double to);
-RcppExport SEXP _gravcal_gc_count_zero(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP fromSEXP, SEXP toSEXP) {
+// gc_blocks_new
+SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature);
+RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
-    Rcpp::traits::input_parameter< double >::type to(toSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_count_zero(x, y, z, from, to));
+    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
+    Rcpp::traits::input_parameter< double >::type per_hour(per_hourSEXP);
+    Rcpp::traits::input_parameter< bool >::type compat(compatSEXP);
+    Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature));
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_sd_below
-Rcpp::LogicalVector gc_sd_below(const Rcpp::List& v, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, double limit, double threshold);
-RcppExport SEXP _gravcal_gc_sd_below(SEXP vSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP limitSEXP, SEXP thresholdSEXP) {
+// gc_blocks_columns
+Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List& y, const Rcpp::List& z, const Rcpp::List& t, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, int rule, Rcpp::NumericVector par);
+RcppExport SEXP _gravcal_gc_blocks_columns(SEXP blocksSEXP, SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP ruleSEXP, SEXP parSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type blocks(blocksSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type t(tSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type from(fromSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type to(toSEXP);
-    Rcpp::traits::input_parameter< double >::type limit(limitSEXP);
-    Rcpp::traits::input_parameter< double >::type threshold(thresholdSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_sd_below(v, from, to, limit, threshold));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_r_mean_sd
-Rcpp::NumericVector gc_r_mean_sd(const Rcpp::List& v, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, double limit);
-RcppExport SEXP _gravcal_gc_r_mean_sd(SEXP vSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP limitSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type v(vSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type from(fromSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type to(toSEXP);
-    Rcpp::traits::input_parameter< double >::type limit(limitSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_r_mean_sd(v, from, to, limit));
+    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_blocks_columns(blocks, x, y, z, t, from, to, rule, par));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -180,10 +264,17 @@ END_RCPP
 }
 
 static const R_CallMethodDef CallEntries[] = {
+    {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
+    {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},
+    {"_gravcal_gc_decoder_unit_samples", (DL_FUNC) &_gravcal_gc_decoder_unit_samples, 1},
+    {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
+    {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
+    {"_gravcal_gc_decoder_segment", (DL_FUNC) &_gravcal_gc_decoder_segment, 6},
+    {"_gravcal_gc_blocks_decode", (DL_FUNC) &_gravcal_gc_blocks_decode, 5},
+    {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
-    {"_gravcal_gc_count_zero", (DL_FUNC) &_gravcal_gc_count_zero, 5},
-    {"_gravcal_gc_sd_below", (DL_FUNC) &_gravcal_gc_sd_below, 5},
-    {"_gravcal_gc_r_mean_sd", (DL_FUNC) &_gravcal_gc_r_mean_sd, 4},
+    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 4},
+    {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},

@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <R_ext/Applic.h>
 
 #include "gravcal/icp.hpp"
+#include "windows_glue.h"
 
 namespace {
 
@@ -37,13 +39,15 @@ struct RLeastSquares {
 
 }  // namespace
 
-// x, y, z: window means; temp: their temperatures or NULL. stop_rule: 0 =
-// GGIR's statistic rule, 1 = parameter convergence.
+// x, y, z: window means; temp: their temperatures or NULL. rule: "ggir_r"
+// (GGIR's stopping statistic in GGIR's arithmetic with R's least squares,
+// bit for bit), "ggir" (the same statistic, gravcal's arithmetic: a cheap
+// early stop) or "converge" (until no parameter moves by tol).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
                       const Rcpp::NumericVector& z,
                       Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp,
-                      int stop_rule, int max_iter, double tol,
+                      const std::string& rule, int max_iter, double tol,
                       double max_weight, bool trace) {
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
@@ -59,9 +63,10 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
   cfg.tol = tol;
   cfg.max_weight = max_weight;
   cfg.use_temp = use_temp && t != nullptr;
-  cfg.stop = stop_rule == 0 ? gravcal::StopRule::ggir : gravcal::StopRule::parameters;
-  // GGIR's rule: GGIR's arithmetic and R's least squares, bit for bit
-  cfg.r_arithmetic = stop_rule == 0;
+  if (rule != "ggir_r" && rule != "ggir" && rule != "converge")
+    Rcpp::stop("rule must be \"ggir_r\", \"ggir\" or \"converge\"");
+  cfg.stop = rule == "converge" ? gravcal::StopRule::parameters : gravcal::StopRule::ggir;
+  cfg.r_arithmetic = rule == "ggir_r";
   std::vector<double> tr;
   const gravcal::IcpResult r = gravcal::fit_icp(
       x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), cfg,
@@ -89,153 +94,53 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
       Rcpp::Named("trace") = tm);
 }
 
-Rcpp::NumericVector gc_r_mean_sd(const Rcpp::List& v,
-                                 const Rcpp::NumericVector& from,
-                                 const Rcpp::NumericVector& to, double limit);
-
-// Samples in [from, to) (0-based) whose x, y and z are all exactly zero
-// (idle sleep); NA and NaN are not zero.
+// GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp).
 // [[Rcpp::export(rng = false)]]
-double gc_count_zero(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
-                     const Rcpp::NumericVector& z, double from, double to) {
-  const R_xlen_t n = x.size();
-  if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
-  if (!(from >= 0 && to <= static_cast<double>(n) && from <= to))
-    Rcpp::stop("range out of bounds");
-  const double* px = x.begin();
-  const double* py = y.begin();
-  const double* pz = z.begin();
-  std::size_t count = 0;
-  // a branch-free scan of stretches of 4096 samples; those holding a zero
-  // sample (rare) are counted exactly
-  const std::size_t end = static_cast<std::size_t>(to);
-  std::size_t i = static_cast<std::size_t>(from);
-  while (i < end) {
-    const std::size_t stop = std::min(end, i + 4096);
-    unsigned any = 0;
-    for (std::size_t k = i; k < stop; ++k) {
-      any |= static_cast<unsigned>((px[k] == 0.0) & (py[k] == 0.0) & (pz[k] == 0.0));
-    }
-    if (any) {
-      for (std::size_t k = i; k < stop; ++k) {
-        count += (px[k] == 0.0) & (py[k] == 0.0) & (pz[k] == 0.0);
-      }
-    }
-    i = stop;
-  }
-  return static_cast<double>(count);
+SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature) {
+  if (!(per_hour >= 1)) Rcpp::stop("per_hour must be at least 1");
+  return Rcpp::XPtr<gravcal_glue::BlocksBox>(
+      new gravcal_glue::BlocksBox(seg, per_hour, compat, temperature), true);
 }
 
-// Is sd(v, na.rm = TRUE) below `threshold`, for the first `limit` values of
-// the pieces (see gc_r_mean_sd())? One pass in double (sums about the first
-// value); only when the answer is within 1e-6 of the threshold does it take
-// R's exact arithmetic (gc_r_mean_sd()), so the answer is R's. NA with fewer
-// than 2 values.
+// One block from columns in memory: the pieces [from[k], to[k]) (0-based) of
+// x[[k]], y[[k]], z[[k]] and t[[k]] (NULL without temperature), in order.
 // [[Rcpp::export(rng = false)]]
-Rcpp::LogicalVector gc_sd_below(const Rcpp::List& v, const Rcpp::NumericVector& from,
-                                const Rcpp::NumericVector& to, double limit,
-                                double threshold) {
-  const R_xlen_t np = v.size();
-  if (from.size() != np || to.size() != np) Rcpp::stop("piece bounds differ");
-  double left = limit, shift = NA_REAL;
-  // four lanes of sums about the first non-NA value (order does not matter:
-  // this is the approximate pass)
-  double s[4] = {0, 0, 0, 0}, ss[4] = {0, 0, 0, 0}, cnt[4] = {0, 0, 0, 0};
+Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List& y,
+                             const Rcpp::List& z, const Rcpp::List& t,
+                             const Rcpp::NumericVector& from,
+                             const Rcpp::NumericVector& to, int rule,
+                             Rcpp::NumericVector par) {
+  Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  const gravcal_glue::RestRule is_rest(rule, par);
+  const R_xlen_t np = x.size();
+  if (y.size() != np || z.size() != np || t.size() != np || from.size() != np ||
+      to.size() != np)
+    Rcpp::stop("piece lists differ in length");
+  gravcal_glue::WindowTable table;
+  auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
+  box->blocks.begin_block();
+  constexpr std::size_t chunk = 1u << 16;
   for (R_xlen_t k = 0; k < np; ++k) {
-    Rcpp::NumericVector c(v[k]);
-    if (!(from[k] >= 0 && to[k] <= static_cast<double>(c.size()) && from[k] <= to[k]))
-      Rcpp::stop("range out of bounds");
-    const double len = std::min(to[k] - from[k], std::max(left, 0.0));
-    left -= len;
-    const double* p = c.begin() + static_cast<R_xlen_t>(from[k]);
-    const std::size_t m = static_cast<std::size_t>(len);
-    std::size_t i = 0;
-    if (std::isnan(shift)) {
-      while (i < m && std::isnan(p[i])) ++i;
-      if (i < m) shift = p[i];
+    Rcpp::NumericVector xv(x[k]), yv(y[k]), zv(z[k]);
+    const R_xlen_t n = xv.size();
+    if (yv.size() != n || zv.size() != n) Rcpp::stop("x, y, z lengths differ");
+    const double* tp = nullptr;
+    Rcpp::NumericVector tv;
+    if (box->temperature && !Rf_isNull(t[k])) {
+      tv = Rcpp::NumericVector(t[k]);
+      if (tv.size() != n) Rcpp::stop("temperature length differs");
+      tp = tv.begin();
     }
-    for (; i + 4 <= m; i += 4) {
-      for (int l = 0; l < 4; ++l) {
-        const double a = p[i + l];
-        const bool ok = !std::isnan(a);
-        const double d = ok ? a - shift : 0.0;
-        s[l] += d;
-        ss[l] += d * d;
-        cnt[l] += ok ? 1.0 : 0.0;
-      }
-    }
-    for (; i < m; ++i) {
-      const double a = p[i];
-      if (std::isnan(a)) continue;
-      const double d = a - shift;
-      s[0] += d;
-      ss[0] += d * d;
-      cnt[0] += 1.0;
+    if (!(from[k] >= 0 && to[k] <= static_cast<double>(n) && from[k] <= to[k]))
+      Rcpp::stop("piece bounds out of range");
+    std::size_t i = static_cast<std::size_t>(from[k]);
+    const std::size_t end = static_cast<std::size_t>(to[k]);
+    while (i < end) {
+      const std::size_t m = std::min(chunk, end - i);
+      box->blocks.push(xv.begin() + i, yv.begin() + i, zv.begin() + i,
+                       tp ? tp + i : nullptr, m, sink);
+      i += m;
     }
   }
-  const double sum = (s[0] + s[1]) + (s[2] + s[3]);
-  const double sumsq = (ss[0] + ss[1]) + (ss[2] + ss[3]);
-  const std::size_t n = static_cast<std::size_t>((cnt[0] + cnt[1]) + (cnt[2] + cnt[3]));
-  if (n < 2) return Rcpp::LogicalVector::create(NA_LOGICAL);
-  const double nn = static_cast<double>(n);
-  const double var = std::max(0.0, (sumsq - sum * sum / nn) / (nn - 1.0));
-  const double sd = std::sqrt(var);
-  if (std::isfinite(sd) && std::fabs(sd - threshold) > 1e-6 * threshold) {
-    return Rcpp::LogicalVector::create(sd < threshold);
-  }
-  const Rcpp::NumericVector exact = gc_r_mean_sd(v, from, to, limit);
-  return Rcpp::LogicalVector::create(exact[1] < threshold);
-}
-
-// mean(v, na.rm = TRUE) and sd(v, na.rm = TRUE) as R computes them (long
-// double sums, R's correction pass for the mean), of the first `limit`
-// values of the pieces: v[[k]][from[k] + 1 .. to[k]] in order, without
-// copying them. Returns c(mean, sd, n) with n the number of non-NA values.
-// [[Rcpp::export(rng = false)]]
-Rcpp::NumericVector gc_r_mean_sd(const Rcpp::List& v,
-                                 const Rcpp::NumericVector& from,
-                                 const Rcpp::NumericVector& to, double limit) {
-  const R_xlen_t np = v.size();
-  if (from.size() != np || to.size() != np) Rcpp::stop("piece bounds differ");
-  std::vector<const double*> base(static_cast<std::size_t>(np));
-  std::vector<R_xlen_t> lo(static_cast<std::size_t>(np)), hi(static_cast<std::size_t>(np));
-  double left = limit;
-  for (R_xlen_t k = 0; k < np; ++k) {
-    Rcpp::NumericVector c(v[k]);
-    if (!(from[k] >= 0 && to[k] <= static_cast<double>(c.size()) && from[k] <= to[k]))
-      Rcpp::stop("range out of bounds");
-    base[k] = c.begin();
-    lo[k] = static_cast<R_xlen_t>(from[k]);
-    const double len = std::min(to[k] - from[k], std::max(left, 0.0));
-    hi[k] = lo[k] + static_cast<R_xlen_t>(len);
-    left -= len;
-  }
-  auto each = [&](auto&& f) {
-    for (R_xlen_t k = 0; k < np; ++k) {
-      const double* p = base[k];
-      for (R_xlen_t i = lo[k]; i < hi[k]; ++i) {
-        if (!std::isnan(p[i])) f(p[i]);
-      }
-    }
-  };
-  std::size_t n = 0;
-  long double s = 0.0L;
-  each([&](double a) { s += a; ++n; });
-  if (n == 0) return Rcpp::NumericVector::create(R_NaN, NA_REAL, 0.0);
-  const long double ln = static_cast<long double>(n);
-  long double m = s / ln;
-  if (std::isfinite(static_cast<double>(m))) {
-    long double c = 0.0L;
-    each([&](double a) { c += (a - m); });
-    m += c / ln;
-  }
-  const double mean = static_cast<double>(m);
-  double sd = NA_REAL;
-  if (n > 1) {
-    long double ss = 0.0L;
-    const long double xm = mean;
-    each([&](double a) { ss += (a - xm) * (a - xm); });
-    sd = std::sqrt(static_cast<double>(ss / static_cast<long double>(n - 1)));
-  }
-  return Rcpp::NumericVector::create(mean, sd, static_cast<double>(n));
+  return gravcal_glue::block_result(table, box->blocks.end_block(sink));
 }

@@ -10,88 +10,14 @@
 #include <vector>
 
 #include "gravcal/gravcal.hpp"
+#include "windows_glue.h"
 
 using gravcal::Segmenter;
 using gravcal::WindowStats;
 
-namespace {
-
-struct WindowTable {
-  std::vector<double> start, mean[3], sd[3], min[3], max[3], norm, temp;
-  std::vector<int> n, n_invalid;
-  std::vector<double> index;
-  std::vector<int> rest;
-
-  // room for about `windows` windows, so that the vectors are allocated
-  // once rather than grown
-  void reserve(std::size_t windows) {
-    start.reserve(windows);
-    for (int a = 0; a < 3; ++a) {
-      mean[a].reserve(windows);
-      sd[a].reserve(windows);
-      min[a].reserve(windows);
-      max[a].reserve(windows);
-    }
-    norm.reserve(windows);
-    temp.reserve(windows);
-    n.reserve(windows);
-    n_invalid.reserve(windows);
-    index.reserve(windows);
-    rest.reserve(windows);
-  }
-
-  void add(const WindowStats& s, bool is_rest) {
-    index.push_back(static_cast<double>(s.index));
-    start.push_back(static_cast<double>(s.first));
-    n.push_back(s.n);
-    n_invalid.push_back(s.n_invalid);
-    for (int a = 0; a < 3; ++a) {
-      mean[a].push_back(s.mean[a]);
-      sd[a].push_back(s.sd[a]);
-      min[a].push_back(s.min[a]);
-      max[a].push_back(s.max[a]);
-    }
-    norm.push_back(s.mean_norm);
-    temp.push_back(s.temperature);
-    rest.push_back(is_rest ? 1 : 0);
-  }
-
-  Rcpp::List to_list() const {
-    Rcpp::LogicalVector r(rest.begin(), rest.end());
-    return Rcpp::List::create(
-        Rcpp::Named("window") = Rcpp::wrap(index),
-        Rcpp::Named("first") = Rcpp::wrap(start),
-        Rcpp::Named("n") = Rcpp::wrap(n),
-        Rcpp::Named("n_invalid") = Rcpp::wrap(n_invalid),
-        Rcpp::Named("mean_x") = Rcpp::wrap(mean[0]),
-        Rcpp::Named("mean_y") = Rcpp::wrap(mean[1]),
-        Rcpp::Named("mean_z") = Rcpp::wrap(mean[2]),
-        Rcpp::Named("sd_x") = Rcpp::wrap(sd[0]),
-        Rcpp::Named("sd_y") = Rcpp::wrap(sd[1]),
-        Rcpp::Named("sd_z") = Rcpp::wrap(sd[2]),
-        Rcpp::Named("min_x") = Rcpp::wrap(min[0]),
-        Rcpp::Named("min_y") = Rcpp::wrap(min[1]),
-        Rcpp::Named("min_z") = Rcpp::wrap(min[2]),
-        Rcpp::Named("max_x") = Rcpp::wrap(max[0]),
-        Rcpp::Named("max_y") = Rcpp::wrap(max[1]),
-        Rcpp::Named("max_z") = Rcpp::wrap(max[2]),
-        Rcpp::Named("mean_norm") = Rcpp::wrap(norm),
-        Rcpp::Named("temperature") = Rcpp::wrap(temp),
-        Rcpp::Named("rest") = r);
-  }
-};
-
-// A segmenter together with the window buffer it borrows in R-compatible
-// arithmetic (the core allocates nothing itself).
-struct SegmenterBox {
-  SegmenterBox(double samples_per_window, bool skip_zero)
-      : L(samples_per_window), seg(samples_per_window, skip_zero) {}
-  double L;
-  std::vector<double> buffer;
-  Segmenter seg;
-};
-
-}  // namespace
+using gravcal_glue::RestRule;
+using gravcal_glue::SegmenterBox;
+using gravcal_glue::WindowTable;
 
 // r_arithmetic: window statistics as GGIR gets them in R (see segmenter.hpp).
 // [[Rcpp::export(rng = false)]]
@@ -138,24 +64,15 @@ Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
   }
   if (from < 0 || to > static_cast<double>(n) || from > to)
     Rcpp::stop("chunk bounds out of range");
-  if (par.size() < 2) Rcpp::stop("par must have 2 values");
+  const RestRule is_rest(rule, par);
   const std::size_t i0 = static_cast<std::size_t>(from);
   const std::size_t len = static_cast<std::size_t>(to) - i0;
-
-  gravcal::RangeRestRule range_rule;
-  range_rule.max_range = par[0];
-  range_rule.axes = static_cast<unsigned>(par[1]);
-  gravcal::SdRestRule sd_rule;
-  sd_rule.max_sd = par[0];
-  sd_rule.max_abs_mean = par[1];
 
   WindowTable out;
   out.reserve(static_cast<std::size_t>(static_cast<double>(len) / box->L) + 2);
   s->push(x.begin() + i0, y.begin() + i0, z.begin() + i0,
           t ? t + i0 : nullptr, len, [&](const WindowStats& w) {
-            const bool r = rule == 0 ? gravcal::is_rest(w, range_rule)
-                                     : gravcal::is_rest(w, sd_rule);
-            out.add(w, r);
+            out.add(w, is_rest(w));
           });
   return out.to_list();
 }

@@ -4,7 +4,10 @@ suppressPackageStartupMessages({
   library(testthat)
   library(gravcal)
 })
-res <- as.data.frame(test_dir(".", reporter = "summary", stop_on_failure = FALSE))
+# the tests see the package namespace (internal helpers such as the file
+# writers), as under R CMD check
+res <- as.data.frame(test_dir(".", reporter = "summary", stop_on_failure = FALSE,
+                              package = "gravcal", load_package = "installed"))
 bad <- sum(res$failed) + sum(res$error)
 cat(sprintf("\n%d tests in %d files, %d expectations; %d failed\n", nrow(res),
             length(unique(res$file)), sum(res$nb), bad))

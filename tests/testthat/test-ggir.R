@@ -78,48 +78,82 @@ test_that("g.calibrate matches GGIR with temperature (ad hoc csv)", {
   expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
 })
 
-test_that("the block scans agree with R", {
+test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
+  # an independent restatement of g.calibrate's block handling in R (GGIR
+  # 3.3: idle-sleep rows removed, whole hours kept, the rest carried, R's
+  # mean and sd of the used temperatures), against the core's GgirBlocks
   set.seed(5)
-  n <- 20000
-  x <- stats::rnorm(n)
-  y <- stats::rnorm(n)
-  z <- stats::rnorm(n)
-  zero <- c(1, 4096, 4097, 8192, 12000, n)
-  x[zero] <- y[zero] <- z[zero] <- 0
-  x[100] <- y[100] <- 0  # not idle sleep: z is not zero
-  z[200] <- NA
-  x[200] <- y[200] <- 0
-  iz <- function(a, b) as.numeric(sum(x[a:b] == 0 & y[a:b] == 0 & z[a:b] == 0, na.rm = TRUE))
-  expect_identical(gravcal:::gc_count_zero(x, y, z, 0, n), iz(1, n))
-  expect_identical(gravcal:::gc_count_zero(x, y, z, 1, 8192), iz(2, 8192))
-  expect_identical(gravcal:::gc_count_zero(x, y, z, 5, 5), 0)
-  expect_error(gravcal:::gc_count_zero(x, y, z, 0, n + 1), "range")
-  # temperature: mean and sd as R's, over pieces, NA removed
-  t <- 25 + cumsum(stats::rnorm(n, sd = 0.01))
-  t[c(3, 500)] <- NA
-  P <- list(gravcal:::piece(x, y, z, t, 10, 5000),
-            gravcal:::piece(x, y, z, t, 100, 900))
-  v <- c(t[11:5000], t[101:900])
-  r <- gravcal:::pieces_temp_stats(P, 5500)
-  expect_identical(r[1], mean(v[1:5500], na.rm = TRUE))
-  expect_identical(r[2], stats::sd(v[1:5500], na.rm = TRUE))
-  expect_identical(r[3], as.numeric(sum(!is.na(v[1:5500]))))
-  # sd below a threshold: the fast pass, and R's exact arithmetic when the
-  # sd is within rounding of the threshold
-  s0 <- stats::sd(v, na.rm = TRUE)
-  for (th in c(s0 * (1 + 1e-3), s0 * (1 - 1e-3), s0, s0 * (1 + 1e-15), s0 * (1 - 1e-15))) {
-    expect_identical(gravcal:::pieces_sd_below(P, length(v), th),
-                     stats::sd(v, na.rm = TRUE) < th)
+  sf <- 1
+  H <- 3600 * sf
+  n1 <- 2 * H + 1234
+  n2 <- 3 * H + 17
+  mk <- function(n) {
+    d <- data.frame(x = stats::rnorm(n), y = stats::rnorm(n), z = stats::rnorm(n),
+                    t = 25 + cumsum(stats::rnorm(n, sd = 0.01)))
+    d
   }
-  expect_identical(gravcal:::pieces_sd_below(P, 1, 1), NA)
-  # pieces: head, drop and copies
-  Q <- gravcal:::pieces_drop(P, 4000)
-  expect_identical(gravcal:::pieces_n(Q), 4990 + 800 - 4000)
-  expect_identical(gravcal:::pieces_col(Q, "t"), v[4001:5790])
-  H <- gravcal:::pieces_head(P, 5000)
-  expect_identical(gravcal:::pieces_col(H, "x"), c(x[11:5000], x[101:110]))
-  O <- gravcal:::pieces_own(P)
-  expect_identical(O[[1]]$z, c(z[11:5000], z[101:900]))
+  b1 <- mk(n1)
+  b2 <- mk(n2)
+  zero <- c(1, 4096, 4097, 5000:5100, n1)  # the block ends on a zero
+  b1[zero, 1:3] <- 0
+  b1$x[100] <- b1$y[100] <- 0  # not idle sleep: z is not zero
+  b1$t[c(3, 500)] <- NA
+  ref_block <- function(P, last_zero, compat) {
+    if (compat && last_zero) P[nrow(P), 1:3] <- P[nrow(P) - 1, 1:3]
+    use <- floor(nrow(P) / H) * H
+    list(used = P[seq_len(use), ], rest = P[-seq_len(use), ])
+  }
+  for (compat in c(TRUE, FALSE)) {
+    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
+    run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE)
+    feed <- function(b) {
+      gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
+                                  list(b$t), 0, nrow(b), 1L, c(0.013, 2))
+    }
+    r1 <- feed(b1)
+    keep <- !(b1$x == 0 & b1$y == 0 & b1$z == 0)
+    e1 <- ref_block(b1[keep, ], TRUE, compat)
+    expect_identical(r1$rows, as.numeric(n1))
+    expect_identical(r1$zeros, as.numeric(sum(!keep)))
+    expect_identical(r1$used, as.numeric(nrow(e1$used)))
+    expect_identical(r1$carried, as.numeric(nrow(e1$rest)))
+    expect_identical(r1$first_mean, mean(e1$used$t[1:10], na.rm = TRUE))
+    expect_identical(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE))
+    expect_identical(length(r1$windows$mean_x), nrow(e1$used) %/% 10L)
+    # window means as GGIR forms them (compatible mode): differences of the
+    # block's cumulative sum; gravcal's own arithmetic: to rounding
+    gmean <- diff(c(0, cumsum(e1$used$x)[seq(10, 50, by = 10)])) / 10
+    if (compat) {
+      expect_identical(r1$windows$mean_x[1:5], gmean)
+    } else {
+      expect_equal(r1$windows$mean_x[1:5], gmean, tolerance = 1e-14)
+    }
+    # the carry goes in front of the next block
+    r2 <- feed(b2)
+    e2 <- ref_block(rbind(e1$rest, b2), FALSE, compat)
+    expect_identical(r2$used, as.numeric(nrow(e2$used)))
+    expect_identical(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE))
+    if (compat) {
+      expect_identical(r2$windows$sd_y[1], stats::sd(e2$used$y[1:10]))
+    } else {
+      expect_equal(r2$windows$sd_y[1], stats::sd(e2$used$y[1:10]), tolerance = 1e-14)
+    }
+  }
+  # a block of whole hours: gravcal carries nothing; GGIR's compatible mode
+  # puts the previous carry in front once more
+  for (compat in c(TRUE, FALSE)) {
+    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
+    run <- gravcal:::gc_blocks_new(seg, H, compat, FALSE)
+    feed <- function(b) {
+      gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
+                                  list(NULL), 0, nrow(b), 1L, c(0.013, 2))
+    }
+    feed(mk(H + 5))
+    r <- feed(mk(2 * H - 5))
+    expect_identical(r$used, 2 * H)
+    r <- feed(mk(H))
+    expect_identical(r$ld, if (compat) H + 5 else H)
+  }
 })
 
 test_that("g.calibrate matches GGIR when it cannot calibrate", {
@@ -256,8 +290,8 @@ test_that("bad input: clear errors or GGIR's QC outcome, never a crash", {
   expect_error(g.calibrate(f, verbose = FALSE), "unsupported extension")
   junk <- tempfile(fileext = ".csv")
   writeLines(c("------------ Data File Created By ActiGraph at 30 Hz", rep("junk", 30)), junk)
-  C <- g.calibrate(junk, verbose = FALSE)
-  expect_match(C$QCmessage, "not enough data in the file or because file is corrupt")
+  # no line of samples at all: an error naming the file and what it holds
+  expect_error(g.calibrate(junk, verbose = FALSE), "ActiGraph csv export.*junk")
   empty <- tempfile(fileext = ".csv")
   file.create(empty)
   expect_error(g.calibrate(empty, verbose = FALSE), "empty")
@@ -340,4 +374,50 @@ test_that("an ActiGraph csv with a time stamp column gives the same calibration"
   expect_identical(b$hours, a$hours)
   # and GGIR agrees on the file with time stamps
   expect_same_as_ggir(run_both(f2))
+})
+
+test_that("a GENEActiv .bin at a rate that is not whole: GGIR's resampling, to the bit", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # 12.5 Hz: GGIR's g.readaccfile interpolates each block onto 12 Hz (R's
+  # round), block by block; 30 hours cross two of its blocks (1741 pages)
+  rec <- simulate_recording(hours = 30, sf = 12.5, seed = 24,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(rec, f, sf = 12.5)
+  pr <- GGIR::load_params()
+  I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr$params_rawdata))
+  expect_identical(I$sf, 12)
+  B <- round((14512 * (I$sf / 50)) * 0.5)
+  fq <- list(filetooshort = FALSE, filecorrupt = FALSE,
+             filedoesnotholdday = FALSE, NFilePagesSkipped = 0)
+  h <- gravcal:::native_open(f, "geneactiv", list(compat = 1))
+  expect_identical(h$info$sf, 12)
+  prev <- c()
+  for (k in 1:2) {
+    g <- GGIR:::g.readaccfile(f, blocksize = B, blocknumber = k, filequality = fq,
+                              ws = 3600, PreviousEndPage = prev,
+                              inspectfileobject = I,
+                              params_rawdata = pr$params_rawdata,
+                              params_general = pr$params_general)
+    prev <- g$endpage
+    b <- gravcal:::native_block(h, B, B * 600, TRUE, TRUE)
+    n <- b$to
+    expect_identical(as.integer(n), nrow(g$P$data))
+    for (col in c("x", "y", "z", "temperature", "time")) {
+      expect_identical(b$cols[[col]][seq_len(n)], g$P$data[[col]], label = col)
+    }
+  }
+  # GGIR takes the first block, resampled to fewer rows than its pages
+  # hold, for the last one and stops there; compatible mode does the same
+  b <- run_both(f)
+  expect_identical(nrow(b$ggir$bsc_qc), 1L)
+  expect_same_as_ggir(b)
+  # 85.7 Hz, GENEActiv's common rate, onto 86 Hz: 26 hours, three blocks
+  rec <- simulate_recording(hours = 26, sf = 85.7, seed = 25)
+  gravcal:::write_geneactiv_bin(rec, f, sf = 85.7)
+  b <- run_both(f)
+  expect_identical(nrow(b$ggir$bsc_qc), 3L)
+  expect_same_as_ggir(b)
 })

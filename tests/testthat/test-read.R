@@ -33,19 +33,37 @@ test_that("missing and unsupported files get clear errors", {
 test_that("the devices' own files read: Axivity, GENEActiv, ActiGraph", {
   skip_if_not_installed("GGIRread")
   cwa <- system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread")
-  rec <- read_recording(cwa)
   ref <- GGIRread::readAxivity(cwa, start = 0, end = 1e6, progressBar = FALSE)
+  # the reference reader: GGIRread's samples, resampled onto its grid
+  rec <- read_recording(cwa, reader = "reference")
   expect_identical(rec$sf, ref$header$frequency)
   expect_true(all(c("x", "y", "z", "temperature") %in% names(rec$data)))
   expect_identical(nrow(rec$data), nrow(ref$data))
   expect_identical(rec$data$x, ref$data$x)
   expect_identical(rec$data$temperature, ref$data$temp)
+  # the native reader: the samples as stored (not resampled), over the same
+  # time span, in the device's 1/256 g steps, nothing skipped
+  nat <- read_recording(cwa)
+  expect_identical(nat$sf, ref$header$frequency)
+  expect_identical(as.numeric(nat$data$time[1]), ref$data$time[1])
+  # 145 packed blocks of 120 samples (GGIRread's grid runs on to the end
+  # time of the last block it looks ahead to)
+  expect_identical(nat$input$report$units, 145)
+  expect_identical(nrow(nat$data), 145L * 120L)
+  expect_identical(nat$data$x * 256, round(nat$data$x * 256))
+  expect_identical(nat$input$report$skipped, 0)
   bin <- system.file("testfiles", "GENEActiv_testfile.bin", package = "GGIRread")
-  rec <- read_recording(bin)
   ref <- GGIRread::readGENEActiv(bin, start = 1, end = 1e6)
+  rec <- read_recording(bin, reader = "reference")
   expect_identical(rec$sf, round(ref$header$SampleRate))
   expect_identical(rec$data$z, ref$data.out$z)
   expect_identical(rec$data$temperature, ref$data.out$temperature)
+  # the native reader: the device's own rate (85.7 Hz), values in double
+  # where GGIRread rounds them to float (so equal to float precision)
+  rec <- read_recording(bin)
+  expect_identical(rec$sf, ref$header$SampleRate)
+  expect_equal(rec$data$z, ref$data.out$z, tolerance = 1e-7)
+  expect_equal(rec$data$temperature, ref$data.out$temperature, tolerance = 1e-7)
   # windows from the file streamed block by block = from the data read whole
   w1 <- rest_windows(bin, progress = FALSE)
   w2 <- rest_windows(rec$data, sf = rec$sf)
@@ -58,7 +76,7 @@ test_that("ActiGraph .gt3x files read (read.gt3x's and GGIR's test files)", {
   f <- system.file("extdata", "TAS1H30182785_2019-09-17.gt3x", package = "read.gt3x")
   rec <- read_recording(f)
   ref <- read.gt3x::read.gt3x(f, asDataFrame = TRUE, imputeZeroes = TRUE)
-  expect_identical(rec$sf, attr(ref, "sample_rate"))
+  expect_identical(rec$sf, as.numeric(attr(ref, "sample_rate")))
   expect_identical(rec$data$y, as.numeric(ref$Y))
   g <- skip_if_no_shared("ggir", "actigraph_testfile.gt3x")
   rec <- read_recording(g)
@@ -75,9 +93,11 @@ test_that("a .gt3x file streamed in blocks gives the samples of a whole read", {
              shared_data("ggir", "actigraph_testfile.gt3x"))
   files <- files[nzchar(files)]
   for (f in files) {
-    whole <- read_recording(f)$data
+    rr <- read_recording(f)
+    whole <- rr$data
     expect_gt(sum(whole$x == 0 & whole$y == 0 & whole$z == 0), 1000)
-    src <- gravcal:::open_source(f, chunksize = 60 / 43200) # 60 s blocks
+    src <- gravcal:::open_source(f, chunksize = 60 / 43200, # 60 s blocks
+                                 reader = "reference")
     parts <- list()
     repeat {
       b <- src$read(length(parts) + 1)
@@ -93,6 +113,11 @@ test_that("a .gt3x file streamed in blocks gives the samples of a whole read", {
     expect_identical(s$z, whole$z[seq_len(n)], label = basename(f))
     rest <- whole[-seq_len(n), ]
     expect_true(all(rest$x == 0 & rest$y == 0 & rest$z == 0))
+    # the native decoder streamed into the segmenter: the windows of the
+    # recording read whole, with the idle-sleep zeros in place
+    w1 <- rest_windows(f, skip_zero = FALSE, progress = FALSE)
+    w2 <- rest_windows(whole, sf = rr$sf, skip_zero = FALSE)
+    expect_identical(w1$mean_x, w2$mean_x[seq_along(w1$mean_x)], label = basename(f))
   }
 })
 
@@ -130,7 +155,11 @@ test_that("read_recording() reads ActiGraph csv exports, with or without time st
     r <- read_recording(f)
     unlink(f)
     expect_identical(r$sf, 30)
-    expect_identical(names(r$data), c("x", "y", "z"))
+    # the native reader adds each sample's time: the header's start + i / sf,
+    # or the time stamp column
+    expect_identical(names(r$data), c("x", "y", "z", "time"))
+    expect_equal(as.numeric(r$data$time[c(1, 31)]),
+                 as.numeric(as.POSIXct("2023-05-11 09:00:00", tz = "UTC")) + c(0, 1))
     expect_identical(nrow(r$data), nrow(rec))
     # fwrite writes the shortest decimal that reads back to the same double
     expect_identical(r$data$y, rec$y)

@@ -38,6 +38,8 @@
 #include <limits>
 #include <vector>
 
+#include "r_arith.hpp"
+
 namespace gravcal {
 
 enum class StopRule { ggir, parameters };
@@ -64,20 +66,6 @@ struct IcpResult {
   double statistic = 0.0;  // last value of GGIR's res
 };
 
-// R's mean(): long double sum, then a correction pass.
-inline double r_mean(const double* v, std::size_t n) {
-  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
-  const long double ln = static_cast<long double>(n);
-  long double s = 0.0L;
-  for (std::size_t i = 0; i < n; ++i) s += v[i];
-  long double m = s / ln;
-  if (std::isfinite(static_cast<double>(m))) {
-    long double t = 0.0L;
-    for (std::size_t i = 0; i < n; ++i) t += (v[i] - m);
-    m += t / ln;
-  }
-  return static_cast<double>(m);
-}
 
 // Weighted least squares by Householder QR. X: n x p, column-major, rows
 // already multiplied by sqrt(weight); y likewise. Writes the p coefficients

@@ -1,0 +1,130 @@
+# Writers of synthetic csv files for the csv decoder's tests and benchmark
+# (not exported). ActiLife's layout as the format description in
+# inst/include/gravcal/decode_csv.hpp gives it: 10 header lines, an optional
+# column-name line, then [time stamp,] x, y, z.
+
+# ActiLife's 10 header lines for a recording of n samples at sf Hz from
+# `start` (UTC), date format M/d/yyyy.
+actigraph_csv_header <- function(sf, start, n, serial = "MOS2E00000000",
+                                 date_format = "M/d/yyyy") {
+  t0 <- as.POSIXct(start, tz = "UTC")
+  t1 <- t0 + n / sf
+  mdy <- function(t) {
+    paste0(as.integer(format(t, "%m")), "/", as.integer(format(t, "%d")), "/",
+           format(t, "%Y"))
+  }
+  c(paste0("------------ Data File Created By ActiGraph GT3X+ ActiLife v6.13.4 ",
+           "Firmware v3.2.1 date format ", date_format, " at ", format(sf),
+           " Hz  Filter Normal -----------"),
+    paste("Serial Number:", serial),
+    paste("Start Time", format(t0, "%H:%M:%S")),
+    paste("Start Date", mdy(t0)),
+    "Epoch Period (hh:mm:ss) 00:00:00",
+    paste("Download Time", format(t1, "%H:%M:%S")),
+    paste("Download Date", mdy(t1)),
+    "Current Memory Address: 0",
+    "Current Battery Voltage: 4.20     Mode = 12",
+    "--------------------------------------------------")
+}
+
+# ActiLife's time stamps "M/d/yyyy HH:MM:SS.fff" of samples i0 + 0:(n-1).
+actilife_stamps <- function(t0, sf, i0, n) {
+  i <- i0 + seq_len(n) - 1
+  ms <- round((i %% sf) * 1000 / sf)
+  whole <- t0 + i %/% sf
+  day <- as.integer(as.numeric(whole) %/% 86400)
+  days <- unique(day)
+  dstr <- format(as.POSIXct(days * 86400, origin = "1970-01-01", tz = "UTC"), "%m/%d/%Y")
+  dstr <- sub("^0", "", sub("/0", "/", dstr))
+  sod <- as.integer(as.numeric(whole) %% 86400)
+  paste0(dstr[match(day, days)], " ", sprintf("%02d:%02d:%02d.%03d", sod %/% 3600L,
+         (sod %/% 60L) %% 60L, sod %% 60L, as.integer(ms)))
+}
+
+# Writes samples x (a data frame or matrix with x, y, z) as an ActiGraph csv
+# export. `digits`: decimals of the values (ActiLife writes 3); `stamps`:
+# "none", "actilife" (M/d/yyyy HH:MM:SS.fff) or "iso" (fwrite's
+# 2023-05-11T09:00:00.010Z, fast); `colnames`: the column-name line; `eol`:
+# line end; `rows`: samples written per fwrite call.
+write_actigraph_csv_file <- function(x, file, sf, start = "2023-05-11 09:00:00",
+                                     stamps = "none", colnames = TRUE, digits = 3,
+                                     eol = "\n", rows = 1e6) {
+  s <- as_samples(x)
+  t0 <- as.POSIXct(start, tz = "UTC")
+  hdr <- actigraph_csv_header(sf, start, s$n)
+  if (colnames) {
+    hdr <- c(hdr, paste0(if (stamps != "none") "Timestamp,",
+                         "Accelerometer X,Accelerometer Y,Accelerometer Z"))
+  }
+  con <- file(file, "wb")
+  writeBin(charToRaw(paste0(paste(hdr, collapse = eol), eol)), con)
+  close(con)
+  for (from in seq(0, max(s$n - 1, 0), by = rows)) {
+    k <- min(rows, s$n - from)
+    if (k <= 0) break
+    j <- from + seq_len(k)
+    d <- list(round(s$x[j], digits), round(s$y[j], digits), round(s$z[j], digits))
+    if (stamps == "actilife") d <- c(list(actilife_stamps(t0, sf, from, k)), d)
+    if (stamps == "iso") d <- c(list(t0 + (from + seq_len(k) - 1) / sf), d)
+    data.table::fwrite(d, file, append = TRUE, col.names = FALSE, eol = eol,
+                       dateTimeAs = "ISO")
+  }
+  invisible(file)
+}
+
+# A synthetic recording of `hours` (whole hours) at sf Hz written as an
+# ActiGraph csv, fast enough for a week at 100 Hz: one hour of motion (the
+# device turning through orientations, with noise) is formatted once as
+# text and written again for every hour, with the hour (and, each new day,
+# the date) of its time stamps rewritten in place. `stamps`: "actilife"
+# (M/d/yyyy HH:MM:SS.fff), "iso" (2023-05-11T09:00:00.010Z) or "none".
+write_actigraph_csv_synthetic <- function(file, hours, sf = 100, stamps = "actilife",
+                                          start = "2023-05-11 09:00:00") {
+  per_hour <- round(3600 * sf)
+  t0 <- as.POSIXct(start, tz = "UTC")
+  h0 <- as.numeric(t0) %/% 3600
+  writeLines(c(actigraph_csv_header(sf, start, hours * per_hour),
+               paste0(if (stamps != "none") "Timestamp,",
+                      "Accelerometer X,Accelerometer Y,Accelerometer Z")), file)
+  i <- seq_len(per_hour) - 1
+  a <- 2 * pi * i / per_hour
+  noise <- ((i * 7919) %% 101 - 50) / 5000
+  values <- paste(round(sin(a) * 0.9 + noise, 3), round(cos(a) * 0.6 - noise, 3),
+                  round(sin(2 * a) * 0.4 + noise / 2, 3), sep = ",")
+  sec <- i %/% sf
+  clock <- sprintf("%02d:%02d.%03d", sec %/% 60, sec %% 60, round((i %% sf) * 1000 / sf))
+  con <- file(file, "ab")
+  on.exit(close(con))
+  block <- NULL
+  day <- -1
+  for (h in h0 + seq_len(hours) - 1) {
+    if (stamps == "none") {
+      if (is.null(block)) block <- charToRaw(paste0(values, "\n", collapse = ""))
+      writeBin(block, con)
+      next
+    }
+    if (h %/% 24 != day) {
+      day <- h %/% 24
+      d <- as.POSIXct(day * 86400, origin = "1970-01-01", tz = "UTC")
+      date <- if (stamps == "iso") format(d, "%Y-%m-%dT") else
+        paste0(as.integer(format(d, "%m")), "/", as.integer(format(d, "%d")), "/",
+               format(d, "%Y"), " ")
+      lines <- paste0(date, "00:", clock, if (stamps == "iso") "Z", ",", values, "\n")
+      block <- charToRaw(paste(lines, collapse = ""))
+      # the hour's two digits, at a fixed place in every line
+      at <- c(0, cumsum(nchar(lines, "bytes"))[-length(lines)]) + nchar(date, "bytes")
+    }
+    hh <- charToRaw(sprintf("%02d", h %% 24))
+    block[at + 1] <- hh[1]
+    block[at + 2] <- hh[2]
+    writeBin(block, con)
+  }
+  invisible(file)
+}
+
+# Writes a data frame as a plain csv with a header line of its column names
+# (POSIXct as ISO text), for the "csv" format.
+write_plain_csv <- function(d, file, sep = ",", dec = ".") {
+  data.table::fwrite(d, file, sep = sep, dec = dec, dateTimeAs = "ISO")
+  invisible(file)
+}

@@ -1,0 +1,294 @@
+// gravcal: what every device-file decoder shares.
+//
+// A decoder turns the bytes of a device file into samples in g (and degrees
+// C, and seconds since 1970-01-01 UTC), pulled by the caller in chunks of a
+// size the caller chooses, into arrays the caller owns. It reads its input
+// sequentially through a ByteSource and keeps only fixed-size state (one
+// format unit: a 512-byte block, a page, a line, a record), so memory does not
+// grow with the recording. The caller decides how many samples it holds at
+// once (a fixed buffer that feeds the segmenter, or a GGIR-sized block).
+//
+// Damage is never the end of the data. A decoder that meets a unit it cannot
+// use (bad checksum, bad header, malformed line, impossible time stamp)
+// skips it, counts it in its Report under a named counter, and goes on with
+// the next good unit; only the true end of the input ends the data. A read
+// error of the ByteSource is recorded (Report::read_error) and ends the data
+// with the report saying so, never silently. Nothing read from a file sizes
+// an allocation: counts and lengths from headers are checked against fixed
+// limits of the format, and a jump in time is reported as a gap.
+//
+// Header-only, standard headers only, no R. What needs a library (inflating
+// a zip entry) is given to the decoder as a ByteSource from outside.
+#ifndef GRAVCAL_DECODE_HPP
+#define GRAVCAL_DECODE_HPP
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gravcal {
+
+// ---------------------------------------------------------------------------
+// Byte sources
+
+class ByteSource {
+ public:
+  virtual ~ByteSource() = default;
+  // Reads up to n bytes into buf; returns how many. Fewer than n only at the
+  // end of the input or on a read error; failed() tells the two apart.
+  virtual std::size_t read(unsigned char* buf, std::size_t n) = 0;
+  // A read error happened (the input did not end, it could not be read).
+  virtual bool failed() const = 0;
+  // Bytes delivered so far.
+  virtual std::int64_t position() const = 0;
+  // Total size in bytes where known (a regular file), else -1. Only a hint
+  // (for progress, for checking a header's claims): never sizes memory.
+  virtual std::int64_t size() const { return -1; }
+  // Moves to an absolute byte position; false when the source cannot.
+  virtual bool seek(std::int64_t) { return false; }
+};
+
+// A file, through stdio with a fixed buffer.
+class FileSource : public ByteSource {
+ public:
+  explicit FileSource(const char* path) {
+    f_ = std::fopen(path, "rb");
+    if (f_ == nullptr) return;
+    std::setvbuf(f_, nullptr, _IOFBF, 1u << 20);
+    if (std::fseek(f_, 0, SEEK_END) == 0) {
+      const long s = std::ftell(f_);
+      if (s >= 0) size_ = s;
+    }
+    std::fseek(f_, 0, SEEK_SET);
+  }
+  ~FileSource() override {
+    if (f_ != nullptr) std::fclose(f_);
+  }
+  FileSource(const FileSource&) = delete;
+  FileSource& operator=(const FileSource&) = delete;
+  bool is_open() const { return f_ != nullptr; }
+  std::size_t read(unsigned char* buf, std::size_t n) override {
+    if (f_ == nullptr || n == 0) return 0;
+    const std::size_t got = std::fread(buf, 1, n, f_);
+    pos_ += static_cast<std::int64_t>(got);
+    if (got < n && std::ferror(f_)) failed_ = true;
+    return got;
+  }
+  bool failed() const override { return failed_; }
+  std::int64_t position() const override { return pos_; }
+  std::int64_t size() const override { return size_; }
+  bool seek(std::int64_t pos) override {
+    if (f_ == nullptr || pos < 0) return false;
+    if (std::fseek(f_, static_cast<long>(pos), SEEK_SET) != 0) return false;
+    pos_ = pos;
+    return true;
+  }
+
+ private:
+  std::FILE* f_ = nullptr;
+  std::int64_t pos_ = 0;
+  std::int64_t size_ = -1;
+  bool failed_ = false;
+};
+
+// Bytes already in memory (tests, fuzzers); the caller keeps them alive.
+class MemorySource : public ByteSource {
+ public:
+  MemorySource(const unsigned char* data, std::size_t n) : p_(data), n_(n) {}
+  std::size_t read(unsigned char* buf, std::size_t n) override {
+    const std::size_t k = n < n_ - at_ ? n : n_ - at_;
+    if (k) std::memcpy(buf, p_ + at_, k);
+    at_ += k;
+    return k;
+  }
+  bool failed() const override { return false; }
+  std::int64_t position() const override { return static_cast<std::int64_t>(at_); }
+  std::int64_t size() const override { return static_cast<std::int64_t>(n_); }
+  bool seek(std::int64_t pos) override {
+    if (pos < 0 || static_cast<std::uint64_t>(pos) > n_) return false;
+    at_ = static_cast<std::size_t>(pos);
+    return true;
+  }
+
+ private:
+  const unsigned char* p_;
+  std::size_t n_;
+  std::size_t at_ = 0;
+};
+
+// Reads exactly n bytes unless the input ends (or fails) first.
+inline std::size_t read_full(ByteSource& src, unsigned char* buf, std::size_t n) {
+  std::size_t got = 0;
+  while (got < n) {
+    const std::size_t k = src.read(buf + got, n - got);
+    if (k == 0) break;
+    got += k;
+  }
+  return got;
+}
+
+// Little- and big-endian integers from bytes.
+inline std::uint16_t le16(const unsigned char* p) {
+  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+}
+inline std::uint32_t le32(const unsigned char* p) {
+  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+inline std::uint16_t be16(const unsigned char* p) {
+  return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
+}
+inline std::uint32_t be32(const unsigned char* p) {
+  return (static_cast<std::uint32_t>(p[0]) << 24) | (static_cast<std::uint32_t>(p[1]) << 16) |
+         (static_cast<std::uint32_t>(p[2]) << 8) | static_cast<std::uint32_t>(p[3]);
+}
+
+// Days since 1970-01-01 of a date of the proleptic Gregorian calendar
+// (H. Hinnant's days_from_civil), for the decoders' time stamps.
+inline std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const unsigned yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+// ---------------------------------------------------------------------------
+// What a decoder gives
+
+// What the file says about itself (from its header).
+struct DeviceInfo {
+  std::string format;   // "cwa", "geneactiv", "gt3x", "actigraph_csv", "csv"
+  std::string device;   // model, as the header names it ("AX3", "GENEActiv 1.1")
+  std::string serial;   // the device's serial number, "" when absent
+  double sf = 0.0;      // sampling rate in Hz (of the samples the decoder gives)
+  double start_time = std::numeric_limits<double>::quiet_NaN();  // s since 1970 UTC
+  bool has_temperature = false;
+  bool has_time = false;  // the decoder gives a time stamp per sample
+  double range_g = std::numeric_limits<double>::quiet_NaN();  // +- full scale, g
+};
+
+// What was read and what was skipped, and why. Counters have names chosen by
+// each decoder ("bad_checksum", "malformed_lines", "gaps", ...) and keep their
+// order of first use; notes hold the first few problems in words, with where
+// they were (byte offset, line), for the user.
+class Report {
+ public:
+  static constexpr std::size_t max_notes = 20;
+  void count(const char* name, std::int64_t k = 1) {
+    for (auto& c : counters) {
+      if (c.first == name) {
+        c.second += k;
+        return;
+      }
+    }
+    counters.emplace_back(name, k);
+  }
+  std::int64_t get(const char* name) const {
+    for (const auto& c : counters) {
+      if (c.first == name) return c.second;
+    }
+    return 0;
+  }
+  void note(std::string what) {
+    ++notes_total;
+    if (notes.size() < max_notes) notes.push_back(std::move(what));
+  }
+  std::int64_t units = 0;     // format units decoded (blocks, pages, lines, records)
+  std::int64_t samples = 0;   // samples given to the caller
+  std::int64_t skipped = 0;   // format units skipped as unusable
+  std::int64_t gaps = 0;      // jumps in time
+  double gap_seconds = 0.0;   // their total length
+  bool truncated = false;     // the input ended inside a unit
+  bool read_error = false;    // the input could not be read to its end
+  std::vector<std::pair<std::string, std::int64_t>> counters;
+  std::vector<std::string> notes;
+  std::int64_t notes_total = 0;
+};
+
+// Arrays owned by the caller, each of `capacity` doubles; t and time may be
+// null (then not written). The decoder appends at n.
+struct SampleBuffer {
+  double* x = nullptr;
+  double* y = nullptr;
+  double* z = nullptr;
+  double* t = nullptr;     // temperature, degrees C
+  double* time = nullptr;  // seconds since 1970-01-01 UTC
+  std::size_t capacity = 0;
+  std::size_t n = 0;
+  bool full() const { return n >= capacity; }
+  std::size_t room() const { return capacity - n; }
+  void put(double xi, double yi, double zi, double ti, double timei) {
+    x[n] = xi;
+    y[n] = yi;
+    z[n] = zi;
+    if (t != nullptr) t[n] = ti;
+    if (time != nullptr) time[n] = timei;
+    ++n;
+  }
+};
+
+// Named options for a decoder (numbers and strings), set by the caller: for
+// example "compat" = 1 for the reference reader's behaviour, or a csv's
+// column layout. A decoder reads the ones it knows, with its own defaults.
+class Options {
+ public:
+  void set(const std::string& name, double v) { num_.emplace_back(name, v); }
+  void set(const std::string& name, const std::string& v) { str_.emplace_back(name, v); }
+  double num(const char* name, double fallback) const {
+    for (auto it = num_.rbegin(); it != num_.rend(); ++it) {
+      if (it->first == name) return it->second;
+    }
+    return fallback;
+  }
+  std::string str(const char* name, const std::string& fallback) const {
+    for (auto it = str_.rbegin(); it != str_.rend(); ++it) {
+      if (it->first == name) return it->second;
+    }
+    return fallback;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>> num_;
+  std::vector<std::pair<std::string, std::string>> str_;
+};
+
+// The interface every format's decoder implements. A decoder is built on a
+// ByteSource it does not own (which must outlive it) and its Options.
+class Decoder {
+ public:
+  virtual ~Decoder() = default;
+  // Reads the header. False when the input is not a readable file of this
+  // format (the reason is in error()); then read() gives nothing.
+  virtual bool open() = 0;
+  // Decodes samples into out until out is full or `max_units` of the
+  // format's units (cwa: 512-byte blocks; GENEActiv: pages; csv: lines;
+  // gt3x: seconds) have been consumed; a negative max_units means no limit.
+  // Returns the units consumed. Resumes where it stopped: a unit whose
+  // samples did not all fit is finished by the next call before any new unit
+  // is counted. done() is true once every sample has been given.
+  virtual std::int64_t read(SampleBuffer& out, std::int64_t max_units) = 0;
+  virtual bool done() const = 0;
+  // An upper bound on the samples one unit gives, fixed by the format (not
+  // read from the file); for sizing a block of `max_units` units.
+  virtual std::size_t max_samples_per_unit() const = 0;
+  const DeviceInfo& info() const { return info_; }
+  const Report& report() const { return report_; }
+  const std::string& error() const { return error_; }
+
+ protected:
+  DeviceInfo info_;
+  Report report_;
+  std::string error_;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_DECODE_HPP

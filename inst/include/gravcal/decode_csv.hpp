@@ -1,0 +1,564 @@
+// gravcal: decoder for csv files of samples: ActiGraph csv exports
+// (ActiLife) and plain csv files with a header line naming the columns.
+//
+// ActiGraph csv (format "actigraph_csv", or "csv" when the first line names
+// ActiGraph): 10 header lines ("------------ Data File Created By ActiGraph
+// GT3X+ ActiLife v6.13.4 Firmware v3.2.1 date format M/d/yyyy at 30 Hz
+// Filter Normal -----------", "Serial Number: ...", "Start Time HH:MM:SS",
+// "Start Date <date in the header's date format>", "Epoch Period
+// (hh:mm:ss) ...", ..., a line of dashes), then an optional column-name line,
+// then rows [time stamp,] x, y, z in g (more columns in count exports).
+// sf from "at N Hz" (else option sf, else the epoch period, else the time
+// stamps); time per sample from the time stamp column ("M/d/yyyy
+// HH:MM:SS.fff" in the header's date order, or ISO "2017-09-12T15:00:00Z"),
+// else start + i / sf with i the data line's index.
+//
+// Plain csv (format "csv"): a header line naming the columns, in any order
+// and case, blanks, dots and underscores ignored: x, y, z (also acc_x,
+// accel_x, accelerometer_x, acceleration_x), optionally time (timestamp,
+// datetime: numeric seconds since 1970 or date-time text) and temperature
+// (temp). sf from option sf, else from time as gravcal's sf_from_time()
+// (R/read.R): 1 / median step of the first 100000 time stamps, signif 6; for
+// whole-second stamps, samples counted between the first and last change.
+//
+// Unit = one line after the header (and after the column-name line):
+// read(out, B) consumes B lines and gives one sample for each good one.
+// GGIR (g.readaccfile, 3.3.9) reads an ActiGraph csv as
+// fread(skip = s, nrows = B, header = FALSE) with s = 10 (+1 when line 11 is
+// a column-name line) and then s + B: successive read(out, B) give the same
+// rows. Values equal fread's bit for bit with compat = 1 (its number parser,
+// see decode_csv_text.hpp).
+//
+// Damage: a line that is blank, has too few or too many fields (a
+// comma-decimal row), holds no number where a value should be, or is longer
+// than 64 KiB is skipped and counted (blank_lines, short_lines, long_lines,
+// non_numeric_lines, overlong_lines; the first ones with line numbers and
+// byte offsets in the notes); every good line after it is kept. An
+// unreadable time stamp keeps its sample with the time one step after the
+// last (bad_timestamps); a jump forward in time stamps is a gap (gaps,
+// gap_seconds), a step back is counted (time_backwards). A last line
+// without line end is kept when it is whole (no_final_line_end), else
+// skipped with truncated = true. CRLF, a UTF-8 BOM, blanks around fields and
+// double-quoted fields are read as fread reads them. Semicolon-separated
+// files (with decimal commas) are read: the separator is the one of ',', ';'
+// and tab that splits the first data lines into a constant number of fields.
+//
+// Where fread (compat = 1) and the format (compat = 0) differ:
+// * x, y, z columns: GGIR takes columns 2:4 whenever there are more than 3
+//   (so of a count export without time stamps, axis 2, 3 and steps);
+//   compat = 0 takes 2:4 only after a time stamp column, else 1:3.
+// * line 11: GGIR takes it for a column-name line when its first field is
+//   not a number, so a time-stamped export without column names loses its
+//   first row (compat = 1 does the same); compat = 0 keeps a line 11 whose
+//   first field is a time stamp.
+// * numbers: fread 1.14.8's long double product (compat = 1) or correctly
+//   rounded (compat = 0).
+// fread's own behaviour on damage is not reproduced in either mode: it stops
+// its block at a malformed line (the rest of the block is lost), skips a
+// malformed first line of a block and then reads one row of the next block
+// twice, gives a block whose first lines have 2 fields as 2 columns (GGIR
+// then ends the recording there), and makes a column with text character
+// (GGIR stops with an error). Both modes keep every good line instead and
+// keep the block boundaries (B lines per call), so a clean file gives
+// exactly GGIR's blocks and a damaged one GGIR's blocks minus the damage.
+// Empty fields and "NA" (NA in fread) make a line non-numeric here.
+#ifndef GRAVCAL_DECODE_CSV_HPP
+#define GRAVCAL_DECODE_CSV_HPP
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "gravcal/decode.hpp"
+#include "gravcal/decode_csv_text.hpp"
+
+namespace gravcal {
+
+class CsvDecoder : public Decoder {
+ public:
+  static constexpr int kActiGraphHeaderLines = 10;  // ActiLife's, as GGIR counts them
+  static constexpr int kMaxFields = 64;             // fields looked at per line
+  static constexpr int kLayoutLines = 64;           // data lines that tell the layout
+  static constexpr std::size_t kSfLines = 100000;   // time stamps for sf, as sf_from_time()
+  static constexpr double kGapSteps = 1.5;          // a step this many sample periods is a gap
+
+  // `format`: "actigraph_csv" (the ActiLife header is required) or "csv"
+  // (either kind). Options: compat (1: fread/GGIR, 0: the format), sf;
+  // buffer (bytes of the read buffer, default 1 MiB; for tests and fuzzers).
+  CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
+      : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
+    compat_ = opts.num("compat", 1) != 0;
+    sf_option_ = opts.num("sf", 0);
+  }
+
+  bool open() override {
+    csv_text::Line ln;
+    if (!lines_.next(ln)) return fail(lines_.read_failed() ? "the file cannot be read" : "the file is empty");
+    std::string first(ln.p, ln.n);
+    if (first.compare(0, 3, "\xEF\xBB\xBF") == 0) first.erase(0, 3);  // UTF-8 BOM
+    const bool actigraph = contains_nocase(first, "actigraph");
+    if (!actigraph && want_actigraph_) {
+      return fail("not an ActiGraph csv export: first line is \"" +
+                  csv_text::excerpt(first.data(), first.size()) + "\"");
+    }
+    const bool ok = actigraph ? open_actigraph(first) : open_plain(first);
+    if (!ok) return false;
+    info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
+    info_.has_temperature = col_temp_ >= 0;
+    opened_ = true;
+    done_ = lines_.exhausted();
+    return true;
+  }
+
+  std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
+    if (!opened_) return 0;
+    std::int64_t used = 0;
+    csv_text::Line ln;
+    while ((max_units < 0 || used < max_units) && !out.full()) {
+      if (!lines_.next(ln)) break;
+      ++used;
+      ++report_.units;
+      take_line(ln, out);
+      ++index_;
+    }
+    done_ = lines_.exhausted();
+    if (done_ && lines_.read_failed() && !report_.read_error) {
+      report_.read_error = true;
+      report_.note("read error at byte " + std::to_string(lines_.offset()) + ": the rest of the file is lost");
+    }
+    return used;
+  }
+
+  bool done() const override { return !opened_ || done_; }
+  std::size_t max_samples_per_unit() const override { return 1; }
+
+ private:
+  static std::size_t buffer_bytes(const Options& opts) {
+    const double b = opts.num("buffer", static_cast<double>(csv_text::LineReader::kBuffer));
+    return b >= 1 && b <= static_cast<double>(csv_text::LineReader::kBuffer)
+               ? static_cast<std::size_t>(b) : csv_text::LineReader::kBuffer;
+  }
+
+  // ---- opening -----------------------------------------------------------
+
+  bool fail(const std::string& why) {
+    error_ = why;
+    return false;
+  }
+
+  static bool contains_nocase(const std::string& s, const char* w) {
+    const std::size_t n = std::strlen(w);
+    for (std::size_t i = 0; i + n <= s.size(); ++i) {
+      std::size_t k = 0;
+      while (k < n && std::tolower(static_cast<unsigned char>(s[i + k])) == w[k]) ++k;
+      if (k == n) return true;
+    }
+    return false;
+  }
+
+  // Text after `key` up to the first comma (ActiLife pads lines with commas).
+  static bool value_after(const std::string& line, const char* key, std::string& v) {
+    const std::size_t at = line.find(key);
+    if (at == std::string::npos) return false;
+    std::size_t b = at + std::strlen(key);
+    std::size_t e = line.find(',', b);
+    if (e == std::string::npos) e = line.size();
+    while (b < e && line[b] == ' ') ++b;
+    while (e > b && (line[e - 1] == ' ' || line[e - 1] == '\r')) --e;
+    v = line.substr(b, e - b);
+    return true;
+  }
+
+  // "... Created By ActiGraph GT3X+ ActiLife v6 ... date format M/d/yyyy at 30 Hz ..."
+  void parse_first_line(const std::string& s) {
+    info_.format = "actigraph_csv";
+    const std::size_t by = s.find("By ");
+    if (by != std::string::npos) {
+      const std::size_t end = s.find(" ActiLife", by);
+      if (end != std::string::npos) info_.device = s.substr(by + 3, end - by - 3);
+    }
+    std::string fmt;
+    if (value_after(s, "date format ", fmt)) {
+      date_format_ = fmt.substr(0, fmt.find(' '));
+      dt_.set_order(csv_text::date_order_of(date_format_));
+    }
+    const std::size_t hz = s.find(" Hz");
+    const std::size_t at = s.rfind(" at ", hz);
+    if (hz != std::string::npos && at != std::string::npos) {
+      double v = 0;
+      std::string num = s.substr(at + 4, hz - at - 4);
+      std::replace(num.begin(), num.end(), ',', '.');  // as GGIR reads it
+      if (csv_text::parse_number(num.data(), num.data() + num.size(), '.', false, v) && v > 0) header_sf_ = v;
+    }
+  }
+
+  void parse_header_line(const std::string& s) {
+    std::string v;
+    if (value_after(s, "Serial Number:", v)) info_.serial = v;
+    if (value_after(s, "Start Time", v)) start_clock_ = v;
+    if (value_after(s, "Start Date", v)) start_date_ = v;
+    if (value_after(s, "Epoch Period (hh:mm:ss)", v)) {
+      const char* p = v.data();
+      double secs = 0;
+      int fd = 0;
+      if (csv_text::parse_clock(p, v.data() + v.size(), secs, fd)) epoch_ = secs;
+    }
+  }
+
+  // ActiGraph's dynamic range by serial prefix (as GGIR's
+  // get_nw_clip_block_params: CLE and NEO 6 g, MOS 8 g).
+  void range_from_serial() {
+    const std::string p = info_.serial.substr(0, 3);
+    if (p == "CLE" || p == "NEO") info_.range_g = 6;
+    if (p == "MOS") info_.range_g = 8;
+  }
+
+  bool open_actigraph(const std::string& first) {
+    parse_first_line(first);
+    csv_text::Line ln;
+    for (int i = 2; i <= kActiGraphHeaderLines; ++i) {
+      if (!lines_.next(ln) || !ln.has_end) {
+        return fail("header truncated at line " + std::to_string(i) + " (byte " +
+                    std::to_string(lines_.offset()) + "): an ActiGraph csv has " +
+                    std::to_string(kActiGraphHeaderLines) + " header lines");
+      }
+      parse_header_line(std::string(ln.p, ln.n));
+    }
+    range_from_serial();
+    if (!start_date_.empty() && !start_clock_.empty()) {
+      double t = 0;
+      int fd = 0;
+      const std::string s = start_date_ + " " + start_clock_;
+      if (dt_.parse(s.data(), s.data() + s.size(), t, fd)) info_.start_time = t;
+    }
+    if (!learn_actigraph_layout()) return false;
+    return choose_sf(header_sf_ > 0 ? header_sf_ : (epoch_ > 0 ? 1 / epoch_ : 0));
+  }
+
+  // Up to kLayoutLines + 1 lines from the bytes buffered ahead, unconsumed.
+  std::vector<std::pair<const char*, std::size_t>> peek_lines() {
+    std::vector<std::pair<const char*, std::size_t>> v;
+    const char* p;
+    std::size_t n;
+    lines_.peek(p, n);
+    const char* e = p + n;
+    while (p < e && v.size() <= static_cast<std::size_t>(kLayoutLines)) {
+      const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(e - p));
+      const char* le = nl != nullptr ? static_cast<const char*>(nl) : e;
+      std::size_t len = static_cast<std::size_t>(le - p);
+      if (len > 0 && p[len - 1] == '\r') --len;
+      v.emplace_back(p, len);
+      if (nl == nullptr) break;
+      p = le + 1;
+    }
+    return v;
+  }
+
+  // The separator that splits the lines into the same number (>= 3) of
+  // fields most often; sets sep_, nfields_, dec_.
+  bool learn_separator(const std::vector<std::pair<const char*, std::size_t>>& v, std::size_t from) {
+    // ';' and tab first: a semicolon file with decimal commas splits at ','
+    // too, but not into a constant number of fields
+    const char seps[3] = {';', '\t', ','};
+    int best = 0;
+    csv_text::Field f[kMaxFields];
+    for (char sep : seps) {
+      std::vector<int> counts;
+      for (std::size_t i = from; i < v.size(); ++i) {
+        if (v[i].second > 0) counts.push_back(csv_text::split(v[i].first, v[i].second, sep, f, kMaxFields));
+      }
+      for (int c : counts) {
+        const int agree = static_cast<int>(std::count(counts.begin(), counts.end(), c));
+        if (c >= 3 && agree > best) { best = agree; sep_ = sep; nfields_ = c; }
+      }
+    }
+    if (best == 0) return false;
+    dec_ = '.';
+    if (sep_ != ',') {
+      for (std::size_t i = from; i < v.size(); ++i) {
+        if (std::memchr(v[i].first, ',', v[i].second) != nullptr) dec_ = ',';
+      }
+    }
+    return true;
+  }
+
+  // The bytes buffered ahead are all that is left of the input.
+  bool lines_at_end() {
+    const char* p;
+    std::size_t n;
+    lines_.peek(p, n);
+    return lines_.input_ended() && (n == 0 || p[n - 1] != '\n');
+  }
+
+  bool is_number(const csv_text::Field& f) const {
+    double v;
+    return csv_text::parse_number(f.b, f.e, dec_, false, v);
+  }
+  bool is_time(const csv_text::Field& f) {
+    double t;
+    int fd;
+    return dt_.parse(f.b, f.e, t, fd);
+  }
+
+  // Line 11 (column names or data) and the x, y, z and time columns.
+  bool learn_actigraph_layout() {
+    const auto v = peek_lines();
+    if (v.empty()) return fail("no data lines after the " + std::to_string(kActiGraphHeaderLines) + " header lines");
+    const std::size_t from = v.size() > 1 ? 1 : 0;
+    if (!learn_separator(v, from)) {
+      return fail("data lines do not have 3 fields (x, y, z): line " +
+                  std::to_string(lines_.line_number() + 1 + from) + " is \"" +
+                  csv_text::excerpt(v[from].first, v[from].second) + "\"" +
+                  (from + 1 == v.size() && lines_at_end() ? " (the file ends there)" : ""));
+    }
+    csv_text::Field f[kMaxFields];
+    csv_text::split(v[0].first, v[0].second, sep_, f, kMaxFields);
+    bool names = !is_number(f[0]);
+    if (!compat_ && names && is_time(f[0])) names = false;
+    if (names) {
+      csv_text::Line ln;
+      lines_.next(ln);
+    }
+    const std::size_t d = names ? 1 : 0;
+    const bool stamped = d < v.size() && csv_text::split(v[d].first, v[d].second, sep_, f, kMaxFields) >= 1 &&
+                         is_time(f[0]);
+    const int x = compat_ ? (nfields_ > 3 ? 1 : 0) : (stamped ? 1 : 0);
+    if (x + 3 > nfields_) return fail("data lines have " + std::to_string(nfields_) + " fields, too few for a time stamp, x, y, z");
+    col_x_ = x;
+    col_time_ = (x == 1 && stamped) ? 0 : -1;
+    return true;
+  }
+
+  static std::string normal_name(const csv_text::Field& f) {
+    std::string s;
+    for (const char* p = f.b; p < f.e; ++p) {
+      const char c = static_cast<char>(std::tolower(static_cast<unsigned char>(*p)));
+      if (c != ' ' && c != '_' && c != '.' && c != '"') s += c;
+    }
+    return s;
+  }
+
+  static int axis_of(const std::string& n) {
+    static const char* const stems[] = {"", "acc", "accel", "accelerometer", "acceleration"};
+    for (const char* st : stems) {
+      for (int a = 0; a < 3; ++a) {
+        if (n == std::string(st) + static_cast<char>('x' + a)) return a;
+      }
+    }
+    return -1;
+  }
+
+  bool open_plain(const std::string& first) {
+    info_.format = "csv";
+    int best = 0;
+    for (char sep : {',', ';', '\t'}) {
+      const int c = static_cast<int>(std::count(first.begin(), first.end(), sep));
+      if (c > best) { best = c; sep_ = sep; }
+    }
+    csv_text::Field f[kMaxFields];
+    nfields_ = csv_text::split(first.data(), first.size(), sep_, f, kMaxFields);
+    int cols[3] = {-1, -1, -1};
+    for (int i = 0; i < std::min(nfields_, kMaxFields); ++i) {
+      const std::string n = normal_name(f[i]);
+      const int a = axis_of(n);
+      if (a >= 0 && cols[a] < 0) cols[a] = i;
+      if ((n == "time" || n == "timestamp" || n == "datetime") && col_time_ < 0) col_time_ = i;
+      if ((n == "temperature" || n == "temp") && col_temp_ < 0) col_temp_ = i;
+    }
+    if (cols[0] < 0 || cols[1] < 0 || cols[2] < 0) {
+      return fail("not a csv of samples: the first line names no x, y, z columns: \"" +
+                  csv_text::excerpt(first.data(), first.size()) + "\"");
+    }
+    col_x_ = cols[0];
+    col_y_ = cols[1];
+    col_z_ = cols[2];
+    const auto v = peek_lines();
+    dec_ = '.';
+    if (sep_ != ',') {
+      for (const auto& l : v) if (std::memchr(l.first, ',', l.second) != nullptr) dec_ = ',';
+    }
+    if (col_time_ >= 0 && !v.empty() && csv_text::split(v[0].first, v[0].second, sep_, f, kMaxFields) > col_time_) {
+      time_text_ = !is_number(f[col_time_]);
+    }
+    return choose_sf(0);
+  }
+
+  // sf: option sf, else the header's, else from the time stamps.
+  bool choose_sf(double from_header) {
+    if (col_x_ >= 0 && col_y_ < 0) {
+      col_y_ = col_x_ + 1;
+      col_z_ = col_x_ + 2;
+    }
+    double sf = sf_option_ > 0 ? sf_option_ : from_header;
+    if (!(sf > 0) && col_time_ >= 0) sf = sf_from_time();
+    if (!(sf > 0)) {
+      return fail(info_.format == "csv" ? "the sampling rate is unknown: no time column and no option sf"
+                                        : "no sampling rate in the header (\"at N Hz\") and no option sf");
+    }
+    info_.sf = sf;
+    step_ = 1 / sf;
+    return true;
+  }
+
+  bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
+    if (!time_text_) {
+      frac_digits = 9;
+      return csv_text::parse_number(f.b, f.e, dec_, compat_, t);
+    }
+    return dt_.parse(f.b, f.e, t, frac_digits);
+  }
+
+  // As sf_from_time() in R/read.R, on the first kSfLines time stamps; reads
+  // them ahead and starts again (0 when they do not tell, or the source
+  // cannot start again).
+  double sf_from_time() {
+    const std::int64_t pos = lines_.offset(), line = lines_.line_number();
+    std::vector<double> t;
+    t.reserve(std::min<std::size_t>(kSfLines, 4096));
+    csv_text::Line ln;
+    csv_text::Field f[kMaxFields];
+    while (t.size() < kSfLines && lines_.next(ln)) {
+      if (ln.too_long || csv_text::split(ln.p, ln.n, sep_, f, kMaxFields) != nfields_) continue;
+      double v;
+      int fd;
+      if (time_of(f[col_time_], v, fd)) t.push_back(v);
+    }
+    if (!lines_.rewind(pos, line)) return 0;
+    if (t.size() < 2) return 0;
+    std::vector<double> d(t.size() - 1);
+    for (std::size_t i = 0; i + 1 < t.size(); ++i) d[i] = t[i + 1] - t[i];
+    const double step = median(d);
+    if (std::isfinite(step) && step > 0) return csv_text::signif(1 / step, 6);
+    std::size_t first = 0, last = 0, k = 0;
+    for (std::size_t i = 0; i + 1 < t.size(); ++i) {
+      if (t[i + 1] - t[i] > 0) { if (k++ == 0) first = i; last = i; }
+    }
+    if (k < 2) return 0;
+    const double sf = static_cast<double>(last - first) / (t[last + 1] - t[first + 1]);
+    return std::isfinite(sf) && sf > 0 ? csv_text::signif(sf, 6) : 0;
+  }
+
+  // R's median: the mean of the two middle values of an even count.
+  static double median(std::vector<double> d) {
+    const std::size_t n = d.size(), h = n / 2;
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(h), d.end());
+    const double hi = d[h];
+    if (n % 2 == 1) return hi;
+    const double lo = *std::max_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(h));
+    return (lo + hi) / 2;
+  }
+
+  // ---- data lines -----------------------------------------------------------
+
+  void skip_line(const csv_text::Line& ln, const char* kind, const char* what) {
+    ++report_.skipped;
+    const char* counter = kind;
+    if (!ln.has_end) {
+      report_.truncated = true;
+      counter = "truncated_lines";
+    }
+    report_.count(counter);
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) + "): " +
+                 (ln.has_end ? what : "the file ends inside this line") + ": \"" +
+                 csv_text::excerpt(ln.p, ln.n) + "\"");
+  }
+
+  static bool blank(const csv_text::Line& ln) {
+    for (std::size_t i = 0; i < ln.n; ++i) {
+      if (ln.p[i] != ' ' && ln.p[i] != '\t') return false;
+    }
+    return true;
+  }
+
+  void take_line(const csv_text::Line& ln, SampleBuffer& out) {
+    if (ln.too_long) return skip_line(ln, "overlong_lines", "longer than 64 KiB");
+    if (blank(ln)) return skip_line(ln, "blank_lines", "blank line");
+    csv_text::Field f[kMaxFields];
+    const int nf = csv_text::split(ln.p, ln.n, sep_, f, kMaxFields);
+    if (nf < nfields_) return skip_line(ln, "short_lines", "too few fields");
+    if (nf > nfields_) return skip_line(ln, "long_lines", "too many fields");
+    double x, y, z, temp = std::numeric_limits<double>::quiet_NaN();
+    if (!csv_text::parse_number(f[col_x_].b, f[col_x_].e, dec_, compat_, x) ||
+        !csv_text::parse_number(f[col_y_].b, f[col_y_].e, dec_, compat_, y) ||
+        !csv_text::parse_number(f[col_z_].b, f[col_z_].e, dec_, compat_, z) ||
+        (col_temp_ >= 0 && !csv_text::parse_number(f[col_temp_].b, f[col_temp_].e, dec_, compat_, temp))) {
+      return skip_line(ln, "non_numeric_lines", "a value is not a number");
+    }
+    if (!ln.has_end) {
+      report_.count("no_final_line_end");
+      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                   "): the last line has no line end; kept");
+    }
+    const double t = col_time_ >= 0 ? stamp_time(f[col_time_], ln) : info_.start_time + static_cast<double>(index_) / info_.sf;
+    out.put(x, y, z, temp, t);
+    ++report_.samples;
+  }
+
+  // The time of a stamped line: its stamp (plus k / sf for the k-th line of
+  // a stamp coarser than a sample period), checked against the last one.
+  double stamp_time(const csv_text::Field& f, const csv_text::Line& ln) {
+    double s;
+    int fd = 0;
+    if (!time_of(f, s, fd)) {
+      report_.count("bad_timestamps");
+      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                   "): unreadable time stamp; time from the line before");
+      last_time_ += step_;
+      return last_time_;
+    }
+    static const double kRes[10] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 0};
+    const double res = kRes[fd < 9 ? fd : 9];
+    if (s == last_stamp_) ++run_;
+    else run_ = 0;
+    last_stamp_ = s;
+    const bool coarse = res > kGapSteps * step_;
+    const double t = coarse ? s + static_cast<double>(run_) * step_ : s;
+    if (std::isfinite(last_time_)) check_step(t - last_time_, coarse ? 0 : res, ln);
+    last_time_ = t;
+    return t;
+  }
+
+  void check_step(double dt, double res, const csv_text::Line& ln) {
+    if (dt > kGapSteps * step_ + res) {
+      ++report_.gaps;
+      report_.gap_seconds += dt - step_;
+      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                   "): time jumps " + std::to_string(dt) + " s");
+    } else if (dt < -(step_ / 2 + res)) {
+      report_.count("time_backwards");
+      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                   "): time goes back " + std::to_string(-dt) + " s");
+    }
+  }
+
+  csv_text::LineReader lines_;
+  csv_text::DateTimeParser dt_;
+  bool want_actigraph_;
+  bool compat_ = true;
+  double sf_option_ = 0;
+  bool opened_ = false, done_ = false;
+  // header
+  double header_sf_ = 0, epoch_ = 0;
+  std::string date_format_, start_date_, start_clock_;
+  // layout
+  char sep_ = ',', dec_ = '.';
+  int nfields_ = 0;
+  int col_x_ = -1, col_y_ = -1, col_z_ = -1, col_time_ = -1, col_temp_ = -1;
+  bool time_text_ = true;
+  double step_ = 0;
+  // position
+  std::int64_t index_ = 0;  // data lines consumed
+  double last_time_ = std::numeric_limits<double>::quiet_NaN();
+  double last_stamp_ = std::numeric_limits<double>::quiet_NaN();
+  std::int64_t run_ = 0;
+};
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_DECODE_CSV_HPP

@@ -1,0 +1,453 @@
+// gravcal: the text primitives of the csv decoder (decode_csv.hpp): numbers,
+// date-times, a line reader over a fixed buffer, field splitting.
+//
+// Numbers. data.table::fread (1.14.8, the version GGIR runs with here) reads
+// a decimal as an integer of at most 18 significant digits times a power of
+// ten, both in long double, and rounds that product to double. That is not
+// correctly rounded: "1.358931", "-1.10116583029324" differ from strtod's
+// value in the last bit (about 1 in 4000 numbers of 6 or more digits; none
+// of 3 or 4 decimals, which ActiLife writes, and none of 17 digits). With
+// compat = 1 the decoder computes fread's product; with compat = 0 it gives
+// the correctly rounded value (std::from_chars). data.table 1.15.0 changed
+// this to a division by the power of ten (its issue 4461), which differs in
+// other last bits: compat follows the installed reference, 1.14.8.
+#ifndef GRAVCAL_DECODE_CSV_TEXT_HPP
+#define GRAVCAL_DECODE_CSV_TEXT_HPP
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "gravcal/decode.hpp"
+
+namespace gravcal {
+namespace csv_text {
+
+// fread reads at most this many significant digits of a number
+constexpr int kMaxSigDigits = 18;
+// and gives up on exponents beyond this (the value is not a number for it)
+constexpr int kMaxExponent = 350;
+
+// 10^e for |e| <= kMaxExponent in long double, each correctly rounded (the
+// value a compiler gives the literal 1e<e>L, as fread's table holds them).
+inline const long double* pow10_table() {
+  static const std::vector<long double> t = [] {
+    std::vector<long double> v(2 * kMaxExponent + 1);
+    for (int e = -kMaxExponent; e <= kMaxExponent; ++e) {
+      const std::string lit = "1e" + std::to_string(e);
+      v[static_cast<std::size_t>(e + kMaxExponent)] = std::strtold(lit.c_str(), nullptr);
+    }
+    return v;
+  }();
+  return t.data();
+}
+
+// The common exponents as long double literals (no look-up call per number).
+constexpr int kNearExponent = 22;
+constexpr long double kPow10Near[2 * kNearExponent + 1] = {
+    1e-22L, 1e-21L, 1e-20L, 1e-19L, 1e-18L, 1e-17L,
+    1e-16L, 1e-15L, 1e-14L, 1e-13L, 1e-12L, 1e-11L,
+    1e-10L, 1e-9L, 1e-8L, 1e-7L, 1e-6L, 1e-5L,
+    1e-4L, 1e-3L, 1e-2L, 1e-1L, 1e0L, 1e1L,
+    1e2L, 1e3L, 1e4L, 1e5L, 1e6L, 1e7L,
+    1e8L, 1e9L, 1e10L, 1e11L, 1e12L, 1e13L,
+    1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L,
+    1e20L, 1e21L, 1e22L};
+
+inline bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// A number in [b, e): [+-]digits[<dec>digits][(e|E)[+-]digits], the whole
+// field. compat: fread 1.14.8's value; else the correctly rounded one.
+inline bool parse_number(const char* b, const char* e, char dec, bool compat, double& out) {
+  const char* p = b;
+  if (p == e) return false;
+  const bool neg = *p == '-';
+  if (neg || *p == '+') ++p;
+  const char* start = p;
+  std::uint64_t acc = 0;
+  int exp10 = 0, left = kMaxSigDigits;
+  bool any = false;
+  while (p < e && *p == '0') { ++p; any = true; }
+  for (; p < e; ++p) {
+    const unsigned d = static_cast<unsigned>(static_cast<unsigned char>(*p) - '0');
+    if (d > 9) break;
+    any = true;
+    if (left > 0) { acc = acc * 10 + d; --left; }
+    else ++exp10;
+  }
+  // fread: a longer integer without a decimal part is not a double
+  if (exp10 > 0 && (p == e || (*p != dec && *p != 'e' && *p != 'E'))) return false;
+  if (p < e && *p == dec) {
+    ++p;
+    if (acc == 0) {
+      while (p < e && *p == '0') { ++p; --exp10; any = true; }
+    }
+    for (; p < e; ++p) {
+      const unsigned d = static_cast<unsigned>(static_cast<unsigned char>(*p) - '0');
+      if (d > 9) break;
+      any = true;
+      if (left > 0) { acc = acc * 10 + d; --left; --exp10; }
+    }
+  }
+  if (!any) return false;
+  const char* mant_end = p;
+  if (p < e && (*p == 'e' || *p == 'E')) {
+    ++p;
+    const bool eneg = p < e && *p == '-';
+    if (p < e && (*p == '-' || *p == '+')) ++p;
+    int x = 0, nd = 0;
+    for (; p < e && is_digit(*p) && nd < 3; ++p, ++nd) x = x * 10 + (*p - '0');
+    if (nd == 0) return false;
+    exp10 += eneg ? -x : x;
+  }
+  if (p != e) return false;
+  if (exp10 < -kMaxExponent || exp10 > kMaxExponent) return false;
+  if (compat) {
+    // acc < 10^18 < 2^63: a signed conversion, exact in long double
+    const long double p10 = (exp10 >= -kNearExponent && exp10 <= kNearExponent)
+                                ? kPow10Near[exp10 + kNearExponent]
+                                : pow10_table()[exp10 + kMaxExponent];
+    const long double r = static_cast<long double>(static_cast<std::int64_t>(acc)) * p10;
+    out = static_cast<double>(neg ? -r : r);
+    return true;
+  }
+  // correctly rounded: one IEEE operation on exact operands when the digits
+  // fit in 53 bits and the power of ten is exact (Clinger's fast path)...
+  static const double exact[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                   1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                   1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  if (acc < (std::uint64_t(1) << 53) && left > 0 && exp10 >= -22 && exp10 <= 22) {
+    const double a = static_cast<double>(acc);
+    const double v = exp10 < 0 ? a / exact[-exp10] : a * exact[exp10];
+    out = neg ? -v : v;
+    return true;
+  }
+  // ...else from_chars, which wants '.' and no '+'
+  char tmp[128];
+  const std::size_t n = static_cast<std::size_t>(e - start);
+  if (n >= sizeof tmp) return false;
+  std::memcpy(tmp, start, n);
+  if (dec != '.') {
+    const std::size_t d = static_cast<std::size_t>(mant_end - start);
+    for (std::size_t i = 0; i < d; ++i) if (tmp[i] == dec) tmp[i] = '.';
+  }
+  double v = 0;
+  const auto r = std::from_chars(tmp, tmp + n, v);
+  if (r.ec != std::errc() || r.ptr != tmp + n) return false;
+  out = neg ? -v : v;
+  return true;
+}
+
+
+inline unsigned days_in_month(std::int64_t y, unsigned m) {
+  static const unsigned k[12] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const bool leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+  return m == 2 && leap ? 29 : k[m - 1];
+}
+
+// The order of a date's parts: month-day-year (ActiLife's M/d/yyyy, R's
+// "%m/%d/%Y"), day-month-year (dd/MM/yyyy). Year-first dates (ISO) are
+// recognised by their four-digit first part whatever the order says.
+enum class DateOrder { mdy, dmy, ymd };
+
+// The order an ActiLife "date format" names (letters M, d, y in some order).
+inline DateOrder date_order_of(const std::string& fmt) {
+  const std::size_t m = fmt.find('M'), d = fmt.find('d'), y = fmt.find('y');
+  if (y != std::string::npos && (m == std::string::npos || y < m) &&
+      (d == std::string::npos || y < d)) return DateOrder::ymd;
+  if (d != std::string::npos && m != std::string::npos && d < m) return DateOrder::dmy;
+  return DateOrder::mdy;
+}
+
+// Reads 1 to max_digits digits at p; false when there are none.
+inline bool read_uint(const char*& p, const char* e, int max_digits, std::int64_t& v, int& nd) {
+  v = 0;
+  nd = 0;
+  while (p < e && is_digit(*p) && nd < max_digits) { v = v * 10 + (*p - '0'); ++p; ++nd; }
+  return nd > 0;
+}
+
+// A date (three numbers split by '/', '-' or '.') as days since 1970.
+inline bool parse_date(const char*& p, const char* e, DateOrder order, std::int64_t& days) {
+  std::int64_t v[3];
+  int nd[3];
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) {
+      if (p >= e || (*p != '/' && *p != '-' && *p != '.')) return false;
+      ++p;
+    }
+    if (!read_uint(p, e, 4, v[i], nd[i])) return false;
+  }
+  std::int64_t y, m, d;
+  if (nd[0] == 4) { y = v[0]; m = v[1]; d = v[2]; }
+  else if (order == DateOrder::dmy) { d = v[0]; m = v[1]; y = v[2]; }
+  else { m = v[0]; d = v[1]; y = v[2]; }
+  if (nd[0] != 4 && nd[2] != 4) return false;
+  if (m < 1 || m > 12 || d < 1 || d > days_in_month(y, static_cast<unsigned>(m))) return false;
+  days = days_from_civil(y, static_cast<unsigned>(m), static_cast<unsigned>(d));
+  return true;
+}
+
+// HH:MM:SS[.fff...] as seconds; `frac_digits` tells the resolution.
+inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_digits) {
+  std::int64_t h, m, s;
+  int nd;
+  if (!read_uint(p, e, 2, h, nd) || p >= e || *p != ':') return false;
+  ++p;
+  if (!read_uint(p, e, 2, m, nd) || nd != 2 || p >= e || *p != ':') return false;
+  ++p;
+  if (!read_uint(p, e, 2, s, nd) || nd != 2) return false;
+  if (h > 24 || m > 59 || s > 60) return false;
+  std::int64_t frac = 0;
+  frac_digits = 0;
+  if (p < e && (*p == '.' || *p == ':')) {  // GENEActiv-like ":fff" too
+    ++p;
+    if (!read_uint(p, e, 9, frac, frac_digits)) return false;
+    while (p < e && is_digit(*p)) ++p;
+  }
+  static const double scale[10] = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
+  secs = static_cast<double>(h * 3600 + m * 60 + s) + static_cast<double>(frac) / scale[frac_digits];
+  return true;
+}
+
+// Parses "<date>[ T]<clock>[Z]" into seconds since 1970 UTC (local times are
+// taken as UTC, as gravcal's R readers do). Keeps the last date's text, so
+// that a file of one date per day parses the date once a day.
+class DateTimeParser {
+ public:
+  explicit DateTimeParser(DateOrder order = DateOrder::mdy) : order_(order) {}
+  void set_order(DateOrder o) { order_ = o; cached_len_ = 0; }
+  bool parse(const char* b, const char* e, double& t, int& frac_digits) {
+    const char* sp = b;
+    while (sp < e && *sp != ' ' && *sp != 'T') ++sp;
+    if (sp == e || sp - b > kMaxDate) return false;
+    const std::size_t dl = static_cast<std::size_t>(sp - b);
+    if (dl != cached_len_ || std::memcmp(b, cached_, dl) != 0) {
+      const char* p = b;
+      std::int64_t days;
+      if (!parse_date(p, sp, order_, days) || p != sp) return false;
+      std::memcpy(cached_, b, dl);
+      cached_len_ = dl;
+      cached_days_ = days;
+    }
+    const char* p = sp + 1;
+    while (p < e && *p == ' ') ++p;
+    double secs;
+    if (!parse_clock(p, e, secs, frac_digits)) return false;
+    if (p < e && *p == 'Z') ++p;
+    if (p != e) return false;
+    t = static_cast<double>(cached_days_ * 86400) + secs;
+    return true;
+  }
+
+ private:
+  static constexpr int kMaxDate = 24;
+  DateOrder order_;
+  char cached_[kMaxDate];
+  std::size_t cached_len_ = 0;
+  std::int64_t cached_days_ = 0;
+};
+
+// One line of the input (without its line end), where it was, and how it
+// ended.
+struct Line {
+  const char* p = nullptr;
+  std::size_t n = 0;
+  std::int64_t number = 0;   // 1-based line number in the file
+  std::int64_t offset = 0;   // byte offset of its first byte
+  bool has_end = true;       // ended by '\n' (else: the input ended)
+  bool too_long = false;     // longer than the limit; p, n hold its start
+};
+
+// Lines from a ByteSource through one fixed buffer. A line longer than
+// kMaxLine is given as too_long (its first bytes) and the rest of it is
+// skipped, so memory stays at the buffer.
+class LineReader {
+ public:
+  static constexpr std::size_t kBuffer = std::size_t(1) << 20;
+  static constexpr std::size_t kMaxLine = 65536;
+  static constexpr std::size_t kMinBuffer = 64;
+  // `buffer` bytes (tests and fuzzers use small ones to cross refills
+  // often); lines longer than half of a smaller buffer count as overlong.
+  explicit LineReader(ByteSource& src, std::size_t buffer = kBuffer)
+      : src_(src), buf_(std::max(kMinBuffer, std::min(buffer, kBuffer))),
+        max_line_(std::min(kMaxLine, buf_.size() / 2)) {}
+
+  bool next(Line& ln) {
+    for (;;) {
+      const char* b = buf_.data() + beg_;
+      const void* nl = std::memchr(b, '\n', end_ - beg_);
+      if (nl != nullptr) {
+        const std::size_t len = static_cast<std::size_t>(static_cast<const char*>(nl) - b);
+        if (skipping_) { skipping_ = false; advance(len + 1, false); continue; }
+        return give(ln, len, true);
+      }
+      if (skipping_) { advance(end_ - beg_, false); if (!fill()) return false; continue; }
+      if (end_ - beg_ >= max_line_) {
+        ln = make(max_line_, true);
+        ln.too_long = true;
+        skipping_ = true;
+        advance(max_line_, true);
+        return true;
+      }
+      if (!fill()) {
+        if (beg_ == end_) return false;
+        return give(ln, end_ - beg_, false);
+      }
+    }
+  }
+  // No more lines (the input ended and every byte was given).
+  bool exhausted() {
+    for (;;) {
+      if (skipping_ && beg_ < end_) {
+        const void* nl = std::memchr(buf_.data() + beg_, '\n', end_ - beg_);
+        if (nl != nullptr) return false;  // the overlong line ends: more follows
+        advance(end_ - beg_, false);      // still inside it: drop what is read
+      }
+      if (beg_ < end_) return false;
+      if (!fill()) return true;
+    }
+  }
+  // The bytes buffered ahead (for looking at the first data lines).
+  void peek(const char*& p, std::size_t& n) {
+    if (!eof_ && end_ - beg_ < buf_.size() / 2) fill();
+    p = buf_.data() + beg_;
+    n = end_ - beg_;
+  }
+  // Starts again at byte `pos` of the source (whose line number is `line`).
+  bool rewind(std::int64_t pos, std::int64_t line) {
+    if (!src_.seek(pos)) return false;
+    beg_ = end_ = 0;
+    eof_ = skipping_ = false;
+    offset_ = pos;
+    line_ = line;
+    return true;
+  }
+  std::int64_t offset() const { return offset_; }
+  std::int64_t line_number() const { return line_; }
+  bool read_failed() const { return src_.failed(); }
+  bool input_ended() const { return eof_; }
+
+ private:
+  Line make(std::size_t len, bool has_end) {
+    Line ln;
+    ln.p = buf_.data() + beg_;
+    ln.n = len;
+    ln.number = line_ + 1;
+    ln.offset = offset_;
+    ln.has_end = has_end;
+    if (ln.n > 0 && ln.p[ln.n - 1] == '\r') --ln.n;  // CRLF
+    return ln;
+  }
+  bool give(Line& ln, std::size_t len, bool has_end) {
+    ln = make(len, has_end);
+    advance(len + (has_end ? 1 : 0), true);
+    return true;
+  }
+  void advance(std::size_t k, bool new_line) {
+    beg_ += k;
+    offset_ += static_cast<std::int64_t>(k);
+    if (new_line) ++line_;
+  }
+  // Moves the unread bytes to the front and reads more; false when nothing
+  // more came (end of input, or a read error).
+  bool fill() {
+    if (eof_) return false;
+    if (beg_ > 0) {
+      std::memmove(buf_.data(), buf_.data() + beg_, end_ - beg_);
+      end_ -= beg_;
+      beg_ = 0;
+    }
+    if (end_ == buf_.size()) return true;
+    const std::size_t got = read_full(src_, reinterpret_cast<unsigned char*>(buf_.data() + end_),
+                                      buf_.size() - end_);
+    end_ += got;
+    if (end_ < buf_.size()) eof_ = true;
+    return got > 0;
+  }
+
+  ByteSource& src_;
+  std::vector<char> buf_;
+  std::size_t max_line_;
+  std::size_t beg_ = 0, end_ = 0;
+  std::int64_t offset_ = 0;  // source offset of buf_[beg_]
+  std::int64_t line_ = 0;    // lines given so far
+  bool eof_ = false;
+  bool skipping_ = false;  // inside an overlong line
+};
+
+// A field of a line: trimmed of blanks and of one pair of double quotes.
+struct Field {
+  const char* b;
+  const char* e;
+};
+
+inline void trim(const char*& b, const char*& e) {
+  while (b < e && (*b == ' ' || *b == '\t')) ++b;
+  while (e > b && (e[-1] == ' ' || e[-1] == '\t')) --e;
+  if (e - b >= 2 && *b == '"' && e[-1] == '"') {
+    ++b;
+    --e;
+    while (b < e && (*b == ' ' || *b == '\t')) ++b;
+    while (e > b && (e[-1] == ' ' || e[-1] == '\t')) --e;
+  }
+}
+
+// Splits [p, p + n) at `sep` into at most max_fields fields; returns the
+// number of fields the line has (which may be more than max_fields).
+inline int split(const char* p, std::size_t n, char sep, Field* f, int max_fields) {
+  const char* e = p + n;
+  int k = 0;
+  const char* b = p;
+  for (;;) {
+    const char* fe = b;
+    while (fe < e && *fe != sep) ++fe;  // fields are short: no memchr call
+    if (k < max_fields) {
+      const char* tb = b;
+      const char* te = fe;
+      if (tb < te && (*tb == ' ' || *tb == '\t' || *tb == '"' || te[-1] == ' ' ||
+                      te[-1] == '\t' || te[-1] == '"')) {
+        trim(tb, te);
+      }
+      f[k] = Field{tb, te};
+    }
+    ++k;
+    if (fe == e) break;
+    b = fe + 1;
+  }
+  return k;
+}
+
+// A short printable excerpt of a line, for notes.
+inline std::string excerpt(const char* p, std::size_t n) {
+  constexpr std::size_t kShown = 40;
+  std::string s;
+  for (std::size_t i = 0; i < n && i < kShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(p[i]);
+    s += (c >= 32 && c < 127) ? static_cast<char>(c) : '?';
+  }
+  if (n > kShown) s += "...";
+  return s;
+}
+
+// R's signif(x, digits) for x > 0 (as its fprec does), for sf from time.
+inline double signif(double x, int digits) {
+  if (!(x > 0) || !std::isfinite(x)) return x;
+  const int e10 = digits - 1 - static_cast<int>(std::floor(std::log10(x)));
+  if (e10 > 0) {
+    const double p10 = std::pow(10.0, e10);
+    return std::nearbyint(x * p10) / p10;
+  }
+  const double p10 = std::pow(10.0, -e10);
+  return std::nearbyint(x / p10) * p10;
+}
+
+}  // namespace csv_text
+}  // namespace gravcal
+
+#endif  // GRAVCAL_DECODE_CSV_TEXT_HPP

@@ -1,0 +1,893 @@
+// gravcal: streaming decoder for GENEActiv .bin files.
+//
+// Format (GENEActiv instructions, "Decoding .bin files"): text lines (CRLF in
+// real files). A header of "Key:value" lines (device identity, capabilities,
+// configuration with "Measurement Frequency:", "Time Zone:", calibration data
+// "x gain:", "x offset:", ..., memory status "Number of Pages:"), then pages
+// of ten lines: "Recorded Data", "Device Unique Serial Code:",
+// "Sequence Number:", "Page Time:YYYY-MM-DD HH:MM:SS:mmm", "Unassigned:",
+// "Temperature:", "Battery voltage:", "Device Status:",
+// "Measurement Frequency:", and 3600 hex digits: 300 samples of 12 digits,
+// x, y, z as 12-bit two's complement, then 10 bits light and 2 status bits.
+// A value in g is (count * 100 - offset) / gain. Unit = one page.
+//
+// Option "compat" = 1 (default) gives GGIRread::readGENEActiv 1.2.0's output
+// bit for bit (GGIR calls it with start = s, end = e, desiredtz = "",
+// configtz = ""); compat = 0 gives the format's values. Differences:
+// - Values: the reference stores x, y, z and temperature as float; compat 1
+//   rounds them to float, compat 0 keeps doubles.
+// - Time: the reference ignores every Page Time but the first page's; it
+//   reads that one in the session's local time zone (TZ; not the header's
+//   "Time Zone:"), counts whole milliseconds from it (each sample's offset
+//   truncated to an integer ms, each page starting where the previous page's
+//   last sample + 1 period truncates), restarts that count in every call, and
+//   adds ((s - 1) * 300) / rate for a call from page s, with the rate of the
+//   call's last page. So within a call a page lasts trunc(300000 / rate) ms
+//   (3500 at 85.7 Hz), but a call from page s starts (s - 1) * 3500.58 ms
+//   after page 1: on the real 85.7 Hz test file, page 11 starts 35.000 s
+//   after page 1 read whole, 35.0058 s read from page 11 (14 s a day).
+//   compat 1 does the same: a read() with max_units >= 0 that starts on a
+//   page boundary is one reference call; with max_units < 0 the whole file
+//   is one call (later such calls continue it). compat 0 times each page by
+//   its own Page Time,
+//   local time at the header's "Time Zone:" (GMT +hh:mm) turned into UTC,
+//   plus i / rate.
+// - End: the reference with end = 0 stops at the header's "Number of Pages"
+//   (GGIR passes an explicit end, so it reads every page); we read every page.
+// - Damage: the reference assumes a 59-line header and 10-line pages (a
+//   missing line shifts every later page), decodes the hex digits before a
+//   bad character (std::stoll stops there), keeps the samples before the
+//   first undecodable group, and its time count closes up what was lost. We
+//   resynchronise on "Recorded Data", skip and count a damaged page whole,
+//   and time later pages as if it had been there (its 300 samples' worth).
+//   A final hex line cut short keeps its samples whose x, y, z digits are
+//   complete (compat 1: those with at least 10 digits, as the reference;
+//   compat 0: whole 12-digit samples only).
+//   A page header cut by the end of the input: the reference gives the
+//   previous page's samples again (std::getline leaves its string as it
+//   was); we drop the page.
+// - Page times and sequence numbers are checked (the reference does not):
+//   expected is the last good page + (units since) * 300 / rate. A jump in
+//   both is a gap (gaps, gap_seconds); a lone page whose time is off while
+//   its sequence number fits keeps its samples, timed as predicted
+//   (bad_page_time), unless the next page confirms the new time (then a gap,
+//   or time_backwards); a lone wrong sequence number is counted and mended
+//   (bad_sequence). None of this changes compat 1 times.
+//
+// max_units counts pages ("Recorded Data" units, damaged ones included, as
+// the reference's page numbers do). GGIR's block k, readGENEActiv(start = s,
+// end = s + B - 1) with s = (k - 1) * B + 1, is the k-th read(out, B) into a
+// buffer of at least B * 300 samples.
+//
+// Report counters: bad_hex, bad_page_header, truncated_page (skipped pages),
+// stray_lines (lines outside any page), bad_sequence, bad_page_time,
+// time_backwards, rate_changes; notes give the page number and byte offset.
+#ifndef GRAVCAL_DECODE_GENEACTIV_HPP
+#define GRAVCAL_DECODE_GENEACTIV_HPP
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string>
+
+#include "decode.hpp"
+
+namespace gravcal {
+
+namespace geneactiv {
+
+constexpr std::size_t kSamplesPerPage = 300;
+constexpr std::size_t kDigitsPerSample = 12;  // x, y, z: 3 each; light+status: 3
+constexpr std::size_t kDigitsPerPage = kSamplesPerPage * kDigitsPerSample;
+constexpr std::size_t kDigitsXyz = 9;
+constexpr std::size_t kDigitsXyzCompat = 10;  // the reference needs 1 light digit
+constexpr int kPageHeaderLines = 8;           // between "Recorded Data" and hex
+constexpr std::size_t kMaxLine = 8192;        // longer lines are cut (and counted)
+constexpr std::size_t kBufferBytes = 1u << 16;
+constexpr int kMaxHeaderLines = 256;          // real headers have 59
+constexpr double kMinRate = 0.1;              // Hz; real devices: 10..100
+constexpr double kMaxRate = 10000.0;
+constexpr double kMinGain = 1.0;              // counts per 100 g; real: ~25000
+constexpr double kMaxGain = 1e7;
+constexpr double kMaxOffset = 1e9;
+constexpr int kCountRange = 4096;             // 12-bit counts
+constexpr int kCountSigned = 2048;
+constexpr double kCountScale = 100.0;         // g = (count * 100 - offset) / gain
+constexpr double kMaxTimeZoneHours = 14.0;
+
+constexpr const char* kFirstLine = "Device Identity";
+constexpr const char* kPageStart = "Recorded Data";
+constexpr const char* kPageKeys[kPageHeaderLines] = {
+    "Device Unique Serial Code:", "Sequence Number:", "Page Time:", "Unassigned:",
+    "Temperature:", "Battery voltage:", "Device Status:", "Measurement Frequency:"};
+enum PageKey { kSerial = 0, kSequence = 1, kTime = 2, kTemperature = 4, kFrequency = 7 };
+
+// Hex digit values; 0x10 marks a byte that is not a hex digit.
+struct HexTable {
+  unsigned char v[256];
+  HexTable() {
+    for (int i = 0; i < 256; ++i) v[i] = 0x10;
+    for (int i = 0; i < 10; ++i) v['0' + i] = static_cast<unsigned char>(i);
+    for (int i = 0; i < 6; ++i) {
+      v['A' + i] = static_cast<unsigned char>(10 + i);
+      v['a' + i] = static_cast<unsigned char>(10 + i);
+    }
+  }
+};
+inline const HexTable& hex_table() {
+  static const HexTable t;
+  return t;
+}
+
+
+// A Page Time "YYYY-MM-DD HH:MM:SS:mmm" (":mmm" optional).
+struct Stamp {
+  int year = 0, month = 0, day = 0, hour = 0, min = 0, sec = 0, ms = 0;
+  std::int64_t naive_ms() const {  // ms since 1970 of the fields read as UTC
+    const std::int64_t d = days_from_civil(year, static_cast<unsigned>(month),
+                                           static_cast<unsigned>(day));
+    return ((d * 24 + hour) * 60 + min) * 60000 + sec * 1000 + ms;
+  }
+};
+
+inline bool read_int(const char*& p, const char* end, int digits_min, int digits_max,
+                     int& out) {
+  int v = 0, k = 0;
+  while (p < end && k < digits_max && *p >= '0' && *p <= '9') {
+    v = v * 10 + (*p - '0');
+    ++p;
+    ++k;
+  }
+  out = v;
+  return k >= digits_min;
+}
+
+inline bool parse_stamp(const char* p, const char* end, Stamp& s) {
+  auto sep = [&](char c) { return p < end && *p++ == c; };
+  if (!read_int(p, end, 4, 4, s.year) || !sep('-') || !read_int(p, end, 1, 2, s.month) ||
+      !sep('-') || !read_int(p, end, 1, 2, s.day) || !sep(' ') ||
+      !read_int(p, end, 1, 2, s.hour) || !sep(':') || !read_int(p, end, 1, 2, s.min) ||
+      !sep(':') || !read_int(p, end, 1, 2, s.sec)) {
+    return false;
+  }
+  s.ms = 0;
+  if (p < end && *p == ':') {
+    ++p;
+    if (!read_int(p, end, 3, 3, s.ms)) return false;
+  }
+  while (p < end && (*p == ' ' || *p == '\0')) ++p;
+  return p == end && s.month >= 1 && s.month <= 12 && s.day >= 1 && s.day <= 31 &&
+         s.hour <= 23 && s.min <= 59 && s.sec <= 60;
+}
+
+// A number after "Key:" (trailing blanks allowed); strtod in the C locale,
+// as std::istream >> double reads it.
+inline bool parse_number(const char* p, const char* end, double& out) {
+  char tmp[64];
+  while (p < end && *p == ' ') ++p;
+  while (end > p && (end[-1] == ' ' || end[-1] == '\0')) --end;
+  const std::size_t n = static_cast<std::size_t>(end - p);
+  if (n == 0 || n >= sizeof tmp) return false;
+  std::memcpy(tmp, p, n);
+  tmp[n] = '\0';
+  char* stop = nullptr;
+  out = std::strtod(tmp, &stop);
+  return stop == tmp + n && std::isfinite(out);
+}
+
+// The first number of a header value ("100 Hz", "-8 to 8"): as istream >>.
+inline bool parse_leading(const char* p, const char* end, double& out) {
+  char tmp[64];
+  const std::size_t n = static_cast<std::size_t>(end - p) < sizeof tmp - 1
+                            ? static_cast<std::size_t>(end - p)
+                            : sizeof tmp - 1;
+  std::memcpy(tmp, p, n);
+  tmp[n] = '\0';
+  char* stop = nullptr;
+  out = std::strtod(tmp, &stop);
+  return stop != tmp && std::isfinite(out);
+}
+
+// Lines of a byte stream through a fixed buffer. A line is valid until the
+// next call; '\r' before '\n' is dropped; lines over kMaxLine are cut.
+class LineReader {
+ public:
+  explicit LineReader(ByteSource& src) : src_(src) {}
+  // The next line; false at the end of the input.
+  bool next() {
+    if (again_) {
+      again_ = false;
+      return true;
+    }
+    if (skip_rest_ && !skip_to_newline()) return false;
+    for (;;) {
+      const unsigned char* s = buf_ + beg_;
+      const void* nl = std::memchr(s, '\n', end_ - beg_);
+      if (nl != nullptr) {
+        const std::size_t len = static_cast<std::size_t>(static_cast<const unsigned char*>(nl) - s);
+        set_line(len, true, false);
+        beg_ += len + 1;
+        return true;
+      }
+      if (end_ - beg_ >= kMaxLine) {
+        set_line(kMaxLine, true, true);
+        beg_ += kMaxLine;
+        skip_rest_ = true;
+        return true;
+      }
+      if (!fill()) {
+        if (beg_ == end_) return false;
+        set_line(end_ - beg_, false, false);
+        beg_ = end_;
+        return true;
+      }
+    }
+  }
+  void unread() { again_ = true; }
+  // No byte left (tries to read more).
+  bool at_end() {
+    if (again_) return false;
+    if (skip_rest_ && !skip_to_newline()) return true;
+    return beg_ == end_ && !fill();
+  }
+  const char* data = nullptr;
+  std::size_t size = 0;
+  std::int64_t offset = 0;  // of the line's first byte
+  bool complete = true;     // ended by '\n' (false: the input ended first)
+  bool cut = false;         // longer than kMaxLine
+  bool read_error() const { return src_.failed(); }
+  // The first bytes that follow the start of the input (open() checks them).
+  std::size_t peek(const unsigned char*& p, std::size_t want) {
+    while (end_ - beg_ < want && fill()) {
+    }
+    p = buf_ + beg_;
+    return end_ - beg_;
+  }
+
+ private:
+  void set_line(std::size_t len, bool ended, bool cut_now) {
+    data = reinterpret_cast<const char*>(buf_ + beg_);
+    offset = base_ + static_cast<std::int64_t>(beg_);
+    size = len;
+    if (size > 0 && data[size - 1] == '\r') --size;
+    complete = ended;
+    cut = cut_now;
+  }
+  // Moves what is left to the front and reads more; false when nothing came.
+  bool fill() {
+    if (eof_) return false;
+    if (beg_ > 0) {
+      std::memmove(buf_, buf_ + beg_, end_ - beg_);
+      base_ += static_cast<std::int64_t>(beg_);
+      end_ -= beg_;
+      beg_ = 0;
+    }
+    const std::size_t got = src_.read(buf_ + end_, kBufferBytes - end_);
+    if (got == 0) eof_ = true;
+    end_ += got;
+    return got > 0;
+  }
+  bool skip_to_newline() {
+    for (;;) {
+      const void* nl = std::memchr(buf_ + beg_, '\n', end_ - beg_);
+      if (nl != nullptr) {
+        beg_ = static_cast<std::size_t>(static_cast<const unsigned char*>(nl) - buf_) + 1;
+        skip_rest_ = false;
+        return true;
+      }
+      beg_ = end_;
+      if (!fill()) return false;
+    }
+  }
+  ByteSource& src_;
+  unsigned char buf_[kBufferBytes];
+  std::size_t beg_ = 0, end_ = 0;
+  std::int64_t base_ = 0;
+  bool eof_ = false, again_ = false, skip_rest_ = false;
+};
+
+inline bool starts_with(const char* p, std::size_t n, const char* key) {
+  const std::size_t k = std::strlen(key);
+  return n >= k && std::memcmp(p, key, k) == 0;
+}
+
+inline bool is_line(const char* p, std::size_t n, const char* text) {
+  while (n > 0 && (p[n - 1] == ' ' || p[n - 1] == '\0')) --n;
+  return n == std::strlen(text) && std::memcmp(p, text, n) == 0;
+}
+
+}  // namespace geneactiv
+
+class GeneactivDecoder : public Decoder {
+ public:
+  // While set, read() continues the current reference call instead of
+  // starting one at a page boundary, so that one call can be read in
+  // several chunks (GgirResampler in decode_ggir_resample.hpp does).
+  void continue_call(bool on) { continue_call_ = on; }
+  GeneactivDecoder(ByteSource& src, const Options& opts)
+      : lines_(src), compat_(opts.num("compat", 1) != 0) {
+    info_.format = "geneactiv";
+  }
+
+  bool open() override;
+  std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
+  bool done() const override { return done_; }
+  std::size_t max_samples_per_unit() const override { return geneactiv::kSamplesPerPage; }
+
+ private:
+  enum class Unit { none, good, skipped };
+  struct Page {
+    std::uint16_t raw[geneactiv::kSamplesPerPage][3];
+    std::size_t count = 0;  // samples decoded
+    double temperature = 0, freq = 0;
+    double time_s = 0;      // compat 0: first sample, s since 1970 UTC
+    std::int64_t base_ms = 0;  // compat 1: the reference's ms count at sample 0
+    std::int64_t seq = 0, stamp_ms = 0;
+    geneactiv::Stamp stamp;
+    std::int64_t offset = 0;
+  };
+
+  bool fail(const std::string& why) {
+    error_ = why;
+    return false;
+  }
+  bool header_line(const char* p, std::size_t n);
+  bool calibration_line(const char* p, std::size_t n);
+  bool check_header();
+  bool recognise();
+  Unit parse_page();
+  Unit skip(const char* counter, const char* what, bool truncated);
+  bool page_field(int k, const char* p, std::size_t n);
+  bool decode_hex(const char* p, std::size_t n, bool complete);
+  void accept(Unit u);
+  void check_time();
+  void advance_chain(double freq, std::size_t count);
+  void emit(SampleBuffer& out);
+  void finish_block(SampleBuffer& out, std::size_t n0);
+  void finish_input();
+  void note_at(const char* what, std::int64_t offset);
+  double anchor_time(const geneactiv::Stamp& s) const;
+
+  geneactiv::LineReader lines_;
+  bool compat_;
+  bool done_ = false;
+  // calibration: value of each 12-bit count per axis
+  double gain_[3] = {0, 0, 0};
+  long offset_[3] = {0, 0, 0};
+  bool have_gain_[3] = {false, false, false}, have_offset_[3] = {false, false, false};
+  double lut_[3][geneactiv::kCountRange];
+  double header_rate_ = 0;
+  double tz_ms_ = 0;
+  long header_pages_ = -1;
+  bool have_pages_line_ = false;
+  // the page being parsed (next_) and the one being given (cur_)
+  Page pages_[2];
+  Page* next_ = &pages_[0];
+  Page* cur_ = &pages_[1];
+  Unit next_unit_ = Unit::none;
+  bool have_next_ = false;
+  std::size_t emitted_ = 0;
+  bool pending_ = false;  // cur_ has samples not yet given
+  std::int64_t pages_seen_ = 0;  // units consumed
+  // time line check
+  bool have_prev_ = false;
+  std::int64_t prev_seq_ = 0, prev_units_ = 0;
+  double prev_ms_ = 0, prev_freq_ = 0;
+  bool have_candidate_ = false, have_seq_candidate_ = false;
+  double candidate_ms_ = 0;
+  std::int64_t seq_candidate_ = 0;
+  // compat 1: the reference's per-call time count
+  std::int64_t chain_ms_ = 0;
+  bool continue_call_ = false;
+  std::int64_t block_first_ = 0;  // pages before this reference call
+  double block_rate_ = 0;
+  bool have_anchor_ = false;
+  double anchor_ = 0;           // first page's time, s (local time zone)
+  double last_good_rate_ = 0;
+  bool block_open_ = false;
+};
+
+// ---------------------------------------------------------------------------
+// Header
+
+inline bool GeneactivDecoder::recognise() {
+  const unsigned char* p = nullptr;
+  const std::size_t n = lines_.peek(p, 600);
+  if (n == 0) return fail("empty file");
+  const char* c = reinterpret_cast<const char*>(p);
+  if (n >= 516 && std::memcmp(p + 512, "MDTC", 4) == 0) {
+    return fail("not a GENEActiv file: it looks like a Matrix/Parmay file (\"MDTC\" at byte 512)");
+  }
+  if (geneactiv::starts_with(c, n, "GENEA/") || geneactiv::starts_with(c, n, "GENEA\r") ||
+      geneactiv::starts_with(c, n, "GENEA\n")) {
+    return fail("not a GENEActiv file: it looks like an older Genea file (first line \"GENEA...\")");
+  }
+  if (geneactiv::starts_with(c, n, geneactiv::kFirstLine)) return true;
+  std::string first;
+  for (std::size_t i = 0; i < n && i < 40 && p[i] != '\n' && p[i] != '\r'; ++i) {
+    first += (p[i] >= 32 && p[i] < 127) ? static_cast<char>(p[i]) : '?';
+  }
+  return fail("not a GENEActiv file: first line is \"" + first + "\", not \"" +
+              geneactiv::kFirstLine + "\"");
+}
+
+// A calibration line ("x gain:25875", "x offset:439"); false when bad.
+inline bool GeneactivDecoder::calibration_line(const char* p, std::size_t n) {
+  using geneactiv::starts_with;
+  static const char* const gains[3] = {"x gain:", "y gain:", "z gain:"};
+  static const char* const offsets[3] = {"x offset:", "y offset:", "z offset:"};
+  const char* end = p + n;
+  for (int a = 0; a < 3; ++a) {
+    double v = 0;
+    const bool gain = starts_with(p, n, gains[a]);
+    if (!gain && !starts_with(p, n, offsets[a])) continue;
+    const char* key = gain ? gains[a] : offsets[a];
+    const bool ok = geneactiv::parse_leading(p + std::strlen(key), end, v) &&
+                    (gain ? v >= geneactiv::kMinGain && v <= geneactiv::kMaxGain
+                          : std::fabs(v) <= geneactiv::kMaxOffset);
+    if (!ok) {
+      return fail(std::string("bad calibration line \"") + key + "\" at byte " +
+                  std::to_string(lines_.offset));
+    }
+    if (gain) {
+      gain_[a] = v;
+      have_gain_[a] = true;
+    } else {
+      offset_[a] = static_cast<long>(v);  // std::istream >> int: the integer part
+      have_offset_[a] = true;
+    }
+  }
+  return true;
+}
+
+// One header line "Key:value"; false when a value the decoder needs is bad.
+inline bool GeneactivDecoder::header_line(const char* p, std::size_t n) {
+  using geneactiv::starts_with;
+  if (!calibration_line(p, n)) return false;
+  const char* end = p + n;
+  auto value = [&](const char* key) { return p + std::strlen(key); };
+  auto trimmed = [&](const char* key) {
+    std::string s(value(key), end);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
+    return s;
+  };
+  double v = 0;
+  if (starts_with(p, n, "Device Unique Serial Code:") && info_.serial.empty()) {
+    info_.serial = trimmed("Device Unique Serial Code:");
+  } else if (starts_with(p, n, "Device Type:")) {
+    info_.device = trimmed("Device Type:") + (info_.device.empty() ? "" : " " + info_.device);
+  } else if (starts_with(p, n, "Device Model:")) {
+    info_.device += (info_.device.empty() ? "" : " ") + trimmed("Device Model:");
+  } else if (starts_with(p, n, "Measurement Frequency:")) {
+    if (geneactiv::parse_leading(value("Measurement Frequency:"), end, v)) header_rate_ = v;
+  } else if (starts_with(p, n, "Accelerometer Range:")) {
+    // "-8 to 8": the full scale is the last number
+    const std::string s(value("Accelerometer Range:"), end);
+    const std::size_t k = s.find("to");
+    if (k != std::string::npos &&
+        geneactiv::parse_leading(s.c_str() + k + 2, s.c_str() + s.size(), v)) {
+      info_.range_g = v;
+    }
+  } else if (starts_with(p, n, "Time Zone:")) {
+    // "GMT +01:00"
+    const std::string s = trimmed("Time Zone:");
+    int h = 0, m = 0;
+    char sign = '+';
+    if (std::sscanf(s.c_str(), "GMT %c%d:%d", &sign, &h, &m) == 3 &&
+        (sign == '+' || sign == '-') && h <= geneactiv::kMaxTimeZoneHours && m < 60) {
+      tz_ms_ = (sign == '-' ? -1.0 : 1.0) * (h * 3600000.0 + m * 60000.0);
+    } else {
+      report_.note("header: time zone \"" + s + "\" not understood, taken as GMT");
+    }
+  } else if (starts_with(p, n, "Number of Pages:")) {
+    have_pages_line_ = true;
+    if (geneactiv::parse_leading(value("Number of Pages:"), end, v) && v >= 0 && v < 1e15) {
+      header_pages_ = static_cast<long>(v);
+    }
+  }
+  return true;
+}
+
+inline bool GeneactivDecoder::check_header() {
+  static const char* const axes = "xyz";
+  for (int a = 0; a < 3; ++a) {
+    if (!have_gain_[a] || !have_offset_[a]) {
+      return fail(std::string("header has no \"") + axes[a] + (have_gain_[a] ? " offset:" : " gain:") +
+                  "\" line (calibration data)");
+    }
+  }
+  if (!(header_rate_ >= geneactiv::kMinRate && header_rate_ <= geneactiv::kMaxRate)) {
+    return fail("header has no usable \"Measurement Frequency:\"");
+  }
+  info_.sf = header_rate_;
+  last_good_rate_ = header_rate_;
+  block_rate_ = header_rate_;
+  // value of every count, as the reference: (count * 100. - offset) / gain,
+  // stored as float
+  for (int a = 0; a < 3; ++a) {
+    for (int u = 0; u < geneactiv::kCountRange; ++u) {
+      const int c = u >= geneactiv::kCountSigned ? u - geneactiv::kCountRange : u;
+      const double g = (c * geneactiv::kCountScale - static_cast<double>(offset_[a])) / gain_[a];
+      lut_[a][u] = compat_ ? static_cast<double>(static_cast<float>(g)) : g;
+    }
+  }
+  return true;
+}
+
+inline bool GeneactivDecoder::open() {
+  if (!recognise()) return false;
+  int k = 0;
+  for (;; ++k) {
+    if (!lines_.next()) {
+      if (lines_.read_error()) return fail("read error in the header");
+      if (!have_pages_line_) {
+        return fail("header truncated at byte " + std::to_string(lines_.offset + static_cast<std::int64_t>(lines_.size)));
+      }
+      break;
+    }
+    if (!lines_.complete && !have_pages_line_) {
+      return fail("header truncated at byte " + std::to_string(lines_.offset + static_cast<std::int64_t>(lines_.size)));
+    }
+    if (geneactiv::is_line(lines_.data, lines_.size, geneactiv::kPageStart)) {
+      lines_.unread();
+      break;
+    }
+    if (k >= geneactiv::kMaxHeaderLines) {
+      return fail("no \"Recorded Data\" page within the first " +
+                  std::to_string(geneactiv::kMaxHeaderLines) + " lines");
+    }
+    if (!header_line(lines_.data, lines_.size)) return false;
+  }
+  if (!check_header()) return false;
+  info_.has_temperature = true;
+  info_.has_time = true;
+  next_unit_ = parse_page();
+  have_next_ = true;
+  if (next_unit_ == Unit::good) {
+    info_.start_time = compat_ ? anchor_time(next_->stamp) : next_->time_s;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Pages
+
+inline void GeneactivDecoder::note_at(const char* what, std::int64_t offset) {
+  report_.note(std::string(what) + " (page " + std::to_string(pages_seen_ + 1) + ", byte " +
+               std::to_string(offset) + ")");
+}
+
+// A value of page header line k; false when it is not what the format says.
+inline bool GeneactivDecoder::page_field(int k, const char* p, std::size_t n) {
+  using namespace geneactiv;
+  if (!starts_with(p, n, kPageKeys[k])) return false;
+  const char* v = p + std::strlen(kPageKeys[k]);
+  const char* end = p + n;
+  double d = 0;
+  switch (k) {
+    case kSequence:
+      if (!parse_number(v, end, d) || d < 0 || d > 1e15 || d != std::floor(d)) return false;
+      next_->seq = static_cast<std::int64_t>(d);
+      return true;
+    case kTime:
+      if (!parse_stamp(v, end, next_->stamp)) return false;
+      next_->stamp_ms = next_->stamp.naive_ms();
+      next_->time_s = (static_cast<double>(next_->stamp_ms) - tz_ms_) / 1000.0;
+      return true;
+    case kTemperature:
+      if (!parse_number(v, end, d) || std::fabs(d) > 1000) return false;
+      next_->temperature = compat_ ? static_cast<double>(static_cast<float>(d)) : d;
+      return true;
+    case kFrequency:
+      if (!parse_number(v, end, d) || !(d >= kMinRate) || d > kMaxRate) return false;
+      next_->freq = d;
+      return true;
+    default:
+      return true;
+  }
+}
+
+// The hex line into next_->raw; false when it is malformed. A line the input
+// cut short (complete false) keeps its samples whose x, y, z are whole.
+inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool complete) {
+  using namespace geneactiv;
+  const unsigned char* h = hex_table().v;
+  const unsigned char* s = reinterpret_cast<const unsigned char*>(p);
+  if (complete ? n != kDigitsPerPage : n > kDigitsPerPage) return false;
+  const std::size_t whole = n / kDigitsPerSample;
+  unsigned bad = 0;
+  for (std::size_t i = 0; i < whole; ++i, s += kDigitsPerSample) {
+    for (int a = 0; a < 3; ++a) {
+      const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
+      bad |= d0 | d1 | d2;
+      next_->raw[i][a] = static_cast<std::uint16_t>((d0 << 8) | (d1 << 4) | d2);
+    }
+    bad |= h[s[9]] | h[s[10]] | h[s[11]];
+  }
+  std::size_t count = whole;
+  const std::size_t rest = n - whole * kDigitsPerSample;
+  if (rest >= (compat_ ? kDigitsXyzCompat : kDigitsPerSample)) {
+    for (int a = 0; a < 3; ++a) {
+      const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
+      bad |= d0 | d1 | d2;
+      next_->raw[count][a] = static_cast<std::uint16_t>((d0 << 8) | (d1 << 4) | d2);
+    }
+    for (std::size_t j = kDigitsXyz; j < rest; ++j) bad |= h[s[j]];
+    ++count;
+  }
+  next_->count = count;
+  return (bad & 0x10u) == 0;
+}
+
+inline GeneactivDecoder::Unit GeneactivDecoder::skip(const char* counter, const char* what,
+                                                     bool truncated) {
+  if (truncated) report_.truncated = true;
+  report_.count(counter);
+  note_at(what, next_->offset);
+  next_->count = 0;
+  return Unit::skipped;
+}
+
+// Reads the next unit into next_. none: the input has ended.
+inline GeneactivDecoder::Unit GeneactivDecoder::parse_page() {
+  using namespace geneactiv;
+  for (;;) {  // to the next "Recorded Data"
+    if (!lines_.next()) return Unit::none;
+    if (is_line(lines_.data, lines_.size, kPageStart)) break;
+    bool blank = true;
+    for (std::size_t i = 0; i < lines_.size && blank; ++i) {
+      blank = lines_.data[i] == ' ' || lines_.data[i] == '\0';
+    }
+    if (!blank) {
+      report_.count("stray_lines");
+      if (report_.get("stray_lines") <= 3) note_at("line outside any page skipped", lines_.offset);
+    }
+  }
+  next_->offset = lines_.offset;
+  next_->count = 0;
+  bool damaged = false;
+  for (int k = 0; k <= kPageHeaderLines; ++k) {  // 8 header lines, then hex
+    if (!lines_.next()) return skip("truncated_page", "input ends inside a page", true);
+    if (is_line(lines_.data, lines_.size, kPageStart)) {
+      lines_.unread();
+      return skip("bad_page_header", "page with a missing line skipped", false);
+    }
+    if (k == kPageHeaderLines) break;
+    if (!lines_.complete) return skip("truncated_page", "input ends inside a page", true);
+    if (!damaged && !page_field(k, lines_.data, lines_.size)) damaged = true;
+  }
+  if (damaged) return skip("bad_page_header", "page with a damaged header line skipped", false);
+  const bool whole_line = lines_.complete;
+  if (lines_.cut || !decode_hex(lines_.data, lines_.size, whole_line)) {
+    if (!whole_line) return skip("truncated_page", "input ends inside a malformed hex line", true);
+    return skip("bad_hex", "page with a malformed hex line skipped", false);
+  }
+  if (!whole_line && lines_.size < kDigitsPerPage) {
+    report_.truncated = true;
+    report_.count("truncated_page");
+    note_at(("input ends inside the hex line: " + std::to_string(next_->count) + " of 300 samples kept").c_str(),
+            next_->offset);
+    if (next_->count == 0) return Unit::skipped;
+  }
+  return Unit::good;
+}
+
+// ---------------------------------------------------------------------------
+// Time
+
+// A Page Time as R's as.POSIXlt(tz = "") then as.numeric() reads it: the
+// fields in the local time zone (mktime), plus the fraction of the seconds
+// "SS.mmm" as strtod reads them.
+inline double GeneactivDecoder::anchor_time(const geneactiv::Stamp& s) const {
+  std::tm tm{};
+  tm.tm_year = s.year - 1900;
+  tm.tm_mon = s.month - 1;
+  tm.tm_mday = s.day;
+  tm.tm_hour = s.hour;
+  tm.tm_min = s.min;
+  tm.tm_sec = s.sec;
+  tm.tm_isdst = -1;
+  const std::time_t t = std::mktime(&tm);
+  char secs[16];
+  std::snprintf(secs, sizeof secs, "%02d.%03d", s.sec % 100, s.ms % 1000);
+  const double v = std::strtod(secs, nullptr);
+  return static_cast<double>(t) + (v - std::floor(v));
+}
+
+// The reference's ms count after a page of `count` samples at `freq`: the
+// last sample's time plus one period, truncated.
+inline void GeneactivDecoder::advance_chain(double freq, std::size_t count) {
+  if (count == 0) return;
+  const double last = static_cast<double>(chain_ms_) +
+                      static_cast<double>(count - 1) * (1.0 / freq) * 1000;
+  chain_ms_ = static_cast<std::int64_t>(last + (1.0 / freq) * 1000);
+}
+
+// Checks next_'s Page Time and Sequence Number against the last good page
+// (expected: one page of 300 / rate later per unit since). A jump is a gap;
+// a lone page whose time disagrees while its sequence number fits is timed
+// as predicted (bad_page_time), unless the next page confirms the new time.
+inline void GeneactivDecoder::check_time() {
+  Page& p = *next_;
+  double t = static_cast<double>(p.stamp_ms);
+  if (have_prev_) {
+    const std::int64_t k = pages_seen_ - prev_units_;
+    const double page_ms = geneactiv::kSamplesPerPage * 1000.0 / prev_freq_;
+    const double tol = 1000.0 / prev_freq_ + 1.0;
+    const double expected = prev_ms_ + static_cast<double>(k) * page_ms;
+    const double d = t - expected;
+    const bool seq_ok = p.seq == prev_seq_ + k;
+    bool jump = false;
+    if (std::fabs(d) <= tol) {
+      // a lone wrong number is counted and mended; a new numbering that
+      // goes on from it is taken
+      if (!seq_ok && !(have_seq_candidate_ && p.seq == seq_candidate_ + 1)) {
+        report_.count("bad_sequence");
+        note_at("sequence number out of order (page kept)", p.offset);
+        have_seq_candidate_ = true;
+        seq_candidate_ = p.seq;
+        p.seq = prev_seq_ + k;
+      } else {
+        have_seq_candidate_ = false;
+      }
+      have_candidate_ = false;
+    } else if (seq_ok && !(have_candidate_ && std::fabs(t - candidate_ms_ - page_ms) <= tol)) {
+      report_.count("bad_page_time");
+      note_at("page time out of line (page kept, timed as predicted)", p.offset);
+      have_candidate_ = true;
+      candidate_ms_ = t;
+      t = expected;
+      p.time_s = (t - tz_ms_) / 1000.0;
+    } else {
+      jump = true;
+      have_candidate_ = false;
+    }
+    if (jump && d > 0) {
+      ++report_.gaps;
+      report_.gap_seconds += d / 1000.0;
+      note_at(("gap of " + std::to_string(d / 1000.0) + " s").c_str(), p.offset);
+    } else if (jump) {
+      report_.count("time_backwards");
+      note_at(("time goes back " + std::to_string(-d / 1000.0) + " s (page kept)").c_str(), p.offset);
+    }
+  }
+  have_prev_ = true;
+  prev_ms_ = t;
+  prev_seq_ = p.seq;
+  prev_units_ = pages_seen_;
+  prev_freq_ = p.freq;
+}
+
+// Consumes the unit in next_.
+inline void GeneactivDecoder::accept(Unit u) {
+  if (u == Unit::skipped) {
+    ++report_.skipped;
+    if (compat_) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
+    ++pages_seen_;
+    return;
+  }
+  Page& p = *next_;
+  check_time();
+  if (p.freq != last_good_rate_ && report_.units > 0) {
+    if (report_.get("rate_changes") == 0) note_at("measurement frequency changes", p.offset);
+    report_.count("rate_changes");
+  }
+  if (!have_anchor_) {
+    have_anchor_ = true;
+    anchor_ = anchor_time(p.stamp);
+    if (pages_seen_ > 0) {
+      anchor_ -= static_cast<double>(pages_seen_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) / p.freq;
+    }
+  }
+  last_good_rate_ = p.freq;
+  block_rate_ = p.freq;
+  p.base_ms = chain_ms_;
+  if (compat_) advance_chain(p.freq, p.count);
+  ++report_.units;
+  ++pages_seen_;
+  std::swap(next_, cur_);
+  emitted_ = 0;
+  pending_ = true;
+}
+
+// Gives cur_'s samples until out is full.
+inline void GeneactivDecoder::emit(SampleBuffer& out) {
+  const Page& p = *cur_;
+  std::size_t k = p.count - emitted_;
+  if (k > out.room()) k = out.room();
+  const std::size_t n = out.n;
+  const double inv = 1.0 / p.freq;
+  for (std::size_t j = 0; j < k; ++j) {
+    const std::size_t i = emitted_ + j;
+    out.x[n + j] = lut_[0][p.raw[i][0]];
+    out.y[n + j] = lut_[1][p.raw[i][1]];
+    out.z[n + j] = lut_[2][p.raw[i][2]];
+  }
+  if (out.t != nullptr) {
+    for (std::size_t j = 0; j < k; ++j) out.t[n + j] = p.temperature;
+  }
+  if (out.time != nullptr) {
+    for (std::size_t j = 0; j < k; ++j) {
+      const double i = static_cast<double>(emitted_ + j);
+      if (compat_) {
+        // Unix ms as the reference: truncated to an integer, then / 1000
+        const double t = static_cast<double>(p.base_ms) + i * inv * 1000;
+        out.time[n + j] = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
+      } else {
+        out.time[n + j] = p.time_s + i / p.freq;
+      }
+    }
+  }
+  out.n += k;
+  emitted_ += k;
+  report_.samples += static_cast<std::int64_t>(k);
+  if (emitted_ >= p.count) pending_ = false;
+}
+
+// compat 1: the reference adds the first page's time and ((s - 1) * 300) /
+// rate (rate of the call's last page) to its ms count / 1000.
+inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
+  if (!compat_ || out.time == nullptr || out.n == n0) return;
+  double start = anchor_;
+  if (block_first_ > 0) {
+    start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
+             block_rate_;
+  }
+  for (std::size_t i = n0; i < out.n; ++i) out.time[i] = out.time[i] + start;
+}
+
+inline void GeneactivDecoder::finish_input() {
+  if (done_) return;
+  done_ = true;
+  if (lines_.read_error()) {
+    report_.read_error = true;
+    report_.note("read error after byte " + std::to_string(lines_.offset) + ": data end there");
+  }
+  if (header_pages_ >= 0 && header_pages_ != pages_seen_) {
+    report_.note("header says " + std::to_string(header_pages_) + " pages, the file has " +
+                 std::to_string(pages_seen_));
+  }
+}
+
+inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_units) {
+  const std::size_t n0 = out.n;
+  std::int64_t units = 0;
+  if (compat_ && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
+    // a new reference call from page pages_seen_ + 1
+    block_open_ = true;
+    chain_ms_ = 0;
+    block_first_ = pages_seen_;
+    block_rate_ = last_good_rate_;
+  }
+  for (;;) {
+    if (pending_) {
+      emit(out);
+      if (pending_) break;  // out is full
+    }
+    if (max_units >= 0 && units >= max_units) break;
+    if (!have_next_) {
+      next_unit_ = parse_page();
+      have_next_ = true;
+    }
+    if (next_unit_ == Unit::none) break;
+    have_next_ = false;
+    accept(next_unit_);
+    ++units;
+  }
+  finish_block(out, n0);
+  if (!pending_) {
+    if (!have_next_) {
+      next_unit_ = parse_page();
+      have_next_ = true;
+    }
+    if (next_unit_ == Unit::none) finish_input();
+  }
+  return units;
+}
+
+}  // namespace gravcal
+
+#endif  // GRAVCAL_DECODE_GENEACTIV_HPP

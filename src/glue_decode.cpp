@@ -1,0 +1,260 @@
+// Rcpp glue for the device-file decoders (decode*.hpp): opens a file with
+// the format's decoder, hands blocks of samples to R, and reports what was
+// skipped. Converts and calls, nothing more.
+#include <Rcpp.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gravcal/decode.hpp"
+#include "decoders.h"
+#include "windows_glue.h"
+
+namespace {
+
+// What an open file needs kept alive: the byte source, the decoder on it.
+struct OpenFile {
+  std::unique_ptr<gravcal::ByteSource> bytes;
+  std::unique_ptr<gravcal::Decoder> decoder;
+};
+
+gravcal::Options to_options(const Rcpp::List& opts) {
+  gravcal::Options o;
+  if (opts.size() == 0) return o;
+  const Rcpp::CharacterVector nm = opts.names();
+  for (R_xlen_t i = 0; i < opts.size(); ++i) {
+    const std::string name = Rcpp::as<std::string>(nm[i]);
+    SEXP v = opts[i];
+    if (TYPEOF(v) == STRSXP && Rf_length(v) == 1) {
+      o.set(name, Rcpp::as<std::string>(v));
+    } else if ((TYPEOF(v) == REALSXP || TYPEOF(v) == INTSXP || TYPEOF(v) == LGLSXP) &&
+               Rf_length(v) == 1) {
+      o.set(name, Rcpp::as<double>(v));
+    } else {
+      Rcpp::stop("decoder option '%s' must be a single number or string", name);
+    }
+  }
+  return o;
+}
+
+OpenFile* get(SEXP ptr) {
+  Rcpp::XPtr<OpenFile> p(ptr);
+  if (p.get() == nullptr) Rcpp::stop("the file is closed");
+  return p.get();
+}
+
+// A fixed buffer of `chunk` samples (x, y, z and, when asked, temperature)
+// that the decoder fills and the core reads, over and over.
+struct ChunkBuffer {
+  static constexpr std::size_t chunk = 1u << 16;
+  explicit ChunkBuffer(bool temperature) : buf((temperature ? 4u : 3u) * chunk) {
+    out.x = buf.data();
+    out.y = out.x + chunk;
+    out.z = out.y + chunk;
+    out.t = temperature ? out.z + chunk : nullptr;
+    out.capacity = chunk;
+  }
+  std::vector<double> buf;
+  gravcal::SampleBuffer out;
+};
+
+Rcpp::List info_list(const gravcal::DeviceInfo& d) {
+  return Rcpp::List::create(
+      Rcpp::Named("format") = d.format, Rcpp::Named("device") = d.device,
+      Rcpp::Named("serial") = d.serial, Rcpp::Named("sf") = d.sf,
+      Rcpp::Named("start_time") = d.start_time,
+      Rcpp::Named("temperature") = d.has_temperature,
+      Rcpp::Named("time") = d.has_time, Rcpp::Named("range_g") = d.range_g);
+}
+
+}  // namespace
+
+// Opens `path` with the decoder for `format`. Returns list(ptr, info), or
+// list(ptr = NULL, error = why) when the file cannot be read as that format.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_open(const std::string& path, const std::string& format,
+                           const Rcpp::List& options) {
+  std::unique_ptr<OpenFile> f(new OpenFile());
+  const gravcal::Options opts = to_options(options);
+  std::string why;
+  f->bytes = gravcal_glue::open_bytes(path, format, opts, why);
+  if (!f->bytes) {
+    return Rcpp::List::create(Rcpp::Named("ptr") = R_NilValue,
+                              Rcpp::Named("error") = why);
+  }
+  f->decoder = gravcal_glue::make_decoder(format, *f->bytes, opts);
+  if (!f->decoder) {
+    return Rcpp::List::create(Rcpp::Named("ptr") = R_NilValue,
+                              Rcpp::Named("error") = "no native decoder for format " + format,
+                              Rcpp::Named("unsupported") = true);
+  }
+  if (!f->decoder->open()) {
+    return Rcpp::List::create(Rcpp::Named("ptr") = R_NilValue,
+                              Rcpp::Named("error") = f->decoder->error());
+  }
+  Rcpp::List info = info_list(f->decoder->info());
+  Rcpp::XPtr<OpenFile> ptr(f.release(), true);
+  return Rcpp::List::create(Rcpp::Named("ptr") = ptr, Rcpp::Named("info") = info);
+}
+
+// The next block: at most `max_units` format units (negative: no limit) and
+// at most `capacity` samples. Returns list(x, y, z, temperature, time, n,
+// units, done); the vectors have length `capacity` and hold n samples
+// (temperature and time are NULL unless asked for and given by the file).
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity,
+                           bool want_temperature, bool want_time) {
+  OpenFile* f = get(ptr);
+  if (!(capacity >= 1) || capacity > 1e9) Rcpp::stop("capacity must be in [1, 1e9]");
+  const R_xlen_t cap = static_cast<R_xlen_t>(capacity);
+  const gravcal::DeviceInfo& d = f->decoder->info();
+  Rcpp::NumericVector x(Rcpp::no_init(cap)), y(Rcpp::no_init(cap)), z(Rcpp::no_init(cap));
+  Rcpp::NumericVector t, tm;
+  gravcal::SampleBuffer out;
+  out.x = x.begin();
+  out.y = y.begin();
+  out.z = z.begin();
+  if (want_temperature && d.has_temperature) {
+    t = Rcpp::NumericVector(Rcpp::no_init(cap));
+    out.t = t.begin();
+  }
+  if (want_time && d.has_time) {
+    tm = Rcpp::NumericVector(Rcpp::no_init(cap));
+    out.time = tm.begin();
+  }
+  out.capacity = static_cast<std::size_t>(cap);
+  const std::int64_t units = f->decoder->read(
+      out, max_units < 0 ? -1 : static_cast<std::int64_t>(max_units));
+  return Rcpp::List::create(
+      Rcpp::Named("x") = x, Rcpp::Named("y") = y, Rcpp::Named("z") = z,
+      Rcpp::Named("temperature") = out.t ? Rcpp::RObject(t) : Rcpp::RObject(R_NilValue),
+      Rcpp::Named("time") = out.time ? Rcpp::RObject(tm) : Rcpp::RObject(R_NilValue),
+      Rcpp::Named("n") = static_cast<double>(out.n),
+      Rcpp::Named("units") = static_cast<double>(units),
+      Rcpp::Named("done") = f->decoder->done());
+}
+
+// Upper bound of samples per unit (format constant).
+// [[Rcpp::export(rng = false)]]
+double gc_decoder_unit_samples(SEXP ptr) {
+  return static_cast<double>(get(ptr)->decoder->max_samples_per_unit());
+}
+
+// What was read and skipped so far.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_report(SEXP ptr) {
+  const gravcal::Report& r = get(ptr)->decoder->report();
+  Rcpp::NumericVector counters(r.counters.size());
+  Rcpp::CharacterVector names(r.counters.size());
+  for (std::size_t i = 0; i < r.counters.size(); ++i) {
+    counters[static_cast<R_xlen_t>(i)] = static_cast<double>(r.counters[i].second);
+    names[static_cast<R_xlen_t>(i)] = r.counters[i].first;
+  }
+  counters.attr("names") = names;
+  return Rcpp::List::create(
+      Rcpp::Named("units") = static_cast<double>(r.units),
+      Rcpp::Named("samples") = static_cast<double>(r.samples),
+      Rcpp::Named("skipped") = static_cast<double>(r.skipped),
+      Rcpp::Named("gaps") = static_cast<double>(r.gaps),
+      Rcpp::Named("gap_seconds") = r.gap_seconds,
+      Rcpp::Named("truncated") = r.truncated,
+      Rcpp::Named("read_error") = r.read_error,
+      Rcpp::Named("counters") = counters,
+      Rcpp::Named("notes") = Rcpp::wrap(r.notes),
+      Rcpp::Named("notes_total") = static_cast<double>(r.notes_total));
+}
+
+// Closes the file now (the finalizer would, later).
+// [[Rcpp::export(rng = false)]]
+void gc_decoder_close(SEXP ptr) {
+  Rcpp::XPtr<OpenFile> p(ptr);
+  p.release();
+}
+
+// Streams at most `max_units` format units (negative: to the end) from the
+// decoder into the segmenter through a fixed buffer, without building R
+// vectors of samples. Returns list(windows = the completed windows, samples
+// = samples pushed, units, done).
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
+                              Rcpp::NumericVector par, bool use_temperature) {
+  OpenFile* f = get(ptr);
+  Rcpp::XPtr<gravcal_glue::SegmenterBox> box(seg);
+  const gravcal_glue::RestRule is_rest(rule, par);
+  ChunkBuffer cb(use_temperature && f->decoder->info().has_temperature);
+  gravcal::SampleBuffer& out = cb.out;
+  gravcal_glue::WindowTable table;
+  std::int64_t left = max_units < 0 ? -1 : static_cast<std::int64_t>(max_units);
+  std::int64_t units = 0;
+  double samples = 0;
+  int rounds = 0;
+  while (!f->decoder->done() && left != 0) {
+    out.n = 0;
+    const std::int64_t u = f->decoder->read(out, left);
+    units += u;
+    if (left > 0) left -= u;
+    box->seg.push(out.x, out.y, out.z, out.t, out.n,
+                  [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); });
+    samples += static_cast<double>(out.n);
+    if (out.n == 0 && u == 0) break;  // nothing more this call
+    if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
+  }
+  return Rcpp::List::create(Rcpp::Named("windows") = table.to_list(),
+                            Rcpp::Named("samples") = samples,
+                            Rcpp::Named("units") = static_cast<double>(units),
+                            Rcpp::Named("done") = f->decoder->done());
+}
+
+// One of GGIR's blocks, `max_units` format units, from the decoder through
+// GGIR's block rules (`blocks`, see gc_blocks_new()) into their segmenter,
+// through a fixed buffer. Returns the block's result (gc_blocks_columns())
+// with `units` and `done`.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
+                            Rcpp::NumericVector par) {
+  OpenFile* f = get(ptr);
+  Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  const gravcal_glue::RestRule is_rest(rule, par);
+  ChunkBuffer cb(box->temperature && f->decoder->info().has_temperature);
+  gravcal::SampleBuffer& out = cb.out;
+  gravcal_glue::WindowTable table;
+  auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
+  box->blocks.begin_block();
+  std::int64_t left = max_units < 0 ? -1 : static_cast<std::int64_t>(max_units);
+  std::int64_t units = 0;
+  int rounds = 0;
+  while (!f->decoder->done() && left != 0) {
+    out.n = 0;
+    const std::int64_t u = f->decoder->read(out, left);
+    units += u;
+    if (left > 0) left -= u;
+    box->blocks.push(out.x, out.y, out.z, out.t, out.n, sink);
+    if (out.n == 0 && u == 0) break;
+    if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
+  }
+  Rcpp::List res = gravcal_glue::block_result(table, box->blocks.end_block(sink));
+  res["units"] = static_cast<double>(units);
+  res["done"] = f->decoder->done();
+  return res;
+}
+
+// Decodes the rest of the file into a fixed buffer and drops the samples:
+// the cost of reading and decoding alone (the benchmarks' floor). Returns
+// the samples decoded.
+// [[Rcpp::export(rng = false)]]
+double gc_decoder_drain(SEXP ptr) {
+  OpenFile* f = get(ptr);
+  ChunkBuffer cb(f->decoder->info().has_temperature);
+  gravcal::SampleBuffer& out = cb.out;
+  double samples = 0;
+  int rounds = 0;
+  while (!f->decoder->done()) {
+    out.n = 0;
+    const std::int64_t u = f->decoder->read(out, -1);
+    samples += static_cast<double>(out.n);
+    if (out.n == 0 && u == 0) break;
+    if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
+  }
+  return samples;
+}

@@ -1,0 +1,106 @@
+// libFuzzer harness: the .cwa decoder on arbitrary bytes, in both modes.
+// The first 3 bytes choose the mode, the window size and whether to make the
+// blocks' checksums (and "MD"/"AX" tags) right, so that fuzzed content gets
+// past the checksum. Checks, besides the sanitizers' findings: no read past
+// the buffer's capacity, the report's counts agree with what was given, the
+// decoder always makes progress, and the samples are the same, to the bit,
+// whether pulled through a large buffer or a 7-sample one.
+#include <cstring>
+#include <vector>
+
+#include "fuzz_input.hpp"
+#include "gravcal/decode_cwa.hpp"
+
+namespace {
+
+constexpr std::size_t max_out = 20000;  // enough; a fuzzed gap may impute far more
+
+struct Run {
+  std::vector<double> v;  // x, y, z, t, time of each sample
+  std::int64_t units = 0;
+  gravcal::Report report;
+};
+
+bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t window,
+         std::size_t cap, Run& r) {
+  gravcal::MemorySource src(file.data(), file.size());
+  gravcal::Options opts;
+  opts.set("compat", compat ? 1.0 : 0.0);
+  gravcal::CwaDecoder dec(src, opts);
+  if (!dec.open()) {
+    if (dec.error().empty()) __builtin_trap();
+    return false;
+  }
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  int idle = 0;
+  while (!dec.done() && r.v.size() / 5 < max_out) {
+    gravcal::SampleBuffer out;
+    out.x = x.data();
+    out.y = y.data();
+    out.z = z.data();
+    out.t = t.data();
+    out.time = tm.data();
+    out.capacity = cap;
+    const std::int64_t u = dec.read(out, window);
+    if (out.n > cap || u < 0) __builtin_trap();
+    if (!compat && window >= 0 && u > window) __builtin_trap();
+    r.units += u;
+    for (std::size_t i = 0; i < out.n; ++i) {
+      const double s[5] = {x[i], y[i], z[i], t[i], tm[i]};
+      r.v.insert(r.v.end(), s, s + 5);
+    }
+    idle = (out.n == 0 && u == 0) ? idle + 1 : 0;
+    if (idle > 2) __builtin_trap();  // no progress and not done
+  }
+  r.report = dec.report();
+  return true;
+}
+
+void check(const Run& r, bool compat, std::size_t blocks) {
+  const gravcal::Report& rep = r.report;
+  if (rep.samples != static_cast<std::int64_t>(r.v.size() / 5)) __builtin_trap();
+  if (rep.units < 0 || rep.skipped < 0 || rep.gaps < 0 || !(rep.gap_seconds >= 0)) __builtin_trap();
+  if (static_cast<std::size_t>(rep.units + rep.skipped) > blocks) __builtin_trap();
+  if (!compat && rep.samples > 120 * rep.units) __builtin_trap();
+}
+
+bool same(const Run& a, const Run& b) {
+  const std::size_t n = std::min(a.v.size(), b.v.size());
+  return n == 0 || std::memcmp(a.v.data(), b.v.data(), n * sizeof(double)) == 0;
+}
+
+// Makes every whole data block's checksum (and optionally its tag) right.
+void repair(std::vector<unsigned char>& f, bool tags) {
+  if (tags && f.size() >= 2) f[0] = 'M', f[1] = 'D';
+  for (std::size_t at = 1024; at + 512 <= f.size(); at += 512) {
+    if (tags) f[at] = 'A', f[at + 1] = 'X', f[at + 2] = 0xfc, f[at + 3] = 0x01;
+    unsigned sum = 0;
+    for (std::size_t i = 0; i < 510; i += 2) sum += gravcal::le16(&f[at + i]);
+    const unsigned c = (0x10000u - (sum & 0xffffu)) & 0xffffu;
+    f[at + 510] = static_cast<unsigned char>(c & 0xff);
+    f[at + 511] = static_cast<unsigned char>(c >> 8);
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzInput in{data, size};
+  const std::uint8_t mode = in.byte();
+  const std::int64_t window = static_cast<std::int64_t>(in.byte() % 50) - 1;  // -1: all
+  const std::uint8_t fix = in.byte();
+  std::vector<unsigned char> file(in.p, in.p + in.n);
+  if (fix & 1) repair(file, (fix & 2) != 0);
+  const bool compat = mode & 1;
+  if (window == 0) return 0;
+  const std::size_t blocks = file.size() > 1024 ? (file.size() - 1024) / 512 : 0;
+  Run big, small;
+  const std::size_t cap = 4096;
+  const bool ok = run(file, compat, window, cap, big);
+  if (run(file, compat, window, 7, small) != ok) __builtin_trap();
+  if (!ok) return 0;
+  check(big, compat, blocks);
+  check(small, compat, blocks);
+  if (!same(big, small)) __builtin_trap();
+  return 0;
+}

@@ -1,0 +1,83 @@
+// libFuzzer harness: the GENEActiv decoder on arbitrary bytes. The first
+// byte picks compat, the block size (max_units) and the buffer; when its low
+// bit is set a valid header goes before the rest, so the fuzzer works on
+// pages. Checks: no crash, no call past the buffer, progress on every call,
+// finite values, report counts consistent with what was given.
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <cstdio>
+
+#include "fuzz_input.hpp"
+#include "gravcal/decode_geneactiv.hpp"
+
+// Stops with the line of the broken invariant.
+#define CHECK(cond)                                             \
+  do {                                                          \
+    if (!(cond)) {                                              \
+      std::fprintf(stderr, "invariant failed, line %d: %s\n", __LINE__, #cond); \
+      __builtin_trap();                                         \
+    }                                                           \
+  } while (0)
+
+static const char kHeader[] =
+    "Device Identity\r\nDevice Unique Serial Code:012967\r\nDevice Type:GENEActiv\r\n"
+    "Device Model:1.1\r\nAccelerometer Range:-8 to 8\r\nConfiguration Info\r\n"
+    "Measurement Frequency:85.7 Hz\r\nTime Zone:GMT +01:00\r\nCalibration Data\r\n"
+    "x gain:25875\r\nx offset:439\r\ny gain:25734\r\ny offset:-662\r\nz gain:25538\r\n"
+    "z offset:-3056\r\nVolts:300\r\nLux:800\r\n\r\nMemory Status\r\nNumber of Pages:2\r\n\r\n";
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzInput in{data, size};
+  const std::uint8_t mode = in.byte();
+  std::vector<unsigned char> bytes;
+  if (mode & 1) bytes.assign(kHeader, kHeader + sizeof kHeader - 1);
+  bytes.insert(bytes.end(), in.p, in.p + in.n);
+  gravcal::MemorySource src(bytes.data(), bytes.size());
+  gravcal::Options opts;
+  opts.set("compat", (mode & 2) ? 0.0 : 1.0);
+  gravcal::GeneactivDecoder dec(src, opts);
+  if (!dec.open()) {
+    CHECK(!(dec.error().empty()));
+    return 0;
+  }
+  const std::int64_t max_units = (mode & 4) ? -1 : 1 + ((mode >> 3) & 3);
+  const std::size_t cap = (mode & 32) ? 7 : 600;
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  std::int64_t samples = 0, units = 0;
+  for (int calls = 0; !dec.done(); ++calls) {
+    gravcal::SampleBuffer out;
+    out.x = x.data();
+    out.y = y.data();
+    out.z = z.data();
+    out.t = t.data();
+    out.time = tm.data();
+    out.capacity = cap;
+    const std::int64_t u = dec.read(out, max_units);
+    CHECK(!(out.n > cap || u < 0 || (max_units >= 0 && u > max_units)));
+    CHECK(!(u == 0 && out.n == 0 && !dec.done()));  // no progress
+    for (std::size_t i = 0; i < out.n; ++i) {
+      CHECK(std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(z[i]) &&
+            std::isfinite(t[i]) && std::isfinite(tm[i]));
+    }
+    samples += static_cast<std::int64_t>(out.n);
+    units += u;
+    CHECK(!(calls > 10000000));
+  }
+  const gravcal::Report& r = dec.report();
+  CHECK(!(r.samples != samples));
+  CHECK(!(r.units + r.skipped != units));
+  CHECK(!(r.samples > r.units * static_cast<std::int64_t>(gravcal::geneactiv::kSamplesPerPage)));
+  CHECK(!(r.gaps < 0 || !(r.gap_seconds >= 0) || !std::isfinite(r.gap_seconds)));
+  CHECK(!(r.notes.size() > gravcal::Report::max_notes));
+  // a further read gives nothing
+  gravcal::SampleBuffer out;
+  out.x = x.data();
+  out.y = y.data();
+  out.z = z.data();
+  out.capacity = cap;
+  CHECK(!(dec.read(out, -1) != 0 || out.n != 0));
+  return 0;
+}

@@ -1,0 +1,361 @@
+# The native GENEActiv .bin decoder (decode_geneactiv.hpp) against the
+# reference reader GGIRread::readGENEActiv 1.2.0 (called as GGIR calls it:
+# desiredtz = "", configtz = ""), on GGIRread's real test file and on files
+# written by write_geneactiv_bin() from the format description.
+
+cols <- c("x", "y", "z", "temperature", "time")
+
+ga_real <- function() {
+  skip_if_not_installed("GGIRread")
+  f <- system.file("testfiles", "GENEActiv_testfile.bin", package = "GGIRread")
+  if (!nzchar(f)) skip("GGIRread has no GENEActiv_testfile.bin")
+  f
+}
+
+ga_ref <- function(file, start = 0, end = 0) {
+  out <- NULL
+  # the reference prints "data error" for a page cut short; quiet here
+  utils::capture.output(type = "message", out <- GGIRread::readGENEActiv(
+    file, start = start, end = end, desiredtz = "", configtz = "")$data.out)
+  out
+}
+
+# resample = 0: the decoder's output as GGIRread::readGENEActiv gives it,
+# before GGIR's own resampling of rates that are not whole (see
+# test-ggir.R for that)
+ga_read <- function(file, ...) {
+  opts <- utils::modifyList(list(resample = 0), list(...))
+  gravcal:::native_read_all(file, "geneactiv", options = opts)
+}
+
+# A smooth recording with temperature; n samples at sf.
+ga_sim <- function(n, sf, seed = 1) {
+  set.seed(seed)
+  t <- seq_len(n) / sf
+  x <- 0.9 * sin(t / 7)
+  y <- 0.4 * cos(t / 5)
+  data.frame(x = x, y = y, z = sqrt(1 - x^2 - y^2) + stats::rnorm(n, 0, 0.02),
+             temperature = 25 + 3 * sin(t / 100))
+}
+
+ga_write <- function(pages, sf = 100, eol = "\r\n", ...) {
+  f <- tempfile(fileext = ".bin")
+  gravcal:::write_geneactiv_bin(ga_sim(pages * 300, sf), f, sf = sf, eol = eol,
+                                gain = c(25875, 25734, 25538),
+                                offset = c(439, -662, -3056), ...)
+  f
+}
+
+# Lines of a small file, and back (damage is done line by line).
+ga_lines <- function(f, eol = "\r\n") {
+  strsplit(rawToChar(readBin(f, "raw", file.size(f))), eol, fixed = TRUE)[[1]]
+}
+ga_put <- function(lines, eol = "\r\n", tail = eol) {
+  f <- tempfile(fileext = ".bin")
+  writeBin(charToRaw(paste0(paste(lines, collapse = eol), tail)), f)
+  f
+}
+# Line number of line k (1 = "Recorded Data", 10 = hex) of page p.
+ga_line <- function(lines, p, k) which(lines == "Recorded Data")[p] + k - 1L
+
+# Rows of page p (1-based) dropped.
+drop_pages <- function(d, p) {
+  rows <- unlist(lapply(p, function(q) (q - 1) * 300 + seq_len(300)))
+  out <- d[-rows, ]
+  rownames(out) <- NULL
+  out
+}
+
+expect_same <- function(a, b, what = cols) {
+  for (v in what) expect_identical(a[[v]], b[[v]], label = v)
+}
+
+# Reads `file` in blocks of B pages as GGIR does (readGENEActiv(start = s,
+# end = s + B - 1)) and natively (read(out, B)); expects identical blocks.
+expect_blocks <- function(file, B, capacity = B * 300) {
+  h <- gravcal:::native_open(file, "geneactiv", list(resample = 0))
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  s <- 1
+  repeat {
+    ref <- ga_ref(file, s, s + B - 1)
+    b <- gravcal:::native_block(h, B, capacity, TRUE, TRUE)
+    got <- lapply(b$cols[cols], function(v) v[seq_len(b$to)])
+    expect_identical(as.integer(b$to), nrow(ref))
+    for (v in cols) expect_identical(got[[v]], ref[[v]], label = paste(v, "from page", s))
+    if (nrow(ref) == 0) break
+    s <- s + B
+  }
+}
+
+test_that("the real test file gives readGENEActiv's samples bit for bit", {
+  f <- ga_real()
+  d <- ga_read(f)
+  ref <- ga_ref(f)
+  # 16 whole pages and 231 samples of a 17th cut short (the file is the
+  # first 64 KiB of a recording); the reference gives 5031 too
+  expect_identical(nrow(d), 5031L)
+  expect_same(d, ref)
+  info <- attr(d, "info")
+  expect_identical(info$serial, "012967")
+  expect_identical(info$device, "GENEActiv 1.1")
+  expect_identical(info$sf, 85.7)
+  expect_identical(info$range_g, 8)
+  expect_identical(info$start_time, ref$time[1])
+  rep <- attr(d, "report")
+  expect_true(rep$truncated)
+  expect_identical(rep$counters[["truncated_page"]], 1)
+  expect_identical(c(rep$units, rep$skipped, rep$gaps), c(17, 0, 0))
+  # GGIR's blocks: round((14512 * (sf / 50)) * 0.5) pages; and small ones
+  expect_blocks(f, round((14512 * (85.7 / 50)) * 0.5))
+  expect_blocks(f, 3)
+  expect_blocks(f, 1)
+})
+
+test_that("time stamps follow the session's time zone as the reference's do", {
+  f <- ga_real()
+  old_tz <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "America/New_York")
+  on.exit(if (is.na(old_tz)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old_tz))
+  d <- ga_read(f)
+  ref <- ga_ref(f)
+  expect_same(d, ref, "time")
+  # 10:12:54.5 New York summer time is 14:12:54.5 UTC
+  expect_identical(d$time[1], as.numeric(as.POSIXct("2013-05-30 14:12:54", tz = "UTC")) + 0.5)
+  expect_blocks(f, 4)
+})
+
+test_that("synthetic files (CRLF and LF, 100 and 85.7 Hz) match the reference", {
+  skip_if_not_installed("GGIRread")
+  for (eol in c("\r\n", "\n")) {
+    for (sf in c(100, 85.7)) {
+      f <- ga_write(12, sf = sf, eol = eol, start = "2024-03-31 01:59:58")
+      d <- ga_read(f)
+      expect_identical(nrow(d), 3600L)
+      expect_same(d, ga_ref(f))
+      expect_blocks(f, 5)
+      expect_identical(attr(d, "report")$counters, stats::setNames(numeric(0), character(0)))
+    }
+  }
+  # a block smaller than the buffer, a buffer smaller than a page: the same
+  f <- ga_write(7)
+  expect_blocks(f, 2, capacity = 7 * 300)
+  a <- ga_read(f)
+  expect_same(gravcal:::native_read_all(f, "geneactiv", list(resample = 0), chunk = 77), a)
+})
+
+test_that("pages at another rate are timed as the reference times them", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(10, sf = 100, page_sf = rep(c(100, 50), each = 5))
+  d <- ga_read(f)
+  expect_same(d, ga_ref(f))
+  expect_blocks(f, 4)
+  rep <- attr(d, "report")
+  expect_identical(rep$counters[["rate_changes"]], 1)
+  expect_identical(rep$gaps, 0)
+  # compat 0: page 6 starts 5 pages of 3 s after page 1, then 1 / 50 s steps
+  d0 <- ga_read(f, compat = 0)
+  t6 <- as.numeric(as.POSIXct("2024-01-01 00:00:15", tz = "UTC"))
+  expect_identical(d0$time[1501:1502], t6 + c(0, 1) / 50)
+})
+
+test_that("compat = 0 gives the format's values and page times in UTC", {
+  skip_if_not_installed("GGIRread")
+  sim <- ga_sim(6 * 300, 100)
+  f <- tempfile(fileext = ".bin")
+  gain <- c(25875, 25734, 25538)
+  off <- c(439, -662, -3056)
+  gravcal:::write_geneactiv_bin(sim, f, sf = 100, gain = gain, offset = off,
+                                start = "2024-01-01 10:00:00.250",
+                                time_zone = "GMT +01:00")
+  d0 <- ga_read(f, compat = 0)
+  d1 <- ga_read(f)
+  # (count * 100 - offset) / gain in double, from the counts written
+  cnt <- gravcal:::ga_counts(sim$x, gain[1], off[1])
+  cnt <- ifelse(cnt >= 2048, cnt - 4096, cnt)
+  expect_identical(d0$x, (cnt * 100 - off[1]) / gain[1])
+  expect_false(identical(d0$x, d1$x))
+  expect_lt(max(abs(d0$x - d1$x)), 1e-6)  # float rounding only
+  temp <- sprintf("%.1f", colMeans(matrix(sim$temperature, 300)))
+  expect_identical(d0$temperature, rep(as.numeric(temp), each = 300))
+  # 10:00:00.250 at GMT+1 is 09:00:00.250 UTC; then 1 / 100 s per sample
+  t0 <- as.numeric(as.POSIXct("2024-01-01 09:00:00", tz = "UTC")) + 0.25
+  expect_identical(attr(d0, "info")$start_time, t0)
+  expect_identical(d0$time, rep(t0 + 3 * (0:5), each = 300) + (0:299) / 100)
+})
+
+test_that("other .bin files and non-files are refused with a clear error", {
+  skip_if_not_installed("GGIRread")
+  tf <- function(name) system.file("testfiles", name, package = "GGIRread")
+  expect_error(ga_read(tf("genea_testfile.bin")), "looks like an older Genea file")
+  for (m in c("mtx_12.5Hz_acc.BIN", "mtx_corrupted.bin")) {
+    expect_error(ga_read(tf(m)), "looks like a Matrix/Parmay file")
+  }
+  g <- tempfile()
+  writeLines(c("time,x,y,z", "1,2,3,4"), g)
+  expect_error(ga_read(g), "first line is \"time,x,y,z\"")
+  file.create(g)
+  expect_error(ga_read(g), "empty file")
+  # a header cut before its memory status
+  lines <- ga_lines(ga_write(2))
+  expect_error(ga_read(ga_put(lines[1:50])), "header truncated at byte")
+  bad <- ga_lines(ga_write(2))
+  bad[startsWith(bad, "y gain:")] <- "y gain:abc"
+  expect_error(ga_read(ga_put(bad)), "bad calibration line \"y gain:\"")
+  expect_error(ga_read(tempfile()), "cannot open")
+})
+
+test_that("a damaged page is skipped and counted, every other sample kept", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(12)
+  clean <- ga_read(f)
+  clean0 <- ga_read(f, compat = 0)
+  lines <- ga_lines(f)
+  damage <- function(p, k, value) {
+    l <- lines
+    if (is.null(value)) l <- l[-ga_line(l, p, k)] else l[ga_line(l, p, k)] <- value
+    ga_put(l)
+  }
+  hex5 <- lines[ga_line(lines, 5, 10)]
+  cases <- list(
+    list(5, 10, substr(hex5, 2, 3600), "bad_hex"),                      # a digit lost
+    list(5, 10, paste0(hex5, "0"), "bad_hex"),                          # one too many
+    list(5, 10, paste0(substr(hex5, 1, 1234), "G", substr(hex5, 1236, 3600)), "bad_hex"),           # not hex
+    list(5, 10, "", "bad_hex"),                                         # empty
+    list(3, 5, NULL, "bad_page_header"),                                # "Unassigned:" gone
+    list(3, 6, "Temperature:2x.5", "bad_page_header"),                  # garbled value
+    list(3, 9, "Measurement Frequency:", "bad_page_header"),            # no value
+    list(3, 4, "Page Tine:2024-01-01 00:00:06:000", "bad_page_header")  # garbled key
+  )
+  for (cs in cases) {
+    g <- damage(cs[[1]], cs[[2]], cs[[3]])
+    for (compat in 1:0) {
+      d <- ga_read(g, compat = compat)
+      expect_same(d, drop_pages(if (compat) clean else clean0, cs[[1]]))
+      rep <- attr(d, "report")
+      expect_identical(rep$counters[[cs[[4]]]], 1, label = cs[[4]])
+      expect_identical(c(rep$units, rep$skipped, rep$gaps), c(11, 1, 0))
+      expect_false(rep$truncated)
+      expect_match(rep$notes[1], paste0("page ", cs[[1]], ", byte "))
+    }
+  }
+  # the same on the real file (NULs in its header: edit bytes): page 3's hex
+  # with a non-hex digit
+  r <- ga_real()
+  rb <- readBin(r, "raw", file.size(r))
+  at <- grepRaw("Recorded Data", rb, fixed = TRUE, all = TRUE)
+  rb[at[4] - 2 - 3600 + 100] <- charToRaw("Z")
+  g <- tempfile(fileext = ".bin")
+  writeBin(rb, g)
+  d <- ga_read(g)
+  expect_same(d, drop_pages(ga_read(r), 3))
+  expect_identical(attr(d, "report")$counters[["bad_hex"]], 1)
+})
+
+test_that("sequence numbers and page times are checked; gaps are reported", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(12)
+  clean <- ga_read(f)
+  clean0 <- ga_read(f, compat = 0)
+  lines <- ga_lines(f)
+  # a wrong sequence number: page kept, counted
+  l <- lines
+  l[ga_line(l, 4, 3)] <- "Sequence Number:99"
+  g <- ga_put(l)
+  d <- ga_read(g)
+  expect_same(d, clean)
+  expect_same(d, ga_ref(g))  # the reference does not look at them
+  expect_identical(attr(d, "report")$counters[["bad_sequence"]], 1)
+  # one page's time an hour off: page kept, timed as predicted
+  l <- lines
+  l[ga_line(l, 6, 4)] <- "Page Time:2024-01-01 01:00:15:000"
+  g <- ga_put(l)
+  expect_same(ga_read(g), ga_ref(g))
+  for (compat in 1:0) {
+    d <- ga_read(g, compat = compat)
+    expect_same(d, if (compat) clean else clean0)
+    rep <- attr(d, "report")
+    expect_identical(rep$counters[["bad_page_time"]], 1)
+    expect_identical(rep$gaps, 0)
+  }
+  # pages 8 and 9 missing (sequence and time jump): a gap of 2 pages of 3 s;
+  # compat 1 times as the reference's (which closes the gap up)
+  l <- lines[-(ga_line(lines, 8, 1):ga_line(lines, 9, 10))]
+  g <- ga_put(l)
+  d <- ga_read(g)
+  rep <- attr(d, "report")
+  expect_identical(c(rep$gaps, rep$gap_seconds, rep$skipped), c(1, 6, 0))
+  expect_same(d, ga_ref(g))
+  d0 <- ga_read(g, compat = 0)
+  expect_same(d0, drop_pages(clean0, 8:9))
+  # the clock really moves (two pages agree on the new time): one gap
+  l <- lines
+  for (p in 6:12) {
+    l[ga_line(l, p, 4)] <- paste0("Page Time:", gravcal:::ga_stamp(
+      as.numeric(as.POSIXct("2024-01-01", tz = "UTC")) + 600 + (p - 1) * 3))
+  }
+  rep <- attr(ga_read(ga_put(l)), "report")
+  expect_identical(c(rep$gaps, rep$gap_seconds), c(1, 600))
+  expect_identical(rep$counters[["bad_page_time"]], 1)
+})
+
+test_that("a file cut short keeps every whole sample and says so", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(12)
+  clean <- ga_read(f)
+  bytes <- readBin(f, "raw", file.size(f))
+  starts <- gregexpr("Recorded Data", rawToChar(bytes), fixed = TRUE)[[1]]
+  cut <- function(n) {
+    g <- tempfile(fileext = ".bin")
+    writeBin(bytes[seq_len(n)], g)
+    g
+  }
+  # 1-based position of page 10's first hex digit (its CRLF ends it)
+  line10 <- starts[11] - 2 - 3600
+  # inside page 10's header lines: page 10 lost
+  g <- cut(starts[10] + 180)
+  d <- ga_read(g)
+  expect_same(d, clean[1:2700, ])
+  # (the reference gives page 9's samples again as page 10: std::getline
+  # at the end of the input leaves its string as it was)
+  ref <- ga_ref(g)
+  expect_identical(ref$x[2701:3000], ref$x[2401:2700])
+  expect_true(attr(d, "report")$truncated)
+  expect_identical(attr(d, "report")$skipped, 1)
+  # inside page 10's hex line after r digits: whole samples kept, and a tail
+  # of 10 or 11 digits (x, y, z whole) as the reference keeps it
+  for (r in c(1200, 1205, 1210, 3599)) {
+    g <- cut(line10 - 1 + r)
+    d <- ga_read(g)
+    rep <- attr(d, "report")
+    expect_true(rep$truncated)
+    expect_identical(rep$counters[["truncated_page"]], 1)
+    expect_same(d, ga_ref(g))
+    expect_identical(nrow(d), as.integer(2700 + r %/% 12 + (r %% 12 >= 10)))
+    expect_same(d, clean[seq_len(nrow(d)), ])
+  }
+  # cut at a page boundary, or before the last CRLF: nothing lost
+  expect_identical(nrow(ga_read(cut(starts[11] - 1))), 3000L)
+  d <- ga_read(cut(length(bytes) - 2))
+  expect_same(d, clean)
+  expect_false(attr(d, "report")$truncated)
+  # compat 0 keeps whole 12-digit samples only
+  d0 <- ga_read(cut(line10 - 1 + 1210), compat = 0)
+  expect_identical(nrow(d0), 2700L + 100L)
+})
+
+test_that("trailing garbage and stray lines are skipped and counted", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(4)
+  clean <- ga_read(f)
+  g <- tempfile(fileext = ".bin")
+  file.copy(f, g)
+  con <- file(g, "ab")
+  writeBin(c(charToRaw("garbage\r\n"), as.raw(c(1, 2, 0, 255, 10)),
+             charToRaw(strrep("F", 20000))), con)
+  close(con)
+  d <- ga_read(g)
+  expect_same(d, clean)
+  rep <- attr(d, "report")
+  expect_identical(rep$counters[["stray_lines"]], 3)
+  expect_identical(rep$skipped, 0)
+})
