@@ -14,10 +14,14 @@ cwa_chunk_blocks <- 8192  # blocks built at once (bounds the writer's memory)
 # its first sample's). `time`: optional time of each sample, to place blocks
 # (gaps, jumps); a block starts at its first sample's time. `fractional`:
 # blocks carry a fraction of a second (deviceFractional's top bit).
+# `append = TRUE` adds the blocks to the end of an existing file written by
+# this function (no header), numbering them from `block0`: long recordings
+# are written in pieces, each with its own `start`.
 write_cwa <- function(x, file, sf = 100, start = 1.7e9, packed = TRUE,
                       temperature = 25, light = 0, range = 8, ax6 = FALSE,
                       time = NULL, fractional = TRUE, device_id = 43981,
-                      session = 7, scale_code = if (ax6) 4 else 0) {
+                      session = 7, scale_code = if (ax6) 4 else 0,
+                      append = FALSE, block0 = 0) {
   x <- as.matrix(x)
   n <- nrow(x)
   if (ax6) packed <- FALSE
@@ -29,13 +33,13 @@ write_cwa <- function(x, file, sf = 100, start = 1.7e9, packed = TRUE,
   first <- (seq_len(nb) - 1) * spb + 1
   t0 <- if (is.null(time)) as.numeric(start) + (first - 1) / sf else as.numeric(time)[first]
   temp <- if (length(temperature) == n) temperature[first] else rep_len(temperature, nb)
-  con <- file(file, "wb")
+  con <- file(file, if (append) "ab" else "wb")
   on.exit(close(con))
-  writeBin(cwa_header(device_id, session, rate_byte, ax6), con)
+  if (!append) writeBin(cwa_header(device_id, session, rate_byte, ax6), con)
   for (b0 in seq(1, nb, by = cwa_chunk_blocks)) {
     bl <- b0:min(nb, b0 + cwa_chunk_blocks - 1)
     rows <- ((bl[1] - 1) * spb + 1):min(n, bl[length(bl)] * spb)
-    w <- cwa_words(x[rows, , drop = FALSE], bl, spb, t0[bl], temp[bl], sf,
+    w <- cwa_words(x[rows, , drop = FALSE], bl + block0, spb, t0[bl], temp[bl], sf,
                    packed, ax6, light, rate_byte, scale_code, fractional,
                    device_id, session)
     writeBin(as.integer(w), con, size = 2, endian = "little")  # 16-bit words

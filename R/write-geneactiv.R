@@ -8,12 +8,16 @@
 # Used by the tests and benchmarks to give gravcal and GGIR a device file.
 # `eol` "\r\n" writes the line ends of real files; `page_sf` (one rate per
 # page) writes pages at other rates, timed one after the other; `time_zone`
-# is the header's "Time Zone:" text. Test-only; not exported.
+# is the header's "Time Zone:" text. `append = TRUE` adds pages to the end
+# of a file written by this function (no header), numbered from `page0`;
+# `pages_total` is the header's page count for a file written in pieces.
+# Test-only; not exported.
 write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
                                 gain = c(25600, 25600, 25600),
                                 offset = c(0, 0, 0), pages_per_write = 2000,
                                 eol = "\n", page_sf = NULL,
-                                time_zone = "GMT +00:00", serial = "000000") {
+                                time_zone = "GMT +00:00", serial = "000000",
+                                append = FALSE, page0 = 0, pages_total = NULL) {
   s <- as_samples(x)
   pages <- s$n %/% 300
   if (pages < 1) abort("`x` has fewer than 300 samples, one GENEActiv page.")
@@ -21,10 +25,11 @@ write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
   if (length(page_sf) != pages) abort("`page_sf` must have one rate per page (", pages, ").")
   t0 <- as.numeric(as.POSIXct(start, tz = "UTC"))
   page_t <- t0 + cumsum(c(0, 300 / page_sf[-pages]))
-  hdr <- ga_header(t0, sf, pages, gain, offset, time_zone, serial)
-  con <- file(file, "wb")
+  hdr <- ga_header(t0, sf, if (is.null(pages_total)) pages else pages_total,
+                   gain, offset, time_zone, serial)
+  con <- file(file, if (append) "ab" else "wb")
   on.exit(close(con))
-  writeLines(hdr, con, sep = eol)
+  if (!append) writeLines(hdr, con, sep = eol)
   lut <- ga_hex_lut()
   for (p0 in seq(0, pages - 1, by = pages_per_write)) {
     p1 <- min(p0 + pages_per_write, pages)
@@ -38,7 +43,7 @@ write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
       colMeans(matrix(s$temperature[from:to], 300))
     idx <- p0 + seq_len(np)
     page <- rbind("Recorded Data", paste0("Device Unique Serial Code:", serial),
-                  paste0("Sequence Number:", idx - 1),
+                  paste0("Sequence Number:", page0 + idx - 1),
                   paste0("Page Time:", ga_stamp(page_t[idx])), "Unassigned:",
                   paste0("Temperature:", sprintf("%.1f", temp)),
                   "Battery voltage:4.1", "Device Status:Recording",
