@@ -17,7 +17,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA)
 
-.PHONY: setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory refresh-vignettes clean
+.PHONY: setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -86,6 +86,11 @@ bench-speed: install
 # peak memory calibrating a 7-day device file, against GGIR (about 15 minutes)
 bench-memory: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/memory.R
+
+# end to end from device files against GGIR, each contender in its own
+# process (about 30 minutes; writes about 9 GB of files once, see the script)
+bench-files: install
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/files.R
 
 # recompute the vignettes' cached results (about 10 minutes)
 refresh-vignettes: install

@@ -190,7 +190,7 @@ for (series in unique(res$series)) {
   md <- c(md, sprintf("## %s", if (series == "typical")
     "A device GGIR's model fits (the error target is reached)" else
       "A device with cross-axis error (GGIR's error target is never reached)"), "",
-    "| file | size (MB) | GGIR::g.calibrate (s, peak MB) | gravcal::g.calibrate (s, ratio, peak MB, same coefficients) | calibrate ggir (s, ratio, peak MB) | calibrate lightweight (s, ratio, peak MB) | decode (s, x cat) | cat (s) |",
+    "| file | size (MB) | GGIR::g.calibrate (s, peak MB) | gravcal::g.calibrate (s, ratio, peak MB, same coefficients) | calibrate ggir (s, ratio, peak MB) | calibrate lightweight (s, ratio, peak MB) | decode floor (s, x cat) | cat (s) |",
     "|---|---|---|---|---|---|---|---|")
   for (k in unique(key[res$series == series])) {
     r <- res[key == k, ]
@@ -209,7 +209,7 @@ for (series in unique(res$series)) {
                         cell("gravcal::g.calibrate", TRUE), cell("calibrate(method = \"ggir\")"),
                         cell("calibrate(method = \"lightweight\")"),
                         if (nrow(dd)) sprintf("%s s, %.1fx", fmt_s(dd$seconds), dd$decode_over_cat) else "",
-                        fmt_s(g("cat (read-once floor of the system)")$seconds)))
+                        sprintf("%.3f", g("cat (read-once floor of the system)")$seconds)))
   }
   md <- c(md, "")
 }
