@@ -5,7 +5,8 @@
 #   Rscript bench/files-one.R <contender> <file>
 #
 # Prints one line: RESULT <contender> <seconds> <peak MB> <baseline MB>
-# <coefficients as exact hexadecimal doubles, comma-separated> <status>.
+# <coefficients as exact hexadecimal doubles, comma-separated> <status>
+# <CPU seconds>.
 # <seconds> is the call's wall time, library loading excluded; <baseline MB>
 # the resident memory after loading the packages, before the call.
 args <- commandArgs(trailingOnly = TRUE)
@@ -59,8 +60,10 @@ run <- switch(contender,
   },
   stop("unknown contender ", contender))
 
-t <- system.time(v <- run(), gcFirst = FALSE)[["elapsed"]]
+st <- system.time(v <- run(), gcFirst = FALSE)
+t <- st[["elapsed"]]
+cpu <- st[["user.self"]] + st[["sys.self"]]
 status <- gsub("[[:space:]]+", "_", paste(v$status, collapse = "_"))
 if (!nzchar(status)) status <- "-"
-cat(sprintf("RESULT\t%s\t%.3f\t%.1f\t%.1f\t%s\t%s\n", contender, t,
-            proc_mb("VmHWM"), base, hex(v$coef), status))
+cat(sprintf("RESULT\t%s\t%.3f\t%.1f\t%.1f\t%s\t%s\t%.3f\n", contender, t,
+            proc_mb("VmHWM"), base, hex(v$coef), status, cpu))

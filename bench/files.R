@@ -116,29 +116,35 @@ run_one <- function(contender, path) {
     return(NULL)
   }
   f <- strsplit(line, "\t")[[1]]
-  data.frame(seconds = as.numeric(f[3]), peak_mb = as.numeric(f[4]),
-             base_mb = as.numeric(f[5]), coef = f[6], status = f[7])
+  data.frame(seconds = as.numeric(f[8]), wall = as.numeric(f[3]),
+             peak_mb = as.numeric(f[4]), base_mb = as.numeric(f[5]), coef = f[6],
+             status = f[7])
 }
 
 cat_seconds <- function(path) {
-  system.time(system2("cat", shQuote(path), stdout = FALSE))[["elapsed"]]
+  st <- system.time(system2("cat", shQuote(path), stdout = FALSE))
+  c(cpu = st[["user.child"]] + st[["sys.child"]], wall = st[["elapsed"]])
 }
 
 rows <- list()
 for (i in seq_len(nrow(specs))) {
   p <- specs$path[i]
   cat_seconds(p)  # into the page cache
-  floor_os <- stats::median(vapply(seq_len(runs), function(r) cat_seconds(p), 0))
+  floor_os <- vapply(seq_len(runs), function(r) cat_seconds(p), c(cpu = 0, wall = 0))
   rows[[length(rows) + 1]] <- data.frame(specs[i, ], contender = "cat (read-once floor of the system)",
-                                         seconds = floor_os, peak_mb = NA, base_mb = NA,
+                                         seconds = stats::median(floor_os["cpu", ]),
+                                         wall = stats::median(floor_os["wall", ]),
+                                         peak_mb = NA, base_mb = NA,
                                          coef = NA, status = NA, runs = runs)
   for (cn in contenders) {
     n <- if (cn == "GGIR::g.calibrate") runs_ggir else runs
     rs <- do.call(rbind, lapply(seq_len(n), function(r) run_one(cn, p)))
     if (is.null(rs)) next
-    say(basename(p), cn, sprintf("%.2f s, %.0f MB", stats::median(rs$seconds), max(rs$peak_mb)))
+    say(basename(p), cn, sprintf("%.2f s CPU, %.2f s wall, %.0f MB", stats::median(rs$seconds),
+                                 stats::median(rs$wall), max(rs$peak_mb)))
     rows[[length(rows) + 1]] <- data.frame(specs[i, ], contender = cn,
                                            seconds = stats::median(rs$seconds),
+                                           wall = stats::median(rs$wall),
                                            peak_mb = max(rs$peak_mb),
                                            base_mb = stats::median(rs$base_mb),
                                            coef = rs$coef[n], status = rs$status[n], runs = n)
@@ -159,6 +165,10 @@ decode_s <- res$seconds[res$contender == "decode (read-once floor of the decoder
 cat_s <- res$seconds[res$contender == "cat (read-once floor of the system)"][
   match(key, key[res$contender == "cat (read-once floor of the system)"])]
 res$speedup_vs_ggir <- ggir_s / res$seconds
+ggir_w <- res$wall[res$contender == "GGIR::g.calibrate"][
+  match(key, key[res$contender == "GGIR::g.calibrate"])]
+res$wall_speedup_vs_ggir <- ggir_w / res$wall
+res$over_decode_floor <- res$seconds / decode_s
 res$seconds_per_day <- res$seconds / res$days
 res$same_coef_as_ggir <- ifelse(res$contender == "gravcal::g.calibrate",
                                 res$coef == ggir_coef, NA)
@@ -183,14 +193,14 @@ md <- c("# End to end from device files",
                 getRversion(), utils::packageVersion("GGIR"),
                 utils::packageVersion("GGIRread"), utils::packageVersion("gravcal"),
                 if (quick) " Quick run (GRAVCAL_BENCH_QUICK)." else ""),
-        sprintf("Each contender in its own R process; seconds are the call's wall time (median of %d runs for gravcal, %d for GGIR), peak is that process's peak resident memory, R included (an R process that has loaded gravcal holds about %.0f MB before the call). Files in the page cache.",
+        sprintf("Each contender in its own R process (all single-threaded). Seconds are the call's CPU time, user + system (median of %d runs for gravcal, %d for GGIR): the machine's two cores were shared with other work, which inflates wall time unevenly; `files.csv` has the wall times too. Ratios are GGIR's seconds over the contender's. Peak is that process's peak resident memory, R included (an R process that has loaded gravcal holds about %.0f MB before the call). Files in the page cache. x decode: the call's time over the decoder's read-once floor on the same file.",
                 runs, runs_ggir, stats::median(res$base_mb[grepl("gravcal|calibrate\\(", res$contender)], na.rm = TRUE)),
         "")
 for (series in unique(res$series)) {
   md <- c(md, sprintf("## %s", if (series == "typical")
     "A device GGIR's model fits (the error target is reached)" else
       "A device with cross-axis error (GGIR's error target is never reached)"), "",
-    "| file | size (MB) | GGIR::g.calibrate (s, peak MB) | gravcal::g.calibrate (s, ratio, peak MB, same coefficients) | calibrate ggir (s, ratio, peak MB) | calibrate lightweight (s, ratio, peak MB) | decode floor (s, x cat) | cat (s) |",
+    "| file | size (MB) | GGIR::g.calibrate (s, peak MB) | gravcal::g.calibrate (s, ratio, peak MB, x decode, same coefficients) | calibrate ggir (s, ratio, peak MB, x decode) | calibrate lightweight (s, ratio, peak MB, x decode) | decode floor (s, x cat) | cat (s) |",
     "|---|---|---|---|---|---|---|---|")
   for (k in unique(key[res$series == series])) {
     r <- res[key == k, ]
@@ -199,7 +209,7 @@ for (series in unique(res$series)) {
       x <- g(cn)
       if (!nrow(x)) return("")
       paste0(fmt_s(x$seconds), " s, ", fmt_x(x$speedup_vs_ggir), ", ",
-             sprintf("%.0f MB", x$peak_mb),
+             sprintf("%.0f MB", x$peak_mb), sprintf(", %.1fx decode", x$over_decode_floor),
              if (same) paste0(", ", if (isTRUE(x$same_coef_as_ggir)) "identical" else "DIFFERENT"))
     }
     gg <- g("GGIR::g.calibrate")

@@ -421,3 +421,21 @@ test_that("a GENEActiv .bin at a rate that is not whole: GGIR's resampling, to t
   expect_identical(nrow(b$ggir$bsc_qc), 3L)
   expect_same_as_ggir(b)
 })
+
+test_that("from a file, calibrate(method = 'ggir') fits the rest windows rest_windows() finds", {
+  # the one-call path and the verbs see the same windows: GGIR's rules leave
+  # out the recording's first window, and calibrate() fits on the rest
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 48,
+                            params = known_params(),
+                            tempoffset = c(0.001, 0, -0.001))
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  write_geneactiv_bin(rec, f, sf = 10)
+  w <- rest_windows(f, method = "ggir")
+  fit <- calibrate(f, method = "ggir")
+  expect_equal(fit$status, "ok")
+  rest <- w[w$rest & seq_len(nrow(w)) > 1, c("mean_x", "mean_y", "mean_z")]
+  expect_equal(nrow(fit$points), nrow(rest))
+  expect_identical(unname(as.matrix(fit$points[, c("mean_x", "mean_y", "mean_z")])),
+                   unname(as.matrix(rest)))
+})
