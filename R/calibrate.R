@@ -358,12 +358,19 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
 #' @export
 summary.gravcal_fit <- function(object, ...) {
   co <- stats::coef(object)
-  err <- data.frame(
-    set = c("fitting points", "held-out rest windows"),
-    n = c(NROW(object$points),
-          NROW(object$windows) - NROW(object$points)),
-    before_mg = 1000 * c(object$error_before, object$error_heldout_before),
-    after_mg = 1000 * c(object$error_after, object$error_heldout_after))
+  num <- function(v) if (length(v) == 1 && is.numeric(v)) v else NA_real_
+  err <- data.frame(set = "fitting points", n = NROW(object$points),
+                    before_mg = 1000 * num(object$error_before),
+                    after_mg = 1000 * num(object$error_after))
+  # the held-out set: rest windows not used as points, where the fit keeps
+  # its rest windows apart from its points (the lightweight method)
+  if (!is.null(object$windows) && !is.null(object$points$row)) {
+    err <- rbind(err, data.frame(
+      set = "held-out rest windows",
+      n = NROW(object$windows) - length(unique(object$points$row)),
+      before_mg = 1000 * num(object$error_heldout_before),
+      after_mg = 1000 * num(object$error_heldout_after)))
+  }
   err$improvement <- err$before_mg / err$after_mg
   bins <- NULL
   if (!is.null(object$points$bin)) bins <- table(object$points$bin)

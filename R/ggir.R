@@ -140,6 +140,12 @@ ggir_run <- function(src, compat = TRUE,
                      printsummary = FALSE, max_iter = ggir_constants$max_iter,
                      tol = ggir_constants$tol) {
   sf <- src$sf
+  if (!(10 * sf >= 1 && 10 * sf < 1e7)) {
+    abort("`sf` must give 1 to 1e7 samples in a 10 s window, not ",
+          format(10 * sf), " (sf = ", format(sf), " Hz",
+          if (isTRUE(!is.na(src$filename))) paste0(", from \"", src$filename, "\""),
+          ").")
+  }
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
   feats <- list()
