@@ -124,7 +124,8 @@ read_plain_csv <- function(file, arg) {
 check_sample_columns <- function(data, file, arg) {
   missing <- setdiff(c("x", "y", "z"), names(data))
   if (length(missing)) {
-    hint <- if (any(grepl(";", names(data), fixed = TRUE))) {
+    first <- tryCatch(readLines(file, n = 1, warn = FALSE), error = function(e) "")
+    hint <- if (any(grepl(";", first, fixed = TRUE))) {
       " It looks separated by semicolons: gravcal's own reader (`reader = \"native\"`) reads those."
     } else ""
     abort("`", arg, "` \"", file, "\" must have columns x, y, z; it has ",
@@ -152,6 +153,10 @@ no_samples_error <- function(data, file, format, arg) {
     "it has a header but no data lines"
   } else {
     "it holds no samples"
+  }
+  if (!is.null(r) && format == "csv" && isTRUE(r$counters[["long_lines"]] > 0)) {
+    why <- paste0(why, ". Fields with comma decimals must be separated by ",
+                  "semicolons")
   }
   abort("`", arg, "` \"", file, "\" holds no samples: ", why, ".")
 }

@@ -97,11 +97,14 @@ random_unit_vectors <- function(n) {
 }
 
 check_params <- function(params) {
-  if (!is.numeric(params) || length(params) != 9 || !all(is.finite(params)) ||
+  if (is.numeric(params) && length(params) == 9 && all(is.finite(params)) &&
       any(params[1:3] <= 0)) {
+    abort("`params` must have positive scales (k_xx, k_yy, k_zz), not ",
+          paste(unname(params[1:3]), collapse = ", "), ".")
+  }
+  if (!is.numeric(params) || length(params) != 9 || !all(is.finite(params))) {
     abort("`params` must be 9 finite numbers (", paste(param_names(),
-          collapse = ", "), ") with positive scales, not ",
-          describe(params), ".")
+          collapse = ", "), "), not ", describe(params), ".")
   }
 }
 
