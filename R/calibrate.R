@@ -313,6 +313,7 @@ calibrate_points <- function(fit, v, temperature = NULL) {
 
 #' @export
 coef.gravcal_fit <- function(object, ...) {
+  check_fit(object, "object")
   K <- object$K
   stats::setNames(c(diag(K), K[2, 1], K[3, 1], K[3, 2], object$offset,
                     object$tempoffset),
@@ -321,6 +322,8 @@ coef.gravcal_fit <- function(object, ...) {
 
 #' @export
 print.gravcal_fit <- function(x, digits = 5, ...) {
+  check_fit(x, "x")
+  check_number(digits, "digits", min = 0, max = 15, integer = TRUE)
   cat("<gravcal_fit> ", x$method, " method, status: ", x$status, "\n",
       sep = "")
   if (nzchar(x$message)) cat("  ", x$message, "\n", sep = "")
@@ -357,6 +360,7 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
 
 #' @export
 summary.gravcal_fit <- function(object, ...) {
+  check_fit(object, "object")
   co <- stats::coef(object)
   num <- function(v) if (length(v) == 1 && is.numeric(v)) v else NA_real_
   err <- data.frame(set = "fitting points", n = NROW(object$points),

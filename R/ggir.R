@@ -531,7 +531,8 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   check_number(a$minloadcrit, "minloadcrit", min = 0)
   check_number(a$chunksize, "chunksize", min = 0, max = 1, min_inclusive = FALSE)
   check_number(a$max_sd, "max_sd", min = 0, min_inclusive = FALSE)
-  check_number(a$max_iter, "max_iter", min = 1)
+  check_number(a$max_iter, "max_iter", min = 1, max = .Machine$integer.max,
+               integer = TRUE)
   check_number(a$tol, "tol", min = 0)
   check_flag(a$verbose, "verbose")
   if (is.null(sf) && !is.character(x) && is.null(attr(x, "sf")) &&

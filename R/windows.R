@@ -102,6 +102,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   }
   check_flag(skip_zero, "skip_zero")
   check_number(chunk_size, "chunk_size", min = 1)
+  if (!is.null(progress)) check_flag(progress, "progress")
   if (method == "lightweight") {
     check_number(max_range, "max_range", min = 0, min_inclusive = FALSE)
     if (!is.character(axes) || !length(axes) ||
