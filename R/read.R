@@ -154,7 +154,7 @@ no_samples_error <- function(data, file, format, arg) {
   } else {
     "it holds no samples"
   }
-  if (!is.null(r) && format == "csv" && isTRUE(r$counters[["long_lines"]] > 0)) {
+  if (!is.null(r) && format == "csv" && isTRUE(unname(r$counters["long_lines"]) > 0)) {
     why <- paste0(why, ". Fields with comma decimals must be separated by ",
                   "semicolons")
   }

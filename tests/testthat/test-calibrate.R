@@ -64,13 +64,19 @@ test_that("a fit that does not lower the error is not applied", {
   a <- gravcal:::random_unit_vectors(3000)
   w <- data.frame(mean_x = a[, 1], mean_y = a[, 2], mean_z = a[, 3])
   fit <- fit_gradient(select_points(w))
+  # the descent only moves away from the sphere: fit_gradient() says so
+  expect_identical(fit$status, "no_improvement")
   g <- gravcal:::guard_fit(fit)
   expect_true(g$status %in% c("ok", "no_improvement"))
+  # guard_fit() on its own: a fit marked ok whose error rose
+  fit$status <- "ok"
+  fit$K[1, 1] <- 1.01
   fit$error_after <- fit$error_before + 1e-3
   g <- gravcal:::guard_fit(fit)
   expect_equal(g$status, "no_improvement")
   expect_equal(unname(g$K), diag(3))
   big <- fit_gradient(select_points(w))
+  big$status <- "ok"
   big$K[1, 1] <- 2
   big$error_after <- 0
   expect_equal(gravcal:::guard_fit(big)$status, "implausible")
