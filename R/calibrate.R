@@ -313,6 +313,7 @@ calibrate_points <- function(fit, v, temperature = NULL) {
 
 #' @export
 coef.gravcal_fit <- function(object, ...) {
+  check_fit(object, "object")
   K <- object$K
   stats::setNames(c(diag(K), K[2, 1], K[3, 1], K[3, 2], object$offset,
                     object$tempoffset),
@@ -321,6 +322,8 @@ coef.gravcal_fit <- function(object, ...) {
 
 #' @export
 print.gravcal_fit <- function(x, digits = 5, ...) {
+  check_fit(x, "x")
+  check_number(digits, "digits", min = 0, max = 15, integer = TRUE)
   cat("<gravcal_fit> ", x$method, " method, status: ", x$status, "\n",
       sep = "")
   if (nzchar(x$message)) cat("  ", x$message, "\n", sep = "")
@@ -357,13 +360,21 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
 
 #' @export
 summary.gravcal_fit <- function(object, ...) {
+  check_fit(object, "object")
   co <- stats::coef(object)
-  err <- data.frame(
-    set = c("fitting points", "held-out rest windows"),
-    n = c(NROW(object$points),
-          NROW(object$windows) - NROW(object$points)),
-    before_mg = 1000 * c(object$error_before, object$error_heldout_before),
-    after_mg = 1000 * c(object$error_after, object$error_heldout_after))
+  num <- function(v) if (length(v) == 1 && is.numeric(v)) v else NA_real_
+  err <- data.frame(set = "fitting points", n = NROW(object$points),
+                    before_mg = 1000 * num(object$error_before),
+                    after_mg = 1000 * num(object$error_after))
+  # the held-out set: rest windows not used as points, where the fit keeps
+  # its rest windows apart from its points (the lightweight method)
+  if (!is.null(object$windows) && !is.null(object$points$row)) {
+    err <- rbind(err, data.frame(
+      set = "held-out rest windows",
+      n = NROW(object$windows) - length(unique(object$points$row)),
+      before_mg = 1000 * num(object$error_heldout_before),
+      after_mg = 1000 * num(object$error_heldout_after)))
+  }
   err$improvement <- err$before_mg / err$after_mg
   bins <- NULL
   if (!is.null(object$points$bin)) bins <- table(object$points$bin)

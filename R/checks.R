@@ -11,23 +11,26 @@ describe <- function(x) {
   if (length(x) == 1 && is.atomic(x)) {
     return(if (is.character(x)) sprintf('"%s"', x) else format(x))
   }
-  sprintf("a %s of length %d", class(x)[1], length(x))
+  cl <- class(x)[1]
+  sprintf("%s %s of length %d", if (grepl("^[aeiou]", cl)) "an" else "a", cl,
+          length(x))
 }
 
 check_number <- function(x, arg, min = -Inf, max = Inf, min_inclusive = TRUE,
-                         integer = FALSE) {
+                         integer = FALSE, max_inclusive = TRUE) {
   ok <- is.numeric(x) && length(x) == 1 && !is.na(x) && is.finite(x)
   if (ok) ok <- if (min_inclusive) x >= min else x > min
-  if (ok) ok <- x <= max
+  if (ok) ok <- if (max_inclusive) x <= max else x < max
   if (ok && integer) ok <- x == round(x)
   if (!ok) {
     what <- if (integer) "a whole number" else "a number"
     range <- if (is.finite(min) && is.finite(max)) {
-      sprintf(" in [%s, %s]", format(min), format(max))
+      sprintf(" in %s%s, %s%s", if (min_inclusive) "[" else "(", format(min),
+              format(max), if (max_inclusive) "]" else ")")
     } else if (is.finite(min)) {
       sprintf(" %s %s", if (min_inclusive) ">=" else ">", format(min))
     } else if (is.finite(max)) {
-      sprintf(" <= %s", format(max))
+      sprintf(" %s %s", if (max_inclusive) "<=" else "<", format(max))
     } else ""
     abort("`", arg, "` must be ", what, range, ", not ", describe(x), ".")
   }
@@ -48,7 +51,10 @@ check_sf <- function(sf) {
 # Raw samples: a data frame or matrix with numeric columns x, y, z (any case),
 # optional temperature and time. Returns a list of plain numeric vectors that
 # point at the caller's memory (no copy for double columns).
-as_samples <- function(x, arg = "x") {
+# `temperature = "ignore"`: a temperature column that is not numeric is left
+# out with a warning (for the methods that do not use it).
+as_samples <- function(x, arg = "x", temperature = c("use", "ignore")) {
+  temperature <- temperature[1]
   if (is.matrix(x)) {
     if (is.null(colnames(x))) {
       if (ncol(x) != 3) {
@@ -84,7 +90,15 @@ as_samples <- function(x, arg = "x") {
   xs <- col("x")
   ys <- col("y")
   zs <- col("z")
-  temp <- col("temperature", required = FALSE)
+  ti <- match("temperature", nm)
+  if (temperature == "ignore" && !is.na(ti) && !is.numeric(x[[ti]])) {
+    warning("Column `", names(x)[ti], "` of `", arg, "` is not numeric (",
+            class(x[[ti]])[1], "); it is ignored, as this method does not ",
+            "use the temperature.", call. = FALSE)
+    temp <- NULL
+  } else {
+    temp <- col("temperature", required = FALSE)
+  }
   ti <- match("time", nm)
   time <- if (is.na(ti)) NULL else x[[ti]]
   list(x = xs, y = ys, z = zs, temperature = temp, time = time, n = length(xs))

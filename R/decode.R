@@ -36,8 +36,8 @@ native_report <- function(h) gc_decoder_report(h$ptr)
 # file has them), with attributes `sf`, `info` and `report`. For tests and
 # read_recording(); calibration streams instead.
 native_read_all <- function(file, format, options = list(), time = TRUE,
-                            chunk = 1e6) {
-  h <- native_open(file, format, options)
+                            chunk = 1e6, arg = "file") {
+  h <- native_open(file, format, options, arg)
   on.exit(gc_decoder_close(h$ptr))
   parts <- list()
   repeat {

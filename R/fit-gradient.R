@@ -52,7 +52,9 @@ param_names <- function() {
 #'   (paper: 0.3, 0.8, 0.2), a named or unnamed vector of 3.
 #' @param h Finite-difference step (paper: 1e-5 for double, float and 32-bit
 #'   fixed point, 0.01 for 16-bit fixed point; the default follows
-#'   `arithmetic`).
+#'   `arithmetic`). It must be at least the arithmetic's resolution near 1:
+#'   2^-14 (about 6.1e-5) for `"fixed16"`, 2^-29 for `"fixed32"`, 2^-23 for
+#'   `"float"` and 2^-52 for `"double"`; a smaller step is an error.
 #' @param objective `"mean"` (default) or `"sum"` over points; see Details.
 #' @param use_sqrt Keep the square root in the objective.
 #' @param tol Stop early once every parameter step is below `tol`; 0 (the
@@ -66,8 +68,11 @@ param_names <- function() {
 #'   step `h = 0.01` (`bench/results/fixed.md`).
 #' @return A `gravcal_fit` (see [calibrate()]) with `K` lower-triangular,
 #'   `offset`, zero `tempoffset`, `params` (the nine named parameters),
-#'   `objective`, and `trace` when asked for. Status `"ok"`, or `"diverged"`
-#'   (identity coefficients) when the parameters left the finite range.
+#'   `objective`, and `trace` when asked for. Status `"ok"`; `"diverged"`
+#'   (identity coefficients) when the parameters left the finite range; or
+#'   `"no_improvement"` (identity coefficients) when the objective at the
+#'   end is not below its value at the start (the identity), for example
+#'   with a step `h` so small that the differences are rounding error.
 #' @references Farago D, Maczak B, Gingl Z (2024). Enhancing accuracy in
 #'   actigraphic measurements: a lightweight calibration method for triaxial
 #'   accelerometers. IEEE Access.
@@ -102,6 +107,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
           "not ", describe(rates), ".")
   }
   check_number(h, "h", min = 0, min_inclusive = FALSE)
+  check_step(h, arithmetic)
   limit <- c(double = Inf, float = Inf, fixed32 = 4, fixed16 = 2)[[arithmetic]]
   if (any(abs(v) >= limit)) {
     abort("`pts` has coordinates beyond the range of ", arithmetic, " (+-",
@@ -131,6 +137,14 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                       objective, "\", rates ", paste(rates, collapse = ", "),
                       "); coefficients left at the identity")
     p <- stats::setNames(c(1, 1, 1, 0, 0, 0, 0, 0, 0), param_names())
+  } else if (!(r$objective < f0)) {
+    status <- "no_improvement"
+    message <- sprintf(paste0(
+      "the objective did not decrease in %d iterations (%s arithmetic, ",
+      "h = %s): %s at the start, %s at the end; coefficients left at the ",
+      "identity"), r$iterations, arithmetic, format(h), format(f0),
+      format(r$objective))
+    p <- stats::setNames(c(1, 1, 1, 0, 0, 0, 0, 0, 0), param_names())
   }
   if (!is.data.frame(pts) || !all(c("mean_x", "mean_y", "mean_z") %in%
                                   names(pts))) {
@@ -152,6 +166,27 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
     fit$trace <- cbind(iteration = seq_len(nrow(tr)), tr)
   }
   fit
+}
+
+# Smallest step each arithmetic can take from parameters near 1: one unit
+# of the last place of its numbers in [1, 2) (float, double), or the
+# resolution of its fixed-point format (Q3.29, Q1.14). A smaller `h` rounds
+# to zero, or leaves the difference quotient all rounding error.
+step_resolution <- c(double = 2^-52, float = 2^-23, fixed32 = 2^-29,
+                     fixed16 = 2^-14)
+
+check_step <- function(h, arithmetic) {
+  res <- step_resolution[[arithmetic]]
+  if (h < res) {
+    what <- switch(arithmetic,
+      fixed16 = "16-bit fixed point (Q1.14)", fixed32 = "32-bit fixed point (Q3.29)",
+      float = "single precision near 1", double = "double precision near 1")
+    abort("`h` must be at least ", format(signif(res, 3)), ", the resolution ",
+          "of ", what, ", not ", format(h), ": a smaller step ",
+          if (arithmetic %in% c("fixed16", "fixed32")) "rounds to zero" else
+            "does not move the parameters", ".")
+  }
+  invisible(h)
 }
 
 # 9 parameters -> lower-triangular K.

@@ -140,6 +140,12 @@ ggir_run <- function(src, compat = TRUE,
                      printsummary = FALSE, max_iter = ggir_constants$max_iter,
                      tol = ggir_constants$tol) {
   sf <- src$sf
+  if (!(10 * sf >= 1 && 10 * sf < 1e7)) {
+    abort("`sf` must give 1 to 1e7 samples in a 10 s window, not ",
+          format(10 * sf), " (sf = ", format(sf), " Hz",
+          if (isTRUE(!is.na(src$filename))) paste0(", from \"", src$filename, "\""),
+          ").")
+  }
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
   feats <- list()
@@ -525,7 +531,8 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   check_number(a$minloadcrit, "minloadcrit", min = 0)
   check_number(a$chunksize, "chunksize", min = 0, max = 1, min_inclusive = FALSE)
   check_number(a$max_sd, "max_sd", min = 0, min_inclusive = FALSE)
-  check_number(a$max_iter, "max_iter", min = 1)
+  check_number(a$max_iter, "max_iter", min = 1, max = .Machine$integer.max,
+               integer = TRUE)
   check_number(a$tol, "tol", min = 0)
   check_flag(a$verbose, "verbose")
   if (is.null(sf) && !is.character(x) && is.null(attr(x, "sf")) &&

@@ -57,11 +57,17 @@ fit_icp <- function(w, use_temp = TRUE, ggir_compat = FALSE, max_iter = 1000,
   call <- match.call()
   check_flag(use_temp, "use_temp")
   check_flag(ggir_compat, "ggir_compat")
-  check_number(max_iter, "max_iter", min = 1)
+  check_number(max_iter, "max_iter", min = 1, max = .Machine$integer.max,
+               integer = TRUE)
   check_number(tol, "tol", min = 0)
   check_number(max_weight, "max_weight", min = 0, min_inclusive = FALSE)
   check_flag(trace, "trace")
   w <- icp_epochs(w)
+  if (use_temp && !is.null(w$temperature) && !is.numeric(w$temperature) &&
+      !all(is.na(w$temperature))) {
+    abort("Column `temperature` of `w` must be numeric (degrees C), not ",
+          class(w$temperature)[1], "; or use `use_temp = FALSE`.")
+  }
   if ("rest" %in% names(w)) w <- w[w$rest %in% TRUE, , drop = FALSE]
   ok <- is.finite(w$mean_x) & is.finite(w$mean_y) & is.finite(w$mean_z)
   w <- w[ok, , drop = FALSE]

@@ -25,11 +25,23 @@ plot.gravcal_fit <- function(x, which = 1:4, set = c("windows", "points"),
   if (!is.numeric(which) || !length(which) || !all(which %in% 1:4)) {
     abort("`which` must be a subset of 1:4, not ", describe(which), ".")
   }
-  d <- if (set == "windows" && NROW(x$windows) > 0) x$windows else x$points
+  check_fit(x, "x")
+  check_number(theta, "theta")
+  check_number(phi, "phi")
+  what <- if (set == "windows" && NROW(x$windows) > 0) "windows" else "points"
+  d <- x[[what]]
   if (NROW(d) == 0) {
     abort("`x` has no rest points to plot (status: ", x$status, ").")
   }
-  before <- point_matrix(d, "points")
+  before <- point_matrix(d, paste0("x$", what))
+  zero <- which(rowSums(before^2) == 0)
+  if (length(zero)) {
+    abort("`x$", what, "` must hold rest windows near 1 g; ", length(zero),
+          " of them (row", if (length(zero) > 1) "s", " ",
+          paste(utils::head(zero, 5), collapse = ", "),
+          if (length(zero) > 5) ", ...", ") ", if (length(zero) > 1) "are" else
+            "is", " the zero vector, which has no direction to plot.")
+  }
   after <- calibrate_points(x, before, d$temperature)
   col <- c(before = grDevices::adjustcolor("#1f78b4", 0.6),
            after = grDevices::adjustcolor("#e31a1c", 0.7))

@@ -43,30 +43,48 @@
 #' rec$sf
 #' head(rec$data)
 read_recording <- function(file, sf = NULL, reader = c("native", "reference")) {
-  if (!is.character(file) || length(file) != 1 || is.na(file)) {
-    abort("`file` must be a single file path, not ", describe(file), ".")
-  }
-  if (!file.exists(file) || dir.exists(file)) {
-    abort("`file` does not exist: \"", file, "\".")
-  }
+  check_file(file, "file")
   reader <- match_choice(reader, "reader")
-  format <- file_format(file)
+  read_file(file, sf, reader, "file")
+}
+
+# `file` must name one existing file (not a folder): an error naming the
+# caller's argument `arg` otherwise.
+check_file <- function(file, arg) {
+  if (!is.character(file) || length(file) != 1 || is.na(file)) {
+    abort("`", arg, "` must be a single file path, not ", describe(file), ".")
+  }
+  if (dir.exists(file)) {
+    abort("`", arg, "` must be a file, not a folder: \"", file, "\".")
+  }
+  if (!file.exists(file)) {
+    abort("`", arg, "` does not exist: \"", file, "\".")
+  }
+  invisible(file)
+}
+
+# read_recording() for a checked path; errors name the caller's argument.
+read_file <- function(file, sf, reader, arg) {
+  format <- file_format(file, arg)
   data <- NULL
   if (reader == "native" && format %in% names(native_block_units)) {
-    data <- read_native(file, format, sf)
+    data <- read_native(file, format, sf, arg)
   }
   if (is.null(data)) {
     data <- switch(format,
-      rds = readRDS(file),
+      rds = read_rds(file, arg),
       actigraph_csv = read_blocks(file, sf, reader),
-      csv = utils::read.csv(file, stringsAsFactors = FALSE),
+      csv = read_plain_csv(file, arg),
       gt3x = read_gt3x_file(file),
       cwa = , geneactiv = read_blocks(file, sf, reader))
   }
   if (!is.data.frame(data)) {
-    abort("`file` does not hold a data frame of samples: \"", file, "\".")
+    abort("`", arg, "` does not hold a data frame of samples: \"", file,
+          "\" holds ", describe(data), ".")
   }
   names(data) <- tolower(names(data))
+  check_sample_columns(data, file, arg)
+  if (nrow(data) == 0) no_samples_error(data, file, format, arg)
   if (is.null(sf)) sf <- attr(data, "sf")
   if (is.null(sf) && !is.null(attr(data, "sample_rate"))) {
     sf <- attr(data, "sample_rate")
@@ -79,9 +97,73 @@ read_recording <- function(file, sf = NULL, reader = c("native", "reference")) {
   list(data = data, sf = sf, input = attr(data, "input"))
 }
 
+# An .rds file: what saveRDS() wrote, or an error naming the file.
+read_rds <- function(file, arg) {
+  if (file.size(file) == 0) {
+    abort("Cannot read `", arg, "` \"", file, "\" as an .rds file: the file ",
+          "is empty.")
+  }
+  tryCatch(readRDS(file), error = function(e) {
+    abort("Cannot read `", arg, "` \"", file, "\" as an .rds file (from ",
+          "saveRDS()): it is truncated or not an .rds file (",
+          conditionMessage(e), ").")
+  })
+}
+
+# A plain csv through utils::read.csv() (the reference reader).
+read_plain_csv <- function(file, arg) {
+  tryCatch(utils::read.csv(file, stringsAsFactors = FALSE),
+           error = function(e) {
+             abort("Cannot read `", arg, "` \"", file, "\" as a csv file of ",
+                   "samples: ", conditionMessage(e), ".")
+           })
+}
+
+# Samples read from a file need numeric columns x, y, z; a csv separated by
+# semicolons or with comma decimals is said to be one.
+check_sample_columns <- function(data, file, arg) {
+  missing <- setdiff(c("x", "y", "z"), names(data))
+  if (length(missing)) {
+    first <- tryCatch(readLines(file, n = 1, warn = FALSE), error = function(e) "")
+    hint <- if (any(grepl(";", first, fixed = TRUE))) {
+      " It looks separated by semicolons: gravcal's own reader (`reader = \"native\"`) reads those."
+    } else ""
+    abort("`", arg, "` \"", file, "\" must have columns x, y, z; it has ",
+          paste(names(data), collapse = ", "), ".", hint)
+  }
+  for (v in c("x", "y", "z")) {
+    if (!is.numeric(data[[v]]) && nrow(data) > 0) {
+      abort("Column `", v, "` of `", arg, "` \"", file, "\" must be numeric ",
+            "(acceleration in g), not ", class(data[[v]])[1],
+            if (is.character(data[[v]]) && any(grepl(",", data[[v]], fixed = TRUE)))
+              " (comma decimals?)", ".")
+    }
+  }
+}
+
+# A file that gave no sample at all: why, in the reader's words where it
+# skipped what it read.
+no_samples_error <- function(data, file, format, arg) {
+  r <- attr(data, "report")
+  why <- if (!is.null(r) && (r$skipped > 0 || isTRUE(r$read_error))) {
+    paste0("every ", unit_name(format, 1), " read was skipped (",
+           format(r$skipped), " skipped",
+           if (length(r$notes)) paste0("; first: ", r$notes[1]), ")")
+  } else if (format %in% c("csv", "actigraph_csv")) {
+    "it has a header but no data lines"
+  } else {
+    "it holds no samples"
+  }
+  if (!is.null(r) && format == "csv" && isTRUE(unname(r$counters["long_lines"]) > 0)) {
+    why <- paste0(why, ". Fields with comma decimals must be separated by ",
+                  "semicolons")
+  }
+  abort("`", arg, "` \"", file, "\" holds no samples: ", why, ".")
+}
+
 # A whole file through its native decoder (raw samples, not resampled), time
 # as POSIXct; NULL when this build has no decoder for the format.
-read_native <- function(file, format, sf) {
+read_native <- function(file, format, sf, arg = "file") {
   opts <- list(compat = 0)
   # a whole .gt3x read gives idle-sleep periods as zeros at their times, as
   # read.gt3x(imputeZeroes = TRUE) does, to its last sample time; calibration
@@ -91,10 +173,10 @@ read_native <- function(file, format, sf) {
   h <- gc_decoder_open(path.expand(file), format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)
-    native_open_error(file, format, h$error, "file")
+    native_open_error(file, format, h$error, arg)
   }
   gc_decoder_close(h$ptr)
-  d <- native_read_all(file, format, opts, time = TRUE)
+  d <- native_read_all(file, format, opts, time = TRUE, arg = arg)
   if (!is.null(d$time)) d$time <- as.POSIXct(d$time, origin = "1970-01-01", tz = "UTC")
   if (isTRUE(is.finite(attr(d, "sf")) && attr(d, "sf") > 0)) sf <- attr(d, "sf")
   attr(d, "sf") <- sf
@@ -219,9 +301,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
     abort("`", arg, "` must be a file path or a data frame of raw samples, ",
           "not ", describe(datafile), ".")
   }
-  if (!file.exists(datafile) || dir.exists(datafile)) {
-    abort("`", arg, "` does not exist: \"", datafile, "\".")
-  }
+  check_file(datafile, arg)
   reader <- match_choice(reader, "reader", c("native", "reference"))
   format <- file_format(datafile, arg)
   src <- NULL
@@ -232,7 +312,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
     src <- switch(format,
       actigraph_csv = , csv = source_csv(datafile, sf, chunksize),
       rds = {
-        rec <- read_recording(datafile, sf)
+        rec <- read_file(datafile, sf, "native", arg)
         source_frame(rec$data, rec$sf, chunksize, arg)
       },
       gt3x = source_gt3x(datafile, chunksize),
@@ -410,7 +490,7 @@ source_csv <- function(file, sf, chunksize) {
   if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
   actigraph <- is_actigraph_csv(file)
   if (!actigraph) {
-    rec <- read_recording(file, sf)
+    rec <- read_file(file, sf, "native", "datafile")
     src <- source_frame(rec$data, rec$sf, chunksize, "datafile")
     src$format <- "csv"
     return(src)

@@ -12,6 +12,10 @@
 #' set.seed(1)
 #' random_params()
 random_params <- function(scale = 0.1, misalignment = 0.05, offset = 0.1) {
+  # scales 1 +- scale must stay positive
+  check_number(scale, "scale", min = 0, max = 1, max_inclusive = FALSE)
+  check_number(misalignment, "misalignment", min = 0, max = 1)
+  check_number(offset, "offset", min = 0)
   u <- function(n, half) 2 * (stats::runif(n) - 0.5) * half
   S <- 1 + u(3, scale)
   Tm <- u(3, misalignment)
@@ -35,6 +39,18 @@ random_params <- function(scale = 0.1, misalignment = 0.05, offset = 0.1) {
 #' v <- distort(diag(3), p)
 #' v
 distort <- function(a, params) {
+  if (is.data.frame(a)) a <- as.matrix(a)
+  if (is.numeric(a) && is.null(dim(a)) && length(a) == 3) a <- matrix(a, 1)
+  if (!is.matrix(a) || !is.numeric(a) || ncol(a) != 3) {
+    abort("`a` must be a numeric matrix with 3 columns (x, y, z in g), not ",
+          if (is.matrix(a)) sprintf("a %s matrix with %d columns",
+                                    mode(a), ncol(a)) else describe(a), ".")
+  }
+  if (!all(is.finite(a))) {
+    abort("`a` must hold finite numbers; it has ", sum(!is.finite(a)),
+          " NA, NaN or Inf.")
+  }
+  check_params(params)
   a <- matrix(as.double(a), ncol = 3)
   p <- unname(params)
   ux <- a[, 1] / p[1]
@@ -63,7 +79,7 @@ distort <- function(a, params) {
 #' fit <- fit_gradient(select_points(cand))
 #' round(fit$params - attr(cand, "params"), 4)
 simulate_points <- function(n = 1000, noise = 0.001, params = NULL) {
-  check_number(n, "n", min = 1, integer = TRUE)
+  check_number(n, "n", min = 1, max = 1e8, integer = TRUE)
   check_number(noise, "noise", min = 0)
   if (is.null(params)) params <- random_params()
   check_params(params)
@@ -81,11 +97,14 @@ random_unit_vectors <- function(n) {
 }
 
 check_params <- function(params) {
-  if (!is.numeric(params) || length(params) != 9 || !all(is.finite(params)) ||
+  if (is.numeric(params) && length(params) == 9 && all(is.finite(params)) &&
       any(params[1:3] <= 0)) {
+    abort("`params` must have positive scales (k_xx, k_yy, k_zz), not ",
+          paste(unname(params[1:3]), collapse = ", "), ".")
+  }
+  if (!is.numeric(params) || length(params) != 9 || !all(is.finite(params))) {
     abort("`params` must be 9 finite numbers (", paste(param_names(),
-          collapse = ", "), ") with positive scales, not ",
-          describe(params), ".")
+          collapse = ", "), "), not ", describe(params), ".")
   }
 }
 
@@ -139,6 +158,15 @@ simulate_recording <- function(hours = 72, sf = 30, params = NULL,
   }
   if (any(tempoffset != 0) && !temperature) {
     abort("`tempoffset` needs `temperature = TRUE`.")
+  }
+  if (!(inherits(start, "POSIXct") && length(start) == 1 && !is.na(start))) {
+    abort("`start` must be one date-time (POSIXct), not ", describe(start),
+          ".")
+  }
+  if (hours * 3600 * sf > 2^31 - 1) {
+    abort("`hours` * 3600 * `sf` must be at most 2^31 - 1 samples, not ",
+          format(hours * 3600 * sf), " (hours = ", format(hours), ", sf = ",
+          format(sf), " Hz).")
   }
   if (!is.null(seed)) {
     check_number(seed, "seed", integer = TRUE)

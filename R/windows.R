@@ -88,18 +88,21 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     s <- list(n = 0, time = NULL)
   } else {
     if (missing(sf)) abort("`sf` (sampling frequency in Hz) is missing.")
-    s <- as_samples(x)
+    s <- as_samples(x, temperature = if (method == "lightweight") "ignore" else "use")
   }
   check_sf(sf)
   if (is.null(window)) window <- if (method == "lightweight") 5 else 10
   check_number(window, "window", min = 0, min_inclusive = FALSE)
-  if (window * sf < 2) {
-    abort("`window` * `sf` must give at least 2 samples per window, not ",
+  if (window * sf < 2 || window * sf >= 1e7) {
+    abort("`window` * `sf` must give ", if (window * sf < 2)
+            "at least 2" else "fewer than 1e7", " samples per window, not ",
           format(window * sf), " (window = ", format(window), " s, sf = ",
-          format(sf), " Hz).")
+          format(sf), " Hz", if (!is.null(src)) paste0(", from \"",
+          src$filename, "\""), ").")
   }
   check_flag(skip_zero, "skip_zero")
   check_number(chunk_size, "chunk_size", min = 1)
+  if (!is.null(progress)) check_flag(progress, "progress")
   if (method == "lightweight") {
     check_number(max_range, "max_range", min = 0, min_inclusive = FALSE)
     if (!is.character(axes) || !length(axes) ||

@@ -24,3 +24,22 @@ skip_if_no_shared <- function(...) {
 # Mean | |v| - 1 | of an n x 3 matrix: an independent restatement of the
 # calibration error for checks.
 err_mg <- function(v) 1000 * mean(abs(sqrt(rowSums(v^2)) - 1))
+
+# A folder for files made by a test, under a fixed name, and a snapshot
+# transform that replaces it with "<dir>", so that snapshots of messages
+# naming those files do not depend on the session's temporary folder.
+snap_dir <- function(name) {
+  d <- file.path(tempdir(), name)
+  unlink(d, recursive = TRUE)
+  dir.create(d)
+  d
+}
+
+scrub_dir <- function(d) {
+  force(d)
+  function(x) {
+    x <- gsub(d, "<dir>", x, fixed = TRUE)
+    gsub(normalizePath(d, winslash = "/", mustWork = FALSE), "<dir>", x,
+         fixed = TRUE)
+  }
+}

@@ -260,3 +260,23 @@ test_that("GGIR method: implausible coefficients are not applied (gravcal's mode
   expect_false(gravcal:::ggir_plausible(c(1, 1, 1), c(0, 0, 0), c(0, 0.06, 0)))
   expect_false(gravcal:::ggir_plausible(c(1, NA, 1), c(0, 0, 0), NULL))
 })
+
+test_that("exported functions: numbers out of range or given as text are named", {
+  w <- rest_windows(base, sf = 10, method = "ggir")
+  expect_snapshot(error = TRUE, calibrate(base, sf = 10, method = "ggir", max_iter = 1e10))
+  expect_snapshot(error = TRUE, calibrate(base, sf = 10, method = "ggir", max_iter = 2.5))
+  expect_snapshot(error = TRUE, rest_windows(base, sf = 10, progress = "a"))
+  expect_snapshot(error = TRUE, rest_windows(base, sf = 10, chunk_size = "a"))
+  expect_snapshot(error = TRUE, g.calibrate(base, sf = 10, verbose = FALSE,
+                                            params_rawdata = list(chunksize = "a")))
+  expect_snapshot(error = TRUE, select_points(w, min_distance = "a"))
+  expect_snapshot(error = TRUE, fit_icp(w, max_weight = 0))
+  expect_snapshot(error = TRUE, fit_gradient(simulate_points(100), rates = "a"))
+  # the methods of the fit class refuse what is not a fit
+  bad <- structure(list(), class = "gravcal_fit")
+  expect_snapshot(error = TRUE, coef(bad))
+  expect_snapshot(error = TRUE, print(bad))
+  expect_snapshot(error = TRUE, summary(bad))
+  fit <- calibrate(base, sf = 10)
+  expect_snapshot(error = TRUE, print(fit, digits = "a"))
+})

@@ -64,13 +64,19 @@ test_that("a fit that does not lower the error is not applied", {
   a <- gravcal:::random_unit_vectors(3000)
   w <- data.frame(mean_x = a[, 1], mean_y = a[, 2], mean_z = a[, 3])
   fit <- fit_gradient(select_points(w))
+  # the descent only moves away from the sphere: fit_gradient() says so
+  expect_identical(fit$status, "no_improvement")
   g <- gravcal:::guard_fit(fit)
   expect_true(g$status %in% c("ok", "no_improvement"))
+  # guard_fit() on its own: a fit marked ok whose error rose
+  fit$status <- "ok"
+  fit$K[1, 1] <- 1.01
   fit$error_after <- fit$error_before + 1e-3
   g <- gravcal:::guard_fit(fit)
   expect_equal(g$status, "no_improvement")
   expect_equal(unname(g$K), diag(3))
   big <- fit_gradient(select_points(w))
+  big$status <- "ok"
   big$K[1, 1] <- 2
   big$error_after <- 0
   expect_equal(gravcal:::guard_fit(big)$status, "implausible")
@@ -119,4 +125,57 @@ test_that("calibrate() lowers the novelty threshold when postures are few", {
   expect_lt(min(attr(fit$points, "min_distance")), 0.3)
   expect_equal(calibrate(x, sf = 10, min_distance = 0.3)$status,
                "bins_incomplete")
+})
+
+test_that("summary() of a GGIR-method fit has no held-out row", {
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 2)
+  fg <- calibrate(rec, sf = 10, method = "ggir")
+  s <- summary(fg)
+  # GGIR's procedure fits all its rest windows: there is no held-out set
+  # (the row had a negative count and the fitting errors copied into it)
+  expect_identical(s$errors$set, "fitting points")
+  expect_identical(s$errors$n, nrow(fg$points))
+  expect_equal(s$errors$after_mg, 1000 * fg$error_after)
+  fl <- calibrate(rec, sf = 10)
+  sl <- summary(fl)
+  expect_identical(sl$errors$n, c(18L, nrow(fl$windows) - 18L))
+  expect_equal(sl$errors$after_mg[2], 1000 * fl$error_heldout_after)
+})
+
+test_that("print() and summary() of every kind of fit (snapshots)", {
+  d <- snap_dir("gravcal-print")
+  on.exit(unlink(d, recursive = TRUE))
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 2,
+                            tempoffset = c(0.001, -0.001, 0.0005))
+  fl <- calibrate(rec, sf = 10)
+  expect_snapshot(print(fl))
+  expect_snapshot(print(summary(fl)))
+  fg <- calibrate(rec, sf = 10, method = "ggir")
+  expect_snapshot(print(fg))
+  expect_snapshot(print(summary(fg)))
+  fi <- fit_icp(rest_windows(rec, sf = 10, method = "ggir"))
+  expect_snapshot(print(fi))
+  expect_snapshot(print(summary(fi)))
+  set.seed(4)
+  pts <- select_points(simulate_points(500, noise = 0.001))
+  fgr <- fit_gradient(pts)
+  expect_snapshot(print(fgr))
+  expect_snapshot(print(summary(fgr)))
+  fe <- fit_ellipsoid(pts)
+  expect_snapshot(print(fe))
+  expect_snapshot(print(summary(fe)))
+  # statuses other than ok
+  short <- rec[1:20, ]
+  expect_snapshot(print(calibrate(short, sf = 10)))
+  expect_snapshot(print(summary(calibrate(short, sf = 10))))
+  expect_snapshot(print(calibrate(short, sf = 10, method = "ggir")))
+  flat <- data.frame(x = 0.01 + 0 * seq_len(36000), y = -0.02, z = 1.03)
+  flat$x <- flat$x + rep(c(0, 0.001), 18000)
+  expect_snapshot(print(calibrate(flat, sf = 10)))
+  expect_snapshot(print(fit_gradient(pts, arithmetic = "fixed16", h = 2^-14)))
+  # a fit from a file: the input line names the file, not its folder
+  f <- file.path(d, "rec.csv")
+  utils::write.csv(data.frame(time = as.numeric(rec$time), rec[c("x", "y", "z")]),
+                   f, row.names = FALSE)
+  expect_snapshot(print(calibrate(f)))
 })

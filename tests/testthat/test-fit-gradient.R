@@ -108,7 +108,12 @@ test_that("fixed-point fits: step defaults, range checks, values on the grid", {
   big <- pts
   big$mean_x[1] <- 2.5
   expect_error(fit_gradient(big, arithmetic = "fixed16"), "range of fixed16")
-  expect_identical(fit_gradient(big, arithmetic = "fixed32")$status, "ok")
+  # in range for fixed32, but its term of the objective saturates (|a|^2 - 1
+  # squared is above 4): the gradient is flat, nothing moves, and the fit
+  # says so (it was status "ok" with identity coefficients)
+  fb <- fit_gradient(big, arithmetic = "fixed32")
+  expect_identical(fb$status, "no_improvement")
+  expect_equal(unname(fb$params), c(1, 1, 1, 0, 0, 0, 0, 0, 0))
   expect_error(fit_gradient(pts, arithmetic = "fixed8"), "arithmetic")
   expect_error(fit_gradient(pts, difference = "backward"), "difference")
   # calibrate() passes the arithmetic through
@@ -117,4 +122,39 @@ test_that("fixed-point fits: step defaults, range checks, values on the grid", {
   expect_identical(fit$status, "ok")
   expect_identical(fit$settings$arithmetic, "fixed32")
   expect_lt(fit$error_heldout_after, 0.002)
+})
+
+test_that("a step h below the arithmetic's resolution is an error naming h", {
+  set.seed(5)
+  pts <- select_points(simulate_points(500, noise = 0.001))
+  # 1e-5 in Q1.14 rounds to zero: every parameter would saturate
+  expect_snapshot(error = TRUE, fit_gradient(pts, arithmetic = "fixed16", h = 1e-5))
+  expect_snapshot(error = TRUE, fit_gradient(pts, arithmetic = "fixed32", h = 1e-10))
+  expect_snapshot(error = TRUE, fit_gradient(pts, arithmetic = "float", h = 1e-8))
+  expect_snapshot(error = TRUE, fit_gradient(pts, h = 1e-17))
+  expect_snapshot(error = TRUE, fit_gradient(pts, h = 0))
+  # one resolution step is allowed (see the next test for its status)
+  expect_s3_class(fit_gradient(pts, arithmetic = "float", h = 2^-23), "gravcal_fit")
+})
+
+test_that("a fit whose objective did not decrease is not ok", {
+  set.seed(5)
+  pts <- select_points(simulate_points(500, noise = 0.001))
+  # one step of Q1.14 (6.1e-5): the differences are all rounding, nothing
+  # moves (this was status "ok")
+  f <- fit_gradient(pts, arithmetic = "fixed16", h = 2^-14)
+  expect_identical(f$status, "no_improvement")
+  expect_equal(unname(f$params), c(1, 1, 1, 0, 0, 0, 0, 0, 0))
+  expect_equal(f$error_after, f$error_before)
+  expect_snapshot(f$message)
+  # points already on the sphere: the forward difference's bias only moves
+  # the parameters away from the optimum; the identity is kept
+  a <- pts[c("mean_x", "mean_y", "mean_z")]
+  a <- a / sqrt(rowSums(a^2))
+  f1 <- fit_gradient(a)
+  expect_identical(f1$status, "no_improvement")
+  expect_equal(unname(coef(f1)[1:9]), c(1, 1, 1, 0, 0, 0, 0, 0, 0))
+  # the same points with an error to remove: ok
+  expect_identical(fit_gradient(pts)$status, "ok")
+  expect_identical(fit_gradient(pts, arithmetic = "fixed16")$status, "ok")
 })

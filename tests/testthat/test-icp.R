@@ -83,3 +83,23 @@ test_that("R-compatible windows are R's own numbers, bit for bit", {
   expect_false(gravcal:::gc_segmenter_new_block(seg))
   expect_length(w2$mean_x, 0)
 })
+
+test_that("fit_icp(): iterations beyond an integer, text temperature", {
+  rec <- simulate_recording(hours = 3, sf = 10, seed = 1)
+  w <- rest_windows(rec, sf = 10, method = "ggir")
+  expect_snapshot(error = TRUE, fit_icp(w, max_iter = 1e10))
+  expect_snapshot(error = TRUE, fit_icp(w, max_iter = 2.5))
+  expect_snapshot(error = TRUE, fit_icp(w, max_iter = "10"))
+  wt <- w
+  wt$temperature <- as.character(wt$temperature)
+  expect_snapshot(error = TRUE, fit_icp(wt))
+  # without the temperature term the column is not used
+  expect_identical(coef(fit_icp(wt, use_temp = FALSE)),
+                   coef(fit_icp(w, use_temp = FALSE)))
+  # the GGIR method refuses it too; the lightweight method, which does not
+  # use it, says that it leaves it out
+  rt <- transform(rec, temperature = as.character(temperature))
+  expect_snapshot(error = TRUE, calibrate(rt, sf = 10, method = "ggir"))
+  expect_snapshot(fl <- calibrate(rt, sf = 10))
+  expect_identical(coef(fl), coef(calibrate(rec, sf = 10)))
+})

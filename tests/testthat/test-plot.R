@@ -22,3 +22,23 @@ test_that("a fit without points cannot be plotted, and says why", {
   expect_output(print(f), "too_short")
   expect_error(plot(f), "no rest points to plot \\(status: too_short\\)")
 })
+
+test_that("plot(): text where a number belongs, zero or missing rest vectors", {
+  rec <- simulate_recording(hours = 3, sf = 10, seed = 1)
+  fit <- calibrate(rec, sf = 10)
+  grDevices::pdf(NULL)
+  on.exit(grDevices::dev.off())
+  expect_snapshot(error = TRUE, plot(fit, which = "1"))
+  expect_snapshot(error = TRUE, plot(fit, theta = "a"))
+  expect_snapshot(error = TRUE, plot(fit, phi = NA))
+  expect_snapshot(error = TRUE, plot(fit, set = 1))
+  zero <- fit
+  zero$windows[c(1, 4), c("mean_x", "mean_y", "mean_z")] <- 0
+  expect_snapshot(error = TRUE, plot(zero))
+  # the fitting points alone have no zero vector: they plot
+  expect_invisible(plot(zero, set = "points"))
+  missing <- fit
+  missing$windows$mean_x[2] <- NA
+  expect_snapshot(error = TRUE, plot(missing))
+  expect_snapshot(error = TRUE, plot.gravcal_fit(list(K = diag(3))))
+})

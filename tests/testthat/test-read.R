@@ -185,3 +185,84 @@ test_that("sf comes from time stamps written as text, whole seconds included", {
   expect_identical(gravcal:::sf_from_time(c(5, 5, 5)), NULL)
   expect_identical(gravcal:::sf_from_time(as.POSIXct("2024-01-01", tz = "UTC") + (0:99) / 25), 25)
 })
+
+test_that("files that hold no samples: errors that name the file and why", {
+  d <- snap_dir("gravcal-read-errors")
+  on.exit(unlink(d, recursive = TRUE))
+  tr <- scrub_dir(d)
+  rec <- simulate_recording(hours = 0.1, sf = 10, seed = 1)
+  # .rds: empty, truncated, not a data frame; folders named like files
+  empty <- file.path(d, "empty.rds")
+  file.create(empty)
+  cut <- file.path(d, "cut.rds")
+  saveRDS(rec, cut)
+  writeBin(readBin(cut, raw(), 200), cut)
+  notdf <- file.path(d, "vector.rds")
+  saveRDS(1:10, notdf)
+  dir.create(folder_rds <- file.path(d, "folder.rds"))
+  dir.create(folder_cwa <- file.path(d, "folder.cwa"))
+  expect_snapshot(error = TRUE, read_recording(empty), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(empty), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(cut), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(cut, method = "ggir"), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(notdf), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(folder_rds), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(folder_cwa), transform = tr)
+  expect_snapshot(error = TRUE, rest_windows(folder_cwa), transform = tr)
+  expect_snapshot(error = TRUE, g.calibrate(folder_rds, verbose = FALSE),
+                  transform = tr)
+  # csv: comma decimals in comma-separated fields, a header and no rows, a
+  # binary file, semicolons through the reference reader
+  commas <- file.path(d, "comma-decimals.csv")
+  writeLines(c("x,y,z", "0,5,1,2,0,3", "0,5,1,2,0,3"), commas)
+  header <- file.path(d, "header-only.csv")
+  writeLines("x,y,z", header)
+  binary <- file.path(d, "binary.csv")
+  writeBin(as.raw((seq_len(2000) * 37) %% 256), binary)
+  semi <- file.path(d, "semicolons.csv")
+  utils::write.table(rec[1:50, c("x", "y", "z")], semi, sep = ";",
+                     row.names = FALSE)
+  expect_snapshot(error = TRUE, read_recording(commas, sf = 10), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(header, sf = 10), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(binary, sf = 10), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(binary, sf = 10), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(semi, sf = 10, reader = "reference"),
+                  transform = tr)
+  # gravcal's own reader reads semicolons (and comma decimals with them)
+  expect_equal(read_recording(semi, sf = 10)$data$x, rec$x[1:50])
+  # a header and no rows is a recording too short to calibrate
+  expect_identical(calibrate(header, sf = 10)$status, "too_short")
+})
+
+test_that("empty, truncated and unusual .bin files: errors that say why", {
+  d <- snap_dir("gravcal-bin-errors")
+  on.exit(unlink(d, recursive = TRUE))
+  tr <- scrub_dir(d)
+  rec <- simulate_recording(hours = 1, sf = 10, seed = 1)
+  ok <- file.path(d, "ok.bin")
+  gravcal:::write_geneactiv_bin(rec, ok, sf = 10)
+  b <- readBin(ok, raw(), file.size(ok))
+  empty <- file.path(d, "empty.bin")
+  file.create(empty)
+  cut <- file.path(d, "cut.bin")
+  writeBin(b[1:100], cut)
+  # a Matrix/Parmay .BIN, an older Genea file: other formats, said so
+  matrix_bin <- file.path(d, "matrix.BIN")
+  writeBin(c(as.raw(rep(0, 512)), charToRaw("MDTC"), as.raw(rep(1, 600))),
+           matrix_bin)
+  genea <- file.path(d, "genea.bin")
+  writeLines(c("GENEA Serial Number:1234", "junk"), genea)
+  # a header rate of 0.1 Hz that no page holds
+  slow <- file.path(d, "slow.bin")
+  L <- readLines(ok)
+  i <- grep("^Measurement Frequency", L)
+  L[i] <- "Measurement Frequency:0.1 Hz"
+  writeLines(L, slow)
+  for (f in c(empty, cut, matrix_bin, genea)) {
+    expect_snapshot(error = TRUE, read_recording(f), transform = tr)
+  }
+  expect_snapshot(error = TRUE, calibrate(cut), transform = tr)
+  expect_snapshot(error = TRUE, read_recording(slow), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(slow), transform = tr)
+  expect_snapshot(error = TRUE, calibrate(slow, method = "ggir"), transform = tr)
+})

@@ -172,3 +172,12 @@ test_that("R-compatible windows do not depend on the chunking", {
   expect_identical(a$sd_y[k], stats::sd(y[idx]))
   expect_identical(a$mean_y[k], diff(cumsum(c(0, y))[c(1, 1001) + (k - 1) * 1000]) / 1000)
 })
+
+test_that("a window of 1e7 samples or more is an error naming window and sf", {
+  rec <- simulate_recording(hours = 0.5, sf = 10, seed = 1)
+  expect_snapshot(error = TRUE, rest_windows(rec, sf = 10, window = 1e7))
+  expect_snapshot(error = TRUE, rest_windows(rec, sf = 1e7))
+  expect_snapshot(error = TRUE, rest_windows(rec, sf = 0.2))
+  expect_snapshot(error = TRUE, calibrate(rec, sf = 0.05, method = "ggir"))
+  expect_snapshot(error = TRUE, g.calibrate(rec, sf = 2e6, verbose = FALSE))
+})
