@@ -12,10 +12,12 @@ TARBALL := gravcal_$(VERSION).tar.gz
 
 # R CMD check on a machine without general network access: skip the parts
 # that must reach servers other than CRAN (current-time lookup) and CRAN's
-# incoming checks that need its database.
+# incoming checks that need its database. NOT_CRAN=true: testthat runs
+# expect_snapshot() only off CRAN, and the snapshots of every error message
+# and printed fit are part of the suite.
 CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE \
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
-             GRAVCAL_SHARED_DATA=$(SHARED_DATA)
+             GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 .PHONY: setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
@@ -50,7 +52,7 @@ sanitize: setup
 	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
 	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) ../../tools/run-tests.R \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true $(RSCRIPT) ../../tools/run-tests.R \
 	  > ../../$(BUILD)/sanitize.log 2>&1 || (tail -60 ../../$(BUILD)/sanitize.log; exit 1)
 	@if grep -qE "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log; then \
 	  grep -E -A20 "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log | head -60; exit 1; fi
