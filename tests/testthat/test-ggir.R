@@ -118,7 +118,13 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     expect_identical(r1$used, as.numeric(nrow(e1$used)))
     expect_identical(r1$carried, as.numeric(nrow(e1$rest)))
     expect_identical(r1$first_mean, mean(e1$used$t[1:10], na.rm = TRUE))
-    expect_identical(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE))
+    # the temperature's sd only decides whether it varies: R's arithmetic in
+    # compatible mode, gravcal's (from the run-length code) to rounding
+    if (compat) {
+      expect_identical(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE))
+    } else {
+      expect_equal(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE), tolerance = 1e-13)
+    }
     expect_identical(length(r1$windows$mean_x), nrow(e1$used) %/% 10L)
     # window means as GGIR forms them (compatible mode): differences of the
     # block's cumulative sum; gravcal's own arithmetic: to rounding
@@ -132,7 +138,11 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     r2 <- feed(b2)
     e2 <- ref_block(rbind(e1$rest, b2), FALSE, compat)
     expect_identical(r2$used, as.numeric(nrow(e2$used)))
-    expect_identical(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE))
+    if (compat) {
+      expect_identical(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE))
+    } else {
+      expect_equal(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE), tolerance = 1e-13)
+    }
     if (compat) {
       expect_identical(r2$windows$sd_y[1], stats::sd(e2$used$y[1:10]))
     } else {

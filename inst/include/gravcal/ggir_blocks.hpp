@@ -29,6 +29,7 @@
 #ifndef GRAVCAL_GGIR_BLOCKS_HPP
 #define GRAVCAL_GGIR_BLOCKS_HPP
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -74,12 +75,14 @@ class GgirBlocks {
     last_zero_ = false;
     first_.clear();
     runs_.clear();
-    for (int c = 0; c < 4; ++c) hold_[c].clear();
+    held_ = 0;
     const std::size_t k = carry_[0].size();
-    for (std::size_t i = 0; i < k; ++i) {
-      retain(carry_[0][i], carry_[1][i], carry_[2][i],
-             temp_ ? carry_[3][i] : std::numeric_limits<double>::quiet_NaN());
+    reserve(k);
+    for (int c = 0; c < columns(); ++c) {
+      std::copy(carry_[c].begin(), carry_[c].end(), hold_[c].begin());
     }
+    held_ = k;
+    if (temp_) note_temperatures(hold_[3].data(), k);
     info_.ld = static_cast<std::int64_t>(k);
   }
 
@@ -88,27 +91,39 @@ class GgirBlocks {
   template <class Sink>
   void push(const double* x, const double* y, const double* z, const double* t,
             std::size_t n, Sink&& sink) {
+    reserve(held_ + n);
+    double* hx = hold_[0].data() + held_;
+    double* hy = hold_[1].data() + held_;
+    double* hz = hold_[2].data() + held_;
+    double* ht = temp_ ? hold_[3].data() + held_ : nullptr;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::size_t m = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      ++info_.rows;
       if (x[i] == 0.0 && y[i] == 0.0 && z[i] == 0.0) {
         ++info_.zeros;
         last_zero_ = true;
         continue;
       }
       last_zero_ = false;
-      retain(x[i], y[i], z[i],
-             t != nullptr ? t[i] : std::numeric_limits<double>::quiet_NaN());
-      ++info_.ld;
+      hx[m] = x[i];
+      hy[m] = y[i];
+      hz[m] = z[i];
+      if (ht != nullptr) ht[m] = t != nullptr ? t[i] : nan;
+      ++m;
     }
+    if (ht != nullptr) note_temperatures(ht, m);
+    held_ += m;
+    info_.rows += static_cast<std::int64_t>(n);
+    info_.ld += static_cast<std::int64_t>(m);
     // everything but the last H samples may go on
-    const std::int64_t free = static_cast<std::int64_t>(hold_[0].size()) - H_;
+    const std::int64_t free = static_cast<std::int64_t>(held_) - H_;
     if (free >= H_) flush(static_cast<std::size_t>(free), sink);
   }
 
   // The block ends: the whole hours go on, the rest is carried.
   template <class Sink>
   GgirBlockInfo end_block(Sink&& sink) {
-    const std::size_t n = hold_[0].size();
+    const std::size_t n = held_;
     if (compat_ && last_zero_ && info_.ld >= 2 && n >= 2) {
       for (int c = 0; c < 3; ++c) hold_[c][n - 1] = hold_[c][n - 2];
     }
@@ -117,30 +132,37 @@ class GgirBlocks {
     if (use > 0) {
       flush(static_cast<std::size_t>(use - pushed_), sink);
       if (use != info_.ld) {
-        take_carry(hold_[0].size());
+        take_carry(held_);
       } else if (!compat_) {
         for (int c = 0; c < 4; ++c) carry_[c].clear();
       }
       temperature_stats(use);
     } else if (!compat_) {
-      take_carry(hold_[0].size());
+      take_carry(held_);
     }
     info_.carried = static_cast<std::int64_t>(carry_[0].size());
     return info_;
   }
 
  private:
-  void retain(double x, double y, double z, double t) {
-    hold_[0].push_back(x);
-    hold_[1].push_back(y);
-    hold_[2].push_back(z);
-    if (temp_) {
-      hold_[3].push_back(t);
-      if (first_.size() < 10) first_.push_back(t);
-      if (!runs_.empty() && same(runs_.back().value, t)) {
+  int columns() const { return temp_ ? 4 : 3; }
+
+  // Room for k held samples. The hold never exceeds two hours plus one
+  // chunk, so its storage stops growing after the first block.
+  void reserve(std::size_t k) {
+    if (hold_[0].size() >= k) return;
+    const std::size_t cap = std::max(k, 2 * hold_[0].size());
+    for (int c = 0; c < columns(); ++c) hold_[c].resize(cap);
+  }
+
+  // The block's temperatures in order: the first 10, and run-length coded.
+  void note_temperatures(const double* t, std::size_t m) {
+    for (std::size_t i = 0; i < m && first_.size() < 10; ++i) first_.push_back(t[i]);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!runs_.empty() && same(runs_.back().value, t[i])) {
         ++runs_.back().count;
       } else {
-        runs_.push_back(Run{t, 1});
+        runs_.push_back(Run{t[i], 1});
       }
     }
   }
@@ -160,9 +182,10 @@ class GgirBlocks {
     seg_.push(hold_[0].data(), hold_[1].data(), hold_[2].data(),
               temp_ ? hold_[3].data() : nullptr, k, sink);
     pushed_ += static_cast<std::int64_t>(k);
-    for (int c = 0; c < (temp_ ? 4 : 3); ++c) {
-      hold_[c].erase(hold_[c].begin(), hold_[c].begin() + static_cast<std::ptrdiff_t>(k));
+    for (int c = 0; c < columns(); ++c) {
+      std::memmove(hold_[c].data(), hold_[c].data() + k, (held_ - k) * sizeof(double));
     }
+    held_ -= k;
   }
 
   // The last k held samples become the carry.
@@ -170,16 +193,26 @@ class GgirBlocks {
     for (int c = 0; c < 4; ++c) {
       carry_[c].clear();
       if (c == 3 && !temp_) continue;
-      carry_[c].assign(hold_[c].end() - static_cast<std::ptrdiff_t>(k), hold_[c].end());
+      carry_[c].assign(hold_[c].begin() + static_cast<std::ptrdiff_t>(held_ - k),
+                       hold_[c].begin() + static_cast<std::ptrdiff_t>(held_));
     }
   }
 
-  // R's mean of the first 10 and sd of the first `use` temperatures.
+  // R's mean of the first 10 and sd of the first `use` temperatures. The sd
+  // only decides whether the temperature varies (sd >= 0.01): gravcal's own
+  // mode takes it from the runs in one pass (exact sums of each run's count
+  // times its value, deviations around the mean); compatible mode repeats
+  // R's arithmetic value by value, so that a block at the threshold goes
+  // GGIR's way.
   void temperature_stats(std::int64_t use) {
     if (!temp_) return;
     info_.first_mean = r_mean_sd([&](auto&& f) {
       for (double v : first_) f(v);
     }).mean;
+    if (!compat_) {
+      info_.temp_sd = runs_sd(use);
+      return;
+    }
     info_.temp_sd = r_mean_sd([&](auto&& f) {
       std::int64_t left = use;
       for (const Run& r : runs_) {
@@ -187,6 +220,36 @@ class GgirBlocks {
         if (left == 0) break;
       }
     }).sd;
+  }
+
+  // sd of the first `use` run-coded temperatures, NaN ones left out (as
+  // R's na.rm); NaN when fewer than 2.
+  double runs_sd(std::int64_t use) const {
+    long double sum = 0;
+    std::int64_t n = 0, left = use;
+    for (const Run& r : runs_) {
+      const std::int64_t c = std::min(r.count, left);
+      left -= c;
+      if (!std::isnan(r.value)) {
+        sum += static_cast<long double>(r.value) * c;
+        n += c;
+      }
+      if (left == 0) break;
+    }
+    if (n < 2) return std::numeric_limits<double>::quiet_NaN();
+    const long double mean = sum / n;
+    long double ss = 0;
+    left = use;
+    for (const Run& r : runs_) {
+      const std::int64_t c = std::min(r.count, left);
+      left -= c;
+      if (!std::isnan(r.value)) {
+        const long double d = r.value - mean;
+        ss += d * d * c;
+      }
+      if (left == 0) break;
+    }
+    return static_cast<double>(std::sqrt(ss / (n - 1)));
   }
 
   struct Run {
@@ -202,7 +265,8 @@ class GgirBlocks {
   std::int64_t pushed_ = 0;
   bool started_ = false;
   bool last_zero_ = false;
-  std::vector<double> hold_[4];   // retained, not yet given on
+  std::size_t held_ = 0;          // samples in hold_
+  std::vector<double> hold_[4];   // retained, not yet given on (held_ used)
   std::vector<double> carry_[4];  // carried to the next block
   std::vector<double> first_;     // the block's first 10 temperatures
   std::vector<Run> runs_;         // the block's temperatures, run-length coded
