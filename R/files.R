@@ -102,7 +102,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   if (length(args) && (is.null(names(args)) || any(!nzchar(names(args))))) {
     abort("All arguments in `...` must be named (they go to calibrate()).")
   }
-  args <- args[order(names(args))]
+  if (length(args)) args <- args[order(names(args))]
   outdir <- cohort_outdir(outdir)
   store <- file.path(outdir, ".gravcal")
   lock <- lock_outdir(store)
@@ -282,15 +282,24 @@ cohort_worker <- function(files, slots, method, args, settings) {
 
 # Run worker(i, progressor) for every i in todo, one future per recording
 # on the plan the user set (a plain loop without the future package).
-# Returns why the recordings whose worker failed have no result, by index.
+# Returns why the recordings without a result have none, by index. When a
+# worker dies, the recordings it was calibrating are reported; those that
+# could not even start on the dead worker are run again once on fresh
+# workers (the plan is set again, which restarts its workers).
 run_cohort <- function(todo, worker, labels) {
   failures <- list()
   if (!length(todo)) return(failures)
+  dead <- FALSE
   failed <- function(i) {
     force(i)
     function(e) {
-      failures[[as.character(i)]] <<- paste0(
-        "the R process calibrating it stopped (", conditionMessage(e), ")")
+      why <- conditionMessage(e)
+      if (inherits(e, "FutureError")) {
+        dead <<- TRUE
+        why <- paste0("the R process calibrating it stopped (",
+                      sub("[.] Post-mortem.*$", "", why), ")")
+      }
+      failures[[as.character(i)]] <<- why
       NULL
     }
   }
@@ -301,17 +310,47 @@ run_cohort <- function(todo, worker, labels) {
     for (i in todo) tryCatch(worker(i, p), error = failed(i))
     return(failures)
   }
-  fs <- list()
-  for (i in todo) {
-    fs[[as.character(i)]] <- tryCatch(
-      future::future(worker(i, p), globals = list(worker = worker, i = i, p = p),
-                     packages = "gravcal", seed = TRUE, label = labels[i]),
-      error = failed(i))
+  run <- function(queue) {
+    fs <- list()
+    unstarted <- integer(0)
+    for (i in queue) {
+      f <- tryCatch(
+        future::future(worker(i, p), globals = list(worker = worker, i = i, p = p),
+                       packages = "gravcal", seed = TRUE, label = labels[i]),
+        error = function(e) e)
+      if (inherits(f, "FutureError")) {
+        # the worker it went to had died with an earlier recording
+        dead <<- TRUE
+        unstarted <- c(unstarted, i)
+      } else if (inherits(f, "error")) {
+        failed(i)(f)
+      } else {
+        fs[[as.character(i)]] <- f
+      }
+    }
+    for (k in names(fs)) tryCatch(future::value(fs[[k]]), error = failed(k))
+    unstarted
   }
-  for (k in names(fs)) {
-    if (!is.null(fs[[k]])) tryCatch(future::value(fs[[k]]), error = failed(k))
+  again <- run(todo)
+  if (dead) {
+    restart_workers()
+    dead <- FALSE
+  }
+  if (length(again)) {
+    again <- run(again)
+    if (dead) restart_workers()
+    for (i in again) {
+      failures[[as.character(i)]] <- "no worker could start it (they had stopped)"
+    }
   }
   failures
+}
+
+# Set the plan again: a cluster plan starts fresh workers.
+restart_workers <- function() {
+  strategies <- future::plan("list")
+  future::plan(future::sequential)
+  future::plan(strategies)
 }
 
 # One recording: the fit and its row, or a row saying what went wrong. The
