@@ -119,6 +119,8 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
     if (resume) read_saved(slots[i], file_identity(files[i]), settings) else list()
   })
   todo <- which(vapply(saved, function(s) is.null(s$result), TRUE))
+  # what is redone is not taken from an earlier run if this one fails
+  unlink(slots[todo])
   failures <- run_cohort(todo, cohort_worker(files, slots, method, args, settings),
                          basename(files))
 
@@ -131,7 +133,8 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
         why <- failures[[as.character(i)]]
         if (is.null(why)) why <- if (is.null(s2$note)) "no saved result" else s2$note
         s$result <- list(row = cohort_row(files[i], NULL, paste0(
-          "no result: ", why, "; run again to retry"), "", NA_real_, method),
+          "no result: ", sub("[.]$", "", why), "; run again to retry"), "",
+          NA_real_, method),
           fit = NULL)
       }
     }
@@ -358,6 +361,7 @@ restart_workers <- function() {
 calibrate_one <- function(file, method, args) {
   t0 <- proc.time()[["elapsed"]]
   cohort_fault("calibrate", file)
+  cohort_fault("pause", file)
   warns <- character(0)
   err <- NULL
   fit <- tryCatch(
@@ -435,12 +439,14 @@ join_notes <- function(a, b) {
 # set through the environment so that workers inherit it.
 # GRAVCAL_FAULT="write:REGEX" writes half the bytes of files whose path
 # matches (a full disk); "calibrate:REGEX" kills the R process that starts
-# to calibrate a matching recording (a worker dying mid-file).
+# to calibrate a matching recording (a worker dying mid-file); "pause:REGEX"
+# waits 3 s before calibrating a matching recording (a long one).
 cohort_fault <- function(stage, path) {
   f <- Sys.getenv("GRAVCAL_FAULT")
   if (!nzchar(f) || !startsWith(f, paste0(stage, ":"))) return(FALSE)
   if (!grepl(substring(f, nchar(stage) + 2), path)) return(FALSE)
   if (stage == "calibrate") tools::pskill(Sys.getpid(), tools::SIGKILL)
+  if (stage == "pause") Sys.sleep(3)
   TRUE
 }
 
@@ -468,8 +474,8 @@ write_bytes_atomic <- function(bytes, path) {
   }
   if (!is.null(err)) {
     unlink(tmp)
-    abort("Could not write \"", path, "\": ", err, ". Nothing was changed ",
-          "in that file.")
+    abort("Could not write \"", path, "\" (", err, "); that file was left ",
+          "as it was.")
   }
   invisible(path)
 }
@@ -546,10 +552,20 @@ lock_outdir <- function(store) {
   host <- Sys.info()[["nodename"]]
   for (attempt in 1:2) {
     if (dir.create(lock, showWarnings = FALSE)) {
-      writeLines(c(paste0("pid=", Sys.getpid()), paste0("host=", host),
-                   paste0("started=", format(Sys.time(), "%Y-%m-%d %H:%M:%S"))),
-                 file.path(lock, "owner"))
+      owner <- c(paste0("pid=", Sys.getpid()), paste0("host=", host),
+                 paste0("started=", format(Sys.time(), "%Y-%m-%d %H:%M:%S")))
+      tryCatch(
+        write_bytes_atomic(charToRaw(paste0(owner, "\n", collapse = "")),
+                           file.path(lock, "owner")),
+        error = function(e) {
+          unlink(lock, recursive = TRUE)
+          stop(e)
+        })
       return(lock)
+    }
+    if (!dir.exists(lock)) {
+      abort("Could not create the lock \"", lock, "\" on `outdir` (is the ",
+            "disk full or the folder read-only?).")
     }
     owner <- lock_owner(lock)
     if (attempt == 2 || !lock_stale(owner, host)) break
