@@ -19,7 +19,8 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
-.PHONY: setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory bench-files refresh-vignettes clean
+# (test-slurm: a single-node Slurm, see below)
+.PHONY: test-slurm setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -100,3 +101,10 @@ refresh-vignettes: install
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png
+
+# calibrate_files() through future.batchtools on a real Slurm: starts a
+# single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort
+# as Slurm jobs, checking the table against a sequential run's
+test-slurm: install
+	bash tools/slurm-setup.sh
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R

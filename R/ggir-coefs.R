@@ -34,6 +34,20 @@ write_ggir_coefs <- function(fits, file) {
   if (!is.character(file) || length(file) != 1 || is.na(file) || !nzchar(file)) {
     abort("`file` must be a single file path, not ", describe(file), ".")
   }
+  if (dir.exists(file)) {
+    abort("`file` must be the path of a csv file, but \"", file,
+          "\" is a directory.")
+  }
+  if (!dir.exists(dirname(file))) {
+    abort("`file`: the folder \"", dirname(file), "\" does not exist.")
+  }
+  out <- ggir_coef_table(fits)
+  write_bytes_atomic(csv_bytes(out), file)
+  invisible(out)
+}
+
+# The rows of GGIR's coefficient file for a fit or a named list of fits.
+ggir_coef_table <- function(fits) {
   if (inherits(fits, "gravcal_fit") || is_ggir_result(fits)) {
     nm <- fits$file
     fits <- list(fits)
@@ -54,10 +68,18 @@ write_ggir_coefs <- function(fits, file) {
     abort("`fits` must be named by the recordings' file names (GGIR matches ",
           "rows by file name), e.g. list(\"p01.bin\" = fit).")
   }
+  if (anyDuplicated(nms)) {
+    abort("`fits` holds two fits for the recording \"",
+          nms[anyDuplicated(nms)], "\"; GGIR takes one row per file name.")
+  }
   rows <- lapply(seq_along(fits), function(i) ggir_coef_row(fits[[i]], nms[i]))
-  out <- do.call(rbind, rows)
-  utils::write.csv(out, file, row.names = FALSE)
-  invisible(out)
+  do.call(rbind, rows)
+}
+
+# The header of GGIR's coefficient file, no rows.
+empty_ggir_coefs <- function() {
+  ggir_coef_row(list(scale = c(1, 1, 1), offset = c(0, 0, 0),
+                     tempoffset = c(0, 0, 0), QCmessage = ""), "none")[0, ]
 }
 
 is_ggir_result <- function(x) {
@@ -69,6 +91,10 @@ ggir_coef_row <- function(f, name) {
   num1 <- function(v) if (length(v)) as.numeric(v[1]) else NA_real_
   if (inherits(f, "gravcal_fit")) {
     K <- f$K
+    if (!is.matrix(K) || !all(dim(K) == 3) || !all(is.finite(K))) {
+      abort("The fit for \"", name, "\" has no 3 x 3 finite `K`; it cannot ",
+            "be written as GGIR coefficients.")
+    }
     if (any(abs(K[row(K) != col(K)]) > 0)) {
       abort("The fit for \"", name, "\" has cross-axis terms (method \"",
             f$method, "\"); GGIR applies only scale, offset and temperature ",
@@ -104,7 +130,8 @@ ggir_coef_row <- function(f, name) {
       length(offset) != 3 || length(to) != 3) {
     abort("The coefficients for \"", name, "\" are not 3 finite values each.")
   }
-  if (!is.finite(mt)) mt <- 0
+  if (!length(mt) || !is.finite(mt[1])) mt <- 0
+  mt <- as.numeric(mt[1])
   data.frame(filename = name,
              scale.x = scale[1], scale.y = scale[2], scale.z = scale[3],
              offset.x = offset[1], offset.y = offset[2], offset.z = offset[3],

@@ -549,6 +549,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
                   minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
                   verbose = a$verbose, max_iter = a$max_iter, tol = a$tol)
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
+  if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
   fit
 }

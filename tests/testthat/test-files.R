@@ -1,5 +1,6 @@
 # calibrate_files(): a folder of recordings in two formats, sequential and in
-# parallel, a corrupt file, resumption after a killed run; cli().
+# parallel, a corrupt file, resumption after a killed run; calibrate_cli().
+# The faults a cohort run must survive are in test-cohort-faults.R.
 
 cohort_dir <- function() {
   dir <- tempfile("cohort")
@@ -24,33 +25,42 @@ test_that("calibrate_files() calibrates a folder, one row per recording", {
   on.exit(unlink(dir, recursive = TRUE))
   out <- file.path(dir, "out")
   tab <- calibrate_files(dir, outdir = out, sf = 10)
+  ggir_names <- c("scale.x", "scale.y", "scale.z", "offset.x", "offset.y",
+                  "offset.z", "temperature.offset.x", "temperature.offset.y",
+                  "temperature.offset.z")
+  expect_identical(names(tab)[1:12], c("file", "status", "message", ggir_names))
   expect_identical(tab$file, c("p01.csv", "p02.csv", "p03_actigraph.csv",
                                "p04.rds", "p05_corrupt.csv"))
   # each row is calibrate() on that file
   for (i in 1:4) {
     f <- calibrate(file.path(dir, tab$file[i]), sf = 10, method = "ggir")
-    expect_equal(unname(unlist(tab[i, c(param_names(), "t_x", "t_y", "t_z")])),
-                 unname(coef(f)), tolerance = 0, label = tab$file[i])
+    expect_equal(unname(unlist(tab[i, ggir_names])),
+                 unname(coef(f)[c(1:3, 7:12)]), tolerance = 0, label = tab$file[i])
     expect_identical(tab$status[i], f$status)
   }
   expect_identical(tab$status[5], "failed")
-  expect_match(tab$error[5], "p05_corrupt.csv.*no lines of it hold samples")
-  expect_true(all(tab$error[1:4] == ""))
+  expect_match(tab$message[5], "p05_corrupt.csv.*no lines of it hold samples")
+  expect_identical(tab$message[1:4], vapply(1:4, function(i) {
+    calibrate(file.path(dir, tab$file[i]), sf = 10, method = "ggir")$message
+  }, ""))
   expect_true(all(tab$error_after_mg[1:4] < tab$error_before_mg[1:4]))
   expect_equal(tab$hours[1], 26, tolerance = 0.01)
   # files written: the table and GGIR's coefficient file, nothing half-done
   written <- utils::read.csv(file.path(out, "calibration.csv"), stringsAsFactors = FALSE)
   expect_identical(written$file, tab$file)
-  expect_equal(written$o_x, tab$o_x)
+  expect_equal(written$offset.x, tab$offset.x)
   coefs <- utils::read.csv(file.path(out, "calibration_ggir_coefs.csv"))
   expect_identical(sort(coefs$filename), sort(tab$file[tab$status %in% c("ok", "high_error")]))
-  expect_length(list.files(out, pattern = "tmp$", recursive = TRUE, all.files = TRUE), 0)
+  expect_length(list.files(out, pattern = "tmp$|part$", recursive = TRUE, all.files = TRUE), 0)
   # the lightweight method too
   tl <- calibrate_files(file.path(dir, c("p01.csv", "p04.rds")),
                         method = "lightweight", outdir = out, sf = 10)
-  expect_identical(unname(unlist(tl[1, param_names()])),
-                   unname(coef(calibrate(file.path(dir, "p01.csv"), sf = 10))[1:9]))
+  expect_identical(unname(unlist(tl[1, c(ggir_names[1:6], "cross.xy", "cross.xz",
+                                         "cross.yz")])),
+                   unname(coef(calibrate(file.path(dir, "p01.csv"), sf = 10))[c(1:3, 7:9, 4:6)]))
   expect_false(file.exists(file.path(out, "calibration_lightweight.csv")))
+  # the GGIR coefficients of the earlier run no longer match the table
+  expect_false(file.exists(file.path(out, "calibration_ggir_coefs.csv")))
 })
 
 test_that("in parallel (multisession, 2 workers) the table is the same", {
@@ -88,15 +98,17 @@ test_that("an interrupted run resumes without redoing finished recordings", {
   expect_gte(length(saved), 2)
   expect_lt(length(saved), 5)  # stopped before the end
   stamp <- file.mtime(saved)
-  tab <- calibrate_files(dir, outdir = out, sf = 10)
+  # the killed run's lock names a process that is gone: taken over
+  expect_message(tab <- calibrate_files(dir, outdir = out, sf = 10),
+                 "took over the lock")
   # finished recordings were not redone, and the table is the same
   expect_identical(file.mtime(saved), stamp)
   expect_identical(tab[setdiff(names(tab), "seconds")],
                    full[setdiff(names(full), "seconds")])
-  expect_length(list.files(out, pattern = "tmp$", recursive = TRUE, all.files = TRUE), 0)
+  expect_length(list.files(out, pattern = "tmp$|part$", recursive = TRUE, all.files = TRUE), 0)
 })
 
-test_that("calibrate_files() and cli() reject bad input clearly", {
+test_that("calibrate_files() and calibrate_cli() reject bad input clearly", {
   expect_error(calibrate_files(character(0), outdir = tempdir()), "`files`")
   expect_error(calibrate_files(tempfile(), outdir = tempdir()), "do not exist")
   d <- tempfile("empty")
@@ -104,19 +116,44 @@ test_that("calibrate_files() and cli() reject bad input clearly", {
   expect_error(calibrate_files(d, outdir = tempdir()), "no recordings")
   expect_error(calibrate_files(gravcal_example()), "`outdir`")
   expect_error(calibrate_files(gravcal_example(), "ggir", tempdir(), 3), "named")
-  expect_output(cli("--help"), "Usage")
-  expect_error(cli(c("--out")), "needs a value")
-  expect_error(cli(c("--bogus", "x")), "unknown option")
-  expect_error(cli(c("--out", tempdir())), "no recordings")
+  expect_error(calibrate_files(c(gravcal_example(), d), outdir = tempdir()),
+               "are directories")
+  expect_error(calibrate_files(gravcal_example(), outdir = gravcal_example()),
+               "is a file")
+  expect_error(calibrate_files(gravcal_example(), outdir = tempdir(), resume = NA),
+               "`resume` must be TRUE or FALSE")
+  help <- utils::capture.output(calibrate_cli("--help", quit = FALSE))
+  expect_match(help[1], "Usage")
+  # --help lists every option the parser takes
+  for (o in c("--method", "--out", "--workers", "--sf", "--pattern",
+              "--no-resume", "--help")) {
+    expect_true(any(grepl(o, help, fixed = TRUE)), label = o)
+  }
+  cli <- function(a) calibrate_cli(a, quit = FALSE)
+  expect_error(cli(c("--out")), "`--out` needs a value")
+  expect_error(cli(c("--out", "--method", "ggir")), "`--out` needs a value")
+  expect_error(cli(c("--bogus", "x")), "Unknown option `--bogus`")
+  expect_error(cli(c("--out", tempdir())), "No recordings")
+  expect_error(cli(gravcal_example()), "`--out DIR` is required")
   expect_error(cli(c("--out", tempdir(), "--method", "x", gravcal_example())), "ggir or lightweight")
+  expect_error(cli(c("--out", tempdir(), "--workers", "0", gravcal_example())),
+               "`--workers` must be a positive whole number, not \"0\"")
+  expect_error(cli(c("--out", tempdir(), "--sf", "fast", gravcal_example())),
+               "`--sf` must be a positive number")
+  expect_error(cli(c("--out", tempdir(), "--out", tempdir(), gravcal_example())),
+               "given twice")
+  expect_error(calibrate_cli("--help", quit = NA), "`quit`")
+  # no function of gravcal's masks cli::cli()
+  expect_false("cli" %in% getNamespaceExports("gravcal"))
 })
 
-test_that("cli() calibrates files given on the command line", {
+test_that("calibrate_cli() calibrates files given on the command line", {
   dir <- cohort_dir()
   on.exit(unlink(dir, recursive = TRUE))
   out <- file.path(dir, "cli")
-  expect_message(tab <- cli(c("--", "--method", "lightweight", "--sf", "10", "--out", out,
-                              file.path(dir, "p01.csv"), file.path(dir, "p05_corrupt.csv"))),
+  expect_message(tab <- calibrate_cli(c("--", "--method", "lightweight", "--sf", "10", "--out", out,
+                              file.path(dir, "p01.csv"), file.path(dir, "p05_corrupt.csv")),
+                              quit = FALSE),
                  "1 calibrated, 0 not calibrated, 1 failed")
   expect_identical(tab$file, c("p01.csv", "p05_corrupt.csv"))
   expect_true(file.exists(file.path(out, "calibration.csv")))
