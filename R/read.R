@@ -124,7 +124,7 @@ read_plain_csv <- function(file, arg) {
 check_sample_columns <- function(data, file, arg) {
   missing <- setdiff(c("x", "y", "z"), names(data))
   if (length(missing)) {
-    first <- tryCatch(readLines(file, n = 1, warn = FALSE), error = function(e) "")
+    first <- tryCatch(suppressWarnings(readLines(file, n = 1, warn = FALSE)), error = function(e) "")
     hint <- if (any(grepl(";", first, fixed = TRUE))) {
       " It looks separated by semicolons: gravcal's own reader (`reader = \"native\"`) reads those."
     } else ""
@@ -188,7 +188,15 @@ read_native <- function(file, format, sf, arg = "file") {
 }
 
 is_actigraph_csv <- function(file) {
-  grepl("ActiGraph", readLines(file, n = 1, warn = FALSE)[1], ignore.case = TRUE)
+  # the first line's bytes, not text: a binary file named .csv must not make
+  # a text connection warn about its encoding
+  con <- if (grepl("\\.gz$", file, ignore.case = TRUE)) gzfile(file, "rb") else file(file, "rb")
+  on.exit(close(con))
+  b <- readBin(con, "raw", 512)
+  nl <- match(as.raw(10), b)
+  if (!is.na(nl)) b <- b[seq_len(nl - 1)]
+  b <- b[b >= as.raw(32) & b < as.raw(127)]
+  grepl("ActiGraph", rawToChar(b), ignore.case = TRUE)
 }
 
 # A whole .cwa, .bin or ActiGraph csv file, from its blocks.
@@ -486,7 +494,7 @@ source_frame <- function(x, sf, chunksize, arg) {
 # ActiGraph csv export (10 header lines, optional column-name line, then
 # [timestamp,] x, y, z) or a plain csv with a header line naming x, y, z.
 source_csv <- function(file, sf, chunksize) {
-  head <- readLines(file, n = 12, warn = FALSE)
+  head <- suppressWarnings(readLines(file, n = 12, warn = FALSE))
   if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
   actigraph <- is_actigraph_csv(file)
   if (!actigraph) {
