@@ -257,42 +257,42 @@ ggir_run <- function(src, compat = TRUE,
       pending <- FALSE
       next_fit <- n_feat * ggir_constants$refit_growth
       spherepopulated <- FALSE
-      ft <- if (length(feats)) do.call(rbind, feats) else
+      # GGIR's table rules as one index into the whole window table (its row
+      # numbers are GGIR's row names), so that the table is copied once
+      # however many rules apply
+      full <- if (length(feats)) do.call(rbind, feats) else
         matrix(numeric(0), 0, if (temp.available) 8 else 7)
-      # ft_id: the window's number in the recording (GGIR's row names)
-      ft_id <- seq_len(nrow(ft))
-      ft_rest <- unlist(rests, use.names = FALSE)
-      keep <- !is.na(ft[, 4]) & !is.na(ft[, 1])
-      ft <- ft[keep, , drop = FALSE]
-      ft_id <- ft_id[keep]
-      ft_rest <- ft_rest[keep]
-      n <- nrow(ft)
+      full_rest <- unlist(rests, use.names = FALSE)
+      idx <- which(!is.na(full[, 4]) & !is.na(full[, 1]))
+      n <- length(idx)
       if (n > 1) {
-        same <- rowSums(ft[1:(n - 1), 2:7, drop = FALSE] == ft[2:n, 2:7, drop = FALSE])
-        cut <- which(same == if (compat) 3 else 6)
-        if (length(cut)) {
-          ft <- ft[-cut, , drop = FALSE]
-          ft_id <- ft_id[-cut]
-          ft_rest <- ft_rest[-cut]
+        # consecutive windows equal in 3 (GGIR) or all 6 of means and sds
+        same <- integer(n - 1)
+        for (j in 2:7) {
+          col <- full[idx, j]
+          same <- same + (col[-n] == col[-1])
         }
+        cut <- which(same == if (compat) 3 else 6)
+        if (length(cut)) idx <- idx[-cut]
+        same <- col <- NULL
       }
+      ft <- NULL
       nhoursused <- 0
       enough <- if (compat) {
-        nrow(ft) > (minloadcrit - ggir_constants$enough_offset)
+        length(idx) > (minloadcrit - ggir_constants$enough_offset)
       } else {
-        nrow(ft) * ggir_constants$window >= ggir_constants$min_hours * 3600
+        length(idx) * ggir_constants$window >= ggir_constants$min_hours * 3600
       }
       if (enough) {
-        nhoursused <- (nrow(ft) * 10) / 3600
-        ft <- ft[-1, , drop = FALSE]
-        ft_id <- ft_id[-1]
-        nomovement <- which(ft_rest[-1])
-        if (length(nomovement) < ggir_constants$min_rest) {
+        nhoursused <- (length(idx) * 10) / 3600
+        # the first window is left out, then the windows at rest
+        idx <- idx[-1]
+        idx <- idx[full_rest[idx]]
+        if (length(idx) < ggir_constants$min_rest) {
           QC <- ggir_messages[["no_rest"]]
-          ft <- NULL
         } else {
-          ft <- ft[nomovement, , drop = FALSE]
-          ft_id <- ft_id[nomovement]
+          ft <- full[idx, , drop = FALSE]
+          ft_id <- idx
           npoints <- nrow(ft)
           cal.error.start <- ggir_error(ft[, 2:4, drop = FALSE], c(1, 1, 1),
                                         c(0, 0, 0))
@@ -305,7 +305,10 @@ ggir_run <- function(src, compat = TRUE,
         }
       } else {
         QC <- ggir_messages[["no_data"]]
+        ft <- full[idx, , drop = FALSE]
+        ft_id <- idx
       }
+      rm(full, full_rest)
       if (spherepopulated) {
         temp <- if (use.temp) ft[, 8] else NULL
         fit_ft <- function(rule) {
