@@ -32,7 +32,7 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check core sanitize valgrind fuzz-short
+test: check core sanitize valgrind fuzz-short test-slurm
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
