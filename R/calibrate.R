@@ -146,7 +146,15 @@
 #'     `error_heldout_before`, `error_heldout_after`: the same over the rest
 #'     windows not used for the fit (NA when there are none);
 #'   * `iterations`, `converged`, `status`, `message`, `method`, `call`, and
-#'     for the lightweight method `params` (the nine parameters).
+#'     for the lightweight method `params` (the nine parameters);
+#'   * `se`: standard errors, named like [coef()]'s coefficients (NA for a
+#'     coefficient the model does not fit, and for every coefficient when
+#'     the fit was not applied); `vcov`: the covariance of the fitted
+#'     coefficients (NULL when not fitted), `df` (residual degrees of
+#'     freedom) and `sigma` (residual standard deviation), from the
+#'     Jacobian of the residuals at the solution (see [vcov.gravcal_fit()]);
+#'   * for the lightweight method from [calibrate()]: `excluded`,
+#'     `excluded_windows` and `guards` (see Details).
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
 #' @export
 #' @examples
@@ -326,7 +334,7 @@ guard_fit <- function(fit) {
     if (!is.null(fit$params)) fit$params[] <- c(1, 1, 1, 0, 0, 0, 0, 0, 0)
     fit$status <- status
     fit$message <- message
-    fit <- refresh_errors(fit)
+    fit <- refresh_errors(clear_uncertainty(fit))
     fit
   }
   before <- fit$error_before
@@ -379,7 +387,7 @@ new_fit <- function(K = diag(3), offset = c(0, 0, 0), tempoffset = c(0, 0, 0),
               iterations = as.integer(iterations), converged = converged,
               status = status, message = message, method = method, call = call)
   class(fit) <- "gravcal_fit"
-  refresh_errors(fit)
+  refresh_errors(clear_uncertainty(fit))
 }
 
 refresh_errors <- function(fit) {
@@ -457,7 +465,26 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
         format(signif(x$tempoffset, digits)), "\n")
     cat("  meantemp (degree C):", format(x$meantemp), "\n")
   }
+  print_se(x$se, x$df)
   invisible(x)
+}
+
+# The standard errors that exist, by group.
+print_se <- function(se, df) {
+  if (is.null(se) || !any(is.finite(se))) return(invisible())
+  cat(sprintf("  standard errors (%d residual df):\n", as.integer(df)))
+  groups <- list("scale" = c("k_xx", "k_yy", "k_zz"),
+                 "cross-axis" = c("k_xy", "k_xz", "k_yz"),
+                 "offset (g)" = c("o_x", "o_y", "o_z"),
+                 "tempoffset (g/degree C)" = c("t_x", "t_y", "t_z"))
+  for (g in names(groups)) {
+    v <- se[groups[[g]]]
+    if (any(is.finite(v))) {
+      cat("    ", g, ": ", paste(format(signif(v, 2)), collapse = " "),
+          "\n", sep = "")
+    }
+  }
+  invisible()
 }
 
 #' @export
@@ -480,8 +507,12 @@ summary.gravcal_fit <- function(object, ...) {
   err$improvement <- err$before_mg / err$after_mg
   bins <- NULL
   if (!is.null(object$points$bin)) bins <- table(object$points$bin)
+  se <- object$se
+  if (is.null(se)) se <- stats::setNames(rep(NA_real_, length(co)), names(co))
+  co <- cbind(estimate = co, se = unname(se[names(co)]))
   structure(list(method = object$method, status = object$status,
                  message = object$message, coefficients = co, errors = err,
+                 df = if (is.null(object$df)) NA_integer_ else object$df,
                  bins = bins, iterations = object$iterations,
                  converged = object$converged),
             class = "summary.gravcal_fit")
@@ -493,7 +524,15 @@ print.summary.gravcal_fit <- function(x, ...) {
   cat("status: ", x$status, if (nzchar(x$message)) paste0(" - ", x$message),
       "\n\n", sep = "")
   cat("Coefficients:\n")
-  print(round(x$coefficients, 6))
+  co <- x$coefficients
+  if (any(is.finite(co[, "se"]))) {
+    cat("(standard errors on ", x$df, " residual df; NA: not fitted)\n",
+        sep = "")
+    print(cbind(estimate = round(co[, "estimate"], 6),
+                se = signif(co[, "se"], 3)))
+  } else {
+    print(round(co[, "estimate"], 6))
+  }
   cat("\nError | |a| - 1 | (mg):\n")
   e <- x$errors
   e$before_mg <- round(e$before_mg, 2)
