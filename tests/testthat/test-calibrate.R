@@ -259,3 +259,25 @@ test_that("all rest windows left out is the status no_rest", {
   expect_equal(f$excluded, c(norm = 60L, clipped = 0L))
   expect_match(f$message, "60 windows met the rest criterion but all")
 })
+
+test_that("the clipping guard takes the full scale from a device file", {
+  rec <- simulate_recording(hours = 12, sf = 25, seed = 3)
+  v <- as.matrix(rec[, c("x", "y", "z")])
+  # the first 5 s stuck at the full scale of a +-2 g Axivity
+  v[1:125, 1] <- 2
+  v[1:125, 2] <- 0.2
+  v[1:125, 3] <- 0.1
+  f <- tempfile(fileext = ".cwa")
+  on.exit(unlink(f))
+  gravcal:::write_cwa(v, f, sf = 25, range = 2)
+  fit <- calibrate(f, max_norm_error = Inf)
+  expect_equal(fit$input$range_g, 2)
+  expect_equal(fit$guards$range_g, 2)
+  expect_equal(fit$excluded, c(norm = 0L, clipped = 1L))
+  expect_equal(fit$status, "ok")
+  # a range given by the user wins: at +-16 g the window is not clipped,
+  # is taken as a point and wrecks the fit
+  wide <- calibrate(f, max_norm_error = Inf, range_g = 16)
+  expect_equal(wide$excluded, c(norm = 0L, clipped = 0L))
+  expect_equal(wide$status, "implausible")
+})
