@@ -23,6 +23,32 @@
 #' iterations, typically 100-700). Give `max_iter = 50, tol = 0` for the
 #' paper's budget, exactly as a device would run it.
 #'
+#' Two guards keep unreliable rest windows out of the lightweight fit (the
+#' paper has none; [select_points()] and [fit_gradient()] called directly
+#' still take every point they are given):
+#' * a window whose mean vector has a norm farther than `max_norm_error`
+#'   (default 0.3 g) from 1 g. Real sensors before calibration are 16-77 mg
+#'   from 1 g on average (van Hees et al. 2014, Table 3), and the
+#'   orientation bins already need every axis within 0.25 g of 0 or 1 g; a
+#'   window 0.3 g off is not gravity (a glitch, a window of zeros, a
+#'   clipped axis), and one such point among 18 can move the fit by
+#'   hundreds of mg. A sensor with an offset above about 0.3 g loses the
+#'   windows of that axis, and the fit reports `"bins_incomplete"` rather
+#'   than wrong coefficients; give a larger `max_norm_error` (or `Inf`, no
+#'   guard) for such a sensor.
+#' * a window that reaches the sensor's range (clipping): on some axis
+#'   `|mean| + (max - min)`, the largest |sample| the window can hold,
+#'   is at least 98 % of the full scale `range_g` (g). For a device file
+#'   the full scale is taken from the file when its reader knows it
+#'   (Axivity, GENEActiv, ActiGraph); for samples in memory it is unknown
+#'   unless `range_g` is given, and then this guard is off.
+#'
+#' The fit records the windows left out: `excluded` (counts, named `norm`
+#' and `clipped`; a clipped window counts as clipped only),
+#' `excluded_windows` (those windows, with a column `why`) and `guards` (the
+#' limits used); `print()` shows the counts. Windows left out are neither
+#' points nor held-out windows.
+#'
 #' The rest windows that were not selected as calibration points are a
 #' held-out set, as in the paper's Table 3: the fit reports the error on them
 #' before and after calibration (`error_heldout_before`,
@@ -54,7 +80,9 @@
 #'   corrected procedure (`FALSE`, default).
 #' @param ... For the lightweight method, arguments passed on to
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
-#'   `chunk_size`, `progress`, `reader`), [select_points()] (`per_bin`, `min_per_bin`,
+#'   `chunk_size`, `progress`, `reader`), the guards (`max_norm_error`, in g,
+#'   default 0.3; `range_g`, the sensor's full scale in g, default from the
+#'   file or unknown; see Details), [select_points()] (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
 #'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`). For the GGIR method:
 #'   `use_temp` (fit the temperature term when there is one, default TRUE),
@@ -118,7 +146,15 @@
 #'     `error_heldout_before`, `error_heldout_after`: the same over the rest
 #'     windows not used for the fit (NA when there are none);
 #'   * `iterations`, `converged`, `status`, `message`, `method`, `call`, and
-#'     for the lightweight method `params` (the nine parameters).
+#'     for the lightweight method `params` (the nine parameters);
+#'   * `se`: standard errors, named like [coef()]'s coefficients (NA for a
+#'     coefficient the model does not fit, and for every coefficient when
+#'     the fit was not applied); `vcov`: the covariance of the fitted
+#'     coefficients (NULL when not fitted), `df` (residual degrees of
+#'     freedom) and `sigma` (residual standard deviation), from the
+#'     Jacobian of the residuals at the solution (see [vcov.gravcal_fit()]);
+#'   * for the lightweight method from [calibrate()]: `excluded`,
+#'     `excluded_windows` and `guards` (see Details).
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
 #' @export
 #' @examples
@@ -145,13 +181,35 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   args <- split_dots(list(...), list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader"),
+    guards = c("max_norm_error", "range_g"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
                      "use_sqrt", "tol", "trace", "difference")))
+  gargs <- args$guards
+  max_norm_error <- if (is.null(gargs$max_norm_error)) 0.3 else
+    gargs$max_norm_error
+  if (!identical(max_norm_error, Inf)) {
+    check_number(max_norm_error, "max_norm_error", min = 0,
+                 min_inclusive = FALSE)
+  }
+  range_g <- gargs$range_g
+  if (!is.null(range_g)) {
+    check_number(range_g, "range_g", min = 0, min_inclusive = FALSE)
+  }
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method),
                                args$rest_windows))
+  if (is.null(range_g)) range_g <- attr(w, "input")$range_g
   rest <- w[w$rest, , drop = FALSE]
+  why <- guard_windows(rest, max_norm_error, range_g)
+  excluded <- table(factor(why[!is.na(why)], levels = c("norm", "clipped")))
+  excluded <- stats::setNames(as.integer(excluded), names(excluded))
+  excluded_windows <- rest[!is.na(why), , drop = FALSE]
+  excluded_windows$why <- why[!is.na(why)]
+  rest <- rest[is.na(why), , drop = FALSE]
+  rownames(rest) <- NULL
   attr(rest, "n_windows") <- nrow(w)
+  guards <- list(max_norm_error = max_norm_error,
+                 range_g = if (is.null(range_g)) NA_real_ else range_g)
   hours <- attr(w, "samples") / attr(w, "sf") / 3600
   fail <- function(status, message, points = rest[0, , drop = FALSE]) {
     f <- new_fit(points = points, method = method, status = status,
@@ -159,12 +217,19 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     f$hours <- hours
     f$input <- attr(w, "input")
     if (is.character(x)) f$file <- basename(x)
+    f <- add_guards(f, excluded, excluded_windows, guards)
     finish_fit(f, rest)
   }
   if (nrow(w) == 0) {
     return(fail("too_short", sprintf(paste0(
       "recording too short: %d samples, fewer than one %g s window at %g Hz"),
       attr(w, "samples"), attr(w, "window"), attr(w, "sf"))))
+  }
+  if (nrow(rest) == 0 && sum(excluded) > 0) {
+    return(fail("no_rest", sprintf(paste0(
+      "no rest: %d windows met the rest criterion but all were left out ",
+      "(%s); are the samples in g?"), sum(excluded), format_excluded(
+        excluded, guards))))
   }
   if (nrow(rest) == 0) {
     return(fail("no_rest", sprintf(paste0(
@@ -191,7 +256,48 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   fit$hours <- hours
   fit$input <- attr(w, "input")
   if (is.character(x)) fit$file <- basename(x)
+  fit <- add_guards(fit, excluded, excluded_windows, guards)
   finish_fit(fit, rest)
+}
+
+# The rest windows that are never calibration points, and why: "clipped"
+# when on some axis the largest |sample| the window can hold, |mean| +
+# (max - min), reaches 98 % of the sensor's full scale `range_g` (skipped
+# when the range is unknown); else "norm" when the mean vector's norm is
+# farther than `max_norm_error` g from 1 g. NA for the windows kept.
+guard_windows <- function(rest, max_norm_error, range_g) {
+  why <- rep(NA_character_, nrow(rest))
+  if (nrow(rest) == 0) return(why)
+  m <- cbind(rest$mean_x, rest$mean_y, rest$mean_z)
+  norm <- sqrt(rowSums(m^2))
+  why[abs(norm - 1) > max_norm_error] <- "norm"
+  if (length(range_g) == 1 && is.finite(range_g) && range_g > 0) {
+    r <- cbind(rest$range_x, rest$range_y, rest$range_z)
+    if (is.null(r) || ncol(r) < 3) r <- matrix(0, nrow(m), 3)
+    r[!is.finite(r)] <- 0
+    reach <- rowSums(abs(m) + r >= clip_fraction * range_g) > 0
+    why[reach] <- "clipped"
+  }
+  why
+}
+
+# A window reaches the sensor's range when a sample may lie within 2 % of
+# full scale: the last counts of an ADC and a decoder's rounding.
+clip_fraction <- 0.98
+
+add_guards <- function(fit, excluded, excluded_windows, guards) {
+  fit$excluded <- excluded
+  fit$excluded_windows <- excluded_windows
+  fit$guards <- guards
+  fit
+}
+
+format_excluded <- function(excluded, guards) {
+  paste0(excluded[["norm"]], " with | |v| - 1 | > ",
+         format(guards$max_norm_error), " g, ", excluded[["clipped"]],
+         " clipped", if (is.finite(guards$range_g))
+           paste0(" (range +-", format(guards$range_g), " g)") else
+             " (sensor range unknown, not checked)")
 }
 
 # Route `...` to the functions that take each argument; unknown names fail.
@@ -228,7 +334,7 @@ guard_fit <- function(fit) {
     if (!is.null(fit$params)) fit$params[] <- c(1, 1, 1, 0, 0, 0, 0, 0, 0)
     fit$status <- status
     fit$message <- message
-    fit <- refresh_errors(fit)
+    fit <- refresh_errors(clear_uncertainty(fit))
     fit
   }
   before <- fit$error_before
@@ -281,7 +387,7 @@ new_fit <- function(K = diag(3), offset = c(0, 0, 0), tempoffset = c(0, 0, 0),
               iterations = as.integer(iterations), converged = converged,
               status = status, message = message, method = method, call = call)
   class(fit) <- "gravcal_fit"
-  refresh_errors(fit)
+  refresh_errors(clear_uncertainty(fit))
 }
 
 refresh_errors <- function(fit) {
@@ -337,6 +443,10 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
                 format(x$n_windows)))
   }
   cat("\n")
+  if (!is.null(x$excluded)) {
+    cat("  rest windows left out: ", format_excluded(x$excluded, x$guards),
+        "\n", sep = "")
+  }
   if (is.finite(x$error_before)) {
     cat(sprintf("  error on fitting points: %.2f mg -> %.2f mg\n",
                 1000 * x$error_before, 1000 * x$error_after))
@@ -355,7 +465,26 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
         format(signif(x$tempoffset, digits)), "\n")
     cat("  meantemp (degree C):", format(x$meantemp), "\n")
   }
+  print_se(x$se, x$df)
   invisible(x)
+}
+
+# The standard errors that exist, by group.
+print_se <- function(se, df) {
+  if (is.null(se) || !any(is.finite(se))) return(invisible())
+  cat(sprintf("  standard errors (%d residual df):\n", as.integer(df)))
+  groups <- list("scale" = c("k_xx", "k_yy", "k_zz"),
+                 "cross-axis" = c("k_xy", "k_xz", "k_yz"),
+                 "offset (g)" = c("o_x", "o_y", "o_z"),
+                 "tempoffset (g/degree C)" = c("t_x", "t_y", "t_z"))
+  for (g in names(groups)) {
+    v <- se[groups[[g]]]
+    if (any(is.finite(v))) {
+      cat("    ", g, ": ", paste(format(signif(v, 2)), collapse = " "),
+          "\n", sep = "")
+    }
+  }
+  invisible()
 }
 
 #' @export
@@ -378,8 +507,12 @@ summary.gravcal_fit <- function(object, ...) {
   err$improvement <- err$before_mg / err$after_mg
   bins <- NULL
   if (!is.null(object$points$bin)) bins <- table(object$points$bin)
+  se <- object$se
+  if (is.null(se)) se <- stats::setNames(rep(NA_real_, length(co)), names(co))
+  co <- cbind(estimate = co, se = unname(se[names(co)]))
   structure(list(method = object$method, status = object$status,
                  message = object$message, coefficients = co, errors = err,
+                 df = if (is.null(object$df)) NA_integer_ else object$df,
                  bins = bins, iterations = object$iterations,
                  converged = object$converged),
             class = "summary.gravcal_fit")
@@ -391,7 +524,15 @@ print.summary.gravcal_fit <- function(x, ...) {
   cat("status: ", x$status, if (nzchar(x$message)) paste0(" - ", x$message),
       "\n\n", sep = "")
   cat("Coefficients:\n")
-  print(round(x$coefficients, 6))
+  co <- x$coefficients
+  if (any(is.finite(co[, "se"]))) {
+    cat("(standard errors on ", x$df, " residual df; NA: not fitted)\n",
+        sep = "")
+    print(cbind(estimate = round(co[, "estimate"], 6),
+                se = signif(co[, "se"], 3)))
+  } else {
+    print(round(co[, "estimate"], 6))
+  }
   cat("\nError | |a| - 1 | (mg):\n")
   e <- x$errors
   e$before_mg <- round(e$before_mg, 2)

@@ -65,7 +65,9 @@
 #'   `temperature.offset.x`, `temperature.offset.y`,
 #'   `temperature.offset.z`, then for the lightweight method the cross-axis
 #'   terms `cross.xy`, `cross.xz`, `cross.yz` (`k_xy`, `k_xz`, `k_yz` of
-#'   `coef()`), and `meantempcal`; `error_before_mg`, `error_after_mg` (on
+#'   `coef()`); their standard errors, in the same order, named with a
+#'   `.se` suffix (`scale.x.se`, ...; `fit$se`, NA for what was not
+#'   fitted or not applied); `meantempcal`; `error_before_mg`, `error_after_mg` (on
 #'   the rest points used); `format`, `hours` (of samples read), `windows`,
 #'   `rest_windows`; what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
@@ -258,7 +260,9 @@ read_saved <- function(slot, identity, settings) {
     return(list(note = paste0("the saved result \"", slot, "\" could not be ",
                               "read (", bad, ") and was recomputed")))
   }
+  # a result saved before the rows carried standard errors is stale too
   if (!identical(res$key$settings, settings) ||
+      !"scale.x.se" %in% names(res$row) ||
       (!is.null(identity) && !identical(res$key$identity, identity))) {
     unlink(slot)
     return(list())
@@ -389,6 +393,10 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
   if (method == "lightweight") {
     coefs[c("cross.xy", "cross.xz", "cross.yz")] <- as.list(cf[4:6])
   }
+  # their standard errors, same order, named with a .se suffix
+  se <- if (na || is.null(fit$se)) rep(NA_real_, 12) else unname(fit$se)
+  se <- se[c(1:3, 7:12, 4:6)[seq_along(coefs)]]
+  coefs[paste0(names(coefs), ".se")] <- as.list(se)
   num <- function(v) if (is.null(v)) NA_real_ else as.numeric(v)[1]
   inp <- if (na) NULL else fit$input
   rep <- inp$report

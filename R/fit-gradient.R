@@ -160,6 +160,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   fit$settings <- list(arithmetic = arithmetic, max_iter = max_iter,
                        rates = rates, h = h, objective = objective,
                        use_sqrt = use_sqrt, tol = tol, difference = difference)
+  if (status == "ok") fit <- add_uncertainty(fit, v, use_sqrt = use_sqrt)
   if (trace) {
     tr <- t(r$trace)
     colnames(tr) <- c(param_names(), "f")

@@ -632,6 +632,12 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
   fit$QCmessage <- qc
   fit$ggir_compat <- compat
   fit$use_temp <- isTRUE(res$use.temp)
+  if (applied && !is.null(pts) && nrow(pts) > 0) {
+    fit <- add_uncertainty(fit, cbind(pts$mean_x, pts$mean_y, pts$mean_z),
+                           if (fit$use_temp) pts$temperature,
+                           weights = "ggir",
+                           max_weight = ggir_constants$max_weight)
+  }
   fit$n_windows <- info$windows
   fit$input <- info$input
   fit$hours <- info$windows * 10 / 3600

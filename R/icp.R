@@ -111,6 +111,12 @@ fit_icp <- function(w, use_temp = TRUE, ggir_compat = FALSE, max_iter = 1000,
                  call = call)
   fit$use_temp <- isTRUE(r$temp_used)
   fit$ggir_compat <- ggir_compat
+  if (status == "ok") {
+    fit <- add_uncertainty(fit, cbind(as.double(w$mean_x),
+                                      as.double(w$mean_y),
+                                      as.double(w$mean_z)),
+                           temp, weights = "ggir", max_weight = max_weight)
+  }
   if (trace) {
     tr <- as.data.frame(t(r$trace))
     names(tr) <- c("scale_x", "scale_y", "scale_z", "offset_x", "offset_y",

@@ -346,6 +346,9 @@ source_input <- function(src, samples) {
   list(source = src$filename, format = src$format,
        reader = if (is.null(src$native)) "reference" else "native",
        serial = if (is.null(src$info$serial)) NA_character_ else src$info$serial,
+       range_g = if (is.numeric(src$info$range_g) &&
+                     length(src$info$range_g) == 1) src$info$range_g else
+                       NA_real_,
        samples = samples, report = rep)
 }
 

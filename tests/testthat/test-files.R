@@ -38,6 +38,16 @@ test_that("calibrate_files() calibrates a folder, one row per recording", {
                  unname(coef(f)[c(1:3, 7:12)]), tolerance = 0, label = tab$file[i])
     expect_identical(tab$status[i], f$status)
   }
+  # their standard errors, named with a .se suffix, are the fits'
+  se_names <- paste0(ggir_names, ".se")
+  expect_identical(names(tab)[13:21], se_names)
+  fits <- attr(tab, "fits")
+  for (i in which(tab$status %in% c("ok", "high_error"))) {
+    expect_equal(unname(unlist(tab[i, se_names])),
+                 unname(fits[[i]]$se[c(1:3, 7:12)]), label = tab$file[i])
+    expect_true(all(is.finite(unlist(tab[i, se_names[1:6]]))))
+  }
+  expect_true(all(is.na(unlist(tab[5, se_names]))))
   expect_identical(tab$status[5], "failed")
   expect_match(tab$message[5], "p05_corrupt.csv.*no lines of it hold samples")
   expect_identical(tab$message[1:4], vapply(1:4, function(i) {
@@ -58,6 +68,10 @@ test_that("calibrate_files() calibrates a folder, one row per recording", {
   expect_identical(unname(unlist(tl[1, c(ggir_names[1:6], "cross.xy", "cross.xz",
                                          "cross.yz")])),
                    unname(coef(calibrate(file.path(dir, "p01.csv"), sf = 10))[c(1:3, 7:9, 4:6)]))
+  expect_identical(unname(unlist(tl[1, c("cross.xy.se", "cross.xz.se",
+                                         "cross.yz.se", "scale.x.se")])),
+                   unname(attr(tl, "fits")[[1]]$se[c(4:6, 1)]))
+  expect_true(all(is.finite(unlist(tl[1, c("cross.xy.se", "offset.z.se")]))))
   expect_false(file.exists(file.path(out, "calibration_lightweight.csv")))
   # the GGIR coefficients of the earlier run no longer match the table
   expect_false(file.exists(file.path(out, "calibration_ggir_coefs.csv")))
