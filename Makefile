@@ -2,6 +2,8 @@
 #   make demo   set up, install, calibrate the bundled example recording
 #   make test   set up, R CMD build + R CMD check --as-cran (all tests),
 #               then the standalone C++ core tests
+#   make site   the pkgdown documentation site (_build/site), checked in
+#               headless Chromium
 R ?= R
 RSCRIPT ?= Rscript
 BUILD := _build
@@ -20,7 +22,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup install demo test check core sanitize valgrind fuzz fuzz-short document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-slurm setup install demo test check core sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -32,7 +34,7 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check core sanitize valgrind fuzz-short test-slurm
+test: check core sanitize valgrind fuzz-short test-slurm site
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
@@ -98,6 +100,22 @@ bench-files: install
 # recompute the vignettes' cached results (about 10 minutes)
 refresh-vignettes: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) tools/refresh-vignettes.R
+
+# the documentation site (_pkgdown.yml) from the installed package, into
+# _build/site, without the network (pkgdown.internet = FALSE: no CRAN or
+# Bioconductor lookups) and on at most 2 cores; then tools/site-test.R opens
+# it in headless Chromium (screenshots in _build/site-shots) and fails on a
+# broken internal link or a missing image
+SITE_ENV := OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2 R_DATATABLE_NUM_THREADS=2 \
+            MC_CORES=2 R_PARALLELLY_AVAILABLECORES_FALLBACK=2 \
+            GRAVCAL_SHARED_DATA=$(SHARED_DATA)
+site: install
+	rm -rf $(BUILD)/site $(BUILD)/site-shots
+	env $(SITE_ENV) R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) -e \
+	  'options(pkgdown.internet = FALSE, Ncpus = 2); pkgdown::build_site(install = FALSE, new_process = FALSE, preview = FALSE)' \
+	  > $(BUILD)/site.log 2>&1 || (tail -60 $(BUILD)/site.log; exit 1)
+	@if grep -n "^Warning\|^Error" $(BUILD)/site.log; then echo "site: pkgdown warned (see $(BUILD)/site.log)"; exit 1; fi
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/site-test.R $(BUILD)/site $(BUILD)/site-shots
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png
