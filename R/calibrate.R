@@ -153,6 +153,10 @@
 #'     coefficients (NULL when not fitted), `df` (residual degrees of
 #'     freedom) and `sigma` (residual standard deviation), from the
 #'     Jacobian of the residuals at the solution (see [vcov.gravcal_fit()]);
+#'   * `model`: the names (as in [coef()]) of the coefficients the model
+#'     fitted: the nine of the lightweight model, GGIR's scale and offset
+#'     with `t_x`, `t_y`, `t_z` when the temperature was used; empty when
+#'     the coefficients are the identity;
 #'   * for the lightweight method from [calibrate()]: `excluded`,
 #'     `excluded_windows` and `guards` (see Details).
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
@@ -387,7 +391,11 @@ new_fit <- function(K = diag(3), offset = c(0, 0, 0), tempoffset = c(0, 0, 0),
               iterations = as.integer(iterations), converged = converged,
               status = status, message = message, method = method, call = call)
   class(fit) <- "gravcal_fit"
-  refresh_errors(clear_uncertainty(fit))
+  fit <- refresh_errors(clear_uncertainty(fit))
+  # the coefficients the model fitted, named as in coef() (none when the
+  # fit is the identity)
+  if (identical(status, "ok")) fit$model <- fitted_names(fit)
+  fit
 }
 
 refresh_errors <- function(fit) {

@@ -11,7 +11,7 @@
 
 # Names of the coefficients each model fits, in coef()'s order.
 fitted_names <- function(fit) {
-  if (identical(fit$method, "lightweight")) return(param_names())
+  if (fit$method %in% c("lightweight", "ellipsoid")) return(param_names())
   nm <- c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z")
   if (isTRUE(fit$use_temp)) {
     nm <- c(nm, "t_x", "t_y", "t_z")
@@ -58,6 +58,7 @@ residual_jacobian <- function(fit, v, temperature = NULL, use_sqrt = FALSE) {
 add_uncertainty <- function(fit, v, temperature = NULL, weights = NULL,
                             use_sqrt = FALSE, max_weight = 100) {
   fit <- clear_uncertainty(fit)
+  fit$model <- fitted_names(fit)
   jr <- residual_jacobian(fit, v, temperature, use_sqrt)
   J <- jr$J
   r <- jr$r
@@ -82,7 +83,10 @@ add_uncertainty <- function(fit, v, temperature = NULL, weights = NULL,
   fit
 }
 
+# (also for a fit whose coefficients are set back to the identity: it then
+# fits nothing, `model` is empty)
 clear_uncertainty <- function(fit) {
+  fit["model"] <- list(character(0))
   fit$se <- stats::setNames(rep(NA_real_, 12),
                             c(param_names(), "t_x", "t_y", "t_z"))
   fit["vcov"] <- list(NULL)

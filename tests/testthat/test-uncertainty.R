@@ -130,3 +130,25 @@ test_that("confint() gives estimate +- t(df) se and checks its arguments", {
   expect_output(print(fit), "standard errors \\(9 residual df\\)")
   expect_output(print(summary(fit)), "estimate +se")
 })
+
+test_that("fits name the coefficients their model fitted", {
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 61,
+                            params = c(1.01, 0.99, 1.02, 0, 0, 0, 0.02, -0.01, 0.015),
+                            tempoffset = c(0.001, 0, -0.001))
+  lw <- calibrate(rec, sf = 10, method = "lightweight")
+  expect_equal(lw$status, "ok")
+  expect_identical(lw$model, param_names())
+  gg <- calibrate(rec, sf = 10, method = "ggir")
+  expect_equal(gg$status, "ok")
+  expect_identical(gg$model, c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z",
+                               "t_x", "t_y", "t_z"))
+  # the model's coefficients are the ones with a standard error
+  expect_identical(names(gg$se)[!is.na(gg$se)], gg$model)
+  gg0 <- calibrate(rec[, c("x", "y", "z")], sf = 10, method = "ggir")
+  expect_identical(gg0$model, c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z"))
+  # not calibrated: identity, no model
+  short <- calibrate(simulate_recording(hours = 1, sf = 10, seed = 62), sf = 10,
+                     method = "ggir")
+  expect_false(short$status == "ok")
+  expect_identical(short$model, character(0))
+})
