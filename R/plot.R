@@ -1,17 +1,28 @@
 #' Plot rest points before and after calibration
 #'
-#' Four panels: (1) the deviation of every rest window from the unit sphere
-#' in 3-D, as in Farago et al. (2024), Fig. 8: each mean vector `v` is drawn
-#' at `v (|v| - 1) / |v|`, so a perfectly calibrated point sits at the origin
-#' and the distance from it is the error; (2-4) the x-y, x-z and y-z
-#' projections of the rest means against the unit circle. Before calibration
-#' in blue, after in red.
+#' `type = "map"` (default): where on the sphere the recording rested, and
+#' how far each rest window is from 1 g before and after calibration. Two
+#' maps of directions, azimuth (`atan2(y, x)`, degrees) against elevation
+#' (`asin(z / |v|)`, degrees), one point per rest window coloured by its
+#' error `| |v| - 1 |` in mg (before calibration on the left, after on the
+#' right, one colour scale); the windows the fit used are ringed in black.
+#' Empty regions of the map are orientations the recording never rested
+#' in, which the fit cannot learn from.
+#'
+#' `type = "panels"`: four panels: (1) the deviation of every rest window
+#' from the unit sphere in 3-D, as in Farago et al. (2024), Fig. 8: each
+#' mean vector `v` is drawn at `v (|v| - 1) / |v|`, so a perfectly
+#' calibrated point sits at the origin and the distance from it is the
+#' error; (2-4) the x-y, x-z and y-z projections of the rest means against
+#' the unit circle. Before calibration in blue, after in red.
 #'
 #' @param x A `gravcal_fit`.
-#' @param which Panels to draw, any of 1:4.
+#' @param which For `type = "panels"`: the panels to draw, any of 1:4
+#'   (giving `which` without `type` means `type = "panels"`).
 #' @param set `"windows"` (all rest windows, default when available) or
 #'   `"points"` (only the fitting points).
 #' @param theta,phi Viewing angles of the 3-D panel (see [graphics::persp()]).
+#' @param type `"map"` or `"panels"`, see Description.
 #' @param ... Unused.
 #' @return `x`, invisibly.
 #' @export
@@ -19,9 +30,14 @@
 #' rec <- simulate_recording(hours = 12, sf = 10, seed = 3)
 #' fit <- calibrate(rec, sf = 10)
 #' plot(fit)
+#' plot(fit, type = "panels")
 plot.gravcal_fit <- function(x, which = 1:4, set = c("windows", "points"),
-                             theta = 35, phi = 20, ...) {
+                             theta = 35, phi = 20, type = c("map", "panels"),
+                             ...) {
   set <- match_choice(set, "set")
+  # panels chosen by number are the "panels" type's
+  if (missing(type) && !missing(which)) type <- "panels"
+  type <- match_choice(type, "type")
   if (!is.numeric(which) || !length(which) || !all(which %in% 1:4)) {
     abort("`which` must be a subset of 1:4, not ", describe(which), ".")
   }
@@ -43,6 +59,10 @@ plot.gravcal_fit <- function(x, which = 1:4, set = c("windows", "points"),
             "is", " the zero vector, which has no direction to plot.")
   }
   after <- calibrate_points(x, before, d$temperature)
+  if (type == "map") {
+    sphere_map(sphere_map_data(x, d, before, after))
+    return(invisible(x))
+  }
   col <- c(before = grDevices::adjustcolor("#1f78b4", 0.6),
            after = grDevices::adjustcolor("#e31a1c", 0.7))
   if (length(which) > 1) {
@@ -90,4 +110,62 @@ projection_panel <- function(before, after, axes, col) {
   graphics::points(after[, axes], pch = 16, cex = 0.5, col = col[["after"]])
   graphics::title(main = paste0(nm[axes[1]], "-", nm[axes[2]], " projection"),
                   cex.main = 0.9)
+}
+
+# One row per rest window: its direction (azimuth and elevation in degrees,
+# from the uncalibrated mean), its error before and after calibration (mg),
+# and whether the fit used it.
+sphere_map_data <- function(fit, d, before, after) {
+  r <- sqrt(rowSums(before^2))
+  key <- function(m) paste(m[, 1], m[, 2], m[, 3])
+  used <- if (NROW(fit$points)) {
+    key(before) %in% key(as.matrix(fit$points[, c("mean_x", "mean_y", "mean_z")]))
+  } else rep(FALSE, nrow(before))
+  data.frame(azimuth = atan2(before[, 2], before[, 1]) * 180 / pi,
+             elevation = asin(pmax(-1, pmin(1, before[, 3] / r))) * 180 / pi,
+             error_before_mg = 1000 * abs(r - 1),
+             error_after_mg = 1000 * abs(sqrt(rowSums(after^2)) - 1),
+             used = used)
+}
+
+sphere_map <- function(m) {
+  old <- graphics::par(no.readonly = TRUE)
+  on.exit(graphics::par(old), add = TRUE)
+  graphics::layout(matrix(1:3, 1), widths = c(1, 1, 0.22))
+  graphics::par(mar = c(4.5, 4, 3, 1))
+  # one colour scale for both maps, on a square-root scale of the error
+  top <- max(c(m$error_before_mg, m$error_after_mg, 1), na.rm = TRUE)
+  pal <- grDevices::hcl.colors(64, "viridis", rev = TRUE)
+  colour <- function(e) pal[pmin(64, 1 + floor(63 * sqrt(pmax(e, 0) / top)))]
+  for (k in 1:2) {
+    e <- if (k == 1) m$error_before_mg else m$error_after_mg
+    graphics::plot(NA, xlim = c(-180, 180), ylim = c(-90, 90), xaxt = "n",
+                   yaxt = "n", xlab = "azimuth (degrees)",
+                   ylab = "elevation (degrees)")
+    graphics::axis(1, at = seq(-180, 180, 90))
+    graphics::axis(2, at = seq(-90, 90, 45))
+    graphics::abline(h = 0, v = c(-90, 0, 90), col = "grey85")
+    o <- order(e)
+    graphics::points(m$azimuth[o], m$elevation[o], pch = 16, cex = 0.7,
+                     col = colour(e[o]))
+    graphics::points(m$azimuth[m$used], m$elevation[m$used], pch = 1,
+                     cex = 1.1, lwd = 1.2)
+    graphics::title(main = sprintf("%s calibration: mean error %.1f mg",
+                                   if (k == 1) "Before" else "After",
+                                   mean(e)), cex.main = 0.9, line = 1.6)
+    graphics::mtext(sprintf("%d rest windows, %d used by the fit (ringed)",
+                            nrow(m), sum(m$used)), side = 3, line = 0.3,
+                    cex = 0.65)
+  }
+  # the colour scale
+  graphics::par(mar = c(4.5, 0.5, 3, 3))
+  ticks <- pretty(c(0, top), n = 5)
+  ticks <- ticks[ticks <= top]
+  yy <- seq(0, 1, length.out = 65)
+  graphics::plot(NA, xlim = c(0, 1), ylim = c(0, 1), axes = FALSE, xlab = "",
+                 ylab = "")
+  graphics::rect(0, yy[-65], 0.5, yy[-1], col = pal, border = NA)
+  graphics::axis(4, at = sqrt(ticks / top), labels = ticks, las = 1,
+                 cex.axis = 0.8, pos = 0.5)
+  graphics::title(main = "error (mg)", cex.main = 0.8)
 }

@@ -11,7 +11,8 @@ truth <- attr(rec$data, "truth")$params
 cat("\nTrue parameters of the simulated sensor, and the fit's:\n")
 print(round(rbind(truth = truth, fit = fit$params), 5))
 out <- "gravcal-example.png"
-grDevices::png(out, width = 1000, height = 900, res = 110)
+grDevices::png(out, width = 1100, height = 500, res = 100)
 plot(fit)
 invisible(grDevices::dev.off())
-cat("\nSphere before and after calibration written to", out, "\n")
+cat("\nWhere the recording rested, and each rest window's error before and after",
+    "calibration, written to", out, "\n")

@@ -42,3 +42,27 @@ test_that("plot(): text where a number belongs, zero or missing rest vectors", {
   expect_snapshot(error = TRUE, plot(missing))
   expect_snapshot(error = TRUE, plot.gravcal_fit(list(K = diag(3))))
 })
+
+test_that("the sphere map places each rest window and marks the fit's points", {
+  rec <- simulate_recording(hours = 12, sf = 10, seed = 61)
+  fit <- calibrate(rec, sf = 10)
+  v <- as.matrix(fit$windows[, c("mean_x", "mean_y", "mean_z")])
+  a <- gravcal:::calibrate_points(fit, v, fit$windows$temperature)
+  m <- gravcal:::sphere_map_data(fit, fit$windows, v, a)
+  # directions and errors, restated independently
+  r <- sqrt(v[, 1]^2 + v[, 2]^2 + v[, 3]^2)
+  expect_equal(m$azimuth, atan2(v[, 2], v[, 1]) / pi * 180)
+  expect_equal(m$elevation, 90 - acos(v[, 3] / r) / pi * 180)
+  expect_equal(m$error_before_mg, 1000 * abs(r - 1))
+  expect_equal(mean(m$error_after_mg), 1000 * fit$error_heldout_after *
+                 (nrow(v) - 18) / nrow(v) + 1000 * fit$error_after * 18 / nrow(v))
+  expect_identical(sum(m$used), nrow(fit$points))
+  expect_true(all(abs(m$elevation) <= 90) && all(abs(m$azimuth) <= 180))
+  f <- tempfile(fileext = ".png")
+  grDevices::png(f, width = 1100, height = 500)
+  expect_invisible(plot(fit))
+  expect_invisible(plot(fit, type = "map", set = "points"))
+  grDevices::dev.off()
+  expect_gt(file.size(f), 5000)
+  expect_error(plot(fit, type = "globe"), "`type`")
+})
