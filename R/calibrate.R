@@ -6,16 +6,44 @@
 #'
 #' With `method = "ggir"` it runs GGIR's procedure (van Hees et al. 2014),
 #' see the section below. With `method = "lightweight"` (Farago et al. 2024)
-#' the steps are
-#' [rest_windows()] (5 s windows, max - min below 0.12 g), [select_points()]
-#' (3 x 3 orientation bins, 2 points each, novelty threshold 0.3 g; bins
-#' that cannot be filled so are filled with 0.1 g, then 0.03 g) and
-#' [fit_gradient()] (9-parameter
-#' model, forward-difference gradient descent). Arguments of those functions
-#' can be given in `...`.
+#' it finds the rest windows with [rest_windows()] (5 s windows, max - min
+#' below 0.12 g), keeps the reliable ones (see the guards below), chooses
+#' calibration points among them and fits the paper's 9-parameter model
+#' `a = K (v + o)` to them. How the points are chosen and fitted is set by
+#' `selection`:
 #'
-#' The paper stops after 50 iterations, a budget for a microcontroller. On
-#' real point sets the slowest direction of the problem (a mix of one axis'
+#' * `"cells"` (default): every distinct posture the recording rested in,
+#'   one point each: [select_points()] with `selection = "cells"` (the
+#'   stillest rest window of each cube of side `cell` = 0.05 g). The
+#'   objective of the paper is minimised by Levenberg-Marquardt
+#'   ([fit_gradient()] with `algorithm = "lm"`) to convergence, and the
+#'   model is the one the points determine: all nine parameters when every
+#'   standard error is at most `max_se` (0.01), else scales and offsets
+#'   (cross-axis terms 0), else offsets alone; when even the offsets are
+#'   not determined, or there are fewer than twice as many points as
+#'   parameters, the status is `"sphere_not_covered"`. The standard errors
+#'   used for that choice are the larger of the robust (HC3) standard
+#'   errors and those the points' geometry allows at a residual sd of
+#'   0.004 (about 2 mg), so that a parameter only the absence of noise
+#'   determines (the x offset of a device that always lay flat) is not
+#'   fitted. `model` forces one of `"full"`, `"scale_offset"`, `"offset"`.
+#'   The status message says which model was fitted and why. People at
+#'   rest in daily life rarely turn every axis fully up and fully down, so
+#'   the paper's bins often cannot all be filled; and 18 points leave nine
+#'   parameters poorly determined, so that the same samples windowed
+#'   differently give different coefficients. On real free-living
+#'   recordings this selection calibrates where the paper's cannot, with a
+#'   held-out error below the GGIR method's (`bench/results/freeliving.md`).
+#' * `"paper"`: the paper's procedure: [select_points()] (3 x 3
+#'   orientation bins, 2 points each, novelty threshold 0.3 g; bins that
+#'   cannot be filled so are filled with 0.1 g, then 0.03 g) and
+#'   [fit_gradient()] (forward-difference gradient descent); status
+#'   `"bins_incomplete"` when the bins cannot be filled.
+#'
+#' Arguments of those functions can be given in `...`.
+#'
+#' With `selection = "paper"`: the paper stops after 50 iterations, a
+#' budget for a microcontroller. On real point sets the slowest direction of the problem (a mix of one axis'
 #' scale, offset and cross terms) contracts by only 2-10 % per iteration with
 #' the paper's rates, so 50 iterations can leave a few mg of error. A
 #' computer can afford to finish: `calibrate()` runs the same descent until
@@ -63,7 +91,8 @@
 #' | `"ok"` | calibrated | |
 #' | `"too_short"` | fewer samples than one window | check `sf` and the file |
 #' | `"no_rest"` | no window met the rest criterion | check units (g) and `sf` |
-#' | `"bins_incomplete"` | rest not seen in enough orientations | use a longer recording, or lower `min_per_bin` / `min_distance` |
+#' | `"bins_incomplete"` | `selection = "paper"`: rest not seen in enough orientations | use a longer recording, the default selection, or lower `min_per_bin` / `min_distance` |
+#' | `"sphere_not_covered"` | rest not seen in enough orientations to determine even the offsets | use a longer recording |
 #' | `"diverged"` | the optimizer left the finite range | report it; try `objective = "mean"` |
 #' | `"no_improvement"` | the fit did not lower the error | the data are likely already calibrated |
 #' | `"implausible"` | coefficients outside plausible ranges | inspect the rest points with `plot()` |
@@ -82,9 +111,13 @@
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
 #'   `chunk_size`, `progress`, `reader`), the guards (`max_norm_error`, in g,
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
-#'   file or unknown; see Details), [select_points()] (`per_bin`, `min_per_bin`,
+#'   file or unknown; see Details), the choice of points and model
+#'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
+#'   `max_se`, default 0.01; `model`, default `"auto"`; see Details),
+#'   [select_points()] for `selection = "paper"` (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
-#'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`). For the GGIR method:
+#'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`,
+#'   `algorithm`, `se`). For the GGIR method:
 #'   `use_temp` (fit the temperature term when there is one, default TRUE),
 #'   `spherecrit` (0.3 g), `minloadcrit` (168 h), `chunksize` (1, about 12 h
 #'   blocks), `max_sd` (0.013 g), `max_iter` (1000), `tol` (1e-10),
@@ -146,7 +179,9 @@
 #'     `error_heldout_before`, `error_heldout_after`: the same over the rest
 #'     windows not used for the fit (NA when there are none);
 #'   * `iterations`, `converged`, `status`, `message`, `method`, `call`, and
-#'     for the lightweight method `params` (the nine parameters);
+#'     for the lightweight method `params` (the nine parameters) and
+#'     `selection` (the choice of points and model: `selection`, `cell`,
+#'     `max_se`, `model`);
 #'   * `se`: standard errors, named like [coef()]'s coefficients (NA for a
 #'     coefficient the model does not fit, and for every coefficient when
 #'     the fit was not applied); `vcov`: the covariance of the fitted
@@ -154,7 +189,7 @@
 #'     freedom) and `sigma` (residual standard deviation), from the
 #'     Jacobian of the residuals at the solution (see [vcov.gravcal_fit()]);
 #'   * `model`: the names (as in [coef()]) of the coefficients the model
-#'     fitted: the nine of the lightweight model, GGIR's scale and offset
+#'     fitted: those of the lightweight model (nine, six or three), GGIR's scale and offset
 #'     with `t_x`, `t_y`, `t_z` when the temperature was used; empty when
 #'     the coefficients are the identity;
 #'   * for the lightweight method from [calibrate()]: `excluded`,
@@ -186,9 +221,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader"),
     guards = c("max_norm_error", "range_g"),
+    choice = c("selection", "cell", "max_se", "model"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
-                     "use_sqrt", "tol", "trace", "difference")))
+                     "use_sqrt", "tol", "trace", "difference", "algorithm",
+                     "se")))
+  choice <- check_choice_args(args$choice, args$select_points)
   gargs <- args$guards
   max_norm_error <- if (is.null(gargs$max_norm_error)) 0.3 else
     gargs$max_norm_error
@@ -240,9 +278,22 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
       "no rest: none of the %d windows met the rest criterion; are the ",
       "samples in g and is sf right?"), nrow(w))))
   }
-  # the bins that a 0.3 g novelty threshold cannot fill are filled with
-  # smaller thresholds, keeping the points already chosen (unless the user
-  # set the thresholds)
+  if (choice$selection == "cells") {
+    pts <- select_points(rest, selection = "cells", cell = choice$cell)
+    fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+    if (fit$status == "sphere_not_covered") return(fit)
+    fit$call <- call
+    fit$selection <- choice
+    fit <- guard_fit(fit)
+    fit$hours <- hours
+    fit$input <- attr(w, "input")
+    if (is.character(x)) fit$file <- basename(x)
+    fit <- add_guards(fit, excluded, excluded_windows, guards)
+    return(finish_fit(fit, rest))
+  }
+  # the paper's procedure: the bins that a 0.3 g novelty threshold cannot
+  # fill are filled with smaller thresholds, keeping the points already
+  # chosen (unless the user set the thresholds)
   sargs <- args$select_points
   if (is.null(sargs$min_distance)) sargs$min_distance <- c(0.3, 0.1, 0.03)
   pts <- do.call(select_points, c(list(w = rest), sargs))
@@ -254,14 +305,110 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   }
   fargs <- utils::modifyList(list(max_iter = 5000, tol = 1e-10),
                              args$fit_gradient)
+  if (choice$model != "auto") fargs$model <- choice$model
   fit <- do.call(fit_gradient, c(list(pts = pts), fargs))
   fit$call <- call
+  fit$selection <- choice
   fit <- guard_fit(fit)
   fit$hours <- hours
   fit$input <- attr(w, "input")
   if (is.character(x)) fit$file <- basename(x)
   fit <- add_guards(fit, excluded, excluded_windows, guards)
   finish_fit(fit, rest)
+}
+
+# The arguments that choose points and model: selection ("cells", the
+# default, or "paper"), cell (g), max_se and model ("auto" or one of
+# fit_gradient()'s models).
+check_choice_args <- function(choice, sargs) {
+  selection <- match_choice(choice$selection %||% "cells", "selection",
+                            c("cells", "paper"))
+  cell <- choice$cell %||% 0.05
+  check_number(cell, "cell", min = 0.001, max = 1)
+  max_se <- choice$max_se %||% default_max_se
+  check_number(max_se, "max_se", min = 0, min_inclusive = FALSE)
+  model <- match_choice(choice$model %||% "auto", "model",
+                        c("auto", "full", "scale_offset", "offset"))
+  if (selection == "cells" && length(sargs)) {
+    abort("`", names(sargs)[1], "` sets the paper's orientation bins; give ",
+          "it with `selection = \"paper\"` (the default, `\"cells\"`, ",
+          "takes one point per distinct posture).")
+  }
+  if (selection == "paper" && model == "auto") model <- "full"
+  list(selection = selection, cell = cell, max_se = max_se, model = model)
+}
+
+# The largest standard error (HC3) a fitted parameter may have for its
+# group to be fitted: 0.01 is 10 mg of error on a 1 g axis, about the
+# error calibration is to remove; a parameter known no better than that
+# is noise.
+default_max_se <- 0.01
+
+# The standard errors the points' geometry alone allows: those of a fit
+# whose residuals had the sd `floor_sigma` (in the objective's units,
+# |a|^2 - 1, about twice |a| - 1). Real rest windows fit to 2-5 mg at
+# best; a simulated or unusually clean recording can fit far better, and
+# a parameter that only its lack of noise determines (the x offset of a
+# device that rested flat on its back) is not determined.
+design_se <- function(fit, pts, floor_sigma = 0.004) {
+  v <- point_matrix(pts, "pts")
+  J <- residual_jacobian(fit, v)$J[, fit$model, drop = FALSE]
+  A <- crossprod(J)
+  inv <- tryCatch(solve(A), error = function(e) NULL)
+  if (is.null(inv) || rcond(A) < 1e-12) return(rep(Inf, ncol(J)))
+  floor_sigma * sqrt(pmax(diag(inv), 0))
+}
+
+# gravcal's lightweight fit: Levenberg-Marquardt on the paper's objective
+# over the points, with the model the points determine. "auto" tries all
+# nine parameters, then scale and offset, then offset alone, and keeps the
+# first whose every standard error is at most max_se; a model needs at
+# least twice as many points as parameters.
+fit_chosen_model <- function(pts, fargs, choice, fail) {
+  if (!is.null(fargs$arithmetic) && fargs$arithmetic != "double" &&
+      is.null(fargs$algorithm)) {
+    fargs$algorithm <- "descent"
+  }
+  fargs <- utils::modifyList(list(algorithm = "lm", se = "robust"), fargs)
+  if (identical(fargs$algorithm, "descent")) {
+    fargs <- utils::modifyList(list(max_iter = 5000, tol = 1e-10), fargs)
+  }
+  models <- if (choice$model == "auto") c("full", "scale_offset", "offset")
+    else choice$model
+  why <- character(0)
+  for (m in models) {
+    k <- sum(model_free(m))
+    if (nrow(pts) < 2 * k) {
+      why <- c(why, sprintf("%d points are too few for %d parameters",
+                            nrow(pts), k))
+      next
+    }
+    fit <- do.call(fit_gradient, c(list(pts = pts, model = m), fargs))
+    if (fit$status != "ok" || choice$model != "auto") return(fit)
+    se <- pmax(fit$se[fit$model], design_se(fit, pts))
+    bad <- !is.finite(se) | se > choice$max_se
+    if (!any(bad)) {
+      fit$message <- paste0(fit$message, sprintf(" on %d points", nrow(pts)))
+      if (length(why)) {
+        fit$message <- paste0(fit$message, "; ", paste(why, collapse = "; "))
+      }
+      return(fit)
+    }
+    worst <- which.max(ifelse(is.finite(se), se, Inf))
+    why <- c(why, sprintf(paste0(
+      "%s not determined by the rest points (standard error of %s %s > ",
+      "max_se = %s)"), switch(m, full = "cross-axis terms",
+                              scale_offset = "scales", offset = "offsets"),
+      names(se)[worst], format(signif(se[worst], 2)), format(choice$max_se)))
+    fit$message <- NULL
+  }
+  need <- 2 * min(vapply(models, function(m) sum(model_free(m)), 0))
+  fail("sphere_not_covered", paste0(
+    "not calibrated: the rest windows do not cover enough of the sphere (",
+    nrow(pts), " distinct posture", if (nrow(pts) != 1) "s", " in cells of ",
+    format(choice$cell), " g); ", if (nrow(pts) < need) {
+      sprintf("at least %d are needed to fit %d parameters", need, need / 2)
+    } else paste(why, collapse = "; ")), points = pts)
 }
 
 # The rest windows that are never calibration points, and why: "clipped"

@@ -66,9 +66,32 @@ param_names <- function() {
 #'   evaluations but remove the forward difference's bias of about `h / 2`
 #'   per parameter: negligible with `h = 1e-5`, about 5 mg with the 16-bit
 #'   step `h = 0.01` (`bench/results/fixed.md`).
+#' @param model Which parameters to fit: `"full"` (all nine, the paper's
+#'   model), `"scale_offset"` (scales and offsets; the cross-axis terms stay
+#'   0) or `"offset"` (offsets only; scales 1, cross-axis terms 0). A
+#'   parameter the points cannot determine (for example the cross-axis
+#'   terms of a recording that rested in few orientations) is better left
+#'   out than fitted to noise; [calibrate()] chooses the model this way.
+#' @param algorithm `"descent"` (the paper's forward-difference gradient
+#'   descent, in any `arithmetic`) or `"lm"` (Levenberg-Marquardt on the
+#'   same objective with its exact Jacobian, double arithmetic only). Both
+#'   minimise the same objective; Levenberg-Marquardt reaches its minimum
+#'   in a handful of iterations where the descent needs hundreds (its
+#'   slowest direction contracts by 2-10 % per iteration). With `"lm"`,
+#'   `rates`, `h` and `difference` are not used, `max_iter` defaults to
+#'   100 and the fit stops once no parameter moves by more than `tol`
+#'   (default `1e-10` when `tol = 0`).
+#' @param se How the standard errors are computed (see
+#'   [vcov.gravcal_fit()]): `"classic"`, `s^2 (J'J)^-1`, which assumes every
+#'   point has the same error variance; or `"robust"`, the HC3 sandwich
+#'   estimator (MacKinnon & White 1985), which stays honest when the
+#'   points' errors differ (real rest windows in rare orientations fit
+#'   worse than common ones). `"robust"` needs more points than parameters
+#'   by a margin (it is [calibrate()]'s choice for its many-point fits).
 #' @return A `gravcal_fit` (see [calibrate()]) with `K` lower-triangular,
 #'   `offset`, zero `tempoffset`, `params` (the nine named parameters),
-#'   `objective`, and `trace` when asked for. Status `"ok"`; `"diverged"`
+#'   `objective`, `model` (the names of the fitted parameters), and `trace`
+#'   when asked for (descent only). Status `"ok"`; `"diverged"`
 #'   (identity coefficients) when the parameters left the finite range; or
 #'   `"no_improvement"` (identity coefficients) when the objective at the
 #'   end is not below its value at the start (the identity), for example
@@ -90,16 +113,29 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          h = if (arithmetic[1] == "fixed16") 0.01 else 1e-5,
                          objective = c("mean", "sum"), use_sqrt = FALSE,
                          tol = 0, trace = FALSE,
-                         difference = c("forward", "central")) {
+                         difference = c("forward", "central"),
+                         model = c("full", "scale_offset", "offset"),
+                         algorithm = c("descent", "lm"),
+                         se = c("classic", "robust")) {
   call <- match.call()
   arithmetic <- match_choice(arithmetic, "arithmetic")
   objective <- match_choice(objective, "objective")
   difference <- match_choice(difference, "difference")
+  model <- match_choice(model, "model")
+  algorithm <- match_choice(algorithm, "algorithm")
+  se <- match_choice(se, "se")
+  free <- model_free(model)
   v <- point_matrix(pts, "pts")
-  if (nrow(v) < 9) {
-    abort("`pts` must hold at least 9 points to fit 9 parameters, not ",
-          nrow(v), ".")
+  if (nrow(v) < sum(free)) {
+    abort("`pts` must hold at least ", sum(free), " points to fit ",
+          sum(free), " parameters, not ", nrow(v), ".")
   }
+  if (algorithm == "lm" && arithmetic != "double") {
+    abort("`algorithm = \"lm\"` computes in double arithmetic only, not ",
+          "`arithmetic = \"", arithmetic, "\"`; use `algorithm = \"descent\"` ",
+          "for the device's arithmetic.")
+  }
+  if (algorithm == "lm" && missing(max_iter)) max_iter <- 100
   check_number(max_iter, "max_iter", min = 1, max = 1e6, integer = TRUE)
   if (!is.numeric(rates) || length(rates) != 3 || !all(is.finite(rates)) ||
       any(rates <= 0)) {
@@ -118,18 +154,35 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   check_number(tol, "tol", min = 0)
   check_flag(trace, "trace")
 
-  r <- gc_fit_gradient(v[, 1], v[, 2], v[, 3],
-                       c(1, 1, 1, 0, 0, 0, 0, 0, 0), as.integer(max_iter), h,
-                       rep(unname(rates), each = 3), use_sqrt,
-                       objective == "sum", tol, trace, arithmetic,
-                       difference == "central")
+  if (algorithm == "lm") {
+    r <- fit_lm(v, free, as.integer(max_iter), if (tol > 0) tol else 1e-10,
+                use_sqrt, objective == "sum")
+    trace <- FALSE
+  } else {
+    r <- gc_fit_gradient(v[, 1], v[, 2], v[, 3],
+                         c(1, 1, 1, 0, 0, 0, 0, 0, 0), as.integer(max_iter), h,
+                         rep(unname(rates), each = 3) * free, use_sqrt,
+                         objective == "sum", tol, trace, arithmetic,
+                         difference == "central")
+  }
   p <- stats::setNames(r$p, param_names())
   status <- "ok"
-  message <- sprintf("fitted in %d iterations (%s arithmetic)", r$iterations,
-                     arithmetic)
-  f0 <- gc_fit_gradient(v[, 1], v[, 2], v[, 3], c(1, 1, 1, 0, 0, 0, 0, 0, 0),
-                        0L, h, rep(1, 9), use_sqrt, objective == "sum", 0,
-                        FALSE, arithmetic, FALSE)$objective
+  message <- if (algorithm == "lm") {
+    sprintf("fitted %s in %d iterations (Levenberg-Marquardt)",
+            model_label(model), r$iterations)
+  } else {
+    sprintf("fitted %sin %d iterations (%s arithmetic)",
+            if (model == "full") "" else paste0(model_label(model), " "),
+            r$iterations, arithmetic)
+  }
+  f0 <- if (algorithm == "lm") {
+    lm_objective(v, c(1, 1, 1, 0, 0, 0, 0, 0, 0), use_sqrt,
+                 objective == "sum")
+  } else {
+    gc_fit_gradient(v[, 1], v[, 2], v[, 3], c(1, 1, 1, 0, 0, 0, 0, 0, 0),
+                    0L, h, rep(1, 9), use_sqrt, objective == "sum", 0,
+                    FALSE, arithmetic, FALSE)$objective
+  }
   if (!r$finite || !all(is.finite(p)) || !is.finite(r$objective) ||
       r$objective > 10 * f0 + 1e-6) {
     status <- "diverged"
@@ -153,14 +206,19 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   fit <- new_fit(K = params_to_K(p), offset = unname(p[7:9]),
                  points = pts, method = "lightweight",
                  iterations = r$iterations,
-                 converged = r$converged || (status == "ok" && tol == 0),
+                 converged = r$converged ||
+                   (algorithm == "descent" && status == "ok" && tol == 0),
                  status = status, message = message, call = call)
   fit$params <- p
   fit$objective <- r$objective
   fit$settings <- list(arithmetic = arithmetic, max_iter = max_iter,
                        rates = rates, h = h, objective = objective,
-                       use_sqrt = use_sqrt, tol = tol, difference = difference)
-  if (status == "ok") fit <- add_uncertainty(fit, v, use_sqrt = use_sqrt)
+                       use_sqrt = use_sqrt, tol = tol, difference = difference,
+                       model = model, algorithm = algorithm, se = se)
+  fit$fitted <- param_names()[free]
+  if (status == "ok") {
+    fit <- add_uncertainty(fit, v, use_sqrt = use_sqrt, type = se)
+  }
   if (trace) {
     tr <- t(r$trace)
     colnames(tr) <- c(param_names(), "f")
@@ -219,4 +277,92 @@ point_matrix <- function(pts, arg) {
     abort("`", arg, "` must not contain NA, NaN or Inf coordinates.")
   }
   v
+}
+
+# Which of the nine parameters each model fits.
+model_free <- function(model) {
+  switch(model,
+         full = rep(TRUE, 9),
+         scale_offset = c(TRUE, TRUE, TRUE, FALSE, FALSE, FALSE,
+                          TRUE, TRUE, TRUE),
+         offset = c(rep(FALSE, 6), TRUE, TRUE, TRUE))
+}
+
+model_label <- function(model) {
+  switch(model,
+         full = "all 9 parameters (scale, cross-axis, offset)",
+         scale_offset = "6 parameters (scale, offset)",
+         offset = "3 parameters (offset)")
+}
+
+# Residuals of the lightweight objective at parameters p: |a|^2 - 1, or
+# |a| - 1 with use_sqrt, a = K (v + o).
+lm_residuals <- function(v, p, use_sqrt) {
+  a <- sweep(v, 2, p[7:9], `+`) %*% t(params_to_K(p))
+  na2 <- rowSums(a^2)
+  if (use_sqrt) sqrt(na2) - 1 else na2 - 1
+}
+
+lm_objective <- function(v, p, use_sqrt, sum_scale) {
+  r <- lm_residuals(v, p, use_sqrt)
+  sum(r^2) / if (sum_scale) 1 else length(r)
+}
+
+# Levenberg-Marquardt (Marquardt 1963, with the scaled damping of More
+# 1978) on the lightweight objective, over the parameters marked in
+# `free`, from the ideal sensor. Stops once no parameter moves by more
+# than `tol`, when the damping can no longer find a step that lowers the
+# objective (the minimum, to rounding), or after `max_iter` iterations.
+fit_lm <- function(v, free, max_iter, tol, use_sqrt, sum_scale) {
+  p <- c(1, 1, 1, 0, 0, 0, 0, 0, 0)
+  jac <- function(p) {
+    f <- list(K = params_to_K(p), offset = p[7:9], method = "lightweight")
+    residual_jacobian(f, v, use_sqrt = use_sqrt)$J[, free, drop = FALSE]
+  }
+  r <- lm_residuals(v, p, use_sqrt)
+  S <- sum(r^2)
+  mu <- 1e-3
+  converged <- FALSE
+  finite <- TRUE
+  it <- 0L
+  while (it < max_iter) {
+    it <- it + 1L
+    J <- jac(p)
+    A <- crossprod(J)
+    g <- crossprod(J, r)
+    d <- pmax(diag(A), 1e-12)
+    moved <- FALSE
+    while (mu < 1e12) {
+      step <- tryCatch(-solve(A + mu * diag(d, length(d)), g),
+                       error = function(e) NULL)
+      if (!is.null(step) && all(is.finite(step))) {
+        pn <- p
+        pn[free] <- p[free] + step
+        rn <- lm_residuals(v, pn, use_sqrt)
+        Sn <- sum(rn^2)
+        if (is.finite(Sn) && Sn <= S) {
+          moved <- TRUE
+          break
+        }
+      }
+      mu <- mu * 10
+    }
+    if (!moved) {
+      # no step lowers the objective: the minimum, to rounding
+      converged <- TRUE
+      break
+    }
+    mu <- max(mu / 10, 1e-15)
+    small <- max(abs(pn - p)) <= tol
+    p <- pn
+    r <- rn
+    S <- Sn
+    if (small) {
+      converged <- TRUE
+      break
+    }
+  }
+  if (!all(is.finite(p))) finite <- FALSE
+  list(p = p, iterations = it, converged = converged, finite = finite,
+       objective = S / if (sum_scale) 1 else length(r))
 }

@@ -118,9 +118,14 @@ projection_panel <- function(before, after, axes, col) {
 sphere_map_data <- function(fit, d, before, after) {
   r <- sqrt(rowSums(before^2))
   key <- function(m) paste(m[, 1], m[, 2], m[, 3])
-  used <- if (NROW(fit$points)) {
+  used <- if (!NROW(fit$points)) {
+    rep(FALSE, nrow(before))
+  } else if (identical(d, fit$windows) && !is.null(fit$points$row)) {
+    # the points are rows of the rest windows (identical windows stay apart)
+    seq_len(nrow(d)) %in% fit$points$row
+  } else {
     key(before) %in% key(as.matrix(fit$points[, c("mean_x", "mean_y", "mean_z")]))
-  } else rep(FALSE, nrow(before))
+  }
   data.frame(azimuth = atan2(before[, 2], before[, 1]) * 180 / pi,
              elevation = asin(pmax(-1, pmin(1, before[, 3] / r))) * 180 / pi,
              error_before_mg = 1000 * abs(r - 1),

@@ -55,9 +55,27 @@ bin_names <- function() {
 #' @param arithmetic Number type of the selector (see [fit_gradient()]):
 #'   the coordinates are rounded to it, as a device holding them in fixed
 #'   point would, so that R selects the points the device selects.
+#' @param selection `"bins"` (default): the paper's selector above.
+#'   `"cells"`: gravcal's selection for recordings of daily life, the
+#'   default of [calibrate()]: every distinct posture the recording rested
+#'   in, one point each. The rest means are put on a grid of cubes of side
+#'   `cell` g; from each cube that holds any, the stillest window (smallest
+#'   largest `range_*`, or `sd_*` for epochs without ranges; the first in
+#'   time on ties) is a point. A recording that lay still in one posture
+#'   for hours gives that posture one point, not hundreds, so the fit is
+#'   not ruled by the postures people keep longest, and every orientation
+#'   seen counts. The number of points is bounded by the grid (at most
+#'   about `4 pi / cell^2`, some 5,000 for 0.05 g), whatever the length of
+#'   the recording. `per_bin`, `min_per_bin`, `min_distance` and
+#'   `arithmetic` are not used.
+#' @param cell For `selection = "cells"`: the grid's side in g (default
+#'   0.05 g, about 3 degrees of tilt).
 #' @return The selected rows of `w` (all its columns), in the order they were
-#'   kept, with two more columns: `bin` (a factor with levels [bin_names()])
-#'   and `row` (the row of `w` the point came from). Attributes: `counts`
+#'   kept (in time order for `"cells"`), with two more columns: `bin` (a
+#'   factor with levels [bin_names()]; for `"cells"` the first of the
+#'   paper's bins the point lies in, NA when in none) and `row` (the row of
+#'   `w` the point came from). For `"cells"`, attributes `selection`,
+#'   `cell`, `offered` and `counts` (points per bin they lie in). Attributes: `counts`
 #'   (points per bin), `complete` (every bin has `min_per_bin`), `per_bin`,
 #'   `min_per_bin`, `min_distance` (the thresholds of the passes made),
 #'   `offered` (rest rows considered).
@@ -69,12 +87,17 @@ bin_names <- function() {
 #' pts <- select_points(cand)
 #' table(pts$bin)
 #' attr(pts, "complete")
+#' # every distinct posture, one point each
+#' nrow(select_points(cand, selection = "cells"))
 select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
                           min_distance = 0.3,
                           arithmetic = c("double", "float", "fixed32",
-                                         "fixed16")) {
+                                         "fixed16"),
+                          selection = c("bins", "cells"), cell = 0.05) {
   arithmetic <- match_choice(arithmetic, "arithmetic")
+  selection <- match_choice(selection, "selection")
   w <- as_epochs(w)
+  if (selection == "cells") return(select_cells(w, cell))
   check_number(per_bin, "per_bin", min = 1, max = 64, integer = TRUE)
   check_number(min_per_bin, "min_per_bin", min = 1, max = per_bin,
                integer = TRUE)
@@ -84,17 +107,7 @@ select_points <- function(w, per_bin = 2, min_per_bin = per_bin,
     abort("`min_distance` must be one or more non-negative numbers in g, ",
           "in decreasing order, not ", describe(min_distance), ".")
   }
-  rows <- seq_len(nrow(w))
-  if ("rest" %in% names(w)) {
-    if (!is.logical(w$rest)) {
-      abort("Column `rest` of `w` must be logical, not ", class(w$rest)[1],
-            ".")
-    }
-    rows <- rows[!is.na(w$rest) & w$rest]
-  }
-  ok <- is.finite(w$mean_x[rows]) & is.finite(w$mean_y[rows]) &
-    is.finite(w$mean_z[rows])
-  rows <- rows[ok]
+  rows <- rest_rows(w)
   # One pass per threshold. A later pass first offers the points kept so far
   # (the selector keeps them again, in the same bins: they are further apart
   # than the smaller threshold), then the other windows in time order, so
@@ -131,4 +144,76 @@ missing_bins <- function(pts) {
   short <- counts < need
   paste(sprintf("%s (%d of %d)", names(counts)[short], counts[short], need),
         collapse = ", ")
+}
+
+# gravcal's selection: the stillest rest window of each cube of side `cell`
+# g that holds rest means, in time order.
+select_cells <- function(w, cell) {
+  check_number(cell, "cell", min = 0.001, max = 1)
+  rows <- rest_rows(w)
+  m <- cbind(w$mean_x[rows], w$mean_y[rows], w$mean_z[rows])
+  key <- paste(round(m[, 1] / cell), round(m[, 2] / cell),
+               round(m[, 3] / cell))
+  stillness <- function(prefix) {
+    cols <- paste0(prefix, c("x", "y", "z"))
+    if (!all(cols %in% names(w))) return(NULL)
+    s <- pmax(w[[cols[1]]][rows], w[[cols[2]]][rows], w[[cols[3]]][rows])
+    s[!is.finite(s)] <- Inf
+    s
+  }
+  still <- stillness("range_")
+  if (is.null(still)) still <- stillness("sd_")
+  if (is.null(still)) still <- rep(0, length(rows))
+  o <- order(key, still, rows)
+  pick <- sort(o[!duplicated(key[o])])
+  kept <- rows[pick]
+  pts <- w[kept, , drop = FALSE]
+  pts$bin <- factor(bin_names()[first_bin(m[pick, , drop = FALSE])],
+                    levels = bin_names())
+  pts$row <- kept
+  rownames(pts) <- NULL
+  attr(pts, "counts") <- bin_counts(m[pick, , drop = FALSE])
+  attr(pts, "selection") <- "cells"
+  attr(pts, "cell") <- cell
+  attr(pts, "offered") <- length(rows)
+  pts
+}
+
+# The rows offered as points: rest rows (all when there is no `rest`
+# column) with finite means.
+rest_rows <- function(w) {
+  rows <- seq_len(nrow(w))
+  if ("rest" %in% names(w)) {
+    if (!is.logical(w$rest)) {
+      abort("Column `rest` of `w` must be logical, not ", class(w$rest)[1],
+            ".")
+    }
+    rows <- rows[!is.na(w$rest) & w$rest]
+  }
+  ok <- is.finite(w$mean_x[rows]) & is.finite(w$mean_y[rows]) &
+    is.finite(w$mean_z[rows])
+  rows[ok]
+}
+
+# n x 9 membership of points in the paper's bins (Eq. 10), bin_names()
+# order.
+bin_membership <- function(m) {
+  inside <- function(v, lo, hi) v >= lo & v <= hi
+  out <- NULL
+  for (j in 1:3) {
+    out <- cbind(out, inside(m[, j], -1.25, -0.75), inside(m[, j], -0.25, 0.25),
+                 inside(m[, j], 0.75, 1.25))
+  }
+  out
+}
+
+first_bin <- function(m) {
+  b <- bin_membership(m)
+  i <- max.col(b, ties.method = "first")
+  i[rowSums(b) == 0] <- NA_integer_
+  i
+}
+
+bin_counts <- function(m) {
+  stats::setNames(as.integer(colSums(bin_membership(m))), bin_names())
 }

@@ -44,6 +44,17 @@ crb_mae <- function(v, p, sigma) {
   sqrt(2 / pi) * sqrt(diag(solve(info)))
 }
 
+# gravcal's default for calibrate(method = "lightweight") on the same
+# candidates: one point per 0.05 g cell, Levenberg-Marquardt, the model
+# the points determine (calibrate()'s own routine, from the candidates).
+default_fit <- function(cand) {
+  choice <- list(selection = "cells", cell = 0.05, max_se = 0.01,
+                 model = "auto")
+  fail <- function(status, message, points) stop(status, ": ", message)
+  gravcal:::fit_chosen_model(select_points(cand, selection = "cells"),
+                             list(), choice, fail)
+}
+
 run <- function(noise, per_axis_noise, seed) {
   set.seed(seed)
   res <- lapply(seq_len(n_cases), function(i) {
@@ -53,7 +64,10 @@ run <- function(noise, per_axis_noise, seed) {
     f50 <- fit_gradient(pts)
     fconv <- fit_gradient(pts, max_iter = 1e5, tol = 1e-12)
     v <- as.matrix(pts[c("mean_x", "mean_y", "mean_z")])
+    fdef <- default_fit(cand)
     list(e50 = abs(f50$params - truth), econv = abs(fconv$params - truth),
+         edef = abs(stats::coef(fdef)[param_names()] - truth),
+         ndef = nrow(fdef$points), mdef = length(fdef$model),
          crb = crb_mae(v, truth, per_axis_noise),
          it = fconv$iterations, status = f50$status)
   })
@@ -64,6 +78,9 @@ run <- function(noise, per_axis_noise, seed) {
              gravcal_50 = m("e50"),
              gravcal_50_sd = apply(sapply(res, `[[`, "e50"), 1, stats::sd),
              converged = m("econv"), crb = m("crb"),
+             default = m("edef"),
+             default_points = stats::median(vapply(res, `[[`, 0, "ndef")),
+             default_model_9 = mean(vapply(res, `[[`, 0, "mdef") == 9),
              median_iterations_to_converge = stats::median(
                vapply(res, `[[`, 0, "it")))
 }
@@ -87,18 +104,29 @@ md <- c("# Table 2 of Farago et al. (2024), reproduced by gravcal", "",
         "Mean absolute error of the estimates. `gravcal 50`: the paper's 50",
         "iterations; `converged`: the same descent to convergence; `CRB`:",
         "Cramer-Rao bound for any unbiased estimator from the same 18 points;",
-        "`ratio`: gravcal 50 / paper.", "")
+        "`ratio`: gravcal 50 / paper. `default`: gravcal's default for",
+        "`calibrate()` on the same 1000 candidates (one point per 0.05 g",
+        "cell, Levenberg-Marquardt, the model the points determine);",
+        "`default / paper`: its error over the paper's (issue 17 asks for at",
+        "most 0.5 for every parameter).", "")
 for (k in unique(paste(tab$noise_mg, tab$per_axis_sd_mg))) {
   d <- tab[paste(tab$noise_mg, tab$per_axis_sd_mg) == k, ]
   md <- c(md, sprintf("## %g mg noise (per-axis sd %.3g mg)", d$noise_mg[1],
                       d$per_axis_sd_mg[1]), "",
-          "| param | paper | gravcal 50 | ratio | converged | CRB |",
-          "|---|---|---|---|---|---|",
-          sprintf("| %s | %s | %s | %.2f | %s | %s |", d$param, fmt(d$paper),
-                  fmt(d$gravcal_50), d$gravcal_50 / d$paper,
-                  fmt(d$converged), fmt(d$crb)),
-          "", sprintf("Median iterations to converge (tol 1e-12): %g", 
-                      d$median_iterations_to_converge[1]), "")
+          "| param | paper | gravcal 50 | ratio | converged | CRB | default | default / paper |",
+          "|---|---|---|---|---|---|---|---|",
+          sprintf("| %s | %s | %s | %.2f | %s | %s | %s | %.3f |", d$param,
+                  fmt(d$paper), fmt(d$gravcal_50), d$gravcal_50 / d$paper,
+                  fmt(d$converged), fmt(d$crb), fmt(d$default),
+                  d$default / d$paper),
+          "", sprintf(paste0(
+            "Geometric mean of the ratios gravcal 50 / paper: %.2f. ",
+            "Median iterations to converge (tol 1e-12): %g. Default: median ",
+            "%g points, all 9 parameters fitted in %.0f %% of the sensors, ",
+            "largest default / paper %.3f."),
+            exp(mean(log(d$gravcal_50 / d$paper))),
+            d$median_iterations_to_converge[1], d$default_points[1],
+            100 * d$default_model_9[1], max(d$default / d$paper)), "")
 }
 writeLines(md, file.path(out_dir, "table2.md"))
 

@@ -136,7 +136,9 @@ test_that("a device on a table for a week: not calibrated, and says why", {
   flat <- data.frame(x = 0.01 + stats::rnorm(n, sd = 0.003), y = -0.02,
                      z = 1.03, temperature = 25)
   unchanged(flat, function(d) {
-    expect_identity_fit(calibrate(d, sf = 1), "bins_incomplete")
+    expect_identity_fit(calibrate(d, sf = 1), "sphere_not_covered")
+    expect_identity_fit(calibrate(d, sf = 1, selection = "paper"),
+                        "bins_incomplete")
     f <- suppressWarnings(calibrate(d, sf = 1, method = "ggir"))
     expect_identity_fit(f, "sphere_not_covered")
   })
@@ -151,7 +153,9 @@ test_that("a device on a table for a week: not calibrated, and says why", {
   one$x <- abs(one$x) * 0.1
   one$y <- abs(one$y) * 0.1
   one$z <- sqrt(pmax(1 - one$x^2 - one$y^2, 0)) + 0.02
-  expect_identity_fit(calibrate(one, sf = 10), "bins_incomplete")
+  expect_identity_fit(calibrate(one, sf = 10), "sphere_not_covered")
+  expect_identity_fit(calibrate(one, sf = 10, selection = "paper"),
+                      "bins_incomplete")
   expect_identity_fit(calibrate(one, sf = 10, method = "ggir"), "sphere_not_covered")
 })
 

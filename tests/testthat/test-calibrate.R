@@ -3,10 +3,12 @@ test_that("calibrate() lowers the held-out error to the noise floor", {
   fit <- calibrate(rec, sf = 10)
   expect_s3_class(fit, "gravcal_fit")
   expect_equal(fit$status, "ok")
-  expect_equal(nrow(fit$points), 18)
+  expect_equal(fit$model, param_names())
+  # one point per distinct posture: many more than the paper's 18
+  expect_gt(nrow(fit$points), 50)
   # held-out rest windows: not used for the fit (paper's Table 3 protocol)
   held <- fit$windows[-fit$points$row, ]
-  expect_equal(nrow(held), nrow(fit$windows) - 18)
+  expect_equal(nrow(held), nrow(fit$windows) - nrow(fit$points))
   v <- as.matrix(held[c("mean_x", "mean_y", "mean_z")])
   expect_equal(fit$error_heldout_before, err_mg(v) / 1000)
   expect_gt(fit$error_heldout_before, 0.02)
@@ -15,6 +17,11 @@ test_that("calibrate() lowers the held-out error to the noise floor", {
   a_true <- t(tr$K %*% (t(v) + tr$offset))
   floor_mg <- err_mg(a_true)
   expect_lt(1000 * fit$error_heldout_after, floor_mg + 1)
+  # the paper's procedure: its 18 points
+  fp <- calibrate(rec, sf = 10, selection = "paper")
+  expect_equal(fp$status, "ok")
+  expect_equal(nrow(fp$points), 18)
+  expect_lt(1000 * fp$error_heldout_after, floor_mg + 1)
 })
 
 test_that("calibrate() statuses: too short, no rest, bins incomplete", {
@@ -34,24 +41,36 @@ test_that("calibrate() statuses: too short, no rest, bins incomplete", {
 
   flat <- data.frame(x = rnorm(n, sd = 0.002), y = rnorm(n, sd = 0.002),
                      z = 1.02 + rnorm(n, sd = 0.002))
-  f <- calibrate(flat, sf = 10)
+  f <- calibrate(flat, sf = 10, selection = "paper")
   expect_equal(f$status, "bins_incomplete")
   expect_match(f$message, "x- \\(0 of 2\\)")
+  expect_equal(unname(coef(f)), c(1, 1, 1, rep(0, 9)))
+  expect_identical(apply_calibration(flat, f), flat)
+  f <- calibrate(flat, sf = 10)
+  expect_equal(f$status, "sphere_not_covered")
+  expect_match(f$message, "at least 6 are needed|not determined")
   expect_equal(unname(coef(f)), c(1, 1, 1, rep(0, 9)))
   expect_identical(apply_calibration(flat, f), flat)
 })
 
 test_that("calibrate() routes ... and rejects unknown arguments", {
   rec <- simulate_recording(hours = 12, sf = 10, seed = 43)
-  f <- calibrate(rec, sf = 10, per_bin = 3, max_iter = 80, tol = 0,
-                 window = 4)
+  f <- calibrate(rec, sf = 10, selection = "paper", per_bin = 3,
+                 max_iter = 80, tol = 0, window = 4)
   expect_equal(nrow(f$points), 27)
   expect_equal(f$iterations, 80L)
   expect_equal(f$settings$max_iter, 80)
-  # by default the descent runs to convergence
-  f2 <- calibrate(rec, sf = 10)
+  # by default the paper's descent runs to convergence
+  f2 <- calibrate(rec, sf = 10, selection = "paper")
   expect_true(f2$converged)
   expect_gt(f2$iterations, 50L)
+  # gravcal's default: Levenberg-Marquardt, converged in a few iterations
+  f3 <- calibrate(rec, sf = 10)
+  expect_true(f3$converged)
+  expect_lt(f3$iterations, 20L)
+  expect_identical(f3$settings$algorithm, "lm")
+  expect_error(calibrate(rec, sf = 10, per_bin = 3),
+               "`per_bin` sets the paper's orientation bins")
   expect_error(calibrate(rec, sf = 10, perbin = 3), "Unknown argument.*perbin")
   expect_error(calibrate(rec, 10, "lightweight", FALSE, 3), "must be named")
   expect_error(calibrate(rec), "`sf`")
@@ -120,11 +139,11 @@ test_that("calibrate() lowers the novelty threshold when postures are few", {
                   z = v[, 3] + rnorm(n, sd = 0.002))
   strict <- select_points(rest_windows(x, sf = 10))
   expect_false(attr(strict, "complete"))
-  fit <- calibrate(x, sf = 10)
+  fit <- calibrate(x, sf = 10, selection = "paper")
   expect_equal(fit$status, "ok")
   expect_lt(min(attr(fit$points, "min_distance")), 0.3)
-  expect_equal(calibrate(x, sf = 10, min_distance = 0.3)$status,
-               "bins_incomplete")
+  expect_equal(calibrate(x, sf = 10, selection = "paper",
+                         min_distance = 0.3)$status, "bins_incomplete")
 })
 
 test_that("summary() of a GGIR-method fit has no held-out row", {
@@ -138,7 +157,8 @@ test_that("summary() of a GGIR-method fit has no held-out row", {
   expect_equal(s$errors$after_mg, 1000 * fg$error_after)
   fl <- calibrate(rec, sf = 10)
   sl <- summary(fl)
-  expect_identical(sl$errors$n, c(18L, nrow(fl$windows) - 18L))
+  expect_identical(sl$errors$n, c(nrow(fl$points),
+                                  nrow(fl$windows) - nrow(fl$points)))
   expect_equal(sl$errors$after_mg[2], 1000 * fl$error_heldout_after)
 })
 
@@ -172,6 +192,7 @@ test_that("print() and summary() of every kind of fit (snapshots)", {
   flat <- data.frame(x = 0.01 + 0 * seq_len(36000), y = -0.02, z = 1.03)
   flat$x <- flat$x + rep(c(0, 0.001), 18000)
   expect_snapshot(print(calibrate(flat, sf = 10)))
+  expect_snapshot(print(calibrate(flat, sf = 10, selection = "paper")))
   expect_snapshot(print(fit_gradient(pts, arithmetic = "fixed16", h = 2^-14)))
   # a fit from a file: the input line names the file, not its folder
   f <- file.path(d, "rec.csv")
@@ -182,14 +203,14 @@ test_that("print() and summary() of every kind of fit (snapshots)", {
 
 test_that("a rest window whose norm is far from 1 g is never a point", {
   rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
-  clean <- calibrate(rec, sf = 10)
+  clean <- calibrate(rec, sf = 10, selection = "paper")
   # the first 5 s window held still at a norm of 0.07 g (a glitch): it lies
   # in the x0, y0 and z0 bands and comes first, so the selector takes it
   bad <- rec
   bad$x[1:50] <- 0.05
   bad$y[1:50] <- 0.04
   bad$z[1:50] <- 0.03
-  off <- calibrate(bad, sf = 10, max_norm_error = Inf)
+  off <- calibrate(bad, sf = 10, selection = "paper", max_norm_error = Inf)
   expect_equal(off$status, "ok")
   expect_equal(off$points$row[1], 1L)
   expect_equal(off$points$mean_norm[1], sqrt(0.05^2 + 0.04^2 + 0.03^2))
@@ -197,7 +218,7 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
   # one such point among 18 shifts the fit: the held-out error is several
   # times the clean fit's (3.5 against 0.46 mg)
   expect_gt(off$error_heldout_after, 4 * clean$error_heldout_after)
-  on <- calibrate(bad, sf = 10)
+  on <- calibrate(bad, sf = 10, selection = "paper")
   expect_equal(on$excluded, c(norm = 1L, clipped = 0L))
   expect_equal(nrow(on$excluded_windows), 1L)
   expect_equal(on$excluded_windows$why, "norm")
@@ -207,9 +228,9 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
   expect_lt(on$error_heldout_after, 1.1 * clean$error_heldout_after)
   expect_output(print(on), "left out: 1 with \\| \\|v\\| - 1 \\| > 0.3 g")
   # the limit is an argument, checked
-  expect_equal(calibrate(bad, sf = 10, max_norm_error = 0.95)$excluded,
+  expect_equal(calibrate(bad, sf = 10, selection = "paper", max_norm_error = 0.95)$excluded,
                c(norm = 0L, clipped = 0L))
-  expect_error(calibrate(bad, sf = 10, max_norm_error = -1),
+  expect_error(calibrate(bad, sf = 10, selection = "paper", max_norm_error = -1),
                "`max_norm_error` must be a number > 0")
   # select_points() and fit_gradient() called directly keep the paper's
   # procedure: no guard
@@ -219,7 +240,7 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
 
 test_that("a rest window that reaches the sensor's range is never a point", {
   rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
-  clean <- calibrate(rec, sf = 10)
+  clean <- calibrate(rec, sf = 10, selection = "paper")
   # x stuck at the full scale of a +-2 g sensor for the first 5 s: flat, so
   # rest by the range criterion, and in the y0 and z0 bands
   clip <- rec
@@ -227,26 +248,31 @@ test_that("a rest window that reaches the sensor's range is never a point", {
   clip$y[1:50] <- 0.2
   clip$z[1:50] <- 0.1
   # norm guard off, range unknown: taken as a point, and the fit is wrecked
-  off <- calibrate(clip, sf = 10, max_norm_error = Inf)
+  off <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf)
   expect_equal(off$excluded, c(norm = 0L, clipped = 0L))
   expect_equal(off$status, "implausible")
   # the clipping guard alone excludes it
-  on <- calibrate(clip, sf = 10, max_norm_error = Inf, range_g = 2)
+  on <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf, range_g = 2)
   expect_equal(on$excluded, c(norm = 0L, clipped = 1L))
   expect_equal(on$excluded_windows$why, "clipped")
   expect_equal(on$status, "ok")
   expect_equal(unname(coef(on)), unname(coef(clean)), tolerance = 1e-6)
   expect_output(print(on), "1 clipped \\(range \\+-2 g\\)")
   # with both guards it counts once, as clipped
-  both <- calibrate(clip, sf = 10, range_g = 2)
+  both <- calibrate(clip, sf = 10, selection = "paper", range_g = 2)
   expect_equal(both$excluded, c(norm = 0L, clipped = 1L))
+  # gravcal's default selection applies the same guards
+  dflt <- calibrate(clip, sf = 10, range_g = 2)
+  expect_equal(dflt$excluded, c(norm = 0L, clipped = 1L))
+  expect_equal(dflt$status, "ok")
+  expect_false(1L %in% dflt$points$row)
   # a window whose samples come within 2 % of the range is clipped; an
   # ordinary rest window of a +-8 g sensor is not
   w <- data.frame(mean_x = c(1.9, 1.0), mean_y = 0, mean_z = 0,
                   range_x = c(0.07, 0.01), range_y = 0, range_z = 0)
   expect_equal(gravcal:::guard_windows(w, Inf, 2), c("clipped", NA))
   expect_equal(gravcal:::guard_windows(w, Inf, 8), c(NA_character_, NA))
-  expect_error(calibrate(clip, sf = 10, range_g = 0), "`range_g` must be")
+  expect_error(calibrate(clip, sf = 10, selection = "paper", range_g = 0), "`range_g` must be")
 })
 
 test_that("all rest windows left out is the status no_rest", {
@@ -277,7 +303,8 @@ test_that("the clipping guard takes the full scale from a device file", {
   expect_equal(fit$status, "ok")
   # a range given by the user wins: at +-16 g the window is not clipped,
   # is taken as a point and wrecks the fit
-  wide <- calibrate(f, max_norm_error = Inf, range_g = 16)
+  wide <- calibrate(f, max_norm_error = Inf, range_g = 16,
+                    selection = "paper")
   expect_equal(wide$excluded, c(norm = 0L, clipped = 0L))
   expect_equal(wide$status, "implausible")
 })

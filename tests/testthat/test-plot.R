@@ -5,7 +5,8 @@ test_that("print, summary and plot describe the fit", {
   expect_output(print(fit), "error on held-out rest: +[0-9.]+ mg -> [0-9.]+ mg")
   s <- summary(fit)
   expect_s3_class(s, "summary.gravcal_fit")
-  expect_equal(s$errors$n, c(18, nrow(fit$windows) - 18))
+  expect_equal(s$errors$n, c(nrow(fit$points),
+                             nrow(fit$windows) - nrow(fit$points)))
   expect_equal(s$errors$before_mg[2], 1000 * fit$error_heldout_before)
   expect_output(print(s), "Points per orientation bin")
   f <- tempfile(fileext = ".png")
@@ -54,8 +55,9 @@ test_that("the sphere map places each rest window and marks the fit's points", {
   expect_equal(m$azimuth, atan2(v[, 2], v[, 1]) / pi * 180)
   expect_equal(m$elevation, 90 - acos(v[, 3] / r) / pi * 180)
   expect_equal(m$error_before_mg, 1000 * abs(r - 1))
+  np <- nrow(fit$points)
   expect_equal(mean(m$error_after_mg), 1000 * fit$error_heldout_after *
-                 (nrow(v) - 18) / nrow(v) + 1000 * fit$error_after * 18 / nrow(v))
+                 (nrow(v) - np) / nrow(v) + 1000 * fit$error_after * np / nrow(v))
   expect_identical(sum(m$used), nrow(fit$points))
   expect_true(all(abs(m$elevation) <= 90) && all(abs(m$azimuth) <= 180))
   f <- tempfile(fileext = ".png")

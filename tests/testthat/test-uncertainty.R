@@ -98,10 +98,14 @@ test_that("standard errors agree with R's nls() on the same residuals", {
 
 test_that("fits not applied have no standard errors", {
   flat <- data.frame(x = 0.01 + 0 * seq_len(3600), y = -0.02, z = 1.03)
-  f <- calibrate(flat, sf = 10)
+  f <- calibrate(flat, sf = 10, selection = "paper")
   expect_equal(f$status, "bins_incomplete")
   expect_true(all(is.na(f$se)))
   expect_error(vcov(f), "no covariance.*bins_incomplete")
+  f <- calibrate(flat, sf = 10)
+  expect_equal(f$status, "sphere_not_covered")
+  expect_true(all(is.na(f$se)))
+  expect_error(vcov(f), "no covariance.*sphere_not_covered")
   expect_error(confint(f), "no covariance")
   # a fit refused by guard_fit() loses its errors with its coefficients
   rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
@@ -109,7 +113,7 @@ test_that("fits not applied have no standard errors", {
   clip$x[1:50] <- 2
   clip$y[1:50] <- 0.2
   clip$z[1:50] <- 0.1
-  bad <- calibrate(clip, sf = 10, max_norm_error = Inf)
+  bad <- calibrate(clip, sf = 10, max_norm_error = Inf, selection = "paper")
   expect_equal(bad$status, "implausible")
   expect_true(all(is.na(bad$se)))
   expect_null(bad$vcov)
@@ -117,7 +121,7 @@ test_that("fits not applied have no standard errors", {
 
 test_that("confint() gives estimate +- t(df) se and checks its arguments", {
   rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
-  fit <- calibrate(rec, sf = 10)
+  fit <- calibrate(rec, sf = 10, selection = "paper")
   ci <- confint(fit)
   expect_equal(rownames(ci), param_names())
   expect_equal(colnames(ci), c("2.5 %", "97.5 %"))
@@ -151,4 +155,35 @@ test_that("fits name the coefficients their model fitted", {
                      method = "ggir")
   expect_false(short$status == "ok")
   expect_identical(short$model, character(0))
+})
+
+test_that("robust (HC3) standard errors: the sandwich, restated", {
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
+  fit <- calibrate(rec, sf = 10)
+  expect_identical(fit$settings$se, "robust")
+  v <- as.matrix(fit$points[c("mean_x", "mean_y", "mean_z")])
+  # an independent restatement: the Jacobian by central differences of
+  # |K(v + o)|^2 - 1 in the nine parameters, then HC3
+  res <- function(p) {
+    K <- matrix(0, 3, 3)
+    diag(K) <- p[1:3]
+    K[2, 1] <- p[4]; K[3, 1] <- p[5]; K[3, 2] <- p[6]
+    u <- t(t(v) + p[7:9])
+    rowSums((u %*% t(K))^2) - 1
+  }
+  p <- unname(fit$params)
+  J <- sapply(1:9, function(j) {
+    e <- replace(numeric(9), j, 1e-6)
+    (res(p + e) - res(p - e)) / 2e-6
+  })
+  r <- res(p)
+  B <- solve(crossprod(J))
+  h <- rowSums((J %*% B) * J)
+  V <- B %*% crossprod(J * (r / (1 - h))) %*% B
+  expect_equal(unname(fit$se[param_names()]), sqrt(diag(V)), tolerance = 1e-5)
+  expect_equal(fit$df, nrow(v) - 9L)
+  # classic on request: s^2 (J'J)^-1
+  fc <- fit_gradient(fit$points, algorithm = "lm", se = "classic")
+  expect_equal(unname(fc$se[param_names()]),
+               sqrt(diag(sum(r^2) / (nrow(v) - 9) * B)), tolerance = 1e-5)
 })
