@@ -67,8 +67,11 @@
 #'   terms `cross.xy`, `cross.xz`, `cross.yz` (`k_xy`, `k_xz`, `k_yz` of
 #'   `coef()`); their standard errors, in the same order, named with a
 #'   `.se` suffix (`scale.x.se`, ...; `fit$se`, NA for what was not
-#'   fitted or not applied); `meantempcal`; `error_before_mg`, `error_after_mg` (on
-#'   the rest points used); `format`, `hours` (of samples read), `windows`,
+#'   fitted or not applied); `parameters` (how many coefficients the model
+#'   fitted: 9, 6 or 3 for the lightweight method, which fits what the
+#'   recording determines; 6 or 9 for the GGIR method; 0 when not
+#'   calibrated) and `points` (calibration points used); `meantempcal`;
+#'   `error_before_mg`, `error_after_mg` (on the rest points used); `format`, `hours` (of samples read), `windows`,
 #'   `rest_windows`; what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
 #'   not use: damaged blocks, pages, records or lines), `gaps` and
@@ -260,9 +263,10 @@ read_saved <- function(slot, identity, settings) {
     return(list(note = paste0("the saved result \"", slot, "\" could not be ",
                               "read (", bad, ") and was recomputed")))
   }
-  # a result saved before the rows carried standard errors is stale too
+  # a result saved before the rows carried standard errors and the model's
+  # size is stale too
   if (!identical(res$key$settings, settings) ||
-      !"scale.x.se" %in% names(res$row) ||
+      !all(c("scale.x.se", "parameters") %in% names(res$row)) ||
       (!is.null(identity) && !identical(res$key$identity, identity))) {
     unlink(slot)
     return(list())
@@ -409,6 +413,8 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
     status = if (na) "failed" else fit$status,
     message = if (na) paste(error, collapse = "; ") else fit$message,
     coefs,
+    parameters = if (na) NA_integer_ else length(fit$model),
+    points = if (na) NA_integer_ else NROW(fit$points),
     meantempcal = if (na) NA_real_ else num(fit$meantemp),
     error_before_mg = if (na) NA_real_ else 1000 * fit$error_before,
     error_after_mg = if (na) NA_real_ else 1000 * fit$error_after,

@@ -396,9 +396,10 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
     }
     worst <- which.max(ifelse(is.finite(se), se, Inf))
     why <- c(why, sprintf(paste0(
-      "%s not determined by the rest points (standard error of %s %s > ",
-      "max_se = %s)"), switch(m, full = "cross-axis terms",
-                              scale_offset = "scales", offset = "offsets"),
+      "%d parameters (%s) not determined by the rest points (standard ",
+      "error of %s %s > max_se = %s)"), k,
+      switch(m, full = "scale, cross-axis, offset",
+             scale_offset = "scale, offset", offset = "offset"),
       names(se)[worst], format(signif(se[worst], 2)), format(choice$max_se)))
     fit$message <- NULL
   }
