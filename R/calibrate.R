@@ -26,7 +26,12 @@
 #'   errors and those the points' geometry allows at a residual sd of
 #'   0.004 (about 2 mg), so that a parameter only the absence of noise
 #'   determines (the x offset of a device that always lay flat) is not
-#'   fitted. `model` forces one of `"full"`, `"scale_offset"`, `"offset"`.
+#'   fitted. Where the rest windows have a temperature that varies (and
+#'   `use_temp`, default TRUE), each model is first tried with a
+#'   temperature offset per axis, `a = K (v + o) + (T - meantemp) t`, as
+#'   GGIR's model has (its standard error, times the sd of the points'
+#'   temperature, against `max_se`). `model` forces one of `"full"`,
+#'   `"scale_offset"`, `"offset"`.
 #'   The status message says which model was fitted and why. People at
 #'   rest in daily life rarely turn every axis fully up and fully down, so
 #'   the paper's bins often cannot all be filled; and 18 points leave nine
@@ -113,7 +118,8 @@
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
 #'   file or unknown; see Details), the choice of points and model
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
-#'   `max_se`, default 0.01; `model`, default `"auto"`; see Details),
+#'   `max_se`, default 0.01; `model`, default `"auto"`; `use_temp`,
+#'   default TRUE; see Details),
 #'   [select_points()] for `selection = "paper"` (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
 #'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`,
@@ -181,7 +187,7 @@
 #'   * `iterations`, `converged`, `status`, `message`, `method`, `call`, and
 #'     for the lightweight method `params` (the nine parameters) and
 #'     `selection` (the choice of points and model: `selection`, `cell`,
-#'     `max_se`, `model`);
+#'     `max_se`, `model`, `use_temp`);
 #'   * `se`: standard errors, named like [coef()]'s coefficients (NA for a
 #'     coefficient the model does not fit, and for every coefficient when
 #'     the fit was not applied); `vcov`: the covariance of the fitted
@@ -221,7 +227,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader"),
     guards = c("max_norm_error", "range_g"),
-    choice = c("selection", "cell", "max_se", "model"),
+    choice = c("selection", "cell", "max_se", "model", "use_temp"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
                      "use_sqrt", "tol", "trace", "difference", "algorithm",
@@ -335,7 +341,10 @@ check_choice_args <- function(choice, sargs) {
           "takes one point per distinct posture).")
   }
   if (selection == "paper" && model == "auto") model <- "full"
-  list(selection = selection, cell = cell, max_se = max_se, model = model)
+  use_temp <- choice$use_temp %||% TRUE
+  check_flag(use_temp, "use_temp")
+  list(selection = selection, cell = cell, max_se = max_se, model = model,
+       use_temp = use_temp)
 }
 
 # The largest standard error (HC3) a fitted parameter may have for its
@@ -352,7 +361,8 @@ default_max_se <- 0.01
 # device that rested flat on its back) is not determined.
 design_se <- function(fit, pts, floor_sigma = 0.004) {
   v <- point_matrix(pts, "pts")
-  J <- residual_jacobian(fit, v)$J[, fit$model, drop = FALSE]
+  temp <- if (any(c("t_x", "t_y", "t_z") %in% fit$model)) pts$temperature
+  J <- residual_jacobian(fit, v, temp)$J[, fit$model, drop = FALSE]
   A <- crossprod(J)
   inv <- tryCatch(solve(A), error = function(e) NULL)
   if (is.null(inv) || rcond(A) < 1e-12) return(rep(Inf, ncol(J)))
@@ -373,19 +383,40 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
   if (identical(fargs$algorithm, "descent")) {
     fargs <- utils::modifyList(list(max_iter = 5000, tol = 1e-10), fargs)
   }
+  # the temperature term, where the points have a temperature that varies
+  # and the fit is Levenberg-Marquardt
+  temp_sd <- if (is.numeric(pts$temperature) &&
+                 all(is.finite(pts$temperature)) && nrow(pts) > 1) {
+    stats::sd(pts$temperature)
+  } else 0
+  with_temp <- isTRUE(choice$use_temp) && temp_sd > 0 &&
+    identical(fargs$algorithm, "lm")
   models <- if (choice$model == "auto") c("full", "scale_offset", "offset")
     else choice$model
+  tries <- expand.grid(temp = if (with_temp) c(TRUE, FALSE) else FALSE,
+                       model = models, stringsAsFactors = FALSE)
   why <- character(0)
-  for (m in models) {
-    k <- sum(model_free(m))
+  for (i in seq_len(nrow(tries))) {
+    m <- tries$model[i]
+    tt <- tries$temp[i]
+    k <- sum(model_free(m)) + 3 * tt
+    what <- sprintf("%d parameters (%s%s)", k,
+                    switch(m, full = "scale, cross-axis, offset",
+                           scale_offset = "scale, offset", offset = "offset"),
+                    if (tt) ", temperature offset" else "")
     if (nrow(pts) < 2 * k) {
-      why <- c(why, sprintf("%d points are too few for %d parameters",
-                            nrow(pts), k))
+      why <- c(why, sprintf("%d points are too few for %s", nrow(pts), what))
       next
     }
-    fit <- do.call(fit_gradient, c(list(pts = pts, model = m), fargs))
-    if (fit$status != "ok" || choice$model != "auto") return(fit)
+    fit <- do.call(fit_gradient, c(list(pts = pts, model = m, use_temp = tt),
+                                   fargs))
+    if (fit$status != "ok") return(fit)
+    if (choice$model != "auto" && (!tt || i == nrow(tries))) return(fit)
+    # standard errors against max_se; a temperature offset's (g per degree
+    # C) at one standard deviation of the points' temperature
     se <- pmax(fit$se[fit$model], design_se(fit, pts))
+    tcols <- fit$model %in% c("t_x", "t_y", "t_z")
+    se[tcols] <- se[tcols] * temp_sd
     bad <- !is.finite(se) | se > choice$max_se
     if (!any(bad)) {
       fit$message <- paste0(fit$message, sprintf(" on %d points", nrow(pts)))
@@ -396,12 +427,10 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
     }
     worst <- which.max(ifelse(is.finite(se), se, Inf))
     why <- c(why, sprintf(paste0(
-      "%d parameters (%s) not determined by the rest points (standard ",
-      "error of %s %s > max_se = %s)"), k,
-      switch(m, full = "scale, cross-axis, offset",
-             scale_offset = "scale, offset", offset = "offset"),
-      names(se)[worst], format(signif(se[worst], 2)), format(choice$max_se)))
-    fit$message <- NULL
+      "%s not determined by the rest points (standard error of %s%s %s > ",
+      "max_se = %s)"), what, names(se)[worst],
+      if (tcols[worst]) " times the temperature's sd" else "",
+      format(signif(se[worst], 2)), format(choice$max_se)))
   }
   need <- 2 * min(vapply(models, function(m) sum(model_free(m)), 0))
   fail("sphere_not_covered", paste0(

@@ -88,8 +88,13 @@ param_names <- function() {
 #'   points' errors differ (real rest windows in rare orientations fit
 #'   worse than common ones). `"robust"` needs more points than parameters
 #'   by a margin (it is [calibrate()]'s choice for its many-point fits).
+#' @param use_temp Also fit a temperature offset per axis, the model
+#'   `a = K (v + o) + (T - meantemp) t` with `meantemp` the points' mean
+#'   temperature (as GGIR's model has, here with the cross-axis terms).
+#'   Needs `algorithm = "lm"` and a `temperature` column in `pts`.
 #' @return A `gravcal_fit` (see [calibrate()]) with `K` lower-triangular,
-#'   `offset`, zero `tempoffset`, `params` (the nine named parameters),
+#'   `offset`, `tempoffset` and `meantemp` (zero and NA unless
+#'   `use_temp`), `params` (the nine named parameters),
 #'   `objective`, `model` (the names of the fitted parameters), and `trace`
 #'   when asked for (descent only). Status `"ok"`; `"diverged"`
 #'   (identity coefficients) when the parameters left the finite range; or
@@ -116,7 +121,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          difference = c("forward", "central"),
                          model = c("full", "scale_offset", "offset"),
                          algorithm = c("descent", "lm"),
-                         se = c("classic", "robust")) {
+                         se = c("classic", "robust"), use_temp = FALSE) {
   call <- match.call()
   arithmetic <- match_choice(arithmetic, "arithmetic")
   objective <- match_choice(objective, "objective")
@@ -134,6 +139,22 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
     abort("`algorithm = \"lm\"` computes in double arithmetic only, not ",
           "`arithmetic = \"", arithmetic, "\"`; use `algorithm = \"descent\"` ",
           "for the device's arithmetic.")
+  }
+  check_flag(use_temp, "use_temp")
+  dT <- NULL
+  meantemp <- NA_real_
+  if (use_temp) {
+    if (algorithm != "lm") {
+      abort("`use_temp = TRUE` needs `algorithm = \"lm\"`: the paper's ",
+            "gradient descent fits the nine parameters only.")
+    }
+    temp <- if (is.data.frame(pts)) pts$temperature else NULL
+    if (!is.numeric(temp) || !all(is.finite(temp))) {
+      abort("`use_temp = TRUE` needs a finite numeric `temperature` column ",
+            "in `pts`.")
+    }
+    meantemp <- mean(temp)
+    dT <- temp - meantemp
   }
   if (algorithm == "lm" && missing(max_iter)) max_iter <- 100
   check_number(max_iter, "max_iter", min = 1, max = 1e6, integer = TRUE)
@@ -155,8 +176,8 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   check_flag(trace, "trace")
 
   if (algorithm == "lm") {
-    r <- fit_lm(v, free, as.integer(max_iter), if (tol > 0) tol else 1e-10,
-                use_sqrt, objective == "sum")
+    r <- fit_lm(v, c(free, rep(use_temp, 3)), as.integer(max_iter),
+                if (tol > 0) tol else 1e-10, use_sqrt, objective == "sum", dT)
     trace <- FALSE
   } else {
     r <- gc_fit_gradient(v[, 1], v[, 2], v[, 3],
@@ -165,18 +186,20 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          objective == "sum", tol, trace, arithmetic,
                          difference == "central")
   }
-  p <- stats::setNames(r$p, param_names())
+  tempoffset <- if (use_temp) r$p[10:12] else c(0, 0, 0)
+  p <- stats::setNames(r$p[1:9], param_names())
   status <- "ok"
   message <- if (algorithm == "lm") {
-    sprintf("fitted %s in %d iterations (Levenberg-Marquardt)",
-            model_label(model), r$iterations)
+    sprintf("fitted %s%s in %d iterations (Levenberg-Marquardt)",
+            model_label(model), if (use_temp) " and a temperature offset"
+            else "", r$iterations)
   } else {
     sprintf("fitted %sin %d iterations (%s arithmetic)",
             if (model == "full") "" else paste0(model_label(model), " "),
             r$iterations, arithmetic)
   }
   f0 <- if (algorithm == "lm") {
-    lm_objective(v, c(1, 1, 1, 0, 0, 0, 0, 0, 0), use_sqrt,
+    lm_objective(v, c(1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0), use_sqrt,
                  objective == "sum")
   } else {
     gc_fit_gradient(v[, 1], v[, 2], v[, 3], c(1, 1, 1, 0, 0, 0, 0, 0, 0),
@@ -190,6 +213,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                       objective, "\", rates ", paste(rates, collapse = ", "),
                       "); coefficients left at the identity")
     p <- stats::setNames(c(1, 1, 1, 0, 0, 0, 0, 0, 0), param_names())
+    tempoffset <- c(0, 0, 0)
   } else if (!(r$objective < f0)) {
     status <- "no_improvement"
     message <- sprintf(paste0(
@@ -198,12 +222,14 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
       "identity"), r$iterations, arithmetic, format(h), format(f0),
       format(r$objective))
     p <- stats::setNames(c(1, 1, 1, 0, 0, 0, 0, 0, 0), param_names())
+    tempoffset <- c(0, 0, 0)
   }
   if (!is.data.frame(pts) || !all(c("mean_x", "mean_y", "mean_z") %in%
                                   names(pts))) {
     pts <- data.frame(mean_x = v[, 1], mean_y = v[, 2], mean_z = v[, 3])
   }
   fit <- new_fit(K = params_to_K(p), offset = unname(p[7:9]),
+                 tempoffset = tempoffset, meantemp = meantemp,
                  points = pts, method = "lightweight",
                  iterations = r$iterations,
                  converged = r$converged ||
@@ -214,10 +240,13 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   fit$settings <- list(arithmetic = arithmetic, max_iter = max_iter,
                        rates = rates, h = h, objective = objective,
                        use_sqrt = use_sqrt, tol = tol, difference = difference,
-                       model = model, algorithm = algorithm, se = se)
-  fit$fitted <- param_names()[free]
+                       model = model, algorithm = algorithm, se = se,
+                       use_temp = use_temp)
+  fit$fitted <- c(param_names(), "t_x", "t_y", "t_z")[c(free,
+                                                        rep(use_temp, 3))]
   if (status == "ok") {
-    fit <- add_uncertainty(fit, v, use_sqrt = use_sqrt, type = se)
+    fit <- add_uncertainty(fit, v, temperature = if (use_temp) pts$temperature,
+                           use_sqrt = use_sqrt, type = se)
   }
   if (trace) {
     tr <- t(r$trace)
@@ -297,8 +326,9 @@ model_label <- function(model) {
 
 # Residuals of the lightweight objective at parameters p: |a|^2 - 1, or
 # |a| - 1 with use_sqrt, a = K (v + o).
-lm_residuals <- function(v, p, use_sqrt) {
+lm_residuals <- function(v, p, use_sqrt, dT = NULL) {
   a <- sweep(v, 2, p[7:9], `+`) %*% t(params_to_K(p))
+  if (!is.null(dT)) a <- a + outer(dT, p[10:12])
   na2 <- rowSums(a^2)
   if (use_sqrt) sqrt(na2) - 1 else na2 - 1
 }
@@ -310,16 +340,19 @@ lm_objective <- function(v, p, use_sqrt, sum_scale) {
 
 # Levenberg-Marquardt (Marquardt 1963, with the scaled damping of More
 # 1978) on the lightweight objective, over the parameters marked in
-# `free`, from the ideal sensor. Stops once no parameter moves by more
+# `free` (12: the nine, then the temperature offsets, fitted when `dT`, the
+# points' temperatures less their mean, is given), from the ideal sensor. Stops once no parameter moves by more
 # than `tol`, when the damping can no longer find a step that lowers the
 # objective (the minimum, to rounding), or after `max_iter` iterations.
-fit_lm <- function(v, free, max_iter, tol, use_sqrt, sum_scale) {
-  p <- c(1, 1, 1, 0, 0, 0, 0, 0, 0)
+fit_lm <- function(v, free, max_iter, tol, use_sqrt, sum_scale, dT = NULL) {
+  p <- c(1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0)
   jac <- function(p) {
-    f <- list(K = params_to_K(p), offset = p[7:9], method = "lightweight")
-    residual_jacobian(f, v, use_sqrt = use_sqrt)$J[, free, drop = FALSE]
+    f <- list(K = params_to_K(p), offset = p[7:9], tempoffset = p[10:12],
+              meantemp = 0, method = "lightweight")
+    J <- residual_jacobian(f, v, temperature = dT, use_sqrt = use_sqrt)$J
+    J[, free[seq_len(ncol(J))], drop = FALSE]
   }
-  r <- lm_residuals(v, p, use_sqrt)
+  r <- lm_residuals(v, p, use_sqrt, dT)
   S <- sum(r^2)
   mu <- 1e-3
   converged <- FALSE
@@ -338,7 +371,7 @@ fit_lm <- function(v, free, max_iter, tol, use_sqrt, sum_scale) {
       if (!is.null(step) && all(is.finite(step))) {
         pn <- p
         pn[free] <- p[free] + step
-        rn <- lm_residuals(v, pn, use_sqrt)
+        rn <- lm_residuals(v, pn, use_sqrt, dT)
         Sn <- sum(rn^2)
         if (is.finite(Sn) && Sn <= S) {
           moved <- TRUE

@@ -27,6 +27,8 @@ residual_jacobian <- function(fit, v, temperature = NULL, use_sqrt = FALSE) {
   if (identical(fit$method, "lightweight")) {
     K <- unname(fit$K)
     a <- u %*% t(K)
+    dt <- if (is.null(temperature)) NULL else temperature - fit$meantemp
+    if (!is.null(dt)) a <- a + outer(dt, fit$tempoffset)
     na <- sqrt(rowSums(a^2))
     if (use_sqrt) {
       r <- na - 1
@@ -40,6 +42,9 @@ residual_jacobian <- function(fit, v, temperature = NULL, use_sqrt = FALSE) {
                g[, 2] * u[, 1], g[, 3] * u[, 1], g[, 3] * u[, 2],
                g %*% K)
     colnames(J) <- param_names()
+    if (!is.null(dt)) {
+      J <- cbind(J, t_x = g[, 1] * dt, t_y = g[, 2] * dt, t_z = g[, 3] * dt)
+    }
     return(list(J = J, r = r))
   }
   s <- diag(fit$K)

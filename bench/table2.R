@@ -49,7 +49,7 @@ crb_mae <- function(v, p, sigma) {
 # the points determine (calibrate()'s own routine, from the candidates).
 default_fit <- function(cand) {
   choice <- list(selection = "cells", cell = 0.05, max_se = 0.01,
-                 model = "auto")
+                 model = "auto", use_temp = TRUE)
   fail <- function(status, message, points) stop(status, ": ", message)
   gravcal:::fit_chosen_model(select_points(cand, selection = "cells"),
                              list(), choice, fail)

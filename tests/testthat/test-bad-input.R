@@ -178,12 +178,18 @@ test_that("idle-sleep zeros are skipped; clipping at +-8 g is never rest", {
 })
 
 test_that("temperature missing, constant, NA or absurd", {
-  # the lightweight method has no temperature term: temperature is ignored
-  for (t in list(NULL, 25, -300, 1e6)) {
+  # the lightweight method fits a temperature term only where the
+  # temperature varies: a constant one, absurd or not, is as none
+  none <- base
+  none$temperature <- NULL
+  f0 <- calibrate(none, sf = 10)
+  expect_false("t_x" %in% f0$model)
+  for (t in list(25, -300, 1e6)) {
     d <- base
     d$temperature <- t
-    expect_identical(coef(calibrate(d, sf = 10))[1:9], coef(calibrate(base, sf = 10))[1:9])
+    expect_identical(coef(calibrate(d, sf = 10)), coef(f0))
   }
+  expect_true(all(c("t_x", "t_y", "t_z") %in% calibrate(base, sf = 10)$model))
   # GGIR method: constant or absurd temperature is not used, with a warning
   d <- base
   d$temperature <- 25

@@ -215,3 +215,31 @@ test_that("on a real free-living recording: ok where the paper gives up, and bet
   expect_lt(err(fl), 1.1 * err(fg))
   expect_lt(err(fl), 0.2 * mean(abs(sqrt(rowSums(v^2)) - 1)))
 })
+
+test_that("a temperature offset is fitted with the nine parameters where it is determined", {
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 8,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  tr <- attr(rec, "truth")
+  fit <- calibrate(rec, sf = 10)
+  expect_identical(fit$model, c(param_names(), "t_x", "t_y", "t_z"))
+  expect_match(fit$message, "and a temperature offset")
+  # within 0.1 mg per degree C (the standard errors are about 0.03)
+  expect_lt(max(abs(fit$tempoffset - c(0.002, -0.001, 0.0015))), 1e-4)
+  expect_equal(unname(fit$params[1:6]), unname(tr$params[1:6]), tolerance = 1e-3)
+  expect_equal(fit$meantemp, mean(fit$points$temperature))
+  # without the term the same points leave more error
+  f9 <- calibrate(rec, sf = 10, use_temp = FALSE)
+  expect_identical(f9$model, param_names())
+  expect_gt(f9$error_heldout_after, 2 * fit$error_heldout_after)
+  # applied by time: apply_calibration() uses the temperature column
+  cal <- apply_calibration(rec, fit)
+  w <- rest_windows(cal, sf = 10)
+  w <- w[w$rest, ]
+  expect_lt(err_mg(as.matrix(w[c("mean_x", "mean_y", "mean_z")])), 1)
+  pts <- fit$points
+  expect_error(fit_gradient(pts, use_temp = TRUE), "needs `algorithm = \"lm\"`")
+  pts$temperature <- NULL
+  expect_error(fit_gradient(pts, algorithm = "lm", use_temp = TRUE),
+               "finite numeric `temperature` column")
+  expect_error(calibrate(rec, sf = 10, use_temp = NA), "`use_temp` must be")
+})

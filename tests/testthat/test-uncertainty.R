@@ -141,7 +141,10 @@ test_that("fits name the coefficients their model fitted", {
                             tempoffset = c(0.001, 0, -0.001))
   lw <- calibrate(rec, sf = 10, method = "lightweight")
   expect_equal(lw$status, "ok")
-  expect_identical(lw$model, param_names())
+  expect_identical(lw$model, c(param_names(), "t_x", "t_y", "t_z"))
+  expect_lt(max(abs(lw$tempoffset - c(0.001, 0, -0.001))), 1e-4)
+  lw9 <- calibrate(rec, sf = 10, use_temp = FALSE)
+  expect_identical(lw9$model, param_names())
   gg <- calibrate(rec, sf = 10, method = "ggir")
   expect_equal(gg$status, "ok")
   expect_identical(gg$model, c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z",
@@ -158,7 +161,7 @@ test_that("fits name the coefficients their model fitted", {
 })
 
 test_that("robust (HC3) standard errors: the sandwich, restated", {
-  rec <- simulate_recording(hours = 24, sf = 10, seed = 3)
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 3, temperature = FALSE)
   fit <- calibrate(rec, sf = 10)
   expect_identical(fit$settings$se, "robust")
   v <- as.matrix(fit$points[c("mean_x", "mean_y", "mean_z")])
