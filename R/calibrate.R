@@ -17,21 +17,29 @@
 #'   stillest rest window of each cube of side `cell` = 0.05 g). The
 #'   objective of the paper is minimised by Levenberg-Marquardt
 #'   ([fit_gradient()] with `algorithm = "lm"`) to convergence, and the
-#'   model is the one the points determine: all nine parameters when every
-#'   standard error is at most `max_se` (0.01), else scales and offsets
-#'   (cross-axis terms 0), else offsets alone; when even the offsets are
-#'   not determined, or there are fewer than twice as many points as
-#'   parameters, the status is `"sphere_not_covered"`. The standard errors
+#'   model is chosen among those the points determine: all nine
+#'   parameters, scales and offsets (cross-axis terms 0), or offsets alone,
+#'   each with and without a temperature offset (below). A model is
+#'   determined when every standard error is at most `max_se` (0.01) and
+#'   there are at least twice as many points as parameters; among the
+#'   determined models the one with the lowest Bayesian information
+#'   criterion (`n log(RSS / n) + k log(n)` over the points) is fitted, so
+#'   that terms the data do not need (cross-axis terms of a device without
+#'   them, a temperature offset of a device whose temperature does not
+#'   move it) are left out. `fit$models` lists the candidates, whether each
+#'   was determined, its BIC and which was chosen. When not even the
+#'   offsets are determined the status is `"sphere_not_covered"`. The standard errors
 #'   used for that choice are the larger of the robust (HC3) standard
 #'   errors and those the points' geometry allows at a residual sd of
 #'   0.004 (about 2 mg), so that a parameter only the absence of noise
 #'   determines (the x offset of a device that always lay flat) is not
 #'   fitted. Where the rest windows have a temperature that varies (and
-#'   `use_temp`, default TRUE), each model is first tried with a
+#'   `use_temp`, default TRUE), each model is also tried with a
 #'   temperature offset per axis, `a = K (v + o) + (T - meantemp) t`, as
 #'   GGIR's model has (its standard error, times the sd of the points'
 #'   temperature, against `max_se`). `model` forces one of `"full"`,
-#'   `"scale_offset"`, `"offset"`.
+#'   `"scale_offset"`, `"offset"` (with the temperature offset when it is
+#'   determined).
 #'   The status message says which model was fitted and why. People at
 #'   rest in daily life rarely turn every axis fully up and fully down, so
 #'   the paper's bins often cannot all be filled; and 18 points leave nine
@@ -353,6 +361,18 @@ check_choice_args <- function(choice, sargs) {
 # is noise.
 default_max_se <- 0.01
 
+# Bayesian information criterion of a lightweight fit on its points: n
+# log(RSS / n) + k log(n), RSS the sum of the squared residuals of the
+# objective (|a|^2 - 1, or |a| - 1 with use_sqrt) and k the parameters
+# fitted (Schwarz 1978).
+model_bic <- function(fit, pts) {
+  v <- point_matrix(pts, "pts")
+  temp <- if (any(c("t_x", "t_y", "t_z") %in% fit$model)) pts$temperature
+  r <- residual_jacobian(fit, v, temp, isTRUE(fit$settings$use_sqrt))$r
+  n <- length(r)
+  n * log(sum(r^2) / n) + length(fit$model) * log(n)
+}
+
 # The standard errors the points' geometry alone allows: those of a fit
 # whose residuals had the sd `floor_sigma` (in the objective's units,
 # |a|^2 - 1, about twice |a| - 1). Real rest windows fit to 2-5 mg at
@@ -396,10 +416,15 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
   tries <- expand.grid(temp = if (with_temp) c(TRUE, FALSE) else FALSE,
                        model = models, stringsAsFactors = FALSE)
   why <- character(0)
+  cand <- list()
+  table <- data.frame(model = tries$model, temperature = tries$temp,
+                      parameters = NA_integer_, determined = FALSE,
+                      bic = NA_real_, chosen = FALSE)
   for (i in seq_len(nrow(tries))) {
     m <- tries$model[i]
     tt <- tries$temp[i]
-    k <- sum(model_free(m)) + 3 * tt
+    k <- as.integer(sum(model_free(m)) + 3 * tt)
+    table$parameters[i] <- k
     what <- sprintf("%d parameters (%s%s)", k,
                     switch(m, full = "scale, cross-axis, offset",
                            scale_offset = "scale, offset", offset = "offset"),
@@ -419,11 +444,12 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
     se[tcols] <- se[tcols] * temp_sd
     bad <- !is.finite(se) | se > choice$max_se
     if (!any(bad)) {
-      fit$message <- paste0(fit$message, sprintf(" on %d points", nrow(pts)))
-      if (length(why)) {
-        fit$message <- paste0(fit$message, "; ", paste(why, collapse = "; "))
-      }
-      return(fit)
+      table$determined[i] <- TRUE
+      table$bic[i] <- model_bic(fit, pts)
+      cand[[i]] <- fit
+      # a forced model: the first determined form (with temperature first)
+      if (choice$model != "auto") break
+      next
     }
     worst <- which.max(ifelse(is.finite(se), se, Inf))
     why <- c(why, sprintf(paste0(
@@ -431,6 +457,22 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
       "max_se = %s)"), what, names(se)[worst],
       if (tcols[worst]) " times the temperature's sd" else "",
       format(signif(se[worst], 2)), format(choice$max_se)))
+  }
+  if (any(table$determined)) {
+    best <- which(table$determined)[which.min(table$bic[table$determined])]
+    table$chosen[best] <- TRUE
+    fit <- cand[[best]]
+    fit$message <- paste0(fit$message, sprintf(" on %d points", nrow(pts)))
+    if (sum(table$determined) > 1) {
+      fit$message <- paste0(fit$message, sprintf(
+        ": of the %d models these points determine, the one with the lowest BIC",
+        sum(table$determined)))
+    }
+    if (length(why)) {
+      fit$message <- paste0(fit$message, "; ", paste(why, collapse = "; "))
+    }
+    fit$models <- table
+    return(fit)
   }
   need <- 2 * min(vapply(models, function(m) sum(model_free(m)), 0))
   fail("sphere_not_covered", paste0(

@@ -189,7 +189,11 @@ test_that("temperature missing, constant, NA or absurd", {
     d$temperature <- t
     expect_identical(coef(calibrate(d, sf = 10)), coef(f0))
   }
-  expect_true(all(c("t_x", "t_y", "t_z") %in% calibrate(base, sf = 10)$model))
+  # a temperature that varies without moving the readings: considered,
+  # and left out by the information criterion
+  fb <- calibrate(base, sf = 10)
+  expect_true(any(fb$models$temperature & fb$models$determined))
+  expect_false("t_x" %in% fb$model)
   # GGIR method: constant or absurd temperature is not used, with a warning
   d <- base
   d$temperature <- 25

@@ -141,10 +141,14 @@ test_that("fits name the coefficients their model fitted", {
                             tempoffset = c(0.001, 0, -0.001))
   lw <- calibrate(rec, sf = 10, method = "lightweight")
   expect_equal(lw$status, "ok")
-  expect_identical(lw$model, c(param_names(), "t_x", "t_y", "t_z"))
+  # no cross-axis terms in the truth: scale, offset and temperature
+  six <- c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z")
+  expect_identical(lw$model, c(six, "t_x", "t_y", "t_z"))
   expect_lt(max(abs(lw$tempoffset - c(0.001, 0, -0.001))), 1e-4)
   lw9 <- calibrate(rec, sf = 10, use_temp = FALSE)
-  expect_identical(lw9$model, param_names())
+  expect_identical(lw9$model, six)
+  expect_identical(calibrate(rec, sf = 10, model = "full")$model,
+                   c(param_names(), "t_x", "t_y", "t_z"))
   gg <- calibrate(rec, sf = 10, method = "ggir")
   expect_equal(gg$status, "ok")
   expect_identical(gg$model, c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z",
