@@ -243,3 +243,39 @@ test_that("a temperature offset is fitted with the nine parameters where it is d
                "finite numeric `temperature` column")
   expect_error(calibrate(rec, sf = 10, use_temp = NA), "`use_temp` must be")
 })
+
+test_that("cross-axis terms and temperature together: the criterion keeps both where the device has both", {
+  # one recording of bench/models.R's scenario A (its results: 9 + T maps
+  # with a small fraction of 6 + T's error)
+  set.seed(31001)
+  p <- random_params()
+  tof <- 2 * (stats::runif(3) - 0.5) * 0.002
+  rec <- simulate_recording(hours = 24, sf = 10, params = p, tempoffset = tof,
+                            seed = 31001)
+  truth <- attr(rec, "truth")
+  f <- calibrate(rec, sf = 10)
+  expect_identical(f$model, c(param_names(), "t_x", "t_y", "t_z"))
+  expect_identical(f$models$chosen, f$models$model == "full" & f$models$temperature)
+  # its BIC, restated: n log(RSS / n) + k log(n) on |a|^2 - 1
+  v <- as.matrix(f$points[c("mean_x", "mean_y", "mean_z")])
+  a <- t(f$K %*% (t(v) + f$offset)) +
+    outer(f$points$temperature - f$meantemp, f$tempoffset)
+  r <- rowSums(a^2) - 1
+  n <- length(r)
+  expect_equal(f$models$bic[f$models$chosen], n * log(sum(r^2) / n) + 12 * log(n))
+  # mapping error over the sphere at the recording's extreme temperatures
+  set.seed(1)
+  u <- gravcal:::random_unit_vectors(500)
+  map_err <- function(fit) {
+    mean(vapply(range(rec$temperature), function(temp) {
+      v <- distort(u - outer(rep(temp - truth$meantemp, 500), tof), p)
+      a <- gravcal:::calibrate_points(fit, v, rep(temp, 500))
+      mean(sqrt(rowSums((a - u)^2)))
+    }, 0))
+  }
+  f6 <- calibrate(rec, sf = 10, model = "scale_offset")
+  expect_identical(f6$model, c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z",
+                               "t_x", "t_y", "t_z"))
+  expect_lt(map_err(f), 0.5 * map_err(f6))
+  expect_lt(1000 * map_err(f), 1)
+})
