@@ -39,6 +39,7 @@ apply_calibration <- function(x, fit) {
       abort("`fit` has a temperature offset but no finite `meantemp`.")
     }
   }
+  if (segmented(fit)) return(apply_segments(x, s, fit))
   K <- fit$K
   o <- fit$offset
   to <- fit$tempoffset
@@ -68,6 +69,11 @@ apply_calibration <- function(x, fit) {
       az <- az + dt * to[[3]]
     }
   }
+  replace_xyz(x, ax, ay, az)
+}
+
+# x with its x, y, z columns replaced, same class and other columns.
+replace_xyz <- function(x, ax, ay, az) {
   cols <- match(c("x", "y", "z"), tolower(colnames(x)))
   if (is.matrix(x) && anyNA(cols)) cols <- 1:3
   if (is.matrix(x)) {
@@ -81,4 +87,33 @@ apply_calibration <- function(x, fit) {
   x[[nm[cols[2]]]] <- ay
   x[[nm[cols[3]]]] <- az
   x
+}
+
+# A fit with coefficients per segment of time: each sample gets its
+# segment's. Times: the `time` column (when the fit's windows were timed by
+# it), else seconds from the first sample (the `time` column less its first
+# value, or the row number over the sampling rate).
+apply_segments <- function(x, s, fit) {
+  st <- fit$segment_settings
+  n <- length(s$x)
+  if (identical(st$time, "time")) {
+    if (is.null(s$time)) {
+      abort("`fit` has coefficients per segment of time, timed by the ",
+            "`time` column it was fitted on, so `x` must have a `time` ",
+            "column.")
+    }
+    t <- as.numeric(s$time)
+  } else if (!is.null(s$time)) {
+    t <- as.numeric(s$time) - as.numeric(s$time[1]) + st$origin
+  } else {
+    t <- (seq_len(n) - 1) / st$sf + st$origin
+  }
+  if (any(fit$segments[c("t_x", "t_y", "t_z")] != 0)) {
+    if (is.null(s$temperature)) {
+      abort("`fit` has a temperature offset, so `x` must have a ",
+            "`temperature` column.")
+    }
+  }
+  a <- calibrate_points_by_time(fit, cbind(s$x, s$y, s$z), t, s$temperature)
+  replace_xyz(x, a[, 1], a[, 2], a[, 3])
 }

@@ -84,6 +84,22 @@
 #'   (Axivity, GENEActiv, ActiGraph); for samples in memory it is unknown
 #'   unless `range_g` is given, and then this guard is off.
 #'
+#' **Coefficients that change over time.** With `segments = "day"` (or a
+#' number of hours) the lightweight method also fits each day (segment) of
+#' the recording on its own rest windows, with the model and reference
+#' temperature the whole recording chose, and merges neighbouring
+#' segments wherever their coefficients do not differ: a Wald test of the
+#' difference against the two fits' covariances, at `change_alpha` (0.01)
+#' divided by the number of neighbouring pairs left. A segment that cannot
+#' be fitted alone is merged with its neighbour. `fit$segments` has a row
+#' per segment (`from`, `to` in the units of the windows' `start`: the
+#' `time` column when the samples have one, else seconds from the start;
+#' the coefficients named as in [coef()] and their standard errors with a
+#' `.se` suffix); [apply_calibration()] applies each segment's
+#' coefficients to its samples, and `plot(fit, type = "segments")` draws
+#' them over time. A recording without drift comes out as one segment.
+#' `K`, `offset` and `tempoffset` stay those of the whole recording.
+#'
 #' The fit records the windows left out: `excluded` (counts, named `norm`
 #' and `clipped`; a clipped window counts as clipped only),
 #' `excluded_windows` (those windows, with a column `why`) and `guards` (the
@@ -127,7 +143,8 @@
 #'   file or unknown; see Details), the choice of points and model
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
 #'   `max_se`, default 0.01; `model`, default `"auto"`; `use_temp`,
-#'   default TRUE; see Details),
+#'   default TRUE; `segments`, default none, and `change_alpha`, default
+#'   0.01; see Details),
 #'   [select_points()] for `selection = "paper"` (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
 #'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`,
@@ -235,7 +252,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader"),
     guards = c("max_norm_error", "range_g"),
-    choice = c("selection", "cell", "max_se", "model", "use_temp"),
+    choice = c("selection", "cell", "max_se", "model", "use_temp",
+               "segments", "change_alpha"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
                      "use_sqrt", "tol", "trace", "difference", "algorithm",
@@ -299,6 +317,15 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     fit$call <- call
     fit$selection <- choice
     fit <- guard_fit(fit)
+    if (!is.null(choice$segments) && fit$status == "ok") {
+      fit <- fit_segments(fit, rest, origin = w$start[1], args$fit_gradient,
+                          choice)
+      fit$segment_settings$time <- if (!is.character(x) &&
+                                       "time" %in% tolower(names(x))) {
+        "time"
+      } else "seconds"
+      fit$segment_settings$sf <- attr(w, "sf")
+    }
     fit$hours <- hours
     fit$input <- attr(w, "input")
     if (is.character(x)) fit$file <- basename(x)
@@ -351,8 +378,19 @@ check_choice_args <- function(choice, sargs) {
   if (selection == "paper" && model == "auto") model <- "full"
   use_temp <- choice$use_temp %||% TRUE
   check_flag(use_temp, "use_temp")
+  segments <- choice$segments
+  if (!is.null(segments)) {
+    segment_seconds(segments)
+    if (selection != "cells") {
+      abort("`segments` needs the default `selection = \"cells\"`: the ",
+            "paper's 18 points cannot be split over time.")
+    }
+  }
+  change_alpha <- choice$change_alpha %||% 0.01
+  check_number(change_alpha, "change_alpha", min = 0, max = 1,
+               min_inclusive = FALSE, max_inclusive = FALSE)
   list(selection = selection, cell = cell, max_se = max_se, model = model,
-       use_temp = use_temp)
+       use_temp = use_temp, segments = segments, change_alpha = change_alpha)
 }
 
 # The largest standard error (HC3) a fitted parameter may have for its
@@ -592,8 +630,14 @@ finish_fit <- function(fit, rest) {
   if (nrow(held) > 0) {
     v <- point_matrix(held, "held")
     fit$error_heldout_before <- sphere_error(v)
-    fit$error_heldout_after <- sphere_error(calibrate_points(fit, v,
-                                                             held$temperature))
+    fit$error_heldout_after <- sphere_error(if (segmented(fit)) {
+      calibrate_points_by_time(fit, v, held$start, held$temperature)
+    } else calibrate_points(fit, v, held$temperature))
+  }
+  if (segmented(fit) && NROW(fit$points)) {
+    v <- point_matrix(fit$points, "points")
+    fit$error_after <- sphere_error(calibrate_points_by_time(
+      fit, v, fit$points$start, fit$points$temperature))
   }
   fit
 }
@@ -693,7 +737,26 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
     cat("  meantemp (degree C):", format(x$meantemp), "\n")
   }
   print_se(x$se, x$df)
+  if (segmented(x)) {
+    seg <- x$segments
+    cat(sprintf("  %d segments over time (coefficients in fit$segments):\n",
+                nrow(seg)))
+    for (i in seq_len(nrow(seg))) {
+      cat(sprintf("    %d: %s to %s, %d points, offset %s\n", i,
+                  format_segment_time(x, seg$from[i]),
+                  format_segment_time(x, seg$to[i]), seg$points[i],
+                  paste(format(round(c(seg$o_x[i], seg$o_y[i], seg$o_z[i]),
+                                     digits), nsmall = digits),
+                        collapse = " ")))
+    }
+  }
   invisible(x)
+}
+
+# A segment boundary for people: hours from the start of the recording.
+format_segment_time <- function(fit, t) {
+  if (!is.finite(t)) return(if (t < 0) "start" else "end")
+  sprintf("%.1f h", (t - fit$segment_settings$origin) / 3600)
 }
 
 # The standard errors that exist, by group.

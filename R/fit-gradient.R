@@ -92,6 +92,10 @@ param_names <- function() {
 #'   `a = K (v + o) + (T - meantemp) t` with `meantemp` the points' mean
 #'   temperature (as GGIR's model has, here with the cross-axis terms).
 #'   Needs `algorithm = "lm"` and a `temperature` column in `pts`.
+#' @param meantemp With `use_temp`: the reference temperature of the model
+#'   (degrees C); default the points' mean. Fits that are to be compared
+#'   (the segments of one recording) share one reference, so that their
+#'   offsets are offsets at the same temperature.
 #' @return A `gravcal_fit` (see [calibrate()]) with `K` lower-triangular,
 #'   `offset`, `tempoffset` and `meantemp` (zero and NA unless
 #'   `use_temp`), `params` (the nine named parameters),
@@ -121,7 +125,8 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          difference = c("forward", "central"),
                          model = c("full", "scale_offset", "offset"),
                          algorithm = c("descent", "lm"),
-                         se = c("classic", "robust"), use_temp = FALSE) {
+                         se = c("classic", "robust"), use_temp = FALSE,
+                         meantemp = NULL) {
   call <- match.call()
   arithmetic <- match_choice(arithmetic, "arithmetic")
   objective <- match_choice(objective, "objective")
@@ -142,7 +147,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   }
   check_flag(use_temp, "use_temp")
   dT <- NULL
-  meantemp <- NA_real_
+  if (!use_temp) meantemp <- NA_real_
   if (use_temp) {
     if (algorithm != "lm") {
       abort("`use_temp = TRUE` needs `algorithm = \"lm\"`: the paper's ",
@@ -153,7 +158,8 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
       abort("`use_temp = TRUE` needs a finite numeric `temperature` column ",
             "in `pts`.")
     }
-    meantemp <- mean(temp)
+    if (is.null(meantemp)) meantemp <- mean(temp)
+    check_number(meantemp, "meantemp")
     dT <- temp - meantemp
   }
   if (algorithm == "lm" && missing(max_iter)) max_iter <- 100

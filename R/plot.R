@@ -22,7 +22,11 @@
 #' @param set `"windows"` (all rest windows, default when available) or
 #'   `"points"` (only the fitting points).
 #' @param theta,phi Viewing angles of the 3-D panel (see [graphics::persp()]).
-#' @param type `"map"` or `"panels"`, see Description.
+#' @param type `"map"`, `"panels"`, or `"segments"` (a fit with
+#'   coefficients per segment of time, see [calibrate()]: the offsets,
+#'   scales and, where fitted, cross-axis terms and temperature offsets of
+#'   each segment over the hours of the recording, with bars of +- 2
+#'   standard errors).
 #' @param ... Unused.
 #' @return `x`, invisibly.
 #' @export
@@ -32,12 +36,21 @@
 #' plot(fit)
 #' plot(fit, type = "panels")
 plot.gravcal_fit <- function(x, which = 1:4, set = c("windows", "points"),
-                             theta = 35, phi = 20, type = c("map", "panels"),
-                             ...) {
+                             theta = 35, phi = 20,
+                             type = c("map", "panels", "segments"), ...) {
   set <- match_choice(set, "set")
   # panels chosen by number are the "panels" type's
   if (missing(type) && !missing(which)) type <- "panels"
   type <- match_choice(type, "type")
+  if (type == "segments") {
+    check_fit(x, "x")
+    if (is.null(x$segments)) {
+      abort("`x` has no segments: fit it with `calibrate(..., segments = ",
+            "\"day\")` (or a number of hours).")
+    }
+    plot_segments(x)
+    return(invisible(x))
+  }
   if (!is.numeric(which) || !length(which) || !all(which %in% 1:4)) {
     abort("`which` must be a subset of 1:4, not ", describe(which), ".")
   }
@@ -173,4 +186,45 @@ sphere_map <- function(m) {
   graphics::axis(4, at = sqrt(ticks / top), labels = ticks, las = 1,
                  cex.axis = 0.8, pos = 0.5)
   graphics::title(main = "error (mg)", cex.main = 0.8)
+}
+
+# Each segment's coefficients over time, +- 2 se, one panel per group.
+plot_segments <- function(fit) {
+  seg <- fit$segments
+  st <- fit$segment_settings
+  last <- max(as.numeric(fit$windows$start), seg$from[is.finite(seg$from)],
+              na.rm = TRUE)
+  from <- ifelse(is.finite(seg$from), seg$from, st$origin)
+  to <- ifelse(is.finite(seg$to), seg$to, pmax(last, from + st$seconds))
+  h0 <- (from - st$origin) / 3600
+  h1 <- (to - st$origin) / 3600
+  groups <- list(offset = c("o_x", "o_y", "o_z"),
+                 scale = c("k_xx", "k_yy", "k_zz"),
+                 "cross-axis" = c("k_xy", "k_xz", "k_yz"),
+                 "temperature offset" = c("t_x", "t_y", "t_z"))
+  fitted <- vapply(groups, function(g) any(g %in% fit$model), NA)
+  groups <- groups[fitted]
+  cols <- c("#1f77b4", "#d62728", "#2ca02c")
+  op <- graphics::par(mfrow = c(length(groups), 1), mar = c(3.6, 4.5, 2, 1),
+                      mgp = c(2.2, 0.7, 0))
+  on.exit(graphics::par(op))
+  for (g in names(groups)) {
+    nm <- groups[[g]]
+    est <- as.matrix(seg[nm])
+    se <- as.matrix(seg[paste0(nm, ".se")])
+    se[!is.finite(se)] <- 0
+    lim <- range(c(est - 2 * se, est + 2 * se), finite = TRUE)
+    graphics::plot(NA, xlim = range(c(h0, h1)), ylim = lim,
+                   xlab = "hours from the start", ylab = g,
+                   main = sprintf("%s, %d segment%s", g, nrow(seg),
+                                  if (nrow(seg) > 1) "s" else ""))
+    for (j in seq_along(nm)) {
+      mid <- (h0 + h1) / 2
+      graphics::segments(h0, est[, j], h1, est[, j], col = cols[j], lwd = 2)
+      graphics::arrows(mid, est[, j] - 2 * se[, j], mid, est[, j] + 2 * se[, j],
+                       angle = 90, code = 3, length = 0.03, col = cols[j])
+    }
+    graphics::legend("topright", legend = sub("^[a-z]_", "", nm), col = cols,
+                     lwd = 2, bty = "n", horiz = TRUE, cex = 0.8)
+  }
 }
