@@ -100,6 +100,17 @@
 #' them over time. A recording without drift comes out as one segment.
 #' `K`, `offset` and `tempoffset` stay those of the whole recording.
 #'
+#' **An adaptive data budget.** With `budget = "adaptive"` the lightweight
+#' method reads the recording block by block and, every `check_hours` (6)
+#' hours of samples, fits what it has read; it stops reading once every
+#' standard error of the fitted coefficients is at most `target_se`
+#' (0.001: each coefficient known to about +-2 mg at 95 %) and the
+#' coefficients moved by less than two standard errors of their
+#' difference since the previous check. `fit$budget` says how much was
+#' read (`hours_read`, and `hours_total` for samples in memory) and
+#' whether it stopped early (`stopped`); `print()` shows it. GGIR's
+#' procedure keeps its own rule (`minloadcrit`).
+#'
 #' The fit records the windows left out: `excluded` (counts, named `norm`
 #' and `clipped`; a clipped window counts as clipped only),
 #' `excluded_windows` (those windows, with a column `why`) and `guards` (the
@@ -144,7 +155,8 @@
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
 #'   `max_se`, default 0.01; `model`, default `"auto"`; `use_temp`,
 #'   default TRUE; `segments`, default none, and `change_alpha`, default
-#'   0.01; see Details),
+#'   0.01; `budget`, `"all"` or `"adaptive"`, `target_se`, default 0.001,
+#'   and `check_hours`, default 6; see Details),
 #'   [select_points()] for `selection = "paper"` (`per_bin`, `min_per_bin`,
 #'   `min_distance`) and [fit_gradient()] (`arithmetic`, `max_iter`, `rates`,
 #'   `h`, `objective`, `use_sqrt`, `tol`, `trace`, `difference`,
@@ -253,7 +265,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                      "chunk_size", "progress", "reader"),
     guards = c("max_norm_error", "range_g"),
     choice = c("selection", "cell", "max_se", "model", "use_temp",
-               "segments", "change_alpha"),
+               "segments", "change_alpha", "budget", "target_se",
+               "check_hours"),
     select_points = c("per_bin", "min_per_bin", "min_distance"),
     fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
                      "use_sqrt", "tol", "trace", "difference", "algorithm",
@@ -270,8 +283,16 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   if (!is.null(range_g)) {
     check_number(range_g, "range_g", min = 0, min_inclusive = FALSE)
   }
-  w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method),
-                               args$rest_windows))
+  rargs <- args$rest_windows
+  if (choice$budget == "adaptive") {
+    rargs$stop <- budget_rule(args$fit_gradient, choice, max_norm_error,
+                              range_g)
+    rargs$stop_every <- choice$check_hours
+    if (is.null(rargs$chunk_size) && !is.character(x)) {
+      rargs$chunk_size <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
+    }
+  }
+  w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
   if (is.null(range_g)) range_g <- attr(w, "input")$range_g
   rest <- w[w$rest, , drop = FALSE]
   why <- guard_windows(rest, max_norm_error, range_g)
@@ -285,10 +306,15 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   guards <- list(max_norm_error = max_norm_error,
                  range_g = if (is.null(range_g)) NA_real_ else range_g)
   hours <- attr(w, "samples") / attr(w, "sf") / 3600
+  budget <- list(budget = choice$budget, target_se = choice$target_se,
+                 check_hours = choice$check_hours,
+                 stopped = isTRUE(attr(w, "stopped")), hours_read = hours,
+                 hours_total = attr(w, "samples_total") / attr(w, "sf") / 3600)
   fail <- function(status, message, points = rest[0, , drop = FALSE]) {
     f <- new_fit(points = points, method = method, status = status,
                  message = message, call = call)
     f$hours <- hours
+    f$budget <- budget
     f$input <- attr(w, "input")
     if (is.character(x)) f$file <- basename(x)
     f <- add_guards(f, excluded, excluded_windows, guards)
@@ -327,6 +353,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
       fit$segment_settings$sf <- attr(w, "sf")
     }
     fit$hours <- hours
+    fit$budget <- budget
     fit$input <- attr(w, "input")
     if (is.character(x)) fit$file <- basename(x)
     fit <- add_guards(fit, excluded, excluded_windows, guards)
@@ -389,8 +416,58 @@ check_choice_args <- function(choice, sargs) {
   change_alpha <- choice$change_alpha %||% 0.01
   check_number(change_alpha, "change_alpha", min = 0, max = 1,
                min_inclusive = FALSE, max_inclusive = FALSE)
+  budget <- match_choice(choice$budget %||% "all", "budget",
+                         c("all", "adaptive"))
+  target_se <- choice$target_se %||% default_target_se
+  check_number(target_se, "target_se", min = 0, min_inclusive = FALSE)
+  check_hours <- choice$check_hours %||% 6
+  check_number(check_hours, "check_hours", min = 0, min_inclusive = FALSE)
+  if (budget == "adaptive" && selection != "cells") {
+    abort("`budget = \"adaptive\"` needs the default `selection = ",
+          "\"cells\"`.")
+  }
   list(selection = selection, cell = cell, max_se = max_se, model = model,
-       use_temp = use_temp, segments = segments, change_alpha = change_alpha)
+       use_temp = use_temp, segments = segments, change_alpha = change_alpha,
+       budget = budget, target_se = target_se, check_hours = check_hours)
+}
+
+# The adaptive data budget's target: every standard error of the fitted
+# coefficients at most 1 mg (g, or g per degree C for a temperature
+# offset), so that each is known to about +-2 mg at 95 %: below the
+# 2-5 mg a calibrated device keeps on real rest windows
+# (bench/results/freeliving.md).
+default_target_se <- 0.001
+
+# The stop rule of the adaptive budget: at each check, fit the rest
+# windows read so far as calibrate() would; stop once every standard error
+# is at most target_se and the coefficients moved by less than two
+# standard errors of their difference since the previous check (the same
+# model both times).
+budget_rule <- function(fargs, choice, max_norm_error, range_g) {
+  prev <- NULL
+  function(w) {
+    rest <- w[!is.na(w$rest) & w$rest, , drop = FALSE]
+    rest <- rest[is.na(guard_windows(rest, max_norm_error, range_g)), ,
+                 drop = FALSE]
+    if (nrow(rest) == 0) return(FALSE)
+    pts <- select_points(rest, selection = "cells", cell = choice$cell)
+    f <- fit_chosen_model(pts, fargs, choice, function(status, message,
+                                                       points) {
+      list(status = status)
+    })
+    if (!identical(f$status, "ok")) {
+      prev <<- NULL
+      return(FALSE)
+    }
+    nm <- f$model
+    se <- f$se[nm]
+    done <- all(is.finite(se)) && all(se <= choice$target_se) &&
+      !is.null(prev) && identical(prev$model, nm) &&
+      all(abs(stats::coef(f)[nm] - stats::coef(prev)[nm]) <=
+            2 * sqrt(se^2 + prev$se[nm]^2))
+    prev <<- f
+    done
+  }
 }
 
 # The largest standard error (HC3) a fitted parameter may have for its
@@ -717,6 +794,15 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
   if (!is.null(x$excluded)) {
     cat("  rest windows left out: ", format_excluded(x$excluded, x$guards),
         "\n", sep = "")
+  }
+  if (identical(x$budget$budget, "adaptive")) {
+    b <- x$budget
+    cat(sprintf("  adaptive budget: read %.1f%s hours, %s\n", b$hours_read,
+                if (is.finite(b$hours_total)) sprintf(" of %.1f", b$hours_total)
+                else "", if (b$stopped) sprintf(paste0(
+                  "stopped once every standard error was at most %s and ",
+                  "the coefficients stable"), format(b$target_se)) else
+                  "the target was not reached before the end"))
   }
   if (is.finite(x$error_before)) {
     cat(sprintf("  error on fitting points: %.2f mg -> %.2f mg\n",

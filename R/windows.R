@@ -49,6 +49,13 @@
 #'   stream the file in bounded memory and count what they skip; or
 #'   `"reference"`, the readers GGIR uses (GGIRread, read.gt3x,
 #'   data.table), block by block.
+#' @param stop `NULL` (read everything), or a function called with the
+#'   windows read so far (a data frame as returned) after every block or
+#'   chunk that ends at least `stop_every` hours of samples after the last
+#'   call; reading stops, and the windows so far are returned, when it
+#'   returns `TRUE` (attribute `stopped` then TRUE). [calibrate()] uses it
+#'   for its adaptive data budget.
+#' @param stop_every Hours of samples between calls of `stop`.
 #' @return A data frame, one row per complete window: `start` (time of the
 #'   first sample, from `time` when given, else seconds from the start), `n`
 #'   (samples), `mean_x`, `mean_y`, `mean_z`, `sd_x`, `sd_y`, `sd_z`,
@@ -77,13 +84,22 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          axes = c("x", "y", "z"), max_sd = 0.013,
                          max_abs_mean = 2, skip_zero = TRUE,
                          chunk_size = 1e6, progress = NULL,
-                         reader = c("native", "reference")) {
+                         reader = c("native", "reference"), stop = NULL,
+                         stop_every = 6) {
   method <- match_choice(method, "method")
+  if (!is.null(stop) && !is.function(stop)) {
+    abort("`stop` must be NULL or a function, not ", describe(stop), ".")
+  }
+  check_number(stop_every, "stop_every", min = 0, min_inclusive = FALSE)
   src <- NULL
   if (is.character(x)) {
     reader <- match_choice(reader, "reader")
+    # blocks of about 12 hours (GGIR's), shorter when `stop` is to be asked
+    # more often
     src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x",
-                       reader = reader, compat = FALSE)
+                       reader = reader, compat = FALSE,
+                       chunksize = if (is.null(stop)) 1 else
+                         min(1, stop_every / 12))
     sf <- src$sf
     s <- list(n = 0, time = NULL)
   } else {
@@ -122,13 +138,27 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     abort("Column `time` of `x` must have one value per sample.")
   }
   seg <- gc_segmenter_new(window * sf, skip_zero, FALSE)
+  halt <- NULL
+  if (!is.null(stop)) {
+    # called with the chunks so far and the samples read: builds the
+    # windows and asks `stop` every `stop_every` hours
+    next_check <- stop_every * 3600 * sf
+    halt <- function(chunks, n) {
+      if (n < next_check) return(FALSE)
+      next_check <<- n + stop_every * 3600 * sf
+      isTRUE(stop(windows_frame(chunks, s, sf)))
+    }
+  }
   if (is.null(src)) {
-    out <- segment_chunks(seg, s, rule, par, chunk_size, progress)
+    out <- segment_chunks(seg, s, rule, par, chunk_size, progress, halt)
   } else {
-    out <- segment_source(seg, src, rule, par, progress)
+    out <- segment_source(seg, src, rule, par, progress, halt)
     s$n <- attr(out, "samples")
   }
   w <- windows_frame(out, s, sf)
+  attr(w, "stopped") <- isTRUE(attr(out, "stopped"))
+  attr(w, "samples_total") <- if (is.null(src)) s$n else NA_real_
+  if (is.null(src) && isTRUE(attr(out, "stopped"))) s$n <- attr(out, "samples")
   state <- gc_segmenter_state(seg)
   attr(w, "sf") <- sf
   attr(w, "method") <- method
@@ -154,7 +184,8 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
 
 # Push the samples through the segmenter chunk by chunk; returns the list of
 # per-chunk column lists.
-segment_chunks <- function(seg, s, rule, par, chunk_size, progress) {
+segment_chunks <- function(seg, s, rule, par, chunk_size, progress,
+                           halt = NULL) {
   n <- s$n
   starts <- seq(0, max(n - 1, 0), by = chunk_size)
   if (n == 0) starts <- numeric(0)
@@ -165,17 +196,25 @@ segment_chunks <- function(seg, s, rule, par, chunk_size, progress) {
     on.exit(close(bar), add = TRUE)
   }
   out <- vector("list", length(starts))
+  read <- n
   for (i in seq_along(starts)) {
     to <- min(starts[i] + chunk_size, n)
     out[[i]] <- gc_segmenter_push(seg, s$x, s$y, s$z, s$temperature,
                                   starts[i], to, rule, par)
     if (!is.null(bar)) utils::setTxtProgressBar(bar, i)
+    if (!is.null(halt) && to < n && halt(out[seq_len(i)], to)) {
+      out <- out[seq_len(i)]
+      read <- to
+      attr(out, "stopped") <- TRUE
+      break
+    }
   }
+  attr(out, "samples") <- read
   out
 }
 
 # The same for a file source (open_source()), one block at a time.
-segment_source <- function(seg, src, rule, par, progress) {
+segment_source <- function(seg, src, rule, par, progress, halt = NULL) {
   if (is.null(progress)) progress <- interactive()
   out <- list()
   n <- 0
@@ -204,6 +243,10 @@ segment_source <- function(seg, src, rule, par, progress) {
       cat(sprintf("\rblock %d: %.1f hours read", i, n / src$sf / 3600))
     }
     if (last) break
+    if (!is.null(halt) && halt(out, n)) {
+      attr(out, "stopped") <- TRUE
+      break
+    }
     if (isTRUE(src$from_file) && is.null(src$segment)) invisible(gc(full = TRUE))
     i <- i + 1
   }
