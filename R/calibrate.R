@@ -293,6 +293,17 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     }
   }
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
+  lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
+                           file = if (is.character(x)) basename(x),
+                           timed = !is.character(x) &&
+                             "time" %in% tolower(names(x)))
+}
+# The lightweight method from its windows (rest_windows()'s table, with its
+# attributes): the guards, the points, the fit and the held-out errors.
+# `file`: the file's name for the fit (NULL for samples in memory); `timed`:
+# whether the windows' start comes from a `time` column.
+lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
+                                     call, file = NULL, timed = FALSE) {
   if (is.null(range_g)) range_g <- attr(w, "input")$range_g
   rest <- w[w$rest, , drop = FALSE]
   why <- guard_windows(rest, max_norm_error, range_g)
@@ -311,12 +322,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                  stopped = isTRUE(attr(w, "stopped")), hours_read = hours,
                  hours_total = attr(w, "samples_total") / attr(w, "sf") / 3600)
   fail <- function(status, message, points = rest[0, , drop = FALSE]) {
-    f <- new_fit(points = points, method = method, status = status,
+    f <- new_fit(points = points, method = "lightweight", status = status,
                  message = message, call = call)
     f$hours <- hours
     f$budget <- budget
     f$input <- attr(w, "input")
-    if (is.character(x)) f$file <- basename(x)
+    f$file <- file
     f <- add_guards(f, excluded, excluded_windows, guards)
     finish_fit(f, rest)
   }
@@ -346,16 +357,13 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     if (!is.null(choice$segments) && fit$status == "ok") {
       fit <- fit_segments(fit, rest, origin = w$start[1], args$fit_gradient,
                           choice)
-      fit$segment_settings$time <- if (!is.character(x) &&
-                                       "time" %in% tolower(names(x))) {
-        "time"
-      } else "seconds"
+      fit$segment_settings$time <- if (timed) "time" else "seconds"
       fit$segment_settings$sf <- attr(w, "sf")
     }
     fit$hours <- hours
     fit$budget <- budget
     fit$input <- attr(w, "input")
-    if (is.character(x)) fit$file <- basename(x)
+    fit$file <- file
     fit <- add_guards(fit, excluded, excluded_windows, guards)
     return(finish_fit(fit, rest))
   }
@@ -380,7 +388,7 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   fit <- guard_fit(fit)
   fit$hours <- hours
   fit$input <- attr(w, "input")
-  if (is.character(x)) fit$file <- basename(x)
+  fit$file <- file
   fit <- add_guards(fit, excluded, excluded_windows, guards)
   finish_fit(fit, rest)
 }
