@@ -56,6 +56,17 @@
 #'   (`TRUE`), or calibrate every recording again (`FALSE`).
 #' @param pattern For a directory: the file names to take (a regular
 #'   expression).
+#' @param pool `"none"` (default) or `"device"`: calibrate the recordings
+#'   that cannot be calibrated alone (status `"sphere_not_covered"`,
+#'   `"bins_incomplete"`, `"too_short"` or `"no_rest"`) with the rest
+#'   windows of all recordings of the same device (the serial number in the
+#'   file's header, column `serial`). The device's recordings that do
+#'   calibrate alone must first agree: no pair of them may differ by a Wald
+#'   test of their coefficients at `0.01` over the number of pairs;
+#'   otherwise, or when the pooled windows do not calibrate either, the
+#'   rows stay as they were and their `message` says why. Pooled rows have
+#'   `pooled = TRUE`, the pooled fit's coefficients and status, and a
+#'   message naming the recordings pooled.
 #' @return A data frame, one row per recording, in the order of `files`:
 #'   `file` (the file name), `status` (see [calibrate()], or `"failed"`),
 #'   `message` (why, for a recording that failed or was not calibrated;
@@ -95,8 +106,10 @@
 #' unlink(dir, recursive = TRUE)
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
-                            pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$") {
+                            pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$",
+                            pool = c("none", "device")) {
   method <- match_choice(method, "method")
+  pool <- match_choice(pool, "pool")
   files <- cohort_files(files, pattern)
   if (missing(outdir) || !is.character(outdir) || length(outdir) != 1 ||
       is.na(outdir) || !nzchar(outdir)) {
@@ -149,6 +162,11 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   tab <- do.call(rbind, lapply(results, `[[`, "row"))
   rownames(tab) <- NULL
   fits <- stats::setNames(lapply(results, `[[`, "fit"), basename(files))
+  if (pool == "device") {
+    pooled <- pool_devices(files, tab, fits, method, args)
+    tab <- pooled$tab
+    fits <- pooled$fits
+  }
   write_owned(csv_bytes(tab), outputs[1], store)
   if (method == "ggir") {
     ok <- tab$status %in% c("ok", "high_error") &
@@ -266,7 +284,7 @@ read_saved <- function(slot, identity, settings) {
   # a result saved before the rows carried standard errors and the model's
   # size is stale too
   if (!identical(res$key$settings, settings) ||
-      !all(c("scale.x.se", "parameters") %in% names(res$row)) ||
+      !all(c("scale.x.se", "parameters", "serial") %in% names(res$row)) ||
       (!is.null(identity) && !identical(res$key$identity, identity))) {
     unlink(slot)
     return(list())
@@ -410,6 +428,9 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
   } else as.numeric(NROW(fit$windows))
   data.frame(
     file = basename(file),
+    serial = if (na || is.null(fit$input$serial)) NA_character_ else
+      as.character(fit$input$serial),
+    pooled = FALSE,
     status = if (na) "failed" else fit$status,
     message = if (na) paste(error, collapse = "; ") else fit$message,
     coefs,
@@ -772,4 +793,105 @@ cli_parse <- function(args) {
   }
   opt$files <- files
   opt
+}
+
+# Statuses of a recording that cannot be calibrated alone, for pooling.
+poolable_status <- c("sphere_not_covered", "bins_incomplete", "too_short",
+                     "no_rest")
+
+# calibrate_files(pool = "device"): see its documentation.
+pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
+  need <- tab$status %in% poolable_status & !is.na(tab$serial)
+  for (s in unique(tab$serial[need])) {
+    idx <- which(tab$serial == s & !is.na(tab$serial))
+    todo <- idx[need[idx]]
+    note <- function(why) {
+      tab$message[todo] <<- join_notes(tab$message[todo], paste0(
+        "not pooled: ", why))
+    }
+    if (length(idx) < 2) {
+      note(sprintf("no other recording of device %s", s))
+      next
+    }
+    alone <- idx[tab$status[idx] == "ok" & !vapply(fits[idx], is.null, NA)]
+    p <- pairwise_wald(fits[alone])
+    if (length(p) && any(p <= alpha / length(p))) {
+      note(sprintf(paste0("the recordings of device %s that calibrate alone ",
+                          "disagree (Wald test, smallest p = %.2g)"), s,
+                   min(p)))
+      next
+    }
+    pf <- tryCatch(pooled_fit(files[idx], method, args),
+                   error = function(e) e)
+    if (inherits(pf, "error")) {
+      note(sprintf("the pooled fit failed: %s", conditionMessage(pf)))
+      next
+    }
+    if (!identical(pf$status, "ok")) {
+      note(sprintf(paste0("pooled, the %d recordings of device %s still do ",
+                          "not calibrate (%s)"), length(idx), s, pf$status))
+      next
+    }
+    pf$pooled <- list(serial = s, files = basename(files[idx]))
+    for (i in todo) {
+      row <- cohort_row(files[i], pf, NULL, "", tab$seconds[i], method)
+      row$pooled <- TRUE
+      row$message <- sprintf(paste0(
+        "calibrated with the rest windows of %d recordings of device %s ",
+        "(%s), pooled; alone: %s"), length(idx), s,
+        paste(basename(files[idx]), collapse = ", "), tab$status[i])
+      row$hours <- tab$hours[i]
+      row$samples <- tab$samples[i]
+      tab[i, ] <- row
+      fits[[i]] <- pf
+    }
+  }
+  list(tab = tab, fits = fits)
+}
+
+# p-values of the Wald tests of every pair of fits' common coefficients.
+pairwise_wald <- function(fits) {
+  p <- numeric(0)
+  if (length(fits) < 2) return(p)
+  for (i in seq_len(length(fits) - 1)) for (j in (i + 1):length(fits)) {
+    a <- fits[[i]]
+    b <- fits[[j]]
+    nm <- intersect(a$model, b$model)
+    if (!length(nm) || is.null(a$vcov) || is.null(b$vcov)) next
+    d <- stats::coef(a)[nm] - stats::coef(b)[nm]
+    V <- a$vcov[nm, nm, drop = FALSE] + b$vcov[nm, nm, drop = FALSE]
+    W <- tryCatch(drop(t(d) %*% solve(V, d)), error = function(e) Inf)
+    p <- c(p, stats::pchisq(W, df = length(nm), lower.tail = FALSE))
+  }
+  p
+}
+
+# One fit on the rest windows of several recordings of a device.
+pooled_fit <- function(files, method, args) {
+  if (method == "ggir") {
+    ggir_args <- args[intersect(names(args), c("use_temp", "max_iter", "tol"))]
+    ws <- lapply(files, function(f) rest_windows(f, method = "ggir"))
+    w <- do.call(rbind, ws)
+    return(do.call(fit_icp, c(list(w = w[w$rest, , drop = FALSE]), ggir_args)))
+  }
+  la <- lightweight_args(args)
+  rargs <- la$args$rest_windows[intersect(names(la$args$rest_windows),
+                                          c("window", "max_range", "axes",
+                                            "skip_zero", "reader"))]
+  ws <- lapply(files, function(f) do.call(rest_windows, c(list(x = f), rargs)))
+  w <- do.call(rbind, ws)
+  attr(w, "sf") <- attr(ws[[1]], "sf")
+  attr(w, "window") <- attr(ws[[1]], "window")
+  attr(w, "samples") <- sum(vapply(ws, function(x) attr(x, "samples"), 0))
+  attr(w, "samples_total") <- NA_real_
+  inp <- attr(ws[[1]], "input")
+  inp$source <- "pooled"
+  inp$samples <- attr(w, "samples")
+  inp$report <- NULL
+  attr(w, "input") <- inp
+  # segments and the adaptive budget are for one recording
+  la$choice$segments <- NULL
+  la$choice$budget <- "all"
+  lightweight_from_windows(w, la$args, la$choice, la$max_norm_error,
+                           la$range_g, call = NULL, file = NULL)
 }

@@ -21,7 +21,9 @@
 #'   parameters, scales and offsets (cross-axis terms 0), or offsets alone,
 #'   each with and without a temperature offset (below). A model is
 #'   determined when every standard error is at most `max_se` (0.01) and
-#'   there are at least twice as many points as parameters; among the
+#'   there are at least twice as many points as parameters (and, for
+#'   offsets alone, which assume scales of 1, when every axis rested beyond
+#'   0.3 g on both sides, GGIR's sphere criterion); among the
 #'   determined models the one with the lowest Bayesian information
 #'   criterion (`n log(RSS / n) + k log(n)` over the points) is fitted, so
 #'   that terms the data do not need (cross-axis terms of a device without
@@ -260,7 +262,30 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   } else if (missing(sf)) {
     abort("`sf` (sampling frequency in Hz) is missing.")
   }
-  args <- split_dots(list(...), list(
+  la <- lightweight_args(list(...))
+  args <- la$args
+  choice <- la$choice
+  max_norm_error <- la$max_norm_error
+  range_g <- la$range_g
+  rargs <- args$rest_windows
+  if (choice$budget == "adaptive") {
+    rargs$stop <- budget_rule(args$fit_gradient, choice, max_norm_error,
+                              range_g)
+    rargs$stop_every <- choice$check_hours
+    if (is.null(rargs$chunk_size) && !is.character(x)) {
+      rargs$chunk_size <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
+    }
+  }
+  w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
+  lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
+                           file = if (is.character(x)) basename(x),
+                           timed = !is.character(x) &&
+                             "time" %in% tolower(names(x)))
+}
+# The lightweight method's arguments from calibrate()'s `...`, routed and
+# checked: list(args (by destination), choice, max_norm_error, range_g).
+lightweight_args <- function(dots) {
+  args <- split_dots(dots, list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader"),
     guards = c("max_norm_error", "range_g"),
@@ -283,21 +308,10 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   if (!is.null(range_g)) {
     check_number(range_g, "range_g", min = 0, min_inclusive = FALSE)
   }
-  rargs <- args$rest_windows
-  if (choice$budget == "adaptive") {
-    rargs$stop <- budget_rule(args$fit_gradient, choice, max_norm_error,
-                              range_g)
-    rargs$stop_every <- choice$check_hours
-    if (is.null(rargs$chunk_size) && !is.character(x)) {
-      rargs$chunk_size <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
-    }
-  }
-  w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
-  lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
-                           file = if (is.character(x)) basename(x),
-                           timed = !is.character(x) &&
-                             "time" %in% tolower(names(x)))
+  list(args = args, choice = choice, max_norm_error = max_norm_error,
+       range_g = range_g)
 }
+
 # The lightweight method from its windows (rest_windows()'s table, with its
 # attributes): the guards, the points, the fit and the held-out errors.
 # `file`: the file's name for the fit (NULL for samples in memory); `timed`:
@@ -484,6 +498,23 @@ budget_rule <- function(fargs, choice, max_norm_error, range_g) {
 # is noise.
 default_max_se <- 0.01
 
+# The offsets-only model needs, on every axis, rest points beyond
+# +-offset_coverage g on both sides (GGIR's sphere criterion, 0.3 g): with
+# an axis seen on one side only, an offset cannot be told from a scale
+# error. The axes that fail, as text ("" when none).
+offset_coverage <- 0.3
+one_sided_axes <- function(pts) {
+  m <- cbind(pts$mean_x, pts$mean_y, pts$mean_z)
+  lo <- apply(m, 2, min) < -offset_coverage
+  hi <- apply(m, 2, max) > offset_coverage
+  bad <- !(lo & hi)
+  if (!any(bad)) return("")
+  paste(sprintf("%s: %s", c("x", "y", "z")[bad],
+                ifelse(!lo[bad] & !hi[bad], "neither side",
+                       ifelse(lo[bad], "none above", "none below"))),
+        collapse = ", ")
+}
+
 # Bayesian information criterion of a lightweight fit on its points: n
 # log(RSS / n) + k log(n), RSS the sum of the squared residuals of the
 # objective (|a|^2 - 1, or |a| - 1 with use_sqrt) and k the parameters
@@ -554,6 +585,15 @@ fit_chosen_model <- function(pts, fargs, choice, fail) {
                     if (tt) ", temperature offset" else "")
     if (nrow(pts) < 2 * k) {
       why <- c(why, sprintf("%d points are too few for %s", nrow(pts), what))
+      next
+    }
+    if (m == "offset" && nzchar(one_sided <- one_sided_axes(pts))) {
+      # offsets alone assume scales of 1: where an axis rested on one side
+      # only, its offset would absorb its scale error
+      why <- c(why, sprintf(paste0(
+        "%s not determined: offsets alone need rest beyond %s g on both ",
+        "sides of every axis (%s)"), what, format(offset_coverage),
+        one_sided))
       next
     }
     fit <- do.call(fit_gradient, c(list(pts = pts, model = m, use_temp = tt),

@@ -122,12 +122,17 @@ test_that("the model is the one the rest points determine, and says so", {
   # the device horizontal-ish only (elevation within +-0.3 rad): z never
   # near +-1, so the cross terms with z and z's scale cannot be told apart
   # from its offset: scale and offset, or offset only
-  flat <- band_recording(c(-0.2, 0.2), p, seed = 2)
+  flat <- band_recording(c(-0.35, 0.35), p, seed = 2)
   ff <- calibrate(flat, sf = 10)
   expect_identical(ff$status, "ok")
   expect_lt(length(ff$model), 9L)
   expect_match(ff$message, "not determined by the rest points")
   expect_true(all(ff$se[ff$model] <= 0.01))
+  # tilts within +-0.2 rad: z never beyond 0.3 g, and offsets alone
+  # (scales assumed 1) need every axis seen on both sides
+  narrow <- calibrate(band_recording(c(-0.2, 0.2), p, seed = 2), sf = 10)
+  expect_identical(narrow$status, "sphere_not_covered")
+  expect_match(narrow$message, "both sides of every axis \\(z: neither side\\)")
   # forcing the model
   fo <- calibrate(all, sf = 10, model = "offset")
   expect_identical(fo$model, c("o_x", "o_y", "o_z"))

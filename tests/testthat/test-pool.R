@@ -1,0 +1,97 @@
+# Pooling a device's recordings (issue 20, item 2).
+
+# Samples of a device (parameters p) resting in `n_post` postures held
+# `hold` s each, directions drawn within `cap` radians of `center` (or all
+# directions when center is NULL), at sf Hz, noise 4 mg per axis.
+device_rest <- function(p, n_post, center = NULL, cap = 0.35, hold = 60,
+                        sf = 25, seed = 1) {
+  set.seed(seed)
+  u <- gravcal:::random_unit_vectors(60 * n_post)
+  if (!is.null(center)) {
+    center <- center / sqrt(sum(center^2))
+    u <- u[acos(pmin(1, u %*% center)) <= cap, , drop = FALSE]
+  }
+  u <- u[seq_len(n_post), , drop = FALSE]
+  v <- distort(u, p)
+  v <- v[rep(seq_len(n_post), each = hold * sf), ]
+  v + matrix(stats::rnorm(length(v), sd = 0.004), ncol = 3)
+}
+
+test_that("recordings too narrow to calibrate alone are calibrated pooled by device", {
+  p <- c(1.03, 0.97, 1.02, 0.02, -0.015, 0.01, 0.04, -0.03, 0.02)
+  dir <- tempfile("pool")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  centers <- list(c(1, 0, 0), c(-1, 0, 0), c(0, 1, 0), c(0, -1, 0),
+                  c(0, 0, 1), c(0, 0, -1))
+  # six 6-hour recordings of device 1234, each resting near one face
+  for (k in seq_along(centers)) {
+    v <- device_rest(p, 360, centers[[k]], seed = k)
+    gravcal:::write_cwa(v, file.path(dir, sprintf("a%d.cwa", k)), sf = 25,
+                        packed = FALSE, device_id = 1234)
+  }
+  # another device (5678) with one short recording only
+  gravcal:::write_cwa(device_rest(p, 360, c(0, 0, 1), seed = 9),
+                      file.path(dir, "b1.cwa"), sf = 25, packed = FALSE,
+                      device_id = 5678)
+  alone <- calibrate_files(dir, method = "lightweight",
+                           outdir = file.path(dir, "alone"))
+  expect_identical(alone$serial, c(rep("1234", 6), "5678"))
+  expect_true(all(alone$status %in% gravcal:::poolable_status))
+  expect_false(any(alone$pooled))
+  res <- calibrate_files(dir, method = "lightweight",
+                         outdir = file.path(dir, "pooled"), pool = "device")
+  a <- res[res$serial == "1234", ]
+  expect_true(all(a$pooled))
+  expect_true(all(a$status == "ok"))
+  expect_match(a$message[1], "rest windows of 6 recordings of device 1234")
+  expect_match(a$message[1], "alone: ")
+  # one device alone is not pooled, and says why
+  b <- res[res$serial == "5678", ]
+  expect_false(b$pooled)
+  expect_match(b$message, "not pooled: no other recording of device 5678")
+  # the pooled fit against one on a long recording of the same device
+  long <- file.path(dir, "long.cwa")
+  gravcal:::write_cwa(device_rest(p, 720, NULL, seed = 20), long, sf = 25,
+                      packed = FALSE, device_id = 1234)
+  fl <- calibrate(long)
+  expect_identical(fl$status, "ok")
+  fp <- attr(res, "fits")[["a1.cwa"]]
+  expect_identical(fp$pooled$serial, "1234")
+  set.seed(2)
+  u <- gravcal:::random_unit_vectors(2000)
+  map_mg <- function(fit) {
+    a <- gravcal:::calibrate_points(fit, distort(u, p))
+    1000 * mean(sqrt(rowSums((a - u)^2)))
+  }
+  expect_lt(abs(map_mg(fp) - map_mg(fl)), 1)
+  expect_lt(map_mg(fp), 2)
+  expect_identical(unname(unlist(a[1, c("offset.x", "offset.y", "offset.z")])),
+                   unname(fp$offset))
+  expect_error(calibrate_files(dir, outdir = file.path(dir, "x"), pool = "all"),
+               "`pool` must be one of")
+})
+
+test_that("a device whose recordings disagree is not pooled", {
+  dir <- tempfile("pool2")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  p1 <- c(1.03, 0.97, 1.02, 0, 0, 0, 0.04, -0.03, 0.02)
+  p2 <- c(1.03, 0.97, 1.02, 0, 0, 0, 0.09, -0.03, 0.02)
+  # two recordings that calibrate alone, 50 mg apart in x offset, and a
+  # narrow one: the same serial number
+  gravcal:::write_cwa(device_rest(p1, 360, NULL, seed = 1),
+                      file.path(dir, "c1.cwa"), sf = 25, packed = FALSE,
+                      device_id = 42)
+  gravcal:::write_cwa(device_rest(p2, 360, NULL, seed = 2),
+                      file.path(dir, "c2.cwa"), sf = 25, packed = FALSE,
+                      device_id = 42)
+  gravcal:::write_cwa(device_rest(p1, 360, c(0, 0, 1), seed = 3),
+                      file.path(dir, "c3.cwa"), sf = 25, packed = FALSE,
+                      device_id = 42)
+  res <- calibrate_files(dir, method = "lightweight",
+                         outdir = file.path(dir, "out"), pool = "device")
+  expect_identical(res$status[1:2], c("ok", "ok"))
+  expect_false(any(res$pooled))
+  expect_match(res$message[3], "not pooled: the recordings of device 42 that calibrate alone disagree")
+})
