@@ -833,6 +833,8 @@ pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
       next
     }
     pf$pooled <- list(serial = s, files = basename(files[idx]))
+    if (is.null(pf$input)) pf$input <- list(source = "pooled")
+    pf$input$serial <- s
     for (i in todo) {
       row <- cohort_row(files[i], pf, NULL, "", tab$seconds[i], method)
       row$pooled <- TRUE

@@ -749,7 +749,7 @@ ggir_coef_row <- function(f, name) {
     scale <- diag(K)
     offset <- f$offset
     to <- f$tempoffset
-    g <- f$ggir
+    g <- f[["ggir"]]  # exact: `$` would take `ggir_compat` for fit_icp() fits
     start <- if (!is.null(g)) num1(g$cal.error.start) else f$error_before
     end <- if (!is.null(g)) num1(g$cal.error.end) else f$error_after
     qc <- if (!is.null(f$QCmessage)) f$QCmessage else f$message

@@ -287,7 +287,9 @@ test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
   # a g.calibrate result needs a name; lightweight fits are refused
   expect_error(write_ggir_coefs(own, coefs), "named")
   expect_silent(write_ggir_coefs(list(rec01.csv = own), coefs))
-  lw <- calibrate(rec, sf = 20)
+  # (a lightweight fit with cross-axis terms; the default leaves them out
+  # of a device without them, and such a fit can be written)
+  lw <- calibrate(rec, sf = 20, model = "full")
   expect_error(write_ggir_coefs(list(a.csv = lw), coefs), "cross-axis")
   expect_error(write_ggir_coefs(fit, NA), "file")
 })
@@ -448,4 +450,16 @@ test_that("from a file, calibrate(method = 'ggir') fits the rest windows rest_wi
   expect_equal(nrow(fit$points), nrow(rest))
   expect_identical(unname(as.matrix(fit$points[, c("mean_x", "mean_y", "mean_z")])),
                    unname(as.matrix(rest)))
+})
+
+test_that("write_ggir_coefs() takes a fit_icp() fit (no `$ggir` partial match)", {
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 2,
+                            params = c(1.02, 0.98, 1.01, 0, 0, 0, 0.03, -0.02, 0.01))
+  fi <- fit_icp(rest_windows(rec, sf = 10, method = "ggir"))
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  write_ggir_coefs(list(rec.csv = fi), f)
+  out <- utils::read.csv(f)
+  expect_equal(out$cal.error.start, fi$error_before)
+  expect_equal(out$cal.error.end, fi$error_after)
 })

@@ -70,6 +70,15 @@ test_that("recordings too narrow to calibrate alone are calibrated pooled by dev
                    unname(fp$offset))
   expect_error(calibrate_files(dir, outdir = file.path(dir, "x"), pool = "all"),
                "`pool` must be one of")
+  # the GGIR method pools GGIR's rest windows the same way
+  unlink(long)
+  gg <- calibrate_files(dir, method = "ggir", outdir = file.path(dir, "ggir"),
+                        pool = "device")
+  g <- gg[gg$serial == "1234", ]
+  expect_true(all(g$pooled))
+  expect_true(all(g$status %in% c("ok", "high_error")))
+  expect_match(g$message[1], "alone: sphere_not_covered")
+  expect_lt(abs(g$offset.x[1] - fp$offset[["x"]]), 0.01)
 })
 
 test_that("a device whose recordings disagree is not pooled", {
