@@ -118,7 +118,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          h = if (arithmetic[1] == "fixed16") 0.01 else 1e-5,
                          objective = c("mean", "sum"), use_sqrt = FALSE,
                          tol = 0, trace = FALSE,
-                         difference = c("forward", "central"),
+                         difference = c("forward", "central", "analytic"),
                          model = c("full", "scale_offset", "offset"),
                          algorithm = c("descent", "lm"),
                          se = c("classic", "robust"), use_temp = FALSE) {
@@ -164,7 +164,8 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
           "not ", describe(rates), ".")
   }
   check_number(h, "h", min = 0, min_inclusive = FALSE)
-  check_step(h, arithmetic)
+  # the analytic gradient takes no step
+  if (difference != "analytic") check_step(h, arithmetic)
   limit <- c(double = Inf, float = Inf, fixed32 = 4, fixed16 = 2)[[arithmetic]]
   if (any(abs(v) >= limit)) {
     abort("`pts` has coordinates beyond the range of ", arithmetic, " (+-",
@@ -184,7 +185,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
                          c(1, 1, 1, 0, 0, 0, 0, 0, 0), as.integer(max_iter), h,
                          rep(unname(rates), each = 3) * free, use_sqrt,
                          objective == "sum", tol, trace, arithmetic,
-                         difference == "central")
+                         difference)
   }
   tempoffset <- if (use_temp) r$p[10:12] else c(0, 0, 0)
   p <- stats::setNames(r$p[1:9], param_names())
@@ -204,7 +205,7 @@ fit_gradient <- function(pts, arithmetic = c("double", "float", "fixed32",
   } else {
     gc_fit_gradient(v[, 1], v[, 2], v[, 3], c(1, 1, 1, 0, 0, 0, 0, 0, 0),
                     0L, h, rep(1, 9), use_sqrt, objective == "sum", 0,
-                    FALSE, arithmetic, FALSE)$objective
+                    FALSE, arithmetic, "forward")$objective
   }
   if (!r$finite || !all(is.finite(p)) || !is.finite(r$objective) ||
       r$objective > 10 * f0 + 1e-6) {

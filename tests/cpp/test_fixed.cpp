@@ -94,7 +94,7 @@ template <typename T>
 static double fit_error(const double* truth, const std::vector<double>& xd,
                         const std::vector<double>& yd,
                         const std::vector<double>& zd, int max_iter,
-                        double h, bool central) {
+                        double h, gravcal::GradientMode mode) {
   const int n = static_cast<int>(xd.size());
   std::vector<T> x(n), y(n), z(n);
   for (int i = 0; i < n; ++i) {
@@ -107,7 +107,7 @@ static double fit_error(const double* truth, const std::vector<double>& xd,
   gravcal::GradientConfig<T> cfg;
   cfg.max_iter = max_iter;
   cfg.h = T(h);
-  cfg.central = central;
+  cfg.gradient = mode;
   gravcal::fit_gradient(p, x.data(), y.data(), z.data(), n, cfg);
   double worst = 0;
   for (int i = 0; i < 9; ++i) {
@@ -122,12 +122,14 @@ static void test_fits() {
   std::vector<double> x, y, z;
   points(truth, x, y, z);
   CHECK(x.size() == 18);
-  const double d = fit_error<double>(truth, x, y, z, 2000, 1e-5, false);
-  const double f32 = fit_error<fixed32>(truth, x, y, z, 2000, 1e-5, false);
-  const double f16 = fit_error<fixed16>(truth, x, y, z, 2000, 0.01, false);
-  const double f16c = fit_error<fixed16>(truth, x, y, z, 2000, 0.01, true);
-  const double d50 = fit_error<double>(truth, x, y, z, 50, 1e-5, false);
-  const double f32_50 = fit_error<fixed32>(truth, x, y, z, 50, 1e-5, false);
+  const auto fwd = gravcal::GRADIENT_FORWARD;
+  const double d = fit_error<double>(truth, x, y, z, 2000, 1e-5, fwd);
+  const double f32 = fit_error<fixed32>(truth, x, y, z, 2000, 1e-5, fwd);
+  const double f16 = fit_error<fixed16>(truth, x, y, z, 2000, 0.01, fwd);
+  const double f16c =
+      fit_error<fixed16>(truth, x, y, z, 2000, 0.01, gravcal::GRADIENT_CENTRAL);
+  const double d50 = fit_error<double>(truth, x, y, z, 50, 1e-5, fwd);
+  const double f32_50 = fit_error<fixed32>(truth, x, y, z, 50, 1e-5, fwd);
   std::printf("gradient, noise-free points, max |p - truth|: double %.2e, "
               "fixed32 %.2e, fixed16 %.2e (central %.2e); 50 iterations: "
               "double %.2e, fixed32 %.2e\n", d, f32, f16, f16c, d50, f32_50);
