@@ -1,22 +1,25 @@
 # R's fit_gradient() against the standalone build of the same core
-# (fit_points), bit for bit, in every arithmetic: the same points go to both,
-# as hexadecimal floating point, and the nine parameters must print the same.
+# (fit_points), bit for bit, in every arithmetic and for every gradient
+# (forward, central, analytic; the analytic one also with the square root in
+# the objective): the same points go to both, as hexadecimal floating point,
+# and the nine parameters must print the same.
 #   Rscript check-r.R ./fit_points        (make -C tests/cpp check-r)
 suppressPackageStartupMessages(library(gravcal))
 prog <- commandArgs(TRUE)[1]
 set.seed(20241)
 cases <- list()
 for (arith in c("double", "float", "fixed32", "fixed16")) {
-  for (difference in c("forward", "central")) {
+  for (difference in c("forward", "central", "analytic")) {
     for (k in 1:10) {
       cand <- simulate_points(600, noise = c(0.001, 0.005)[k %% 2 + 1])
       pts <- select_points(cand)
       max_iter <- c(50L, 300L)[k %% 2 + 1]
+      use_sqrt <- difference == "analytic" && k > 6
       fit <- fit_gradient(pts, arithmetic = arith, difference = difference,
-                          max_iter = max_iter)
+                          max_iter = max_iter, use_sqrt = use_sqrt)
       cases[[length(cases) + 1]] <- list(
-        head = sprintf("%s %s %d %s %d", arith, difference, max_iter,
-                       sprintf("%a", fit$settings$h), nrow(pts)),
+        head = sprintf("%s %s %d %s %d %d", arith, difference, max_iter,
+                       sprintf("%a", fit$settings$h), nrow(pts), use_sqrt),
         pts = sprintf("%a %a %a", pts$mean_x, pts$mean_y, pts$mean_z),
         r = paste(sprintf("%a", unname(fit$params)), collapse = " "))
     }

@@ -60,12 +60,7 @@ struct GradientConfig {
   GradientMode gradient = GRADIENT_FORWARD;
 };
 
-// f / n. Fixed-point types overload this (fixed_point.hpp), dividing the
-// raw integer, because n itself may be out of their range.
-template <typename T>
-inline T divide_by_count(T f, int n) {
-  return f / T(n);
-}
+// divide_by_count(f, n), f / n: gradient_analytic.hpp.
 
 // f(p) over n points given as coordinate arrays.
 template <typename T>
