@@ -4,8 +4,13 @@
 # the objective): the same points go to both, as hexadecimal floating point,
 # and the nine parameters must print the same.
 #   Rscript check-r.R ./fit_points        (make -C tests/cpp check-r)
+#   Rscript check-r.R ./fit_points CASES EXPECTED
+#                                         also keeps the cases (the input of
+#                                         fit_points) and R's results, one
+#                                         line per fit (make check-m4)
 suppressPackageStartupMessages(library(gravcal))
-prog <- commandArgs(TRUE)[1]
+args <- commandArgs(TRUE)
+prog <- args[1]
 set.seed(20241)
 cases <- list()
 for (arith in c("double", "float", "fixed32", "fixed16")) {
@@ -25,10 +30,11 @@ for (arith in c("double", "float", "fixed32", "fixed16")) {
     }
   }
 }
-input <- tempfile()
+input <- if (length(args) >= 3) args[2] else tempfile()
 writeLines(unlist(lapply(cases, function(k) c(k$head, k$pts))), input)
 out <- system2(prog, stdin = input, stdout = TRUE)
 r <- vapply(cases, `[[`, "", "r")
+if (length(args) >= 3) writeLines(r, args[3])
 same <- length(out) == length(r) && all(out == r)
 cat(sprintf("R vs standalone core: %d of %d fits identical to the bit\n",
             sum(out == r[seq_along(out)]), length(r)))
