@@ -38,10 +38,11 @@ test: check core sanitize valgrind fuzz-short test-slurm site
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
-# instruction counts, and R's fit_gradient() against it bit for bit
+# instruction counts, and R's fit_gradient() against it bit for bit, built
+# for the host and run on an emulated Cortex-M4
 core: install
 	$(MAKE) -C tests/cpp test arm cost
-	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r check-m4
 
 # the whole test suite against the package built with AddressSanitizer and
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not

@@ -65,8 +65,8 @@ gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance, ar
     .Call(`_gravcal_gc_select_points`, x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic)
 }
 
-gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central = FALSE) {
-    .Call(`_gravcal_gc_fit_gradient`, x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central)
+gc_fit_gradient <- function(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, difference = "forward") {
+    .Call(`_gravcal_gc_fit_gradient`, x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, difference)
 }
 
 gc_read_once <- function(cols) {

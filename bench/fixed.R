@@ -5,12 +5,15 @@
 # bench/table2.R), at 1 mg and 5 mg of noise per axis, the 18 points fitted
 # by 50 iterations (the paper's budget) in double, float, fixed32 (Q3.29)
 # and fixed16 (Q1.14, h = 0.01, as the paper's 16-bit version), the last also
-# with central differences. Mean absolute error of each parameter and its
-# ratio to double's.
+# with central differences, and with the analytic gradient (no step; block
+# floating point in fixed point) in double, fixed32 and fixed16. Mean
+# absolute error of each parameter and its ratio to double's (the paper's
+# forward differences).
 #
 # Cost: instructions executed by one calibration (N = 18, M = 50) on this
-# host, counted by valgrind's callgrind (`make -C tests/cpp cost`), beside the
-# paper's operation count M (100 N + 3).
+# host, counted by valgrind's callgrind (`make -C tests/cpp cost`), with
+# forward differences and with the analytic gradient, beside the paper's
+# operation count M (100 N + 3).
 #
 # Run from the package root with gravcal installed: Rscript bench/fixed.R
 # Writes bench/results/fixed.md and fixed.csv.
@@ -24,7 +27,10 @@ variants <- list(
   float = list(arithmetic = "float"),
   fixed32 = list(arithmetic = "fixed32"),
   fixed16 = list(arithmetic = "fixed16"),
-  "fixed16, central" = list(arithmetic = "fixed16", difference = "central"))
+  "fixed16, central" = list(arithmetic = "fixed16", difference = "central"),
+  "double, analytic" = list(arithmetic = "double", difference = "analytic"),
+  "fixed32, analytic" = list(arithmetic = "fixed32", difference = "analytic"),
+  "fixed16, analytic" = list(arithmetic = "fixed16", difference = "analytic"))
 
 run <- function(noise, seed) {
   set.seed(seed)
@@ -48,7 +54,7 @@ cost <- tryCatch({
   out <- system2("make", c("-s", "-C", file.path("tests", "cpp"), "cost"),
                  stdout = TRUE, stderr = TRUE)
   l <- grep("^instructions", out, value = TRUE)
-  stats::setNames(as.numeric(sub(".*: ", "", l)), sub(".*\\), ([a-z0-9]+):.*", "\\1", l))
+  stats::setNames(as.numeric(sub(".*: ", "", l)), sub(".*\\), ([a-z0-9, ]+):.*", "\\1", l))
 }, error = function(e) NULL, warning = function(w) NULL)
 
 f3 <- function(x) formatC(x, format = "e", digits = 2)
@@ -59,8 +65,12 @@ md <- c("# The lightweight method in fixed point", "",
                 format(Sys.Date()), R.version.string, cases, elapsed), "",
         "fixed32 is Q3.29 in 32-bit integers with 64-bit intermediates, fixed16 Q1.14 in",
         "16-bit integers with 32-bit intermediates, both saturating",
-        "(`inst/include/gravcal/fixed_point.hpp`). Mean absolute error of each parameter;",
-        "in brackets, the ratio to double's.", "")
+        "(`inst/include/gravcal/fixed_point.hpp`). \"analytic\": the gradient's closed form,",
+        "no step; in fixed point in block floating point (16 x 16 -> 32-bit products for",
+        "fixed16, the scale of every sum a power of two chosen from the data) with the",
+        "parameters kept in 32 bits between steps (`inst/include/gravcal/gradient_analytic.hpp`).",
+        "Mean absolute error of each parameter; in brackets, the ratio to double's (forward",
+        "differences, the paper's method).", "")
 for (nz in unique(tab$noise_mg)) {
   d <- tab[tab$noise_mg == nz, ]
   cols <- names(variants)

@@ -222,8 +222,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_fit_gradient
-Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::NumericVector& p0, int max_iter, double h, const Rcpp::NumericVector& rates, bool use_sqrt, bool sum_scale, double tol, bool trace, std::string arithmetic, bool central);
-RcppExport SEXP _gravcal_gc_fit_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP p0SEXP, SEXP max_iterSEXP, SEXP hSEXP, SEXP ratesSEXP, SEXP use_sqrtSEXP, SEXP sum_scaleSEXP, SEXP tolSEXP, SEXP traceSEXP, SEXP arithmeticSEXP, SEXP centralSEXP) {
+Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::NumericVector& p0, int max_iter, double h, const Rcpp::NumericVector& rates, bool use_sqrt, bool sum_scale, double tol, bool trace, std::string arithmetic, std::string difference);
+RcppExport SEXP _gravcal_gc_fit_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP p0SEXP, SEXP max_iterSEXP, SEXP hSEXP, SEXP ratesSEXP, SEXP use_sqrtSEXP, SEXP sum_scaleSEXP, SEXP tolSEXP, SEXP traceSEXP, SEXP arithmeticSEXP, SEXP differenceSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -238,8 +238,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
     Rcpp::traits::input_parameter< bool >::type trace(traceSEXP);
     Rcpp::traits::input_parameter< std::string >::type arithmetic(arithmeticSEXP);
-    Rcpp::traits::input_parameter< bool >::type central(centralSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_fit_gradient(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, central));
+    Rcpp::traits::input_parameter< std::string >::type difference(differenceSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fit_gradient(x, y, z, p0, max_iter, h, rates, use_sqrt, sum_scale, tol, trace, arithmetic, difference));
     return rcpp_result_gen;
 END_RCPP
 }

@@ -147,7 +147,8 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
                         const Rcpp::NumericVector& z,
                         const Rcpp::NumericVector& p0, int max_iter, double h,
                         const Rcpp::NumericVector& rates, bool use_sqrt,
-                        bool sum_scale, double tol, bool trace, bool central) {
+                        bool sum_scale, double tol, bool trace,
+                        gravcal::GradientMode mode) {
   const int n = static_cast<int>(x.size());
   std::vector<T> xs(n), ys(n), zs(n);
   for (int i = 0; i < n; ++i) {
@@ -162,7 +163,7 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
   cfg.use_sqrt = use_sqrt;
   cfg.scale = sum_scale ? gravcal::SCALE_SUM : gravcal::SCALE_MEAN;
   cfg.tol = T(tol);
-  cfg.central = central;
+  cfg.gradient = mode;
   T p[gravcal::NPARAM];
   for (int i = 0; i < gravcal::NPARAM; ++i) p[i] = T(p0[i]);
   std::vector<double> tr;
@@ -193,6 +194,7 @@ Rcpp::List run_gradient(const Rcpp::NumericVector& x,
 
 }  // namespace
 
+// difference: "forward" (the paper's), "central" or "analytic".
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x,
                            const Rcpp::NumericVector& y,
@@ -201,23 +203,28 @@ Rcpp::List gc_fit_gradient(const Rcpp::NumericVector& x,
                            double h, const Rcpp::NumericVector& rates,
                            bool use_sqrt, bool sum_scale, double tol,
                            bool trace, std::string arithmetic,
-                           bool central = false) {
+                           std::string difference = "forward") {
   if (y.size() != x.size() || z.size() != x.size())
     Rcpp::stop("x, y, z lengths differ");
   if (p0.size() != gravcal::NPARAM || rates.size() != gravcal::NPARAM)
     Rcpp::stop("p0 and rates must have 9 values");
+  gravcal::GradientMode mode;
+  if (difference == "forward") mode = gravcal::GRADIENT_FORWARD;
+  else if (difference == "central") mode = gravcal::GRADIENT_CENTRAL;
+  else if (difference == "analytic") mode = gravcal::GRADIENT_ANALYTIC;
+  else Rcpp::stop("unknown difference");
   if (arithmetic == "double")
     return run_gradient<double>(x, y, z, p0, max_iter, h, rates, use_sqrt,
-                                sum_scale, tol, trace, central);
+                                sum_scale, tol, trace, mode);
   if (arithmetic == "float")
     return run_gradient<float>(x, y, z, p0, max_iter, h, rates, use_sqrt,
-                               sum_scale, tol, trace, central);
+                               sum_scale, tol, trace, mode);
   if (arithmetic == "fixed32")
     return run_gradient<gravcal::fixed32>(x, y, z, p0, max_iter, h, rates,
-                                          use_sqrt, sum_scale, tol, trace, central);
+                                          use_sqrt, sum_scale, tol, trace, mode);
   if (arithmetic == "fixed16")
     return run_gradient<gravcal::fixed16>(x, y, z, p0, max_iter, h, rates,
-                                          use_sqrt, sum_scale, tol, trace, central);
+                                          use_sqrt, sum_scale, tol, trace, mode);
   Rcpp::stop("unknown arithmetic");
 }
 

@@ -9,7 +9,7 @@ cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
 r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
 r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
-libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib clang libclang-rt-14-dev zlib1g-dev"
+libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev zlib1g-dev"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""

@@ -4,8 +4,10 @@
 // 5 s window whose range stays below 0.12 g on every axis is a rest window,
 // offered to the 3 x 3 bin selector; once the bins are complete, the 9
 // parameters are fitted by 50 iterations of gradient descent in 32-bit fixed
-// point and applied to later samples. Everything is static: no malloc, no
-// new (the Makefile checks the linked image for them).
+// point (the paper's forward differences) and, from the same points, in
+// 16-bit fixed point with the analytic gradient (what a device without
+// 32-bit multiplies would run), and applied to later samples. Everything is
+// static: no malloc, no new (the Makefile checks the linked image for them).
 #include <cstdint>
 
 #include "gravcal/gravcal.hpp"
@@ -17,10 +19,12 @@ constexpr double kWindowSeconds = 5.0;
 constexpr double kMaxRange = 0.12;   // g
 
 using Num = gravcal::fixed32;
+using Num16 = gravcal::fixed16;
 
 gravcal::Segmenter segmenter(kRate * kWindowSeconds, true);
 gravcal::BinSelector<Num, 18> bins{gravcal::BinConfig{}};
 Num params[gravcal::NPARAM];
+Num16 params16[gravcal::NPARAM];
 bool calibrated = false;
 
 void on_window(const gravcal::WindowStats& w) {
@@ -47,6 +51,17 @@ extern "C" int gravcal_push(double x, double y, double z) {
     gravcal::identity_params(params);
     gravcal::GradientConfig<Num> cfg;  // the paper's rates, h = 1e-5, M = 50
     gravcal::fit_gradient(params, px, py, pz, n, cfg);
+    // the same points in Q1.14 (Q3.29 rounded by 15 bits), analytic gradient
+    Num16 qx[18], qy[18], qz[18];
+    for (int i = 0; i < n; ++i) {
+      qx[i] = Num16::from_raw(gravcal::fx::round_shift<std::int32_t>(px[i].raw, 15));
+      qy[i] = Num16::from_raw(gravcal::fx::round_shift<std::int32_t>(py[i].raw, 15));
+      qz[i] = Num16::from_raw(gravcal::fx::round_shift<std::int32_t>(pz[i].raw, 15));
+    }
+    gravcal::identity_params(params16);
+    gravcal::GradientConfig<Num16> cfg16;
+    cfg16.gradient = gravcal::GRADIENT_ANALYTIC;
+    gravcal::fit_gradient(params16, qx, qy, qz, n, cfg16);
     calibrated = true;
   }
   return calibrated ? 1 : 0;
@@ -57,6 +72,16 @@ extern "C" void gravcal_apply(std::int32_t* xyz) {
   const gravcal::Vec3<Num> v{Num::from_raw(xyz[0]), Num::from_raw(xyz[1]),
                              Num::from_raw(xyz[2])};
   const gravcal::Vec3<Num> a = gravcal::apply_model(params, v);
+  xyz[0] = a.x.raw;
+  xyz[1] = a.y.raw;
+  xyz[2] = a.z.raw;
+}
+
+// The same with the 16-bit parameters (raw Q1.14 in and out).
+extern "C" void gravcal_apply16(std::int16_t* xyz) {
+  const gravcal::Vec3<Num16> v{Num16::from_raw(xyz[0]), Num16::from_raw(xyz[1]),
+                               Num16::from_raw(xyz[2])};
+  const gravcal::Vec3<Num16> a = gravcal::apply_model(params16, v);
   xyz[0] = a.x.raw;
   xyz[1] = a.y.raw;
   xyz[2] = a.z.raw;
@@ -81,7 +106,9 @@ void Reset_Handler() {
   }
   std::int32_t v[3] = {1 << 29, 0, 0};
   gravcal_apply(v);
-  sink = v[0];
+  std::int16_t w[3] = {1 << 14, 0, 0};
+  gravcal_apply16(w);
+  sink = v[0] + w[0];
   for (;;) {
   }
 }

@@ -1,10 +1,13 @@
 // The gradient fit of the standalone core, for comparison with R and for
 // counting instructions:
 //   fit_points < cases.txt      one fit per case, the 9 parameters in %a
-//   fit_points --once ARITH     one calibration (18 points, 50 iterations)
-//                               in ARITH, for callgrind (see Makefile)
-// A case is a line "ARITH DIFFERENCE MAX_ITER H N" (ARITH double, float,
-// fixed32 or fixed16; DIFFERENCE forward or central; H in %a) followed by N
+//   fit_points --once ARITH [DIFFERENCE]
+//                               one calibration (18 points, 50 iterations)
+//                               in ARITH (forward differences unless
+//                               DIFFERENCE says), for callgrind (Makefile)
+// A case is a line "ARITH DIFFERENCE MAX_ITER H N SQRT" (ARITH double,
+// float, fixed32 or fixed16; DIFFERENCE forward, central or analytic; H in
+// %a; SQRT 1 for the objective with the square root, else 0) followed by N
 // lines "x y z" (%a). The points are rounded to ARITH as R's fit_gradient()
 // rounds them, and the fit is the same template, so the output must be R's
 // to the bit (check-r.R).
@@ -29,7 +32,7 @@ void run_fit(T* p, const T* x, const T* y, const T* z, int n,
 template <typename T>
 static void fit_case(const std::vector<double>& xd, const std::vector<double>& yd,
                      const std::vector<double>& zd, int max_iter, double h,
-                     bool central) {
+                     gravcal::GradientMode mode, bool use_sqrt) {
   const int n = static_cast<int>(xd.size());
   std::vector<T> x(n), y(n), z(n);
   for (int i = 0; i < n; ++i) {
@@ -40,7 +43,8 @@ static void fit_case(const std::vector<double>& xd, const std::vector<double>& y
   gravcal::GradientConfig<T> cfg;
   cfg.max_iter = max_iter;
   cfg.h = T(h);
-  cfg.central = central;
+  cfg.gradient = mode;
+  cfg.use_sqrt = use_sqrt;
   T p[9];
   run_fit(p, x.data(), y.data(), z.data(), n, cfg);
   for (int i = 0; i < 9; ++i) {
@@ -51,19 +55,28 @@ static void fit_case(const std::vector<double>& xd, const std::vector<double>& y
 
 static void dispatch(const std::string& a, const std::vector<double>& x,
                      const std::vector<double>& y, const std::vector<double>& z,
-                     int max_iter, double h, bool central) {
-  if (a == "double") fit_case<double>(x, y, z, max_iter, h, central);
-  else if (a == "float") fit_case<float>(x, y, z, max_iter, h, central);
-  else if (a == "fixed32") fit_case<gravcal::fixed32>(x, y, z, max_iter, h, central);
-  else if (a == "fixed16") fit_case<gravcal::fixed16>(x, y, z, max_iter, h, central);
+                     int max_iter, double h, gravcal::GradientMode mode,
+                     bool use_sqrt = false) {
+  if (a == "double") fit_case<double>(x, y, z, max_iter, h, mode, use_sqrt);
+  else if (a == "float") fit_case<float>(x, y, z, max_iter, h, mode, use_sqrt);
+  else if (a == "fixed32") fit_case<gravcal::fixed32>(x, y, z, max_iter, h, mode, use_sqrt);
+  else if (a == "fixed16") fit_case<gravcal::fixed16>(x, y, z, max_iter, h, mode, use_sqrt);
   else {
     std::fprintf(stderr, "unknown arithmetic %s\n", a.c_str());
     std::exit(2);
   }
 }
 
+static gravcal::GradientMode mode_of(const char* d) {
+  if (std::strcmp(d, "forward") == 0) return gravcal::GRADIENT_FORWARD;
+  if (std::strcmp(d, "central") == 0) return gravcal::GRADIENT_CENTRAL;
+  if (std::strcmp(d, "analytic") == 0) return gravcal::GRADIENT_ANALYTIC;
+  std::fprintf(stderr, "unknown difference %s\n", d);
+  std::exit(2);
+}
+
 int main(int argc, char** argv) {
-  if (argc == 3 && std::strcmp(argv[1], "--once") == 0) {
+  if ((argc == 3 || argc == 4) && std::strcmp(argv[1], "--once") == 0) {
     // 18 rest means of a sensor with p = (0.96, 1.04, 1.01, 0.02, -0.03,
     // 0.01, 0.05, -0.04, 0.02), two per bin
     static const double pts[18][3] = {
@@ -80,12 +93,14 @@ int main(int argc, char** argv) {
       z.push_back(q[2]);
     }
     const std::string a = argv[2];
-    dispatch(a, x, y, z, 50, a == "fixed16" ? 0.01 : 1e-5, false);
+    dispatch(a, x, y, z, 50, a == "fixed16" ? 0.01 : 1e-5,
+             mode_of(argc == 4 ? argv[3] : "forward"));
     return 0;
   }
   char arith[32], diff[32], hs[64];
-  int max_iter, n;
-  while (std::scanf("%31s %31s %d %63s %d", arith, diff, &max_iter, hs, &n) == 5) {
+  int max_iter, n, use_sqrt;
+  while (std::scanf("%31s %31s %d %63s %d %d", arith, diff, &max_iter, hs, &n,
+                    &use_sqrt) == 6) {
     std::vector<double> x(n), y(n), z(n);
     for (int i = 0; i < n; ++i) {
       char a[64], b[64], c[64];
@@ -95,7 +110,7 @@ int main(int argc, char** argv) {
       z[i] = std::strtod(c, nullptr);
     }
     dispatch(arith, x, y, z, max_iter, std::strtod(hs, nullptr),
-             std::strcmp(diff, "central") == 0);
+             mode_of(diff), use_sqrt != 0);
   }
   return 0;
 }

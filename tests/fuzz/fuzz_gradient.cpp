@@ -1,5 +1,6 @@
-// libFuzzer harness: the gradient fit on arbitrary points and settings, in
-// double, float and both fixed-point types. Checks: no sanitizer finding,
+// libFuzzer harness: the gradient fit on arbitrary points and settings
+// (forward, central or analytic gradient), in double, float and both
+// fixed-point types. Checks: no sanitizer finding,
 // the iteration count within bounds, and a fit that reports itself finite
 // has finite parameters (double, float).
 #include <cmath>
@@ -12,7 +13,7 @@
 template <typename T>
 static void run(const std::vector<double>& xs, const std::vector<double>& ys,
                 const std::vector<double>& zs, int max_iter, double h,
-                const double* rates, bool use_sqrt, bool sum, bool central) {
+                const double* rates, bool use_sqrt, bool sum, gravcal::GradientMode mode) {
   const int n = static_cast<int>(xs.size());
   std::vector<T> x(n), y(n), z(n);
   for (int i = 0; i < n; ++i) x[i] = T(xs[i]), y[i] = T(ys[i]), z[i] = T(zs[i]);
@@ -22,7 +23,7 @@ static void run(const std::vector<double>& xs, const std::vector<double>& ys,
   for (int i = 0; i < 9; ++i) cfg.rate[i] = T(rates[i]);
   cfg.use_sqrt = use_sqrt;
   cfg.scale = sum ? gravcal::SCALE_SUM : gravcal::SCALE_MEAN;
-  cfg.central = central;
+  cfg.gradient = mode;
   T p[9];
   gravcal::identity_params(p);
   const gravcal::GradientResult r =
@@ -49,7 +50,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     y.push_back(in.sample());
     z.push_back(in.sample());
   }
-  const bool s = flags & 1, sum = flags & 2, c = flags & 4;
+  const bool s = flags & 1, sum = flags & 2;
+  const gravcal::GradientMode c = static_cast<gravcal::GradientMode>((flags >> 2) % 3);
   if (type == 0) run<double>(x, y, z, max_iter, h, rates, s, sum, c);
   else if (type == 1) run<float>(x, y, z, max_iter, h, rates, s, sum, c);
   else if (type == 2) run<gravcal::fixed32>(x, y, z, max_iter, h, rates, s, sum, c);

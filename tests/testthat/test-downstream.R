@@ -4,7 +4,8 @@
 # running the lightweight pipeline in one streaming pass as a device would:
 # the segmenter fed in chunks of an odd size, the range rest rule, the bin
 # selector offered each rest window as it closes, and the gradient fit in
-# double and in Q3.29 fixed point. The R functions run the same core, so
+# double and in Q3.29 fixed point (the paper's forward differences) and in
+# Q1.14 with the analytic gradient. The R functions run the same core, so
 # their results must be the same to the bit.
 #
 # Skipped only when there is no C++ compiler; compiled into tempdir() so
@@ -84,13 +85,15 @@ Rcpp::List downstream_windows(Rcpp::NumericVector x, Rcpp::NumericVector y,
 
 template <typename T>
 Rcpp::List fit_in(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
-                  const Rcpp::NumericVector& z, int max_iter, double h) {
+                  const Rcpp::NumericVector& z, int max_iter, double h,
+                  bool analytic) {
   const int n = x.size();
   std::vector<T> xs(n), ys(n), zs(n);
   for (int i = 0; i < n; ++i) { xs[i] = T(x[i]); ys[i] = T(y[i]); zs[i] = T(z[i]); }
   gravcal::GradientConfig<T> cfg;   // the paper\'s rates, mean objective
   cfg.max_iter = max_iter;
   cfg.h = T(h);
+  if (analytic) cfg.gradient = gravcal::GRADIENT_ANALYTIC;
   T p[gravcal::NPARAM];
   gravcal::identity_params(p);
   const gravcal::GradientResult r =
@@ -105,9 +108,12 @@ Rcpp::List fit_in(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
 // [[Rcpp::export]]
 Rcpp::List downstream_fit(Rcpp::NumericVector x, Rcpp::NumericVector y,
                           Rcpp::NumericVector z, std::string arithmetic,
-                          int max_iter, double h) {
-  if (arithmetic == "fixed32") return fit_in<gravcal::fixed32>(x, y, z, max_iter, h);
-  return fit_in<double>(x, y, z, max_iter, h);
+                          int max_iter, double h, bool analytic = false) {
+  if (arithmetic == "fixed32")
+    return fit_in<gravcal::fixed32>(x, y, z, max_iter, h, analytic);
+  if (arithmetic == "fixed16")
+    return fit_in<gravcal::fixed16>(x, y, z, max_iter, h, analytic);
+  return fit_in<double>(x, y, z, max_iter, h, analytic);
 }
 '
 
@@ -166,4 +172,12 @@ test_that("a program built against the installed headers gives the R functions' 
   expect_identical(f_r32$status, "ok")
   expect_identical(f_c32$p, unname(f_r32$params))
   expect_false(identical(f_c32$p, f_c$p))
+
+  # Q1.14 with the analytic gradient
+  f_r16 <- fit_gradient(pts, arithmetic = "fixed16", difference = "analytic")
+  f_c16 <- env$downstream_fit(pts$mean_x, pts$mean_y, pts$mean_z, "fixed16",
+                              50L, 0.01, TRUE)
+  expect_identical(f_r16$status, "ok")
+  expect_identical(f_c16$p, unname(f_r16$params))
+  expect_lt(max(abs(f_c16$p - f_c$p)), 0.002)
 })

@@ -158,3 +158,101 @@ test_that("a fit whose objective did not decrease is not ok", {
   expect_identical(fit_gradient(pts)$status, "ok")
   expect_identical(fit_gradient(pts, arithmetic = "fixed16")$status, "ok")
 })
+
+test_that("the analytic gradient is the objective's derivative (double, to 1e-8)", {
+  # a step moves p by exactly rate * gradient: read the gradient off the
+  # trace (at the start and after one step) and compare it with central
+  # differences of the objective computed in R
+  set.seed(36)
+  rate <- 0.01
+  worst <- 0
+  for (use_sqrt in c(FALSE, TRUE)) {
+    for (objective in c("mean", "sum")) {
+      pts <- select_points(simulate_points(1000, noise = 0.002))
+      v <- as.matrix(pts[c("mean_x", "mean_y", "mean_z")])
+      fit <- fit_gradient(pts, difference = "analytic", max_iter = 2,
+                          rates = rep(rate, 3), use_sqrt = use_sqrt,
+                          objective = objective, trace = TRUE)
+      p <- rbind(c(1, 1, 1, 0, 0, 0, 0, 0, 0),
+                 unname(fit$trace[, param_names()]))
+      for (k in 1:2) {
+        g <- (p[k, ] - p[k + 1, ]) / rate
+        f <- function(q) lm_objective(v, c(q, 0, 0, 0), use_sqrt,
+                                      objective == "sum")
+        h <- 1e-6
+        num <- vapply(1:9, function(j) {
+          e <- replace(numeric(9), j, h)
+          (f(p[k, ] + e) - f(p[k, ] - e)) / (2 * h)
+        }, 0)
+        worst <- max(worst, abs(g - num) / pmax(1, abs(num)))
+      }
+    }
+  }
+  expect_lt(worst, 1e-8)
+  # and the fit itself: the same optimum as forward differences, without
+  # their bias of about h
+  pts <- select_points(simulate_points(1000, noise = 0))
+  fa <- fit_gradient(pts, difference = "analytic", max_iter = 5000,
+                     tol = 1e-14)
+  expect_true(fa$converged)
+  expect_lt(max(abs(fa$params - attr(pts, "params"))), 1e-9)
+})
+
+test_that("fixed16 with the analytic gradient fits within 1.5 times double's error", {
+  # A regression check of bench/results/fixed.md (500 cases: fixed16 with
+  # the analytic gradient at 1.00 of double's mean absolute error at 1 mg,
+  # with the paper's forward differences at h = 0.01 about 11 times): 100
+  # cases of the paper's simulation at 1 mg, 18 points, 50 iterations.
+  set.seed(79)
+  err <- replicate(100, {
+    cand <- simulate_points(1000, noise = 0.001)
+    pts <- select_points(cand)
+    truth <- attr(cand, "params")
+    cbind(double = abs(fit_gradient(pts)$params - truth),
+          fixed16a = abs(fit_gradient(pts, arithmetic = "fixed16",
+                                      difference = "analytic")$params - truth),
+          fixed16 = abs(fit_gradient(pts, arithmetic = "fixed16")$params - truth))
+  }, simplify = "array")
+  m <- apply(err, c(1, 2), mean)
+  expect_lt(mean(m[, "fixed16a"]), 1.5 * mean(m[, "double"]))
+  # every parameter, not only on average
+  expect_true(all(m[, "fixed16a"] < 1.5 * m[, "double"]))
+  expect_gt(mean(m[, "fixed16"]), 3 * mean(m[, "double"]))
+})
+
+test_that("difference = 'analytic': settings, no step check, every arithmetic", {
+  set.seed(80)
+  cand <- simulate_points(1000, noise = 0.001)
+  pts <- select_points(cand)
+  fd <- fit_gradient(pts)
+  for (arith in c("double", "float", "fixed32", "fixed16")) {
+    f <- fit_gradient(pts, arithmetic = arith, difference = "analytic")
+    expect_identical(f$status, "ok")
+    expect_identical(f$settings$difference, "analytic")
+    expect_lt(max(abs(f$params - fd$params)), 3e-4)
+  }
+  # values on the grid of the type, though the steps are kept in 32 bits
+  f16 <- fit_gradient(pts, arithmetic = "fixed16", difference = "analytic")
+  expect_true(all(f16$params * 2^14 == round(f16$params * 2^14)))
+  # no step: h below the type's resolution is no error
+  expect_identical(fit_gradient(pts, arithmetic = "fixed16", h = 1e-9,
+                                difference = "analytic")$params, f16$params)
+  expect_error(fit_gradient(pts, arithmetic = "fixed16", h = 1e-9), "`h`")
+  # fewer parameters: the others stay exactly at the identity
+  fo <- fit_gradient(pts, arithmetic = "fixed16", difference = "analytic",
+                     model = "offset")
+  expect_identical(unname(fo$params[1:6]), c(1, 1, 1, 0, 0, 0))
+  expect_lt(max(abs(fo$params[7:9] - fd$params[7:9])), 0.05)
+  # the square-root objective, tol and the trace
+  fs <- fit_gradient(pts, arithmetic = "fixed16", difference = "analytic",
+                     use_sqrt = TRUE, trace = TRUE)
+  expect_identical(fs$status, "ok")
+  expect_equal(nrow(fs$trace), 50)
+  ds <- fit_gradient(pts, difference = "analytic", use_sqrt = TRUE)
+  expect_lt(max(abs(fs$params - ds$params)), 5e-4)
+  ft <- fit_gradient(pts, difference = "analytic", max_iter = 5000, tol = 1e-9)
+  expect_true(ft$converged)
+  expect_lt(ft$iterations, 5000)
+  expect_error(fit_gradient(pts, difference = "backward"),
+               "\"forward\", \"central\", \"analytic\"")
+})

@@ -108,14 +108,91 @@ struct Fixed {
   friend constexpr bool operator!=(Fixed a, Fixed b) { return a.raw != b.raw; }
 };
 
-// Square root, for the objective's optional use_sqrt form (the paper leaves
-// it out): the integer square root of raw * 2^Frac, by bits, rounded down.
-template <typename Int, typename Wide, int Frac>
-inline Fixed<Int, Wide, Frac> sqrt(Fixed<Int, Wide, Frac> a) {
-  using F = Fixed<Int, Wide, Frac>;
-  if (a.raw <= 0) return F();
-  using U = typename std::make_unsigned<Wide>::type;
-  U n = static_cast<U>(Wide(a.raw)) << Frac;
+// Integer helpers on the wide type, for code that keeps its own scaling in
+// raw integers (the analytic gradient, gradient_analytic.hpp). Saturation is
+// symmetric, to [-max, max], so that |x| of a saturated value never
+// overflows. Right shifts of negative values are arithmetic (floor), as the
+// products above already assume.
+namespace fx {
+
+template <typename W>
+constexpr W top() {
+  return std::numeric_limits<W>::max();
+}
+
+// a + b, saturated to [-max, max] (a and b within that range).
+template <typename W>
+inline W sat_add(W a, W b) {
+  if (b > 0 && a > top<W>() - b) return top<W>();
+  if (b < 0 && a < -top<W>() - b) return -top<W>();
+  return a + b;
+}
+
+template <typename W>
+inline W clamp(W v, W lo, W hi) {
+  return v < lo ? lo : (v > hi ? hi : v);
+}
+
+template <typename W>
+inline W abs(W v) {
+  return v < 0 ? -v : v;
+}
+
+// v / 2^s rounded to nearest, ties up (s >= 0), without forming v + 2^(s-1).
+template <typename W>
+inline W round_shift(W v, int s) {
+  return s <= 0 ? v : (v >> s) + ((v >> (s - 1)) & W(1));
+}
+
+// v * 2^s (s >= 0), saturated.
+template <typename W>
+inline W sat_shl(W v, int s) {
+  if (v == 0 || s <= 0) return v;
+  if (s >= 8 * static_cast<int>(sizeof(W)) - 1) return v > 0 ? top<W>() : -top<W>();
+  const W lim = top<W>() >> s;
+  if (v > lim) return top<W>();
+  if (v < -lim) return -top<W>();
+  return v * (W(1) << s);
+}
+
+// v * 2^s for any sign of s: rounded when s < 0, saturated when s > 0.
+template <typename W>
+inline W scale2(W v, int s) {
+  return s >= 0 ? sat_shl(v, s) : round_shift(v, -s);
+}
+
+// v / d rounded to nearest (ties away from zero), d > 0.
+template <typename W>
+inline W round_div(W v, W d) {
+  const W a = abs(v);
+  const W q = a / d + ((a % d) >= d - (a % d) ? W(1) : W(0));
+  return v < 0 ? -q : q;
+}
+
+// v * 2^k / d truncated toward zero and saturated, d > 0 and
+// d < 2^(bits - 1 - k), by long division: the remainder times 2^k fits.
+template <typename W>
+inline W div_shift(W v, W d, int k) {
+  const W a = abs(v);
+  const W q = sat_add(sat_shl(a / d, k), ((a % d) * (W(1) << k)) / d);
+  return v < 0 ? -q : q;
+}
+
+// Number of bits of v >= 0 (0 for 0).
+template <typename W>
+inline int bit_length(W v) {
+  int b = 0;
+  while (v > 0) {
+    v >>= 1;
+    ++b;
+  }
+  return b;
+}
+
+// floor(sqrt(n)), by bits.
+template <typename U>
+inline U isqrt(U n) {
+  static_assert(!std::numeric_limits<U>::is_signed, "isqrt takes an unsigned type");
   U r = 0;
   U bit = U(1) << (8 * sizeof(U) - 2);
   while (bit > n) bit >>= 2;
@@ -128,7 +205,19 @@ inline Fixed<Int, Wide, Frac> sqrt(Fixed<Int, Wide, Frac> a) {
     }
     bit >>= 2;
   }
-  return F::from_raw(static_cast<Wide>(r));
+  return r;
+}
+
+}  // namespace fx
+
+// Square root, for the objective's optional use_sqrt form (the paper leaves
+// it out): the integer square root of raw * 2^Frac, by bits, rounded down.
+template <typename Int, typename Wide, int Frac>
+inline Fixed<Int, Wide, Frac> sqrt(Fixed<Int, Wide, Frac> a) {
+  using F = Fixed<Int, Wide, Frac>;
+  if (a.raw <= 0) return F();
+  using U = typename std::make_unsigned<Wide>::type;
+  return F::from_raw(static_cast<Wide>(fx::isqrt(static_cast<U>(Wide(a.raw)) << Frac)));
 }
 
 // A value divided by a count (the mean over points), without representing

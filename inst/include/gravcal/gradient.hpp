@@ -12,6 +12,8 @@
 // iterations, as its Fig. 9 shows.
 //
 // Gradient by forward differences, g_i = (f(p + h e_i) - f(p)) / h (Eq. 13),
+// by central differences, or in closed form (gradient_analytic.hpp: no step,
+// and in fixed point computed so that 16 bits fit as well as double);
 // update p <- p - alpha * g with per-group rates (Eq. 14, 16):
 // alpha_s = 0.3 (k_xx, k_yy, k_zz), alpha_m = 0.8 (k_xy, k_xz, k_yz),
 // alpha_o = 0.2 (o_x, o_y, o_z); h = 1e-5 (double, float, 32-bit fixed point)
@@ -23,11 +25,24 @@
 
 #include <cmath>
 
+#include "gradient_analytic.hpp"
 #include "model.hpp"
 
 namespace gravcal {
 
 enum ObjectiveScale { SCALE_MEAN = 0, SCALE_SUM = 1 };
+
+// How the gradient is obtained:
+//   GRADIENT_FORWARD   (f(p + h e_i) - f(p)) / h, the paper's Eq. 13: N + 9 N
+//                      model evaluations per iteration, biased by about h / 2
+//                      times the curvature;
+//   GRADIENT_CENTRAL   (f(p + h e_i) - f(p - h e_i)) / 2h: twice the
+//                      evaluations, without that bias;
+//   GRADIENT_ANALYTIC  the closed form (gradient_analytic.hpp), one pass over
+//                      the points, no h. In fixed point it keeps its own
+//                      scaling and the parameters in the wide type between
+//                      steps: fixed16 then fits as well as double.
+enum GradientMode { GRADIENT_FORWARD = 0, GRADIENT_CENTRAL = 1, GRADIENT_ANALYTIC = 2 };
 
 template <typename T>
 struct GradientConfig {
@@ -39,19 +54,13 @@ struct GradientConfig {
   ObjectiveScale scale = SCALE_MEAN;
   // Stop early when every |step| is below tol (0: always run max_iter).
   T tol = T(0);
-  // Central differences (f(p + h e_i) - f(p - h e_i)) / 2h instead of the
-  // paper's forward differences: twice the evaluations, but without the
-  // forward difference's bias of about h / 2 per parameter, which matters
-  // with the 16-bit step h = 0.01.
-  bool central = false;
+  // The paper's forward differences by default. The forward difference's
+  // bias of about h / 2 per parameter matters with the 16-bit step h = 0.01;
+  // central differences remove it, the analytic gradient needs no h at all.
+  GradientMode gradient = GRADIENT_FORWARD;
 };
 
-// f / n. Fixed-point types overload this (fixed_point.hpp), dividing the
-// raw integer, because n itself may be out of their range.
-template <typename T>
-inline T divide_by_count(T f, int n) {
-  return f / T(n);
-}
+// divide_by_count(f, n), f / n: gradient_analytic.hpp.
 
 // f(p) over n points given as coordinate arrays.
 template <typename T>
@@ -92,28 +101,29 @@ inline GradientResult fit_gradient(T* p, const T* x, const T* y, const T* z,
                                    Observer&& observe = Observer()) {
   GradientResult res{0, false, true};
   T g[NPARAM];
+  AnalyticDescent<T> analytic(p);
+  const bool mean = cfg.scale == SCALE_MEAN;
   for (int it = 1; it <= cfg.max_iter; ++it) {
     const T f0 = gradient_objective(p, x, y, z, n, cfg.use_sqrt, cfg.scale);
-    for (int i = 0; i < NPARAM; ++i) {
-      const T saved = p[i];
-      p[i] = saved + cfg.h;
-      const T fi = gradient_objective(p, x, y, z, n, cfg.use_sqrt, cfg.scale);
-      if (cfg.central) {
-        p[i] = saved - cfg.h;
-        const T fm = gradient_objective(p, x, y, z, n, cfg.use_sqrt, cfg.scale);
-        p[i] = saved;
-        g[i] = (fi - fm) / (cfg.h + cfg.h);
-      } else {
-        p[i] = saved;
-        g[i] = (fi - f0) / cfg.h;
+    bool small;
+    if (cfg.gradient == GRADIENT_ANALYTIC) {
+      small = analytic.step(p, x, y, z, n, cfg.use_sqrt, mean, cfg.rate, cfg.tol);
+    } else {
+      for (int i = 0; i < NPARAM; ++i) {
+        const T saved = p[i];
+        p[i] = saved + cfg.h;
+        const T fi = gradient_objective(p, x, y, z, n, cfg.use_sqrt, cfg.scale);
+        if (cfg.gradient == GRADIENT_CENTRAL) {
+          p[i] = saved - cfg.h;
+          const T fm = gradient_objective(p, x, y, z, n, cfg.use_sqrt, cfg.scale);
+          p[i] = saved;
+          g[i] = (fi - fm) / (cfg.h + cfg.h);
+        } else {
+          p[i] = saved;
+          g[i] = (fi - f0) / cfg.h;
+        }
       }
-    }
-    bool small = true;
-    for (int i = 0; i < NPARAM; ++i) {
-      T step = cfg.rate[i] * g[i];
-      p[i] = p[i] - step;
-      if (step < T(0)) step = -step;
-      if (!(step < cfg.tol)) small = false;
+      small = descend(p, g, cfg.rate, cfg.tol);
     }
     res.iterations = it;
     observe(it, static_cast<const T*>(p), f0);
