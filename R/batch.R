@@ -82,7 +82,9 @@
 #'   fitted: 9, 6 or 3 for the lightweight method, which fits what the
 #'   recording determines; 6 or 9 for the GGIR method; 0 when not
 #'   calibrated) and `points` (calibration points used); `meantempcal`;
-#'   `error_before_mg`, `error_after_mg` (on the rest points used); `format`, `hours` (of samples read), `windows`,
+#'   `error_before_mg`, `error_after_mg` (on the rest points used); `format`,
+#'   `serial` (the device's serial number from the file's header, NA
+#'   where there is none), `pooled` (see `pool`), `hours` (of samples read), `windows`,
 #'   `rest_windows`; what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
 #'   not use: damaged blocks, pages, records or lines), `gaps` and
@@ -428,9 +430,6 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
   } else as.numeric(NROW(fit$windows))
   data.frame(
     file = basename(file),
-    serial = if (na || is.null(fit$input$serial)) NA_character_ else
-      as.character(fit$input$serial),
-    pooled = FALSE,
     status = if (na) "failed" else fit$status,
     message = if (na) paste(error, collapse = "; ") else fit$message,
     coefs,
@@ -440,6 +439,9 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
     error_before_mg = if (na) NA_real_ else 1000 * fit$error_before,
     error_after_mg = if (na) NA_real_ else 1000 * fit$error_after,
     format = format,
+    serial = if (na || is.null(fit$input$serial)) NA_character_ else
+      as.character(fit$input$serial),
+    pooled = FALSE,
     hours = if (na) NA_real_ else fit_hours(fit),
     windows = if (na) NA_real_ else num(fit$n_windows),
     rest_windows = rest,

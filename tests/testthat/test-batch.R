@@ -71,7 +71,15 @@ test_that("calibrate_files() calibrates a folder, one row per recording", {
   expect_identical(unname(unlist(tl[1, c("cross.xy.se", "cross.xz.se",
                                          "cross.yz.se", "scale.x.se")])),
                    unname(attr(tl, "fits")[[1]]$se[c(4:6, 1)]))
-  expect_true(all(is.finite(unlist(tl[1, c("cross.xy.se", "offset.z.se")]))))
+  # the model fitted: standard errors for its coefficients, NA for the
+  # others (the simulated device has no cross-axis error: 6 parameters)
+  f1 <- attr(tl, "fits")[[1]]
+  expect_identical(tl$parameters[1], length(f1$model))
+  expect_identical(tl$points[1], nrow(f1$points))
+  expect_true(all(is.finite(unlist(tl[1, c("scale.x.se", "offset.z.se")]))))
+  expect_identical(is.finite(unlist(tl[1, c("cross.xy.se", "cross.xz.se", "cross.yz.se")])),
+                   stats::setNames(c("k_xy", "k_xz", "k_yz") %in% f1$model,
+                                   c("cross.xy.se", "cross.xz.se", "cross.yz.se")))
   expect_false(file.exists(file.path(out, "calibration_lightweight.csv")))
   # the GGIR coefficients of the earlier run no longer match the table
   expect_false(file.exists(file.path(out, "calibration_ggir_coefs.csv")))
