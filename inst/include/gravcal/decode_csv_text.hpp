@@ -248,6 +248,28 @@ GRAVCAL_CSV_INLINE bool plain_value(const PlainNumber& n, const char* b, const c
   return parse_number(b, e, dec, false, out);
 }
 
+// The values of the numbers with 3 decimals and fewer than 5 digits
+// (ActiLife's, to 16.383 g), by their digits: t[1234] is the value of
+// "1.234", fread's (compat) or correctly rounded. Computed once per
+// process, on first use, by fread_value / exact_value (128 KiB each).
+constexpr std::size_t kThousandths = 16384;
+inline std::vector<double> thousandths_values(bool compat) {
+  std::vector<double> t(kThousandths);
+  for (std::uint64_t k = 0; k < kThousandths; ++k) {
+    if (compat) t[k] = fread_value(k, -3, false);
+    else exact_value(k, -3, false, t[k]);  // (exact for every k here)
+  }
+  return t;
+}
+inline const double* thousandths(bool compat) {
+  if (compat) {
+    static const std::vector<double> t = thousandths_values(true);
+    return t.data();
+  }
+  static const std::vector<double> t = thousandths_values(false);
+  return t.data();
+}
+
 inline unsigned days_in_month(std::int64_t y, unsigned m) {
   static const unsigned k[12] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
   const bool leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
