@@ -8,6 +8,8 @@
 // * parse_number (compat = 0) against std::from_chars (correctly rounded);
 // * the plain shape (scan_plain_number + plain_value) against parse_number,
 //   every number of up to 6 digits and random longer ones;
+// * the date-time parser that keeps the last date and second against a
+//   fresh one for each stamp;
 // * a decoder reading lines in place against one reading every line through
 //   the general parser (option fast = 0), bit for bit, on files of several
 //   layouts, with damage, CRLF and small buffers.
@@ -170,6 +172,54 @@ static void test_long_numbers(std::mt19937_64& rng) {
       }
       std::snprintf(buf, sizeof buf, "%.3f5", y);  // halfway between 4-decimal values
       check_number(buf);
+    }
+  }
+}
+
+// ---- time stamps: the parser's caches change no value ----------------------
+
+// A run of stamps such as files hold (and some they should not): each
+// parsed by one parser, which keeps the last date and second, and by a
+// fresh one; the same success and bits.
+static void test_stamps(std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> k(0, 99), sec(0, 61), ms(0, 999);
+  const std::vector<std::string> dates = {"5/11/2023", "5/12/2023", "12/31/2023", "1/1/2024",
+                                          "2023-05-11", "11/5/2023", "5/11/23", "2/30/2023"};
+  const std::vector<std::string> tails = {"", "Z", "1", " ", ".", ":5", ".0000000001", "x"};
+  for (csv::DateOrder order : {csv::DateOrder::mdy, csv::DateOrder::dmy}) {
+    csv::DateTimeParser kept(order);
+    std::string date = dates[0];
+    int hh = 9, mm = 0, ss = 0;
+    for (int i = 0; i < 200000; ++i) {
+      const int c = k(rng);
+      if (c == 0) date = dates[static_cast<std::size_t>(k(rng)) % dates.size()];
+      if (c == 1) ss = sec(rng);
+      if (c < 10) ss = (ss + 1) % 62;
+      if (c == 2) mm = (mm + 1) % 61;
+      if (c == 3) hh = (hh + 1) % 26;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s%02d:%02d:%02d", date.c_str(),
+                    c == 4 ? "T" : (c == 5 ? "  " : " "), hh, mm, ss);
+      std::string stamp = buf;
+      if (c < 90) {
+        std::snprintf(buf, sizeof buf, ".%0*d", 1 + c % 3, ms(rng) % (c % 3 == 0 ? 10 : 1000));
+        stamp += buf;
+      }
+      if (c >= 85) stamp += tails[static_cast<std::size_t>(c) % tails.size()];
+      if (c == 6) stamp = stamp.substr(0, stamp.size() - 2);
+      // now and then another date with an impossible time, then this stamp
+      // again (the parser has taken in the other date meanwhile)
+      std::vector<std::string> run = {stamp};
+      if (c == 7) run = {stamp, dates[(i / 7) % dates.size()] + " 25:00:00.000", stamp};
+      for (const std::string& st : run) {
+        double a = 0, b = 0;
+        int fa = -1, fb = -1;
+        csv::DateTimeParser fresh(order);
+        const bool oa = kept.parse(st.data(), st.data() + st.size(), a, fa);
+        const bool ob = fresh.parse(st.data(), st.data() + st.size(), b, fb);
+        CHECK(oa == ob, st);
+        if (oa && ob) CHECK(same_bits(a, b) && fa == fb, st);
+      }
     }
   }
 }
@@ -356,6 +406,7 @@ int main() {
   }
   test_short_numbers(6);
   test_long_numbers(rng);
+  test_stamps(rng);
   test_files(rng);
   std::printf("csv: %ld checks, %s\n", checked, failures ? "FAILED" : "all passed");
   return failures ? 1 : 0;

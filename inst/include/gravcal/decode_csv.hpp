@@ -572,8 +572,7 @@ class CsvDecoder : public Decoder {
       const Role r = static_cast<Role>(role_[i]);
       const bool last = i + 1 == nfields_;
       if (r == kSkip || r == kTime) {
-        const char* fe = p;
-        while (*fe != sep_ && *fe != '\n') ++fe;
+        const char* fe = csv_text::field_end(p, sep_);
         if (r == kTime) tf = csv_text::Field{p, fe};
         p = fe;
       } else {
@@ -677,15 +676,28 @@ class CsvDecoder : public Decoder {
 
   void check_step(double dt, double res, const csv_text::Line& ln) {
     if (dt > kGapSteps * step_ + res) {
-      ++report_.gaps;
-      report_.gap_seconds += dt - step_;
-      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
-                   "): time jumps " + std::to_string(dt) + " s");
+      gap(dt, ln);
     } else if (dt < -(step_ / 2 + res)) {
-      report_.count("time_backwards");
-      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
-                   "): time goes back " + std::to_string(-dt) + " s");
+      backwards(dt, ln);
     }
+  }
+  // (the rare cases out of line: check_step() stays small enough to inline)
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  void gap(double dt, const csv_text::Line& ln) {
+    ++report_.gaps;
+    report_.gap_seconds += dt - step_;
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                 "): time jumps " + std::to_string(dt) + " s");
+  }
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  void backwards(double dt, const csv_text::Line& ln) {
+    report_.count("time_backwards");
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                 "): time goes back " + std::to_string(-dt) + " s");
   }
 
   csv_text::LineReader lines_;

@@ -248,6 +248,46 @@ GRAVCAL_CSV_INLINE bool plain_value(const PlainNumber& n, const char* b, const c
   return parse_number(b, e, dec, false, out);
 }
 
+// 8 bytes at p as a word, byte 0 lowest (one load on a little-endian
+// machine).
+inline std::uint64_t load_le64(const char* p) {
+  const unsigned char* b = reinterpret_cast<const unsigned char*>(p);
+  return static_cast<std::uint64_t>(b[0]) | static_cast<std::uint64_t>(b[1]) << 8 |
+         static_cast<std::uint64_t>(b[2]) << 16 | static_cast<std::uint64_t>(b[3]) << 24 |
+         static_cast<std::uint64_t>(b[4]) << 32 | static_cast<std::uint64_t>(b[5]) << 40 |
+         static_cast<std::uint64_t>(b[6]) << 48 | static_cast<std::uint64_t>(b[7]) << 56;
+}
+
+// The top bit of every byte of x that is 0, no other bit.
+inline std::uint64_t zero_bytes(std::uint64_t x) {
+  const std::uint64_t low7 = 0x7F7F7F7F7F7F7F7FULL;
+  return ~(((x & low7) + low7) | x | low7);
+}
+
+// The index of the lowest byte flagged in m (top bits only, at least one).
+inline int first_flagged(std::uint64_t m) {
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctzll(m) >> 3;
+#else
+  int k = 0;
+  for (; (m & 0x80) == 0; m >>= 8) ++k;
+  return k;
+#endif
+}
+
+// The first byte at or after p that is `sep` or '\n', one of which lies
+// ahead; 8 bytes at a time, so it may read up to 7 bytes past it (the
+// LineReader's kPad).
+GRAVCAL_CSV_INLINE const char* field_end(const char* p, char sep) {
+  const std::uint64_t ones = 0x0101010101010101ULL;
+  const std::uint64_t s = ones * static_cast<unsigned char>(sep), nl = ones * '\n';
+  for (;; p += 8) {
+    const std::uint64_t w = load_le64(p);
+    const std::uint64_t m = zero_bytes(w ^ s) | zero_bytes(w ^ nl);
+    if (m != 0) return p + first_flagged(m);
+  }
+}
+
 // The values of the numbers with 3 decimals and fewer than 5 digits
 // (ActiLife's, to 16.383 g), by their digits: t[1234] is the value of
 // "1.234", fread's (compat) or correctly rounded. Computed once per
@@ -319,8 +359,8 @@ inline bool parse_date(const char*& p, const char* e, DateOrder order, std::int6
   return true;
 }
 
-// HH:MM:SS[.fff...] as seconds; `frac_digits` tells the resolution.
-inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_digits) {
+// HH:MM:SS as whole seconds.
+inline bool parse_hms(const char*& p, const char* e, std::int64_t& whole) {
   std::int64_t h, m, s;
   int nd;
   if (!read_uint(p, e, 2, h, nd) || p >= e || *p != ':') return false;
@@ -329,54 +369,99 @@ inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_d
   ++p;
   if (!read_uint(p, e, 2, s, nd) || nd != 2) return false;
   if (h > 24 || m > 59 || s > 60) return false;
-  std::int64_t frac = 0;
+  whole = h * 3600 + m * 60 + s;
+  return true;
+}
+
+// What may follow the seconds: [.fff...] (or GENEActiv-like ":fff"), its
+// first 9 digits as an integer; frac_digits = 0 when there is none.
+inline bool parse_fraction(const char*& p, const char* e, std::int64_t& frac, int& frac_digits) {
+  frac = 0;
   frac_digits = 0;
-  if (p < e && (*p == '.' || *p == ':')) {  // GENEActiv-like ":fff" too
+  if (p < e && (*p == '.' || *p == ':')) {
     ++p;
     if (!read_uint(p, e, 9, frac, frac_digits)) return false;
     while (p < e && is_digit(*p)) ++p;
   }
+  return true;
+}
+
+inline double clock_seconds(std::int64_t whole, std::int64_t frac, int frac_digits) {
   static const double scale[10] = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
-  secs = static_cast<double>(h * 3600 + m * 60 + s) + static_cast<double>(frac) / scale[frac_digits];
+  return static_cast<double>(whole) + static_cast<double>(frac) / scale[frac_digits];
+}
+
+// HH:MM:SS[.fff...] as seconds; `frac_digits` tells the resolution.
+inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_digits) {
+  std::int64_t whole, frac;
+  if (!parse_hms(p, e, whole) || !parse_fraction(p, e, frac, frac_digits)) return false;
+  secs = clock_seconds(whole, frac, frac_digits);
   return true;
 }
 
 // Parses "<date>[ T]<clock>[Z]" into seconds since 1970 UTC (local times are
-// taken as UTC, as gravcal's R readers do). Keeps the last date's text, so
-// that a file of one date per day parses the date once a day.
+// taken as UTC, as gravcal's R readers do). Keeps the text of the last
+// date and of the last date and time to the whole second, so that a file
+// of one stamp per sample parses a date once a day and a time once a
+// second: a stamp that starts with the same text has the same value to
+// the second, whatever follows.
 class DateTimeParser {
  public:
   explicit DateTimeParser(DateOrder order = DateOrder::mdy) : order_(order) {}
-  void set_order(DateOrder o) { order_ = o; cached_len_ = 0; }
+  void set_order(DateOrder o) {
+    order_ = o;
+    cached_len_ = 0;
+    second_len_ = 0;
+  }
   bool parse(const char* b, const char* e, double& t, int& frac_digits) {
-    const char* sp = b;
-    while (sp < e && *sp != ' ' && *sp != 'T') ++sp;
-    if (sp == e || sp - b > kMaxDate) return false;
-    const std::size_t dl = static_cast<std::size_t>(sp - b);
-    if (dl != cached_len_ || std::memcmp(b, cached_, dl) != 0) {
-      const char* p = b;
-      std::int64_t days;
-      if (!parse_date(p, sp, order_, days) || p != sp) return false;
-      std::memcpy(cached_, b, dl);
-      cached_len_ = dl;
-      cached_days_ = days;
+    const std::size_t n = static_cast<std::size_t>(e - b);
+    const char* p;
+    std::int64_t days, whole;
+    if (second_len_ > 0 && n >= second_len_ && std::memcmp(b, second_, second_len_) == 0) {
+      p = b + second_len_;
+      days = second_days_;
+      whole = second_whole_;
+    } else {
+      const char* sp = b;
+      while (sp < e && *sp != ' ' && *sp != 'T') ++sp;
+      if (sp == e || sp - b > kMaxDate) return false;
+      const std::size_t dl = static_cast<std::size_t>(sp - b);
+      if (dl != cached_len_ || std::memcmp(b, cached_, dl) != 0) {
+        p = b;
+        if (!parse_date(p, sp, order_, days) || p != sp) return false;
+        std::memcpy(cached_, b, dl);
+        cached_len_ = dl;
+        cached_days_ = days;
+      }
+      days = cached_days_;
+      p = sp + 1;
+      while (p < e && *p == ' ') ++p;
+      if (!parse_hms(p, e, whole)) return false;
+      if (p - b <= kMaxSecond) {
+        second_len_ = static_cast<std::size_t>(p - b);
+        std::memcpy(second_, b, second_len_);
+        second_days_ = days;
+        second_whole_ = whole;
+      }
     }
-    const char* p = sp + 1;
-    while (p < e && *p == ' ') ++p;
-    double secs;
-    if (!parse_clock(p, e, secs, frac_digits)) return false;
+    std::int64_t frac;
+    if (!parse_fraction(p, e, frac, frac_digits)) return false;
     if (p < e && *p == 'Z') ++p;
     if (p != e) return false;
-    t = static_cast<double>(cached_days_ * 86400) + secs;
+    t = static_cast<double>(days * 86400) + clock_seconds(whole, frac, frac_digits);
     return true;
   }
 
  private:
   static constexpr int kMaxDate = 24;
+  static constexpr int kMaxSecond = 48;
   DateOrder order_;
   char cached_[kMaxDate];
   std::size_t cached_len_ = 0;
   std::int64_t cached_days_ = 0;
+  char second_[kMaxSecond];  // the text of a date and time to the second
+  std::size_t second_len_ = 0;
+  std::int64_t second_days_ = 0, second_whole_ = 0;
 };
 
 // One line of the input (without its line end), where it was, and how it
