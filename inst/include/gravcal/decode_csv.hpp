@@ -62,6 +62,14 @@
 // keep the block boundaries (B lines per call), so a clean file gives
 // exactly GGIR's blocks and a damaged one GGIR's blocks minus the damage.
 // Empty fields and "NA" (NA in fread) make a line non-numeric here.
+//
+// Speed: a line whose fields are all plain numbers ([+-]digits[.digits],
+// up to 18 digits) or text the layout does not parse as a number (a time
+// stamp) is parsed where it lies in the read buffer, with 3-decimal values
+// looked up (read_plain_as); any other line, damaged or unusual, goes
+// through take_line() and the general parser. Both give the same samples,
+// counters and notes (option fast = 0 takes every line through
+// take_line(); tests/cpp/test_csv and the fuzzer compare the two).
 #ifndef GRAVCAL_DECODE_CSV_HPP
 #define GRAVCAL_DECODE_CSV_HPP
 

@@ -71,8 +71,8 @@ inline bool is_digit(char c) { return c >= '0' && c <= '9'; }
 // The value of the byte as a digit; above 9 when it is not one.
 inline unsigned digit_of(char c) { return static_cast<unsigned>(static_cast<unsigned char>(c)) - '0'; }
 
-// The same by sign, [1] the negative ones: a negative number's value is
-// its digits times a negative power, with no branch on the sign (which
+// kPow10Near by sign, [1] the negative powers: a negative number's value
+// is its digits times a negative power, with no branch on the sign (which
 // varies from number to number). Rounding to nearest is symmetric, so
 // round(acc * -p) is -round(acc * p), and 0 * -p is -0.
 struct Pow10BySign {
@@ -236,8 +236,8 @@ GRAVCAL_CSV_INLINE const char* scan_plain_number(const char* p, char dec, PlainN
 }
 
 // The value parse_number gives for [b, e), the text scan_plain_number read
-// as `n`: fread_value() and exact_value() for exp10 = -frac in [-18, 0]
-// (no range checks), else parse_number itself.
+// as `n` (every digit kept, exp10 = -frac): fread_value() or exact_value(),
+// as parse_number computes it, else parse_number itself.
 GRAVCAL_CSV_INLINE bool plain_value(const PlainNumber& n, const char* b, const char* e, char dec,
                                     bool compat, double& out) {
   if (compat) {
