@@ -62,6 +62,14 @@
 // keep the block boundaries (B lines per call), so a clean file gives
 // exactly GGIR's blocks and a damaged one GGIR's blocks minus the damage.
 // Empty fields and "NA" (NA in fread) make a line non-numeric here.
+//
+// Speed: a line whose fields are all plain numbers ([+-]digits[.digits],
+// up to 18 digits) or text the layout does not parse as a number (a time
+// stamp) is parsed where it lies in the read buffer, with 3-decimal values
+// looked up (read_plain_as); any other line, damaged or unusual, goes
+// through take_line() and the general parser. Both give the same samples,
+// counters and notes (option fast = 0 takes every line through
+// take_line(); tests/cpp/test_csv and the fuzzer compare the two).
 #ifndef GRAVCAL_DECODE_CSV_HPP
 #define GRAVCAL_DECODE_CSV_HPP
 
@@ -90,11 +98,14 @@ class CsvDecoder : public Decoder {
 
   // `format`: "actigraph_csv" (the ActiLife header is required) or "csv"
   // (either kind). Options: compat (1: fread/GGIR, 0: the format), sf;
-  // buffer (bytes of the read buffer, default 1 MiB; for tests and fuzzers).
+  // buffer (bytes of the read buffer, default 1 MiB) and fast (0: every
+  // line through take_line(), none parsed in place; the same samples) for
+  // tests and fuzzers.
   CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
       : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
     compat_ = opts.num("compat", 1) != 0;
     sf_option_ = opts.num("sf", 0);
+    fast_ = opts.num("fast", 1) != 0;
   }
 
   bool open() override {
@@ -111,6 +122,7 @@ class CsvDecoder : public Decoder {
     if (!ok) return false;
     info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
     info_.has_temperature = col_temp_ >= 0;
+    learn_roles();
     opened_ = true;
     done_ = lines_.exhausted();
     return true;
@@ -121,6 +133,12 @@ class CsvDecoder : public Decoder {
     std::int64_t used = 0;
     csv_text::Line ln;
     while ((max_units < 0 || used < max_units) && !out.full()) {
+      // the lines of the common shape where they lie, then one line of
+      // another shape (or one that needs more input) line by line
+      if (plain_) {
+        used += read_plain(out, max_units < 0 ? -1 : max_units - used);
+        if ((max_units >= 0 && used >= max_units) || out.full()) break;
+      }
       if (!lines_.next(ln)) break;
       ++used;
       ++report_.units;
@@ -456,6 +474,146 @@ class CsvDecoder : public Decoder {
 
   // ---- data lines -----------------------------------------------------------
 
+  // What each field of a data line is for.
+  enum Role : unsigned char { kSkip, kX, kY, kZ, kTemp, kTime };
+
+  // The role of each field; lines are parsed in place when every field has
+  // one column at most (plain_ = 2 when the fields are x, y, z and no
+  // more, the commonest layout, which has a loop of its own).
+  void learn_roles() {
+    plain_ = 0;
+    if (!fast_ || nfields_ < 3 || nfields_ > kMaxFields) return;
+    std::fill(role_, role_ + kMaxFields, kSkip);
+    const int cols[5] = {col_x_, col_y_, col_z_, col_temp_, col_time_};
+    const Role roles[5] = {kX, kY, kZ, kTemp, kTime};
+    for (int i = 0; i < 5; ++i) {
+      if (cols[i] < 0) continue;
+      if (cols[i] >= nfields_ || role_[cols[i]] != kSkip) return;
+      role_[cols[i]] = roles[i];
+    }
+    if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return;
+    plain_ = nfields_ == 3 && role_[0] == kX && role_[1] == kY && role_[2] == kZ ? 2 : 1;
+    thousandths_ = csv_text::thousandths(compat_);
+  }
+
+  std::int64_t read_plain(SampleBuffer& out, std::int64_t max_lines) {
+    return plain_ == 2 ? read_plain_as<true>(out, max_lines) : read_plain_as<false>(out, max_lines);
+  }
+
+  // Lines parsed where they lie in the read buffer, up to the first that
+  // is not of the common shape (or `max_lines`, or a full `out`); returns
+  // the lines taken. Each gives what take_line() gives for it.
+  template <bool kXyz>
+  std::int64_t read_plain_as(SampleBuffer& out, std::int64_t max_lines) {
+    const char* p0;
+    const std::size_t n = lines_.whole_lines(p0);
+    if (n == 0) return 0;
+    const char* const end = p0 + n;
+    const std::size_t first = out.n;
+    const std::size_t most = max_lines >= 0 && static_cast<std::size_t>(max_lines) < out.room()
+                                 ? static_cast<std::size_t>(max_lines) : out.room();
+    const std::size_t last = first + most;
+    const std::int64_t line0 = lines_.line_number(), offset0 = lines_.offset();
+    double* const x = out.x;
+    double* const y = out.y;
+    double* const z = out.z;
+    double* const temp = out.t;
+    double* const time = out.time;
+    const char* q = p0;
+    std::size_t i = first;
+    for (; i < last && q < end; ++i) {
+      double v[kTime];  // by role
+      csv_text::Field tf{q, q};
+      const char* nl = kXyz ? xyz_fields(q, v) : plain_fields(q, v, tf);
+      if (nl == nullptr) break;
+      double t = 0;
+      if (!kXyz && col_time_ >= 0) {
+        csv_text::Line ln;
+        ln.number = line0 + static_cast<std::int64_t>(i - first) + 1;
+        ln.offset = offset0 + (q - p0);
+        t = stamp_time(tf, ln);
+      } else if (time != nullptr) {
+        t = info_.start_time + static_cast<double>(index_ + static_cast<std::int64_t>(i - first)) / info_.sf;
+      }
+      x[i] = v[kX];
+      y[i] = v[kY];
+      z[i] = v[kZ];
+      if (temp != nullptr) temp[i] = kXyz ? std::numeric_limits<double>::quiet_NaN() : v[kTemp];
+      if (time != nullptr) time[i] = t;
+      q = nl + 1;
+    }
+    const std::int64_t k = static_cast<std::int64_t>(i - first);
+    out.n = i;
+    lines_.consume(static_cast<std::size_t>(q - p0), k);
+    report_.units += k;
+    report_.samples += k;
+    index_ += k;
+    return k;
+  }
+
+  // The value of the plain number (csv_text::scan_plain_number) at p when
+  // the byte after it is `a` or `b` (the field ends there); returns that
+  // byte's address, or nullptr.
+  GRAVCAL_CSV_INLINE const char* plain_number(const char* p, char a, char b, double& v) const {
+    csv_text::PlainNumber pn;
+    const char* e = csv_text::scan_plain_number(p, dec_, pn);
+    if (e == nullptr || (*e != a && *e != b)) return nullptr;
+    if (pn.frac == 3 && pn.acc < csv_text::kThousandths) {
+      // a look-up instead of a long double product or a division; the sign
+      // by a product with -1: exact, and -(+0) is -0, as above
+      static constexpr double kSign[2] = {1.0, -1.0};
+      v = thousandths_[pn.acc] * kSign[pn.neg];
+      return e;
+    }
+    return csv_text::plain_value(pn, p, e, dec_, compat_, v) ? e : nullptr;
+  }
+
+  // The fields of the data line at q (whole, ending in '\n') when they are
+  // all of the common shape: every value a plain number that fills its
+  // field, nfields_ fields. Puts the values in v (by role) and the time
+  // field in tf, and returns the line's '\n'; nullptr for any other line
+  // (take_line() decides).
+  const char* plain_fields(const char* q, double* v, csv_text::Field& tf) const {
+    v[kTemp] = std::numeric_limits<double>::quiet_NaN();
+    const char* p = q;
+    for (int i = 0; i < nfields_; ++i) {
+      const Role r = static_cast<Role>(role_[i]);
+      const bool last = i + 1 == nfields_;
+      if (r == kSkip || r == kTime) {
+        const char* fe = csv_text::field_end(p, sep_);
+        if (r == kTime) tf = csv_text::Field{p, fe};
+        p = fe;
+      } else {
+        p = last ? plain_number(p, '\n', '\r', v[r]) : plain_number(p, sep_, sep_, v[r]);
+        if (p == nullptr) return nullptr;
+      }
+      if (!last) {
+        if (*p != sep_) return nullptr;
+        ++p;
+      }
+    }
+    if (*p == '\r') {
+      ++p;
+    } else if (role_[nfields_ - 1] == kTime && p[-1] == '\r') {
+      tf.e = p - 1;  // CRLF: the line ends before the '\r'
+    }
+    if (*p != '\n') return nullptr;
+    if (col_time_ >= 0) tf = csv_text::field_of(tf.b, tf.e);
+    return p;
+  }
+
+  // The same for the fields x, y, z.
+  GRAVCAL_CSV_INLINE const char* xyz_fields(const char* q, double* v) const {
+    const char* p = plain_number(q, sep_, sep_, v[kX]);
+    if (p == nullptr) return nullptr;
+    p = plain_number(p + 1, sep_, sep_, v[kY]);
+    if (p == nullptr) return nullptr;
+    p = plain_number(p + 1, '\n', '\r', v[kZ]);
+    if (p == nullptr) return nullptr;
+    if (*p == '\r') ++p;
+    return *p == '\n' ? p : nullptr;
+  }
+
   void skip_line(const csv_text::Line& ln, const char* kind, const char* what) {
     ++report_.skipped;
     const char* counter = kind;
@@ -526,21 +684,35 @@ class CsvDecoder : public Decoder {
 
   void check_step(double dt, double res, const csv_text::Line& ln) {
     if (dt > kGapSteps * step_ + res) {
-      ++report_.gaps;
-      report_.gap_seconds += dt - step_;
-      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
-                   "): time jumps " + std::to_string(dt) + " s");
+      gap(dt, ln);
     } else if (dt < -(step_ / 2 + res)) {
-      report_.count("time_backwards");
-      report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
-                   "): time goes back " + std::to_string(-dt) + " s");
+      backwards(dt, ln);
     }
+  }
+  // (the rare cases out of line: check_step() stays small enough to inline)
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  void gap(double dt, const csv_text::Line& ln) {
+    ++report_.gaps;
+    report_.gap_seconds += dt - step_;
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                 "): time jumps " + std::to_string(dt) + " s");
+  }
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  void backwards(double dt, const csv_text::Line& ln) {
+    report_.count("time_backwards");
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
+                 "): time goes back " + std::to_string(-dt) + " s");
   }
 
   csv_text::LineReader lines_;
   csv_text::DateTimeParser dt_;
   bool want_actigraph_;
   bool compat_ = true;
+  bool fast_ = true;
   double sf_option_ = 0;
   bool opened_ = false, done_ = false;
   // header
@@ -552,6 +724,9 @@ class CsvDecoder : public Decoder {
   int col_x_ = -1, col_y_ = -1, col_z_ = -1, col_time_ = -1, col_temp_ = -1;
   bool time_text_ = true;
   double step_ = 0;
+  const double* thousandths_ = nullptr;  // csv_text::thousandths(compat_)
+  unsigned char role_[kMaxFields] = {};  // a Role for each field
+  int plain_ = 0;  // lines parsed in place: 0 no, 1 yes, 2 yes and they are x, y, z
   // position
   std::int64_t index_ = 0;  // data lines consumed
   double last_time_ = std::numeric_limits<double>::quiet_NaN();

@@ -25,6 +25,13 @@
 
 #include "gravcal/decode.hpp"
 
+// Inlined into the loop over a line's fields (GCC's heuristics would not).
+#if defined(__GNUC__) || defined(__clang__)
+#define GRAVCAL_CSV_INLINE inline __attribute__((always_inline))
+#else
+#define GRAVCAL_CSV_INLINE inline
+#endif
+
 namespace gravcal {
 namespace csv_text {
 
@@ -61,6 +68,61 @@ constexpr long double kPow10Near[2 * kNearExponent + 1] = {
 
 inline bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
+// The value of the byte as a digit; above 9 when it is not one.
+inline unsigned digit_of(char c) { return static_cast<unsigned>(static_cast<unsigned char>(c)) - '0'; }
+
+// kPow10Near by sign, [1] the negative powers: a negative number's value
+// is its digits times a negative power, with no branch on the sign (which
+// varies from number to number). Rounding to nearest is symmetric, so
+// round(acc * -p) is -round(acc * p), and 0 * -p is -0.
+struct Pow10BySign {
+  long double v[2][2 * kNearExponent + 1];
+};
+constexpr Pow10BySign pow10_by_sign() {
+  Pow10BySign t{};
+  for (int i = 0; i < 2 * kNearExponent + 1; ++i) {
+    t.v[0][i] = kPow10Near[i];
+    t.v[1][i] = -kPow10Near[i];
+  }
+  return t;
+}
+constexpr Pow10BySign kPow10Signed = pow10_by_sign();
+
+// 10^e in long double for kNearExponent < |e| <= kMaxExponent (out of line:
+// rare, and it keeps fread_value small enough to inline).
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+inline long double pow10_far(int e) {
+  return pow10_table()[e + kMaxExponent];
+}
+
+// fread 1.14.8's value of (-)acc * 10^exp10, for acc < 10^18 and |exp10| <=
+// kMaxExponent: acc and the power of ten in long double, their product
+// rounded to double (fread negates the product; the same value, above).
+GRAVCAL_CSV_INLINE double fread_value(std::uint64_t acc, int exp10, bool neg) {
+  const long double p10 = (exp10 >= -kNearExponent && exp10 <= kNearExponent)
+                              ? kPow10Signed.v[neg][exp10 + kNearExponent]
+                              : (neg ? -pow10_far(exp10) : pow10_far(exp10));
+  // acc < 10^18 < 2^63: a signed conversion, exact in long double
+  return static_cast<double>(static_cast<long double>(static_cast<std::int64_t>(acc)) * p10);
+}
+
+// The correctly rounded value of (-)acc * 10^exp10 when one IEEE operation
+// on exact operands gives it (Clinger's fast path: acc < 2^53, |exp10| <=
+// 22); false otherwise. The sign rides on the power, as above.
+constexpr double kExactSigned[2][23] = {
+    {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22},
+    {-1e0, -1e1, -1e2, -1e3, -1e4, -1e5, -1e6, -1e7, -1e8, -1e9, -1e10, -1e11,
+     -1e12, -1e13, -1e14, -1e15, -1e16, -1e17, -1e18, -1e19, -1e20, -1e21, -1e22}};
+GRAVCAL_CSV_INLINE bool exact_value(std::uint64_t acc, int exp10, bool neg, double& out) {
+  if (acc >= (std::uint64_t(1) << 53) || exp10 < -22 || exp10 > 22) return false;
+  const double a = static_cast<double>(acc);
+  out = exp10 < 0 ? a / kExactSigned[neg][-exp10] : a * kExactSigned[neg][exp10];
+  return true;
+}
+
 // A number in [b, e): [+-]digits[<dec>digits][(e|E)[+-]digits], the whole
 // field. compat: fread 1.14.8's value; else the correctly rounded one.
 inline bool parse_number(const char* b, const char* e, char dec, bool compat, double& out) {
@@ -74,7 +136,7 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
   bool any = false;
   while (p < e && *p == '0') { ++p; any = true; }
   for (; p < e; ++p) {
-    const unsigned d = static_cast<unsigned>(static_cast<unsigned char>(*p) - '0');
+    const unsigned d = digit_of(*p);
     if (d > 9) break;
     any = true;
     if (left > 0) { acc = acc * 10 + d; --left; }
@@ -88,7 +150,7 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
       while (p < e && *p == '0') { ++p; --exp10; any = true; }
     }
     for (; p < e; ++p) {
-      const unsigned d = static_cast<unsigned>(static_cast<unsigned char>(*p) - '0');
+      const unsigned d = digit_of(*p);
       if (d > 9) break;
       any = true;
       if (left > 0) { acc = acc * 10 + d; --left; --exp10; }
@@ -108,25 +170,12 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
   if (p != e) return false;
   if (exp10 < -kMaxExponent || exp10 > kMaxExponent) return false;
   if (compat) {
-    // acc < 10^18 < 2^63: a signed conversion, exact in long double
-    const long double p10 = (exp10 >= -kNearExponent && exp10 <= kNearExponent)
-                                ? kPow10Near[exp10 + kNearExponent]
-                                : pow10_table()[exp10 + kMaxExponent];
-    const long double r = static_cast<long double>(static_cast<std::int64_t>(acc)) * p10;
-    out = static_cast<double>(neg ? -r : r);
+    out = fread_value(acc, exp10, neg);
     return true;
   }
-  // correctly rounded: one IEEE operation on exact operands when the digits
-  // fit in 53 bits and the power of ten is exact (Clinger's fast path)...
-  static const double exact[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                   1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                   1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-  if (acc < (std::uint64_t(1) << 53) && left > 0 && exp10 >= -22 && exp10 <= 22) {
-    const double a = static_cast<double>(acc);
-    const double v = exp10 < 0 ? a / exact[-exp10] : a * exact[exp10];
-    out = neg ? -v : v;
-    return true;
-  }
+  // correctly rounded: one IEEE operation when it is exact (the first
+  // digit kept is not 0, so acc < 2^53 means fewer than 18 digits kept)...
+  if (exact_value(acc, exp10, neg, out)) return true;
   // ...else from_chars, which wants '.' and no '+'
   char tmp[128];
   const std::size_t n = static_cast<std::size_t>(e - start);
@@ -143,6 +192,123 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
   return true;
 }
 
+// The shape nearly every number in a csv of samples has: [+-]digits
+// [<dec>digits], 1 to kMaxSigDigits digits in all (leading zeros counted),
+// so that parse_number keeps every digit: its acc is the digits read as one
+// integer and its exp10 minus the count of digits after `dec`.
+struct PlainNumber {
+  std::uint64_t acc = 0;
+  int frac = 0;  // digits after `dec`: exp10 is -frac
+  bool neg = false;
+};
+
+// Reads a number of that shape at p and returns the byte after it, or
+// nullptr when the text at p has another shape (then parse_number decides).
+// The text must go on to a byte that is neither a digit nor `dec` (a line
+// end): the scan stops there at the latest. Whether the number ends its
+// field (the byte after it) is the caller's to check. Byte by byte, with
+// branches: a number's length is predicted, so the next field's start does
+// not wait for this one's bytes (a word-at-a-time scan that computed the
+// length would).
+GRAVCAL_CSV_INLINE const char* scan_plain_number(const char* p, char dec, PlainNumber& n) {
+  n.neg = false;
+  if (*p == '-') {
+    n.neg = true;
+    ++p;
+  } else if (*p == '+') {
+    ++p;
+  }
+  const char* const first = p;
+  std::uint64_t acc = 0;
+  for (unsigned d; (d = digit_of(*p)) <= 9; ++p) acc = acc * 10 + d;
+  std::ptrdiff_t count = p - first, frac = 0;
+  if (*p == dec) {
+    const char* const f = ++p;
+    for (unsigned d; (d = digit_of(*p)) <= 9; ++p) acc = acc * 10 + d;
+    frac = p - f;
+    count += frac;
+  }
+  // (acc wraps past 19 digits, but such a number is not taken)
+  if (count < 1 || count > kMaxSigDigits) return nullptr;
+  n.acc = acc;
+  n.frac = static_cast<int>(frac);
+  return p;
+}
+
+// The value parse_number gives for [b, e), the text scan_plain_number read
+// as `n` (every digit kept, exp10 = -frac): fread_value() or exact_value(),
+// as parse_number computes it, else parse_number itself.
+GRAVCAL_CSV_INLINE bool plain_value(const PlainNumber& n, const char* b, const char* e, char dec,
+                                    bool compat, double& out) {
+  if (compat) {
+    out = fread_value(n.acc, -n.frac, n.neg);
+    return true;
+  }
+  if (exact_value(n.acc, -n.frac, n.neg, out)) return true;
+  return parse_number(b, e, dec, false, out);
+}
+
+// 8 bytes at p as a word, byte 0 lowest (one load on a little-endian
+// machine).
+inline std::uint64_t load_le64(const char* p) {
+  const unsigned char* b = reinterpret_cast<const unsigned char*>(p);
+  return static_cast<std::uint64_t>(b[0]) | static_cast<std::uint64_t>(b[1]) << 8 |
+         static_cast<std::uint64_t>(b[2]) << 16 | static_cast<std::uint64_t>(b[3]) << 24 |
+         static_cast<std::uint64_t>(b[4]) << 32 | static_cast<std::uint64_t>(b[5]) << 40 |
+         static_cast<std::uint64_t>(b[6]) << 48 | static_cast<std::uint64_t>(b[7]) << 56;
+}
+
+// The top bit of every byte of x that is 0, no other bit.
+inline std::uint64_t zero_bytes(std::uint64_t x) {
+  const std::uint64_t low7 = 0x7F7F7F7F7F7F7F7FULL;
+  return ~(((x & low7) + low7) | x | low7);
+}
+
+// The index of the lowest byte flagged in m (top bits only, at least one).
+inline int first_flagged(std::uint64_t m) {
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctzll(m) >> 3;
+#else
+  int k = 0;
+  for (; (m & 0x80) == 0; m >>= 8) ++k;
+  return k;
+#endif
+}
+
+// The first byte at or after p that is `sep` or '\n', one of which lies
+// ahead; 8 bytes at a time, so it may read up to 7 bytes past it (the
+// LineReader's kPad).
+GRAVCAL_CSV_INLINE const char* field_end(const char* p, char sep) {
+  const std::uint64_t ones = 0x0101010101010101ULL;
+  const std::uint64_t s = ones * static_cast<unsigned char>(sep), nl = ones * '\n';
+  for (;; p += 8) {
+    const std::uint64_t w = load_le64(p);
+    const std::uint64_t m = zero_bytes(w ^ s) | zero_bytes(w ^ nl);
+    if (m != 0) return p + first_flagged(m);
+  }
+}
+
+// The values of the numbers with 3 decimals and fewer than 5 digits
+// (ActiLife's, to 16.383 g), by their digits: t[1234] is the value of
+// "1.234", fread's (compat) or correctly rounded. Computed once per
+// process, on first use, by fread_value / exact_value (128 KiB each).
+constexpr std::size_t kThousandths = 16384;
+inline std::vector<double> thousandths_values(bool compat) {
+  std::vector<double> t(kThousandths);
+  for (std::uint64_t k = 0; k < kThousandths; ++k) {
+    if (compat) t[k] = fread_value(k, -3, false);
+    else exact_value(k, -3, false, t[k]);  // (exact for every k here)
+  }
+  return t;
+}
+inline const double* thousandths(bool compat) {
+  if (compat) {
+    static const std::vector<double> t = thousandths_values(true);
+    return t.data();
+  }
+  static const std::vector<double> t = thousandths_values(false);
+  return t.data();
+}
 
 inline unsigned days_in_month(std::int64_t y, unsigned m) {
   static const unsigned k[12] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
@@ -193,8 +359,8 @@ inline bool parse_date(const char*& p, const char* e, DateOrder order, std::int6
   return true;
 }
 
-// HH:MM:SS[.fff...] as seconds; `frac_digits` tells the resolution.
-inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_digits) {
+// HH:MM:SS as whole seconds.
+inline bool parse_hms(const char*& p, const char* e, std::int64_t& whole) {
   std::int64_t h, m, s;
   int nd;
   if (!read_uint(p, e, 2, h, nd) || p >= e || *p != ':') return false;
@@ -203,54 +369,99 @@ inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_d
   ++p;
   if (!read_uint(p, e, 2, s, nd) || nd != 2) return false;
   if (h > 24 || m > 59 || s > 60) return false;
-  std::int64_t frac = 0;
+  whole = h * 3600 + m * 60 + s;
+  return true;
+}
+
+// What may follow the seconds: [.fff...] (or GENEActiv-like ":fff"), its
+// first 9 digits as an integer; frac_digits = 0 when there is none.
+inline bool parse_fraction(const char*& p, const char* e, std::int64_t& frac, int& frac_digits) {
+  frac = 0;
   frac_digits = 0;
-  if (p < e && (*p == '.' || *p == ':')) {  // GENEActiv-like ":fff" too
+  if (p < e && (*p == '.' || *p == ':')) {
     ++p;
     if (!read_uint(p, e, 9, frac, frac_digits)) return false;
     while (p < e && is_digit(*p)) ++p;
   }
+  return true;
+}
+
+inline double clock_seconds(std::int64_t whole, std::int64_t frac, int frac_digits) {
   static const double scale[10] = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
-  secs = static_cast<double>(h * 3600 + m * 60 + s) + static_cast<double>(frac) / scale[frac_digits];
+  return static_cast<double>(whole) + static_cast<double>(frac) / scale[frac_digits];
+}
+
+// HH:MM:SS[.fff...] as seconds; `frac_digits` tells the resolution.
+inline bool parse_clock(const char*& p, const char* e, double& secs, int& frac_digits) {
+  std::int64_t whole, frac;
+  if (!parse_hms(p, e, whole) || !parse_fraction(p, e, frac, frac_digits)) return false;
+  secs = clock_seconds(whole, frac, frac_digits);
   return true;
 }
 
 // Parses "<date>[ T]<clock>[Z]" into seconds since 1970 UTC (local times are
-// taken as UTC, as gravcal's R readers do). Keeps the last date's text, so
-// that a file of one date per day parses the date once a day.
+// taken as UTC, as gravcal's R readers do). Keeps the text of the last
+// date and of the last date and time to the whole second, so that a file
+// of one stamp per sample parses a date once a day and a time once a
+// second: a stamp that starts with the same text has the same value to
+// the second, whatever follows.
 class DateTimeParser {
  public:
   explicit DateTimeParser(DateOrder order = DateOrder::mdy) : order_(order) {}
-  void set_order(DateOrder o) { order_ = o; cached_len_ = 0; }
+  void set_order(DateOrder o) {
+    order_ = o;
+    cached_len_ = 0;
+    second_len_ = 0;
+  }
   bool parse(const char* b, const char* e, double& t, int& frac_digits) {
-    const char* sp = b;
-    while (sp < e && *sp != ' ' && *sp != 'T') ++sp;
-    if (sp == e || sp - b > kMaxDate) return false;
-    const std::size_t dl = static_cast<std::size_t>(sp - b);
-    if (dl != cached_len_ || std::memcmp(b, cached_, dl) != 0) {
-      const char* p = b;
-      std::int64_t days;
-      if (!parse_date(p, sp, order_, days) || p != sp) return false;
-      std::memcpy(cached_, b, dl);
-      cached_len_ = dl;
-      cached_days_ = days;
+    const std::size_t n = static_cast<std::size_t>(e - b);
+    const char* p;
+    std::int64_t days, whole;
+    if (second_len_ > 0 && n >= second_len_ && std::memcmp(b, second_, second_len_) == 0) {
+      p = b + second_len_;
+      days = second_days_;
+      whole = second_whole_;
+    } else {
+      const char* sp = b;
+      while (sp < e && *sp != ' ' && *sp != 'T') ++sp;
+      if (sp == e || sp - b > kMaxDate) return false;
+      const std::size_t dl = static_cast<std::size_t>(sp - b);
+      if (dl != cached_len_ || std::memcmp(b, cached_, dl) != 0) {
+        p = b;
+        if (!parse_date(p, sp, order_, days) || p != sp) return false;
+        std::memcpy(cached_, b, dl);
+        cached_len_ = dl;
+        cached_days_ = days;
+      }
+      days = cached_days_;
+      p = sp + 1;
+      while (p < e && *p == ' ') ++p;
+      if (!parse_hms(p, e, whole)) return false;
+      if (p - b <= kMaxSecond) {
+        second_len_ = static_cast<std::size_t>(p - b);
+        std::memcpy(second_, b, second_len_);
+        second_days_ = days;
+        second_whole_ = whole;
+      }
     }
-    const char* p = sp + 1;
-    while (p < e && *p == ' ') ++p;
-    double secs;
-    if (!parse_clock(p, e, secs, frac_digits)) return false;
+    std::int64_t frac;
+    if (!parse_fraction(p, e, frac, frac_digits)) return false;
     if (p < e && *p == 'Z') ++p;
     if (p != e) return false;
-    t = static_cast<double>(cached_days_ * 86400) + secs;
+    t = static_cast<double>(days * 86400) + clock_seconds(whole, frac, frac_digits);
     return true;
   }
 
  private:
   static constexpr int kMaxDate = 24;
+  static constexpr int kMaxSecond = 48;
   DateOrder order_;
   char cached_[kMaxDate];
   std::size_t cached_len_ = 0;
   std::int64_t cached_days_ = 0;
+  char second_[kMaxSecond];  // the text of a date and time to the second
+  std::size_t second_len_ = 0;
+  std::int64_t second_days_ = 0, second_whole_ = 0;
 };
 
 // One line of the input (without its line end), where it was, and how it
@@ -272,11 +483,13 @@ class LineReader {
   static constexpr std::size_t kBuffer = std::size_t(1) << 20;
   static constexpr std::size_t kMaxLine = 65536;
   static constexpr std::size_t kMinBuffer = 64;
+  // bytes readable after the buffered ones (a word read at the last byte)
+  static constexpr std::size_t kPad = 8;
   // `buffer` bytes (tests and fuzzers use small ones to cross refills
   // often); lines longer than half of a smaller buffer count as overlong.
   explicit LineReader(ByteSource& src, std::size_t buffer = kBuffer)
-      : src_(src), buf_(std::max(kMinBuffer, std::min(buffer, kBuffer))),
-        max_line_(std::min(kMaxLine, buf_.size() / 2)) {}
+      : src_(src), cap_(std::max(kMinBuffer, std::min(buffer, kBuffer))), buf_(cap_ + kPad),
+        max_line_(std::min(kMaxLine, cap_ / 2)) {}
 
   bool next(Line& ln) {
     for (;;) {
@@ -313,16 +526,30 @@ class LineReader {
       if (!fill()) return true;
     }
   }
+  // The unread bytes buffered up to and with the last '\n': whole lines, to
+  // be parsed where they lie (none while inside an overlong line), with
+  // kPad readable bytes after them. What next() gives of them is these
+  // lines one by one.
+  std::size_t whole_lines(const char*& p) const {
+    p = buf_.data() + beg_;
+    return skipping_ || whole_end_ <= beg_ ? 0 : whole_end_ - beg_;
+  }
+  // Moves past `bytes` bytes of whole_lines(), the first `lines` lines.
+  void consume(std::size_t bytes, std::int64_t lines) {
+    beg_ += bytes;
+    offset_ += static_cast<std::int64_t>(bytes);
+    line_ += lines;
+  }
   // The bytes buffered ahead (for looking at the first data lines).
   void peek(const char*& p, std::size_t& n) {
-    if (!eof_ && end_ - beg_ < buf_.size() / 2) fill();
+    if (!eof_ && end_ - beg_ < cap_ / 2) fill();
     p = buf_.data() + beg_;
     n = end_ - beg_;
   }
   // Starts again at byte `pos` of the source (whose line number is `line`).
   bool rewind(std::int64_t pos, std::int64_t line) {
     if (!src_.seek(pos)) return false;
-    beg_ = end_ = 0;
+    beg_ = end_ = whole_end_ = 0;
     eof_ = skipping_ = false;
     offset_ = pos;
     line_ = line;
@@ -361,21 +588,27 @@ class LineReader {
     if (beg_ > 0) {
       std::memmove(buf_.data(), buf_.data() + beg_, end_ - beg_);
       end_ -= beg_;
+      whole_end_ = whole_end_ > beg_ ? whole_end_ - beg_ : 0;
       beg_ = 0;
     }
-    if (end_ == buf_.size()) return true;
+    if (end_ == cap_) return true;
     const std::size_t got = read_full(src_, reinterpret_cast<unsigned char*>(buf_.data() + end_),
-                                      buf_.size() - end_);
+                                      cap_ - end_);
+    for (std::size_t i = end_ + got; i > end_; --i) {
+      if (buf_[i - 1] == '\n') { whole_end_ = i; break; }
+    }
     end_ += got;
-    if (end_ < buf_.size()) eof_ = true;
+    if (end_ < cap_) eof_ = true;
     return got > 0;
   }
 
   ByteSource& src_;
-  std::vector<char> buf_;
+  std::size_t cap_;        // bytes the buffer holds
+  std::vector<char> buf_;  // cap_ bytes and kPad more, never read into
   std::size_t max_line_;
   std::size_t beg_ = 0, end_ = 0;
-  std::int64_t offset_ = 0;  // source offset of buf_[beg_]
+  std::size_t whole_end_ = 0;  // one past the last '\n' in buf_[0, end_), else 0
+  std::int64_t offset_ = 0;    // source offset of buf_[beg_]
   std::int64_t line_ = 0;    // lines given so far
   bool eof_ = false;
   bool skipping_ = false;  // inside an overlong line
@@ -398,6 +631,15 @@ inline void trim(const char*& b, const char*& e) {
   }
 }
 
+// The field [b, e) of a line, trimmed.
+inline Field field_of(const char* b, const char* e) {
+  if (b < e && (*b == ' ' || *b == '\t' || *b == '"' || e[-1] == ' ' || e[-1] == '\t' ||
+                e[-1] == '"')) {
+    trim(b, e);
+  }
+  return Field{b, e};
+}
+
 // Splits [p, p + n) at `sep` into at most max_fields fields; returns the
 // number of fields the line has (which may be more than max_fields).
 inline int split(const char* p, std::size_t n, char sep, Field* f, int max_fields) {
@@ -407,15 +649,7 @@ inline int split(const char* p, std::size_t n, char sep, Field* f, int max_field
   for (;;) {
     const char* fe = b;
     while (fe < e && *fe != sep) ++fe;  // fields are short: no memchr call
-    if (k < max_fields) {
-      const char* tb = b;
-      const char* te = fe;
-      if (tb < te && (*tb == ' ' || *tb == '\t' || *tb == '"' || te[-1] == ' ' ||
-                      te[-1] == '\t' || te[-1] == '"')) {
-        trim(tb, te);
-      }
-      f[k] = Field{tb, te};
-    }
+    if (k < max_fields) f[k] = field_of(b, fe);
     ++k;
     if (fe == e) break;
     b = fe + 1;

@@ -1,0 +1,413 @@
+// Standalone tests of the csv decoder's numbers and of its lines parsed in
+// place (decode_csv_text.hpp, decode_csv.hpp), built without R:
+//   make -C tests/cpp
+// * parse_number (compat = 1) against fread 1.14.8's rule written out here
+//   on its own: the digits as an integer (at most 18 kept), times 10^e in
+//   long double (the literal's value, as strtold gives it), rounded to
+//   double, the sign applied to the long double product;
+// * parse_number (compat = 0) against std::from_chars (correctly rounded);
+// * the plain shape (scan_plain_number + plain_value) against parse_number,
+//   every number of up to 6 digits and random longer ones;
+// * the date-time parser that keeps the last date and second against a
+//   fresh one for each stamp;
+// * a decoder reading lines in place against one reading every line through
+//   the general parser (option fast = 0), bit for bit, on files of several
+//   layouts, with damage, CRLF and small buffers.
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gravcal/decode_csv.hpp"
+
+namespace csv = gravcal::csv_text;
+
+static int failures = 0;
+static long checked = 0;
+#define CHECK(cond, what)                                                      \
+  do {                                                                         \
+    ++checked;                                                                 \
+    if (!(cond)) {                                                             \
+      if (failures < 20) std::printf("FAIL %s:%d: %s (%s)\n", __FILE__, __LINE__, #cond, \
+                                     std::string(what).c_str());               \
+      ++failures;                                                              \
+    }                                                                          \
+  } while (0)
+
+static bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// fread 1.14.8's value of s ([+-]digits[.digits][(e|E)[+-]digits], the
+// whole text), written from its description: leading zeros skipped, at
+// most 18 digits kept (a longer integer needs a point or an exponent), at
+// most 3 exponent digits, the product of the kept digits and 10^e in long
+// double, rounded to double, the sign applied to the long double product.
+// NaN when it is not a number (|e| <= 300 here, where fread multiplies once).
+static double fread_rule(const std::string& s) {
+  std::size_t i = 0;
+  const bool neg = i < s.size() && s[i] == '-';
+  if (i < s.size() && (s[i] == '-' || s[i] == '+')) ++i;
+  std::string digits;
+  int e = 0;
+  bool any = false, point = false, lead = true;
+  for (; i < s.size() && s[i] != 'e' && s[i] != 'E'; ++i) {
+    const char c = s[i];
+    if (c == '.' && !point) { point = true; continue; }
+    if (c < '0' || c > '9') return NAN;
+    any = true;
+    if (lead && c == '0') {
+      if (point) --e;
+      continue;
+    }
+    lead = false;
+    if (digits.size() < 18) {
+      digits += c;
+      if (point) --e;
+    } else if (!point) {
+      ++e;
+    }
+  }
+  if (!any || (e > 0 && !point && i == s.size())) return NAN;
+  if (i < s.size()) {  // the exponent
+    ++i;
+    const bool eneg = i < s.size() && s[i] == '-';
+    if (i < s.size() && (s[i] == '-' || s[i] == '+')) ++i;
+    const std::size_t from = i;
+    int x = 0;
+    for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) x = x * 10 + (s[i] - '0');
+    if (i == from || i - from > 3 || i != s.size()) return NAN;
+    e += eneg ? -x : x;
+  }
+  const long double acc = digits.empty() ? 0.0L : std::strtold(digits.c_str(), nullptr);
+  const long double p10 = std::strtold(("1e" + std::to_string(e)).c_str(), nullptr);
+  const long double r = acc * p10;
+  return static_cast<double>(neg ? -r : r);
+}
+
+static double correctly_rounded(const std::string& s) {
+  std::size_t i = 0;
+  const bool neg = !s.empty() && s[0] == '-';
+  if (!s.empty() && (s[0] == '-' || s[0] == '+')) i = 1;
+  double v = NAN;
+  const auto r = std::from_chars(s.data() + i, s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return NAN;
+  return neg ? -v : v;
+}
+
+static bool parse(const std::string& s, bool compat, double& v) {
+  return csv::parse_number(s.data(), s.data() + s.size(), '.', compat, v);
+}
+
+// The plain shape on s (followed by a line end); false when not taken.
+static bool plain(const std::string& s, bool compat, double& v) {
+  const std::string t = s + "\n";
+  csv::PlainNumber n;
+  const char* e = csv::scan_plain_number(t.data(), '.', n);
+  if (e == nullptr || e != t.data() + s.size()) return false;
+  return csv::plain_value(n, t.data(), e, '.', compat, v);
+}
+
+// What is a number is fread's in both modes; its value fread's (compat = 1)
+// or the correctly rounded one (compat = 0).
+static void check_number(const std::string& s) {
+  const double fr = fread_rule(s);
+  for (int compat = 0; compat <= 1; ++compat) {
+    double v = 0;
+    const bool ok = parse(s, compat != 0, v);
+    CHECK(ok == !std::isnan(fr), s);
+    if (ok) {
+      CHECK(same_bits(v, compat ? fr : correctly_rounded(s)),
+            s + (compat ? " (compat 1)" : " (compat 0)"));
+    }
+    double w = 0;
+    if (plain(s, compat != 0, w)) CHECK(ok && same_bits(v, w), s + " (plain shape)");
+  }
+}
+
+// Every number of the plain shape with up to `nd` digits around the point,
+// with and without a sign.
+static void test_short_numbers(int nd) {
+  char buf[32];
+  for (int digits = 1; digits <= nd; ++digits) {
+    long top = 1;
+    for (int k = 0; k < digits; ++k) top *= 10;
+    for (int point = 0; point <= digits; ++point) {
+      for (long m = 0; m < top; ++m) {
+        std::snprintf(buf, sizeof buf, "%0*ld", digits, m);
+        std::string s(buf);
+        if (point < digits) s.insert(static_cast<std::size_t>(point), ".");
+        check_number(s);
+        check_number("-" + s);
+        if (m % 7 == 0) check_number("+" + s);
+      }
+    }
+  }
+}
+
+// Random numbers of 7 to 21 digits (15 to 19 significant are fread's and
+// the fast path's edges), and values next to rounding boundaries: the
+// shortest decimal of a double and of its neighbours, with a digit added.
+static void test_long_numbers(std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> nd(7, 21), pos(0, 21), dig(0, 9), coin(0, 3);
+  for (int i = 0; i < 200000; ++i) {
+    const int n = nd(rng);
+    std::string s;
+    for (int k = 0; k < n; ++k) s += static_cast<char>('0' + dig(rng));
+    if (coin(rng) > 0) s.insert(static_cast<std::size_t>(pos(rng) % (n + 1)), ".");
+    if (coin(rng) == 0) s = "-" + s;
+    check_number(s);
+  }
+  std::uniform_real_distribution<double> u(-16, 16);
+  char buf[64];
+  for (int i = 0; i < 100000; ++i) {
+    const double x = u(rng);
+    for (double y : {x, std::nextafter(x, 100.0), std::nextafter(x, -100.0)}) {
+      for (int prec = 15; prec <= 19; ++prec) {
+        std::snprintf(buf, sizeof buf, "%.*f", prec, y);
+        check_number(buf);
+      }
+      std::snprintf(buf, sizeof buf, "%.3f5", y);  // halfway between 4-decimal values
+      check_number(buf);
+    }
+  }
+}
+
+// ---- time stamps: the parser's caches change no value ----------------------
+
+// A run of stamps such as files hold (and some they should not): each
+// parsed by one parser, which keeps the last date and second, and by a
+// fresh one; the same success and bits.
+static void test_stamps(std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> k(0, 99), sec(0, 61), ms(0, 999);
+  const std::vector<std::string> dates = {"5/11/2023", "5/12/2023", "12/31/2023", "1/1/2024",
+                                          "2023-05-11", "11/5/2023", "5/11/23", "2/30/2023"};
+  const std::vector<std::string> tails = {"", "Z", "1", " ", ".", ":5", ".0000000001", "x"};
+  for (csv::DateOrder order : {csv::DateOrder::mdy, csv::DateOrder::dmy}) {
+    csv::DateTimeParser kept(order);
+    std::string date = dates[0];
+    int hh = 9, mm = 0, ss = 0;
+    for (int i = 0; i < 200000; ++i) {
+      const int c = k(rng);
+      if (c == 0) date = dates[static_cast<std::size_t>(k(rng)) % dates.size()];
+      if (c == 1) ss = sec(rng);
+      if (c < 10) ss = (ss + 1) % 62;
+      if (c == 2) mm = (mm + 1) % 61;
+      if (c == 3) hh = (hh + 1) % 26;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s%02d:%02d:%02d", date.c_str(),
+                    c == 4 ? "T" : (c == 5 ? "  " : " "), hh, mm, ss);
+      std::string stamp = buf;
+      if (c < 90) {
+        std::snprintf(buf, sizeof buf, ".%0*d", 1 + c % 3, ms(rng) % (c % 3 == 0 ? 10 : 1000));
+        stamp += buf;
+      }
+      if (c >= 85) stamp += tails[static_cast<std::size_t>(c) % tails.size()];
+      if (c == 6) stamp = stamp.substr(0, stamp.size() - 2);
+      // now and then another date with an impossible time, then this stamp
+      // again (the parser has taken in the other date meanwhile)
+      std::vector<std::string> run = {stamp};
+      if (c == 7) run = {stamp, dates[(i / 7) % dates.size()] + " 25:00:00.000", stamp};
+      for (const std::string& st : run) {
+        double a = 0, b = 0;
+        int fa = -1, fb = -1;
+        csv::DateTimeParser fresh(order);
+        const bool oa = kept.parse(st.data(), st.data() + st.size(), a, fa);
+        const bool ob = fresh.parse(st.data(), st.data() + st.size(), b, fb);
+        CHECK(oa == ob, st);
+        if (oa && ob) CHECK(same_bits(a, b) && fa == fb, st);
+      }
+    }
+  }
+}
+
+// ---- whole files: in place against line by line ---------------------------
+
+struct Decoded {
+  bool opened = false;
+  std::string error;
+  std::vector<double> values;
+  std::vector<std::int64_t> blocks;
+  gravcal::Report report;
+};
+
+static Decoded decode(const std::string& text, const std::string& format, double compat,
+                      double fast, double buffer, std::size_t cap, std::int64_t units) {
+  Decoded d;
+  gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(text.data()), text.size());
+  gravcal::Options o;
+  o.set("compat", compat);
+  o.set("fast", fast);
+  o.set("buffer", buffer);
+  if (text.compare(0, 6, "x,y,z\n") == 0) o.set("sf", 30.0);  // no time column
+  gravcal::CsvDecoder dec(src, o, format);
+  d.opened = dec.open();
+  d.error = dec.error();
+  if (!d.opened) return d;
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  for (int calls = 0; calls < 1000000 && !dec.done(); ++calls) {
+    gravcal::SampleBuffer b;
+    b.x = x.data(); b.y = y.data(); b.z = z.data(); b.t = t.data(); b.time = tm.data();
+    b.capacity = cap;
+    const std::int64_t u = dec.read(b, units);
+    d.blocks.push_back(u);
+    d.blocks.push_back(static_cast<std::int64_t>(b.n));
+    for (std::size_t i = 0; i < b.n; ++i) {
+      for (double v : {x[i], y[i], z[i], t[i], tm[i]}) d.values.push_back(v);
+    }
+    if (u == 0 && b.n == 0) break;
+  }
+  d.report = dec.report();
+  return d;
+}
+
+static bool same(const Decoded& a, const Decoded& b) {
+  if (a.opened != b.opened || a.error != b.error || a.blocks != b.blocks) return false;
+  if (a.values.size() != b.values.size()) return false;
+  for (std::size_t i = 0; i < a.values.size(); ++i) {
+    if (!same_bits(a.values[i], b.values[i])) return false;
+  }
+  const gravcal::Report& r = a.report;
+  const gravcal::Report& s = b.report;
+  return r.units == s.units && r.samples == s.samples && r.skipped == s.skipped &&
+         r.gaps == s.gaps && same_bits(r.gap_seconds, s.gap_seconds) &&
+         r.truncated == s.truncated && r.counters == s.counters && r.notes == s.notes;
+}
+
+static std::string actigraph_header() {
+  return "------------ Data File Created By ActiGraph GT3X+ ActiLife v6.13.4 Firmware v3.2.1 "
+         "date format M/d/yyyy at 30 Hz  Filter Normal -----------\n"
+         "Serial Number: MOS2E00000000\nStart Time 10:00:00\nStart Date 5/11/2023\n"
+         "Epoch Period (hh:mm:ss) 00:00:00\nDownload Time 10:00:00\nDownload Date 5/12/2023\n"
+         "Current Memory Address: 0\nCurrent Battery Voltage: 4.20     Mode = 12\n"
+         "--------------------------------------------------\n";
+}
+
+// A number as a csv writer might give it: mostly 3 decimals, sometimes
+// more digits, a sign, an exponent or text.
+static std::string some_number(std::mt19937_64& rng) {
+  std::uniform_int_distribution<int> k(0, 99);
+  std::uniform_real_distribution<double> u(-8, 8);
+  char buf[64];
+  const int c = k(rng);
+  if (c < 70) std::snprintf(buf, sizeof buf, "%.3f", u(rng));
+  else if (c < 80) std::snprintf(buf, sizeof buf, "%.*f", 1 + c % 17, u(rng));
+  else if (c < 85) std::snprintf(buf, sizeof buf, "%+.4f", u(rng));
+  else if (c < 88) std::snprintf(buf, sizeof buf, "%.6e", u(rng));
+  else if (c < 90) std::snprintf(buf, sizeof buf, "%.17g", u(rng));
+  else if (c < 92) std::snprintf(buf, sizeof buf, "%d", c % 5);
+  else if (c < 93) std::snprintf(buf, sizeof buf, "-0.000");
+  else if (c < 94) std::snprintf(buf, sizeof buf, " %.3f", u(rng));
+  else if (c < 95) std::snprintf(buf, sizeof buf, "\"%.3f\"", u(rng));
+  else if (c < 96) std::snprintf(buf, sizeof buf, "NA");
+  else if (c < 97) std::snprintf(buf, sizeof buf, "%s", "");
+  else if (c < 98) std::snprintf(buf, sizeof buf, "1.5.2");
+  else std::snprintf(buf, sizeof buf, "%.3f\r", u(rng));
+  return buf;
+}
+
+static std::string some_line(std::mt19937_64& rng, const std::vector<std::string>& cols,
+                             char sep, int i) {
+  std::uniform_int_distribution<int> k(0, 199);
+  const int damage = k(rng);
+  std::string s;
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    if (c) s += sep;
+    if (cols[c] == "stamp") {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "5/11/2023 10:%02d:%02d.%03d", (i / 1800) % 60, (i / 30) % 60,
+                    (i % 30) * 33);
+      s += buf;
+    } else if (cols[c] == "time") {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.3f", 1683799200.0 + i / 30.0);
+      s += buf;
+    } else if (cols[c] == "iso") {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "2023-05-11T10:%02d:%02d.%03dZ", (i / 1800) % 60,
+                    (i / 30) % 60, (i % 30) * 33);
+      s += buf;
+    } else if (cols[c] == "steps") {
+      s += std::to_string(i % 3);
+    } else {
+      std::string v = some_number(rng);
+      if (sep == ';') {
+        for (char& ch : v) if (ch == '.') ch = ',';
+      }
+      s += v;
+    }
+  }
+  if (damage == 0) s = "";
+  if (damage == 1) s += sep;
+  if (damage == 2) s = s.substr(0, s.size() / 2);
+  if (damage == 3) s = "  ";
+  return s;
+}
+
+static void test_files(std::mt19937_64& rng) {
+  struct Layout {
+    std::string format, head;
+    std::vector<std::string> cols;
+    char sep;
+  };
+  const std::vector<Layout> layouts = {
+      {"actigraph_csv", "Accelerometer X,Accelerometer Y,Accelerometer Z\n", {"x", "y", "z"}, ','},
+      {"actigraph_csv", "", {"x", "y", "z"}, ','},
+      {"actigraph_csv", "Timestamp,Accelerometer X,Accelerometer Y,Accelerometer Z\n",
+       {"stamp", "x", "y", "z"}, ','},
+      {"actigraph_csv", "", {"iso", "x", "y", "z"}, ','},
+      {"actigraph_csv", "Axis1,Axis2,Axis3,Steps\n", {"x", "y", "z", "steps"}, ','},
+      {"csv", "x,y,z\n", {"x", "y", "z"}, ','},
+      {"csv", "time,x,y,z,temperature\n", {"time", "x", "y", "z", "temp"}, ','},
+      {"csv", "z;temp;y;x;time\n", {"z", "temp", "y", "x", "iso"}, ';'},
+      {"csv", "acc_x\tacc_y\tacc_z\ttimestamp\n", {"x", "y", "z", "iso"}, '\t'},
+  };
+  int files = 0;
+  for (const Layout& l : layouts) {
+    for (int eol = 0; eol < 2; ++eol) {
+      for (int rep = 0; rep < 3; ++rep) {
+        std::string text = l.format == "actigraph_csv" ? actigraph_header() : "";
+        text += l.head;
+        const int n = 3000;
+        for (int i = 0; i < n; ++i) {
+          text += some_line(rng, l.cols, l.sep, i);
+          text += eol ? "\r\n" : "\n";
+        }
+        if (rep == 2) text.resize(text.size() - 5);  // cut inside the last line
+        for (double compat : {0.0, 1.0}) {
+          // small buffers: lines cross refills (an ActiLife header line needs 300)
+          const double small = l.format == "csv" ? 64 : 300;
+          for (double buffer : {small, 333.0, 1048576.0}) {
+            const std::size_t cap = rep == 1 ? 7 : 1000;
+            const std::int64_t units = rep == 0 ? -1 : 11;
+            const Decoded a = decode(text, l.format, compat, 1, buffer, cap, units);
+            const Decoded b = decode(text, l.format, compat, 0, buffer, cap, units);
+            CHECK(a.opened, l.format + " " + l.head + " " + a.error);
+            CHECK(same(a, b), l.format + " " + l.head);
+            ++files;
+          }
+        }
+      }
+    }
+  }
+  std::printf("csv files: %d decodings in place and line by line compared\n", files);
+}
+
+int main() {
+  std::mt19937_64 rng(20240601);
+  for (const char* s : {"0.121", "-0.891", "+1.5", "-0.000", "0", "-0", ".5", "5.", "-.5", "1e-3",
+                        "1.358931", "-1.10116583029324", "123456789012345678",
+                        "1234567890123456789", "0.000000000000000000000001",
+                        "9007199254740993", "0.1234567890123456789", "00000000000000000001.5"}) {
+    check_number(s);
+  }
+  test_short_numbers(6);
+  test_long_numbers(rng);
+  test_stamps(rng);
+  test_files(rng);
+  std::printf("csv: %ld checks, %s\n", checked, failures ? "FAILED" : "all passed");
+  return failures ? 1 : 0;
+}
