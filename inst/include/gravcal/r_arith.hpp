@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 
 namespace gravcal {
@@ -56,6 +57,45 @@ RMeanSd r_mean_sd(Each&& each) {
     });
     r.sd = std::sqrt(static_cast<double>(ss / static_cast<long double>(n - 1)));
   }
+  return r;
+}
+
+// The sd of values given as runs (value, count), in one pass over the runs:
+// the mean from the exact counts times the values, then the squared
+// deviations times the counts, in long double (not R's bits). `each(f)`
+// calls f(value, count) for every run in order; NaN values are left out
+// (na.rm). sd is NaN with fewer than 2 values.
+struct RunsSd {
+  double sd = std::numeric_limits<double>::quiet_NaN();
+  long double var = 0.0L;    // sd's square before rounding: ss / (n - 1)
+  std::uint64_t n = 0;       // values that are not NaN
+  std::uint64_t runs = 0;    // runs that are not NaN
+  double max_abs = 0.0;      // largest |value|
+  bool finite = true;        // no infinite value
+};
+
+template <class EachRun>
+RunsSd runs_sd(EachRun&& each) {
+  RunsSd r;
+  long double sum = 0.0L;
+  each([&](double v, std::uint64_t c) {
+    if (std::isnan(v) || c == 0) return;
+    sum += static_cast<long double>(v) * c;
+    r.n += c;
+    ++r.runs;
+    if (!std::isfinite(v)) r.finite = false;
+    if (std::fabs(v) > r.max_abs) r.max_abs = std::fabs(v);
+  });
+  if (r.n < 2) return r;
+  const long double mean = sum / r.n;
+  long double ss = 0.0L;
+  each([&](double v, std::uint64_t c) {
+    if (std::isnan(v) || c == 0) return;
+    const long double d = v - mean;
+    ss += d * d * c;
+  });
+  r.var = ss / (r.n - 1);
+  r.sd = static_cast<double>(std::sqrt(r.var));
   return r;
 }
 
