@@ -37,8 +37,8 @@ gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight,
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }
 
-gc_blocks_new <- function(seg, per_hour, compat, temperature) {
-    .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature)
+gc_blocks_new <- function(seg, per_hour, compat, temperature, temp_min_sd) {
+    .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature, temp_min_sd)
 }
 
 gc_blocks_columns <- function(blocks, x, y, z, t, from, to, rule, par) {

@@ -175,13 +175,15 @@ ggir_run <- function(src, compat = TRUE,
   feed <- function(i) {
     if (!is.null(src$native)) {
       temp <- isTRUE(src$temperature)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
+                                                  ggir_constants$temp_min_sd)
       r <- gc_blocks_decode(runner, src$native$ptr, src$block_units, 1L, rule_par)
     } else {
       blk <- src$read(i)
       if (is.null(blk)) return(NULL)
       temp <- block_has_temp(blk)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
+                                                  ggir_constants$temp_min_sd)
       P <- block_pieces(blk, temp)
       r <- gc_blocks_columns(runner, lapply(P, `[[`, "x"), lapply(P, `[[`, "y"),
                              lapply(P, `[[`, "z"), lapply(P, function(p) p$t),

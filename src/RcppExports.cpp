@@ -125,15 +125,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_blocks_new
-SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature);
-RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP) {
+SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature, double temp_min_sd);
+RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP, SEXP temp_min_sdSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
     Rcpp::traits::input_parameter< double >::type per_hour(per_hourSEXP);
     Rcpp::traits::input_parameter< bool >::type compat(compatSEXP);
     Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature));
+    Rcpp::traits::input_parameter< double >::type temp_min_sd(temp_min_sdSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature, temp_min_sd));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -273,7 +274,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_blocks_decode", (DL_FUNC) &_gravcal_gc_blocks_decode, 5},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
-    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 4},
+    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
     {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},

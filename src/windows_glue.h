@@ -110,9 +110,11 @@ struct RestRule {
 // GGIR's block rules in front of a segmenter (ggir_blocks.hpp). Keeps the
 // segmenter's R object alive for as long as it is used.
 struct BlocksBox {
-  BlocksBox(SEXP seg, double per_hour, bool compat, bool temperature)
+  BlocksBox(SEXP seg, double per_hour, bool compat, bool temperature,
+            double temp_min_sd)
       : seg_keep(seg),
-        blocks(Rcpp::XPtr<SegmenterBox>(seg)->seg, per_hour, compat, temperature),
+        blocks(Rcpp::XPtr<SegmenterBox>(seg)->seg, per_hour, compat, temperature,
+               temp_min_sd),
         temperature(temperature) {}
   Rcpp::RObject seg_keep;
   gravcal::GgirBlocks blocks;
@@ -129,7 +131,8 @@ inline Rcpp::List block_result(const WindowTable& table, const gravcal::GgirBloc
       Rcpp::Named("used") = static_cast<double>(b.used),
       Rcpp::Named("carried") = static_cast<double>(b.carried),
       Rcpp::Named("first_mean") = b.first_mean,
-      Rcpp::Named("temp_sd") = b.temp_sd);
+      Rcpp::Named("temp_sd") = b.temp_sd,
+      Rcpp::Named("temp_sd_exact") = b.temp_sd_exact);
 }
 
 }  // namespace gravcal_glue

@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "gravcal/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
 #include "gravcal/icp.hpp"
 
@@ -208,6 +209,72 @@ static void test_r_arithmetic() {
   CHECK(a[7].n_invalid == 1 && std::isnan(a[7].mean[2]) == false);
 }
 
+// The temperature check's fast sd (runs_sd(), r_sd_below()) decides as R's
+// sd() (r_mean_sd()) does, and leaves to R's arithmetic only what lies
+// within rounding of the threshold: values scaled so that their sd is the
+// threshold, then moved by a few doubles; and values clearly either side.
+static void test_r_sd_below() {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::uniform_int_distribution<int> runs_n(1, 60), count(1, 400), ulps(-3, 3);
+  const double thr = 0.01;
+  int decided = 0, near_exact = 0, disagree = 0, far_undecided = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int k = runs_n(rng);
+    std::vector<double> v(static_cast<std::size_t>(k));
+    std::vector<std::uint64_t> c(v.size());
+    const double centre = trial % 3 == 0 ? 0.0 : (trial % 3 == 1 ? 25.0 : -1e6);
+    for (std::size_t j = 0; j < v.size(); ++j) {
+      v[j] = centre + nd(rng);
+      c[j] = static_cast<std::uint64_t>(count(rng));
+    }
+    auto each_value = [&](auto&& f) {
+      for (std::size_t j = 0; j < v.size(); ++j)
+        for (std::uint64_t i = 0; i < c[j]; ++i) f(v[j]);
+    };
+    auto each_run = [&](auto&& f) {
+      for (std::size_t j = 0; j < v.size(); ++j) f(v[j], c[j]);
+    };
+    const gravcal::RMeanSd r0 = gravcal::r_mean_sd(each_value);
+    if (!(r0.sd > 0)) continue;
+    // scale the deviations to an sd of thr (near), or 0.5 or 2 times it (far)
+    const int kind = trial % 4;
+    const double target = kind == 0 ? 0.5 * thr : (kind == 1 ? 2 * thr : thr);
+    for (double& a : v) a = r0.mean + (a - r0.mean) * (target / r0.sd);
+    if (kind >= 2) {
+      for (double& a : v) {
+        const int u = ulps(rng);
+        for (int i = 0; i < (u < 0 ? -u : u); ++i)
+          a = std::nextafter(a, u < 0 ? -INFINITY : INFINITY);
+      }
+    }
+    const gravcal::RunsSd f = gravcal::runs_sd(each_run);
+    const int b = gravcal::r_sd_below(f, thr);
+    const double exact = gravcal::r_mean_sd(each_value).sd;
+    if (b >= 0) {
+      ++decided;
+      if ((exact < thr) != (b == 1)) ++disagree;
+    } else if (kind >= 2) {
+      ++near_exact;
+    }
+    if (kind < 2 && b < 0) ++far_undecided;
+  }
+  CHECK(disagree == 0);
+  CHECK(far_undecided == 0);
+  CHECK(decided > 1000);
+  CHECK(near_exact > 100);  // values at the threshold go to R's arithmetic
+  // outside the bounds' domain: always R's arithmetic
+  gravcal::RunsSd inf = gravcal::runs_sd([](auto&& f) {
+    f(1.0, 3);
+    f(INFINITY, 1);
+  });
+  CHECK(gravcal::r_sd_below(inf, thr) == -1);
+  gravcal::RunsSd one = gravcal::runs_sd([](auto&& f) { f(1.0, 1); });
+  CHECK(std::isnan(one.sd) && gravcal::r_sd_below(one, thr) == -1);
+  gravcal::RunsSd same = gravcal::runs_sd([](auto&& f) { f(25.5, 1000); });
+  CHECK(same.sd == 0 && gravcal::r_sd_below(same, thr) == 1);
+}
+
 // A digest of the windows of a fixed stream, printed so that the Makefile
 // can check that the SSE2 and the portable builds give the same bits.
 static void print_digest() {
@@ -235,6 +302,7 @@ int main(int argc, char** argv) {
   }
   test_icp();
   test_r_arithmetic();
+  test_r_sd_below();
   test_model();
   test_segmenter();
   test_bins();

@@ -22,7 +22,8 @@ bool same_info(const gravcal::GgirBlockInfo& a, const gravcal::GgirBlockInfo& b)
   return a.rows == b.rows && a.zeros == b.zeros && a.ld == b.ld && a.used == b.used &&
          a.carried == b.carried &&
          std::memcmp(&a.first_mean, &b.first_mean, sizeof(double)) == 0 &&
-         std::memcmp(&a.temp_sd, &b.temp_sd, sizeof(double)) == 0;
+         std::memcmp(&a.temp_sd, &b.temp_sd, sizeof(double)) == 0 &&
+         a.temp_sd_exact == b.temp_sd_exact;
 }
 
 }  // namespace

@@ -33,7 +33,10 @@
 // The temperature checks need R's mean and sd of the block's used
 // temperatures; they are kept run-length coded, in order, so that they cost
 // a few bytes per run of equal values (device files repeat one temperature
-// over a page or a block).
+// over a page or a block). The sd only decides whether the temperature
+// varies (sd >= temp_min_sd): computed from the runs, it is R's decision
+// except within rounding of the threshold, where compatible mode repeats
+// R's arithmetic (r_arith.hpp, r_sd_below()).
 #ifndef GRAVCAL_GGIR_BLOCKS_HPP
 #define GRAVCAL_GGIR_BLOCKS_HPP
 
@@ -60,7 +63,11 @@ struct GgirBlockInfo {
   double first_mean = std::numeric_limits<double>::quiet_NaN();  // mean of the
                              // first 10 used temperatures (R's, na.rm)
   double temp_sd = std::numeric_limits<double>::quiet_NaN();     // sd of the
-                             // used temperatures (R's, na.rm); NaN if < 2
+                             // used temperatures (na.rm); NaN if < 2. In
+                             // compatible mode on the same side of
+                             // temp_min_sd as R's sd(), and R's to the bit
+                             // when near it (temp_sd_exact)
+  bool temp_sd_exact = false;  // temp_sd was computed in R's arithmetic
 };
 
 // Where the caller writes samples for commit(): columns x, y, z and t
@@ -76,12 +83,15 @@ struct BlockSpace {
 class GgirBlocks {
  public:
   // per_hour: samples per hour (3600 sf); compat: GGIR's accidents;
-  // temperature: the stream has a temperature column.
-  GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature)
+  // temperature: the stream has a temperature column; temp_min_sd: the
+  // threshold the temperature's sd is compared with (GGIR: 0.01).
+  GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature,
+             double temp_min_sd = 0.01)
       : seg_(seg),
         H_(static_cast<std::int64_t>(std::floor(per_hour))),
         compat_(compat),
-        temp_(temperature) {
+        temp_(temperature),
+        temp_min_sd_(temp_min_sd) {
     if (H_ < 1) H_ = 1;
   }
 
@@ -319,19 +329,25 @@ class GgirBlocks {
     }
   }
 
-  // R's mean of the first 10 and sd of the first `use` temperatures. The sd
-  // only decides whether the temperature varies (sd >= 0.01): gravcal's own
-  // mode takes it from the runs in one pass (exact products of each run's
-  // count and value, deviations around the mean); compatible mode repeats
-  // R's arithmetic value by value, so that a block at the threshold goes
-  // GGIR's way.
+  // R's mean of the first 10 and the sd of the first `use` temperatures.
+  // The sd comes from the runs in one pass (exact products of each run's
+  // count and value, deviations around the mean); gravcal's own mode takes
+  // it as it is, compatible mode only when it is clearly on one side of the
+  // threshold (r_sd_below()), and otherwise repeats R's arithmetic value by
+  // value, so that a block at the threshold goes GGIR's way.
   void temperature_stats(std::int64_t use) {
     if (!temp_) return;
     info_.first_mean = r_mean_sd([&](auto&& f) {
       for (double v : first_) f(v);
     }).mean;
+    const RunsSd fast = runs_sd([&](auto&& f) { each_run(use, f); });
     if (!compat_) {
-      info_.temp_sd = runs_sd([&](auto&& f) { each_run(use, f); }).sd;
+      info_.temp_sd = fast.sd;
+      return;
+    }
+    const int below = r_sd_below(fast, temp_min_sd_);
+    if (below >= 0 && (fast.sd < temp_min_sd_) == (below == 1)) {
+      info_.temp_sd = fast.sd;
       return;
     }
     info_.temp_sd = r_mean_sd([&](auto&& f) {
@@ -339,6 +355,7 @@ class GgirBlocks {
         for (std::uint64_t i = 0; i < c; ++i) f(v);
       });
     }).sd;
+    info_.temp_sd_exact = true;
   }
 
   struct Run {
@@ -351,6 +368,7 @@ class GgirBlocks {
   std::int64_t H_;
   bool compat_;
   bool temp_;
+  double temp_min_sd_;
   GgirBlockInfo info_;
   std::int64_t pushed_ = 0;    // the block's samples given to the segmenter
   bool started_ = false;

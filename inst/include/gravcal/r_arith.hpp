@@ -99,6 +99,59 @@ RunsSd runs_sd(EachRun&& each) {
   return r;
 }
 
+// Whether R's sd() of the same values is below `thr` (1), not below (0), or
+// too close to tell (-1), from runs_sd()'s result alone. Only when this is
+// -1 need R's arithmetic be repeated (r_mean_sd()).
+//
+// Why the answer is R's. Let the n values a_i have true mean mu, true
+// variance s2 = sum (a_i - mu)^2 / (n - 1) and M = max |a_i|, all finite;
+// u = 2^-64 (long double), v = 2^-53 (double); standard bounds for
+// recursive summation (Higham, Accuracy and Stability of Numerical
+// Algorithms, 2nd ed., sec. 4.2; gamma_k = k u / (1 - k u)).
+// - R's mean (r_mean_sd()): the sum is off by at most gamma_(n-1) n M, so
+//   s / n by about n u M; the correction pass brings it to within
+//   (2.1 n + 2) u M of mu, and rounding to double adds 1.01 v M (plus
+//   2^-1075 when subnormal). So R's xm is within dR = (2 v + (4 n + 8) u) M
+//   + 1e-300 of mu.
+// - R's ss = sum (a_i - xm)^2 (non-negative terms, each with 2 roundings)
+//   is within gamma_(n+2) of the exact sum, which is (n - 1) s2 + n (mu -
+//   xm)^2; dividing by n - 1, rounding to double, sqrt() and squaring back
+//   add u + 3 v. So sd_R^2 = (s2 + n / (n - 1) dR'^2) (1 + e), |dR'| <= dR,
+//   |e| <= (n + 3) u + 3 v (times 1.02), n / (n - 1) <= 2.
+// - runs_sd(): the mean is within (K + 1) u M (times 1.05) of mu, K runs;
+//   the squared deviations times counts have 3 roundings each, their sum
+//   K, the division 1: var = (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (K +
+//   2) u M, |f| <= (K + 5) u (times 1.02).
+// With eps = 4 (n + K + 16) u + 16 v >= |e|, |f| (and room for the rounding
+// of the bounds themselves) and d2 = 2 max(dR, dF)^2:
+//   s2 in [var / (1 + eps) - d2, var / (1 - eps)], so
+//   sd_R^2 <= (var / (1 - eps) + d2) (1 + eps) = hi and
+//   sd_R^2 >= (var / (1 + eps) - d2) (1 - eps) = lo.
+// hi < thr^2 (1 - 1e-15) means sd_R < thr; lo > thr^2 (1 + 1e-15) means
+// sd_R > thr; otherwise -1. The bounds need n u small, M and thr within
+// [1e-100, 1e100] (M = 0 too), and no infinite value; outside that, -1.
+// The margins are far wider than the errors seen in practice (about 1e-12
+// relative for 4e6 values), so -1 happens only within about 1e-12 of thr.
+inline int r_sd_below(const RunsSd& r, double thr) {
+  if (r.n < 2 || !r.finite) return -1;
+  if (!(thr >= 1e-100 && thr <= 1e100)) return -1;
+  if (r.max_abs > 1e100 || (r.max_abs != 0.0 && r.max_abs < 1e-100)) return -1;
+  if (r.n > (std::uint64_t(1) << 40) || r.runs > (std::uint64_t(1) << 40)) return -1;
+  const long double u = std::ldexp(1.0L, -64), v = std::ldexp(1.0L, -53);
+  const long double n = static_cast<long double>(r.n);
+  const long double k = static_cast<long double>(r.runs);
+  const long double M = r.max_abs;
+  const long double eps = 4.0L * (n + k + 16.0L) * u + 16.0L * v;
+  const long double dm = (2.0L * v + (4.0L * n + 4.0L * k + 16.0L) * u) * M + 1e-300L;
+  const long double d2 = 2.0L * dm * dm;
+  const long double hi = (r.var / (1.0L - eps) + d2) * (1.0L + eps) + 1e-300L;
+  const long double lo = (r.var / (1.0L + eps) - d2) * (1.0L - eps) - 1e-300L;
+  const long double t2 = static_cast<long double>(thr) * thr;
+  if (hi < t2 * (1.0L - 1e-15L)) return 1;
+  if (lo > t2 * (1.0L + 1e-15L)) return 0;
+  return -1;
+}
+
 // R's mean() of n contiguous values (no NaN handling: R's mean without
 // na.rm gives NaN when any value is NaN, as this does).
 inline double r_mean(const double* v, std::size_t n) {
