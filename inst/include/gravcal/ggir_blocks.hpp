@@ -231,20 +231,32 @@ class GgirBlocks {
     return x == 0.0 && y == 0.0 && z == 0.0;
   }
 
-  // Removes the idle-sleep samples among n in place; returns how many are
-  // left. Looks for the first in blocks of 64 without branching, so that
-  // the usual case (none) is one quick pass.
-  static std::size_t drop_zeros(double* x, double* y, double* z, double* t,
+  // Where the first idle-sleep sample among n is (n if none): two samples
+  // per instruction with SSE2.
+  static std::size_t first_zero(const double* x, const double* y, const double* z,
                                 std::size_t n) {
     std::size_t i = 0;
-    for (; i + 64 <= n; i += 64) {
-      int any = 0;
-      for (std::size_t k = i; k < i + 64; ++k) {
-        any |= (x[k] == 0.0) & (y[k] == 0.0) & (z[k] == 0.0);
+#if defined(GRAVCAL_SSE2)
+    const __m128d zr = _mm_setzero_pd();
+    for (; i + 8 <= n; i += 8) {
+      __m128d any = zr;
+      for (std::size_t k = i; k < i + 8; k += 2) {
+        any = _mm_or_pd(any, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(_mm_loadu_pd(x + k), zr),
+                                                   _mm_cmpeq_pd(_mm_loadu_pd(y + k), zr)),
+                                        _mm_cmpeq_pd(_mm_loadu_pd(z + k), zr)));
       }
-      if (any) break;
+      if (_mm_movemask_pd(any) != 0) break;
     }
+#endif
     while (i < n && !is_zero(x[i], y[i], z[i])) ++i;
+    return i;
+  }
+
+  // Removes the idle-sleep samples among n in place; returns how many are
+  // left.
+  static std::size_t drop_zeros(double* x, double* y, double* z, double* t,
+                                std::size_t n) {
+    std::size_t i = first_zero(x, y, z, n);
     if (i == n) return n;
     std::size_t m = i;
     for (; i < n; ++i) {
@@ -295,11 +307,27 @@ class GgirBlocks {
       if (runs_.empty() || runs_.back().bits != bits) {
         runs_.push_back(Run{bits, t[i], 0});
       }
-      std::size_t j = i + 1;
-      while (j < m && std::memcmp(t + j, &bits, sizeof bits) == 0) ++j;
+      const std::size_t j = run_end(t, i, m, bits);
       runs_.back().count += static_cast<std::int64_t>(j - i);
       i = j;
     }
+  }
+
+  // The end of the run of values with these bits that starts at t[i].
+  static std::size_t run_end(const double* t, std::size_t i, std::size_t m,
+                             std::uint64_t bits) {
+    std::size_t j = i + 1;
+#if defined(GRAVCAL_SSE2)
+    const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
+    for (; j + 4 <= m; j += 4) {
+      const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(t + j));
+      const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(t + j + 2));
+      const __m128i eq = _mm_and_si128(_mm_cmpeq_epi32(a0, b), _mm_cmpeq_epi32(a1, b));
+      if (_mm_movemask_epi8(eq) != 0xffff) break;
+    }
+#endif
+    while (j < m && std::memcmp(t + j, &bits, sizeof bits) == 0) ++j;
+    return j;
   }
 
   // The first k waiting samples go to the segmenter.
