@@ -163,7 +163,7 @@ inline Status parse_header(const unsigned char* b, Header& h) {
 inline Params own_params(const Header& h) {
   Params p;
   p.axes = h.axes;
-  p.accel_scale = 1.0 / std::pow(2.0, 8 + h.scale_code);
+  p.accel_scale = std::ldexp(1.0, -(8 + h.scale_code));  // 1 / 2^(8 + code), exactly
   p.frequency = h.own_frequency;
   p.fractional = h.rate != 0 && (h.ts_offset & 0x8000u) != 0;
   return p;
@@ -194,8 +194,7 @@ inline double block_start(double T, const Header& h, const Params& p) {
 }
 
 inline int signed10(std::uint32_t v) {
-  const int s = static_cast<int>(v & 0x3ffu);
-  return s >= 0x200 ? s - 0x400 : s;
+  return static_cast<int>((v & 0x3ffu) ^ 0x200u) - 0x200;
 }
 
 // The block's accelerometer samples in g, xyz interleaved.
@@ -203,12 +202,15 @@ inline void scale_samples(const unsigned char* b, const Header& h, const Params&
                           double packed_scale, double* xyz) {
   const unsigned char* d = b + data_offset;
   if (h.packed) {
+    // value * 2^exponent * scale: both factors are powers of two, so their
+    // product first gives the same (exact) result
+    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
     for (int i = 0; i < h.count; ++i) {
       const std::uint32_t v = le32(d + 4 * i);
-      const int mult = 1 << (v >> 30);
-      xyz[3 * i] = signed10(v) * mult * packed_scale;
-      xyz[3 * i + 1] = signed10(v >> 10) * mult * packed_scale;
-      xyz[3 * i + 2] = signed10(v >> 20) * mult * packed_scale;
+      const double m = f[v >> 30];
+      xyz[3 * i] = signed10(v) * m;
+      xyz[3 * i + 1] = signed10(v >> 10) * m;
+      xyz[3 * i + 2] = signed10(v >> 20) * m;
     }
     return;
   }
@@ -538,10 +540,22 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
     const double dt = 1.0 / raw_.frequency;
     const int n = static_cast<int>(std::min<std::size_t>(
         out.room(), static_cast<std::size_t>(raw_.h.count - raw_next_)));
-    for (int k = 0; k < n; ++k, ++raw_next_) {
-      const double* v = raw_.xyz + 3 * raw_next_;
-      out.put(v[0], v[1], v[2], raw_.h.temperature, raw_.start + raw_next_ * dt);
+    // column by column (what out.put() would write, sample by sample)
+    const double* v = raw_.xyz + 3 * raw_next_;
+    double* ox = out.x + out.n;
+    double* oy = out.y + out.n;
+    double* oz = out.z + out.n;
+    for (int k = 0; k < n; ++k) {
+      ox[k] = v[3 * k];
+      oy[k] = v[3 * k + 1];
+      oz[k] = v[3 * k + 2];
     }
+    if (out.t != nullptr) std::fill(out.t + out.n, out.t + out.n + n, raw_.h.temperature);
+    if (out.time != nullptr) {
+      for (int k = 0; k < n; ++k) out.time[out.n + k] = raw_.start + (raw_next_ + k) * dt;
+    }
+    out.n += static_cast<std::size_t>(n);
+    raw_next_ += n;
     report_.samples += n;
     if (raw_next_ == raw_.h.count) raw_open_ = false;
   }
