@@ -809,42 +809,80 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
 }
 
 // Writes the open span's grid points into out; false when out filled first.
+// The loop keeps its state in locals (the output columns could alias the
+// members, so the compiler would store and reload them every sample) and
+// writes it back once; the arithmetic is grid() and out.put()'s.
 inline bool CwaDecoder::emit_span(SampleBuffer& out) {
   const cwa::Block& p = blk_[span_blk_];
   const int len = span_len_;
   const double lim = raw_t_[len];
-  std::int64_t given = 0;
+  const double temp = p.h.temperature;
+  const double start = start_ts_, step = step_, end = end_ts_;
+  const double il[3] = {ianchor_[0], ianchor_[1], ianchor_[2]};
+  const bool impute = impute_;
+  const std::int64_t last = last_;
+  std::int64_t pos = pos_;
+  int source = source_;
+  // the last output sample, in scalars (an array here ends up on the stack)
+  double a0 = anchor_[0], a1 = anchor_[1], a2 = anchor_[2];
+  double at = anchor_t_;
+  std::size_t n = out.n;
+  const std::size_t cap = out.capacity;
+  double* const ox = out.x;
+  double* const oy = out.y;
+  double* const oz = out.z;
+  double* const ot = out.t;
+  double* const otime = out.time;
+  const std::int64_t pos0 = pos;
   bool full = false;
-  while (pos_ <= last_) {
-    const double t = grid(pos_);
-    if (impute_ ? !(t < lim) : !(t <= lim)) break;
-    if (out.full()) {
+  while (pos <= last) {
+    volatile double e = static_cast<double>(pos) * step;  // as grid(): no fused multiply-add
+    double t = start + e;
+    t = t < end ? t : end;
+    if (impute ? !(t < lim) : !(t <= lim)) break;
+    if (n >= cap) {
       full = true;
       break;
     }
-    if (impute_) {
-      for (int a = 0; a < 3; ++a) anchor_[a] = imputed_[a];
+    if (impute) {
+      a0 = imputed_[0];
+      a1 = imputed_[1];
+      a2 = imputed_[2];
     } else {
-      while (source_ < len && raw_t_[source_] < t) ++source_;
-      const double w = (t - raw_t_[source_ - 1]) / (raw_t_[source_] - raw_t_[source_ - 1]);
-      const double* right = p.xyz + 3 * (source_ - 1);
-      const double* left = source_ == 1 ? ianchor_ : right - 3;
-      for (int a = 0; a < 3; ++a) anchor_[a] = w * (right[a] - left[a]) + left[a];
+      while (source < len && raw_t_[source] < t) ++source;
+      const double w = (t - raw_t_[source - 1]) / (raw_t_[source] - raw_t_[source - 1]);
+      const double* right = p.xyz + 3 * (source - 1);
+      const double* left = source == 1 ? il : right - 3;
+      a0 = w * (right[0] - left[0]) + left[0];
+      a1 = w * (right[1] - left[1]) + left[1];
+      a2 = w * (right[2] - left[2]) + left[2];
     }
-    out.put(anchor_[0], anchor_[1], anchor_[2], p.h.temperature, t);
-    anchor_t_ = t;
-    ++pos_;
-    ++given;
+    ox[n] = a0;
+    oy[n] = a1;
+    oz[n] = a2;
+    if (ot != nullptr) ot[n] = temp;
+    if (otime != nullptr) otime[n] = t;
+    ++n;
+    at = t;
+    ++pos;
   }
+  const std::int64_t given = pos - pos0;
+  out.n = n;
+  pos_ = pos;
+  source_ = source;
+  anchor_[0] = a0;
+  anchor_[1] = a1;
+  anchor_[2] = a2;
+  anchor_t_ = at;
   report_.samples += given;
   if (impute_) report_.count("imputed_samples", given);
   if (full) return false;
   if (impute_) {  // go on from the imputed output, not the raw samples
     ianchor_t_ = anchor_t_;
-    for (int a = 0; a < 3; ++a) ianchor_[a] = anchor_[a];
+    for (int c = 0; c < 3; ++c) ianchor_[c] = anchor_[c];
   } else {
     ianchor_t_ = lim;
-    for (int a = 0; a < 3; ++a) ianchor_[a] = p.xyz[3 * (len - 1) + a];
+    for (int c = 0; c < 3; ++c) ianchor_[c] = p.xyz[3 * (len - 1) + c];
   }
   span_open_ = false;
   return true;
