@@ -207,6 +207,36 @@ static void test_r_arithmetic() {
   }
   CHECK(same);
   CHECK(a[7].n_invalid == 1 && std::isnan(a[7].mean[2]) == false);
+
+  // min and max of whole windows (two samples at a time) against the
+  // sample-by-sample rule, where it matters: zeros of both signs as the
+  // extreme value, first at an even or an odd position
+  const double zs[2] = {0.0, -0.0};
+  for (int trial = 0; trial < 64; ++trial) {
+    const std::size_t m = 8 + static_cast<std::size_t>(trial % 5);
+    std::vector<double> u(3 * m);
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      u[i] = (trial & 1 ? 1.0 : -1.0) * (0.5 + 0.01 * static_cast<double>(i % 7));
+    }
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t i = static_cast<std::size_t>((trial >> 1) + 3 * k) % (3 * m);
+      u[i] = zs[(trial >> 2) & 1];
+      u[(i + 1 + static_cast<std::size_t>(trial % 3)) % (3 * m)] = zs[((trial >> 3) & 1) ^ 1];
+    }
+    std::vector<gravcal::WindowStats> wa, wb;
+    std::vector<double> ba(3 * (m + 2)), bb(3 * (m + 2));
+    gravcal::Segmenter sa(static_cast<double>(m), false), sb(static_cast<double>(m), false);
+    CHECK(sa.use_r_arithmetic(ba.data(), ba.size()));
+    CHECK(sb.use_r_arithmetic(bb.data(), bb.size()));
+    sa.push(u.data(), u.data() + m, u.data() + 2 * m, nullptr, m,
+            [&](const gravcal::WindowStats& w) { wa.push_back(w); });
+    for (std::size_t i = 0; i < m; ++i) {
+      sb.push(u.data() + i, u.data() + m + i, u.data() + 2 * m + i, nullptr, 1,
+              [&](const gravcal::WindowStats& w) { wb.push_back(w); });
+    }
+    CHECK(wa.size() == 1 && wb.size() == 1 &&
+          std::memcmp(&wa[0], &wb[0], sizeof(gravcal::WindowStats)) == 0);
+  }
 }
 
 // The temperature check's fast sd (runs_sd(), r_sd_below()) decides as R's

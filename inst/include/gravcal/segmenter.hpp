@@ -195,19 +195,28 @@ class Segmenter {
       }
     } else {
       for (int k = 0; k < 5; ++k) r.c[k] = csum_[k];
-      scan_r(x, y, z, t, m, r);
+      scan_r(x, y, z, m, r);
       // the running sums stay finite through windows of finite samples
       // (add() leaves out non-finite ones), so a non-finite sum here means
       // this window holds a non-finite value
       if ((skip_zero_ && r.zero) ||
-          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3])) ||
-          (t != nullptr && !std::isfinite(static_cast<double>(r.c[4])))) {
+          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3]))) {
         return false;
       }
+      // the sds, with the temperature's running sum riding along their
+      // second pass (a single chain of additions is cheaper there), before
+      // anything changes: a non-finite temperature still sends the window
+      // to the sample-by-sample path
+      const double* cols[3] = {x, y, z};
+      if (m > 1) {
+        r_sd3(cols, m, r.w, t, &r.c[4], wsd_);
+      } else if (t != nullptr) {
+        r.c[4] += t[0];
+      }
+      if (t != nullptr && !std::isfinite(static_cast<double>(r.c[4]))) return false;
       for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
       a = StreamScan();  // sums replaced by close_r()
       for (int k = 0; k < 3; ++k) {
-        wsum_[k] = r.w[k];
         a.lo[k] = r.lo[k];
         a.hi[k] = r.hi[k];
       }
@@ -373,10 +382,10 @@ class Segmenter {
   // R's cumsum(), one column at a time, continuing o.c, and the norm as
   // add() forms it; the window's own long double sums (the first pass of
   // R's sd) ride along. Scalar accumulators, so that they stay in x87
-  // registers; min, max and temperature in a second loop.
+  // registers (seven of the eight); min, max and the zero test two samples
+  // at a time in a second loop (the temperature's sum: r_sd3()).
   GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
-                                      const double* z, const double* t,
-                                      std::size_t m, RScan& o) {
+                                      const double* z, std::size_t m, RScan& o) {
     long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
     long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
     for (std::size_t k = 0; k < m; ++k) {
@@ -397,28 +406,66 @@ class Segmenter {
     o.w[0] = w0;
     o.w[1] = w1;
     o.w[2] = w2;
-    const double h0 = x[0], h1 = y[0], h2 = z[0];
-    double lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+    min_max(x, y, z, m, o);
+  }
+
+  // min, max and whether some sample is all zeros. min and max are those of
+  // the sequential rule (v < lo ? v : lo from the first sample, as add()):
+  // the same value in any order, except that a zero minimum (maximum) is
+  // the first zero met, with its sign, which a second look finds.
+  static void min_max(const double* x, const double* y, const double* z,
+                      std::size_t m, RScan& o) {
+    const double* col[3] = {x, y, z};
+    double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
     bool zero = false;
-    long double c4 = o.c[4];
-    for (std::size_t k = 0; k < m; ++k) {
-      const double xi = x[k], yi = y[k], zi = z[k];
-      zero |= (xi == 0.0) & (yi == 0.0) & (zi == 0.0);
-      lo0 = xi < lo0 ? xi : lo0;
-      lo1 = yi < lo1 ? yi : lo1;
-      lo2 = zi < lo2 ? zi : lo2;
-      hi0 = xi > hi0 ? xi : hi0;
-      hi1 = yi > hi1 ? yi : hi1;
-      hi2 = zi > hi2 ? zi : hi2;
-      if (t != nullptr) c4 += t[k];
+    std::size_t k = 0;
+#if defined(GRAVCAL_SSE2)
+    {
+      const __m128d zr = _mm_setzero_pd();
+      __m128d lo0 = _mm_set1_pd(lo[0]), lo1 = _mm_set1_pd(lo[1]), lo2 = _mm_set1_pd(lo[2]);
+      __m128d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
+      for (; k + 2 <= m; k += 2) {
+        const __m128d a = _mm_loadu_pd(x + k), b = _mm_loadu_pd(y + k),
+                      c = _mm_loadu_pd(z + k);
+        lo0 = _mm_min_pd(a, lo0);
+        lo1 = _mm_min_pd(b, lo1);
+        lo2 = _mm_min_pd(c, lo2);
+        hi0 = _mm_max_pd(a, hi0);
+        hi1 = _mm_max_pd(b, hi1);
+        hi2 = _mm_max_pd(c, hi2);
+        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(a, zr),
+                                                     _mm_cmpeq_pd(b, zr)),
+                                          _mm_cmpeq_pd(c, zr)));
+      }
+      const __m128d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
+      for (int a = 0; a < 3; ++a) {
+        double e[2];
+        _mm_storeu_pd(e, lov[a]);
+        lo[a] = e[0] < e[1] ? e[0] : e[1];
+        _mm_storeu_pd(e, hiv[a]);
+        hi[a] = e[0] > e[1] ? e[0] : e[1];
+      }
+      zero = _mm_movemask_pd(zacc) != 0;
     }
-    o.c[4] = c4;
-    o.lo[0] = lo0;
-    o.lo[1] = lo1;
-    o.lo[2] = lo2;
-    o.hi[0] = hi0;
-    o.hi[1] = hi1;
-    o.hi[2] = hi2;
+#endif
+    for (; k < m; ++k) {
+      zero = zero || (x[k] == 0.0 && y[k] == 0.0 && z[k] == 0.0);
+      for (int a = 0; a < 3; ++a) {
+        const double v = col[a][k];
+        lo[a] = v < lo[a] ? v : lo[a];
+        hi[a] = v > hi[a] ? v : hi[a];
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (lo[a] == 0.0 || hi[a] == 0.0) {
+        std::size_t j = 0;
+        while (j < m && col[a][j] != 0.0) ++j;
+        if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
+        if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
+      }
+      o.lo[a] = lo[a];
+      o.hi[a] = hi[a];
+    }
     o.zero = zero;
   }
 
@@ -537,8 +584,11 @@ class Segmenter {
         v[a] = cols != nullptr ? cols[a]
                                : rbuf_ + static_cast<std::size_t>(a) * rcap_;
       }
-      r_sd3(v, static_cast<std::size_t>(n_valid_), cols != nullptr ? wsum_ : nullptr,
-            s.sd);
+      if (cols != nullptr) {
+        for (int a = 0; a < 3; ++a) s.sd[a] = wsd_[a];  // whole_window()'s
+      } else {
+        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, nullptr, s.sd);
+      }
     } else {
       for (int a = 0; a < 3; ++a) s.sd[a] = NAN;
     }
@@ -548,9 +598,12 @@ class Segmenter {
   // correction pass, then the sum of squared deviations, in long double. The
   // three columns go through each pass together (independent sums, so the
   // result is that of three separate calls). sum1: the first pass's sums
-  // when the caller has them already, or null.
-  static void r_sd3(const double* const* v, std::size_t n,
-                    const long double* sum1, double* out) {
+  // when the caller has them already, or null. t, tsum: when not null, the
+  // n temperatures are added to *tsum in order during the second pass (an
+  // independent chain, nearly free there).
+  GRAVCAL_NOINLINE static void r_sd3(const double* const* v, std::size_t n,
+                                     const long double* sum1, const double* t,
+                                     long double* tsum, double* out) {
     const long double ln = static_cast<long double>(n);
     const double* a = v[0];
     const double* b = v[1];
@@ -574,10 +627,21 @@ class Segmenter {
     sa = sb = sc = 0.0L;
     {
       const long double m0 = m[0], m1 = m[1], m2 = m[2];
-      for (std::size_t k = 0; k < n; ++k) {
-        sa += (a[k] - m0);
-        sb += (b[k] - m1);
-        sc += (c[k] - m2);
+      if (t != nullptr && tsum != nullptr) {
+        long double st = *tsum;
+        for (std::size_t k = 0; k < n; ++k) {
+          sa += (a[k] - m0);
+          sb += (b[k] - m1);
+          sc += (c[k] - m2);
+          st += t[k];
+        }
+        *tsum = st;  // out of the registers before the third pass
+      } else {
+        for (std::size_t k = 0; k < n; ++k) {
+          sa += (a[k] - m0);
+          sb += (b[k] - m1);
+          sc += (c[k] - m2);
+        }
       }
     }
     if (fin[0]) m[0] = m[0] + sa / ln;
@@ -604,7 +668,7 @@ class Segmenter {
   double* rbuf_ = nullptr;
   std::size_t rcap_ = 0;
   long double csum_[5];
-  long double wsum_[3] = {0.0L, 0.0L, 0.0L};  // see whole_window()
+  double wsd_[3] = {0.0, 0.0, 0.0};  // the sds whole_window() computed
   double cprev_[5];
   std::int64_t window_, retained_, seen_, skipped_zero_, next_boundary_, first_;
   std::int64_t n_, n_invalid_, n_valid_, n_temp_;
