@@ -314,9 +314,8 @@ ggir_run <- function(src, compat = TRUE,
       if (spherepopulated) {
         temp <- if (use.temp) ft[, 8] else NULL
         fit_ft <- function(rule) {
-          r <- gc_fit_icp(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
-                          as.integer(max_iter), tol,
-                          ggir_constants$max_weight, FALSE)
+          r <- icp_means(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
+                         max_iter, tol)
           r$meantemp <- if (use.temp) r$meantemp else 0
           r$error <- ggir_error(ft[, 2:4, drop = FALSE], r$scale, r$offset,
                                 r$tempoffset, temp, r$meantemp)
