@@ -49,6 +49,10 @@ gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic = FALSE
     .Call(`_gravcal_gc_segmenter_new`, samples_per_window, skip_zero, r_arithmetic)
 }
 
+gc_segmenter_lazy_sd <- function(seg, max_sd) {
+    invisible(.Call(`_gravcal_gc_segmenter_lazy_sd`, seg, max_sd))
+}
+
 gc_segmenter_new_block <- function(seg) {
     .Call(`_gravcal_gc_segmenter_new_block`, seg)
 }

@@ -148,6 +148,9 @@ ggir_run <- function(src, compat = TRUE,
   }
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
+  # compatible mode: R's sds only where GGIR's rules can see them (the rest
+  # rule, the duplicate filter): see Segmenter::lazy_r_sd()
+  if (compat) gc_segmenter_lazy_sd(seg, sdcriter)
   feats <- list()
   rests <- list()  # the core's rest flag of each window (GGIR's rule)
   n_feat <- 0

@@ -168,6 +168,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_segmenter_lazy_sd
+void gc_segmenter_lazy_sd(SEXP seg, double max_sd);
+RcppExport SEXP _gravcal_gc_segmenter_lazy_sd(SEXP segSEXP, SEXP max_sdSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
+    Rcpp::traits::input_parameter< double >::type max_sd(max_sdSEXP);
+    gc_segmenter_lazy_sd(seg, max_sd);
+    return R_NilValue;
+END_RCPP
+}
 // gc_segmenter_new_block
 bool gc_segmenter_new_block(SEXP seg);
 RcppExport SEXP _gravcal_gc_segmenter_new_block(SEXP segSEXP) {
@@ -277,6 +287,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
     {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
+    {"_gravcal_gc_segmenter_lazy_sd", (DL_FUNC) &_gravcal_gc_segmenter_lazy_sd, 2},
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},

@@ -181,6 +181,7 @@ Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
                               Rcpp::NumericVector par, bool use_temperature) {
   OpenFile* f = get(ptr);
   Rcpp::XPtr<gravcal_glue::SegmenterBox> box(seg);
+  if (box->lazy_max_sd > 0) Rcpp::stop("a lazy segmenter is for GGIR's blocks only");
   const gravcal_glue::RestRule is_rest(rule, par);
   ChunkBuffer cb(use_temperature && f->decoder->info().has_temperature);
   gravcal::SampleBuffer& out = cb.out;
@@ -215,6 +216,7 @@ Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
                             Rcpp::NumericVector par) {
   OpenFile* f = get(ptr);
   Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  gravcal_glue::check_lazy_rule(*box, rule, par);
   const gravcal_glue::RestRule is_rest(rule, par);
   const bool temperature = box->temperature && f->decoder->info().has_temperature;
   gravcal_glue::WindowTable table;

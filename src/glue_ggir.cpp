@@ -114,6 +114,7 @@ Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List&
                              const Rcpp::NumericVector& to, int rule,
                              Rcpp::NumericVector par) {
   Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  gravcal_glue::check_lazy_rule(*box, rule, par);
   const gravcal_glue::RestRule is_rest(rule, par);
   const R_xlen_t np = x.size();
   if (y.size() != np || z.size() != np || t.size() != np || from.size() != np ||

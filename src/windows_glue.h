@@ -85,6 +85,9 @@ struct SegmenterBox {
       : L(samples_per_window), seg(samples_per_window, skip_zero) {}
   double L;
   std::vector<double> buffer;
+  std::vector<double> held;    // Segmenter::lazy_r_sd()'s buffer and state
+  gravcal::LazySd lazy;
+  double lazy_max_sd = 0.0;    // > 0: lazy_r_sd() with this threshold
   gravcal::Segmenter seg;
 };
 
@@ -120,6 +123,14 @@ struct BlocksBox {
   gravcal::GgirBlocks blocks;
   bool temperature;
 };
+
+// A lazy segmenter (Segmenter::lazy_r_sd()) gives R's sds only where the
+// sd rule with its own threshold can see them: refuse any other rule.
+inline void check_lazy_rule(const BlocksBox& box, int rule, const Rcpp::NumericVector& par) {
+  const double m = Rcpp::XPtr<SegmenterBox>(box.seg_keep)->lazy_max_sd;
+  if (m > 0 && !(rule == 1 && par.size() >= 1 && par[0] == m))
+    Rcpp::stop("this segmenter gives R's sds for the sd rule with max_sd = %g only", m);
+}
 
 // A block's result for R: the windows and what the block rules saw.
 inline Rcpp::List block_result(const WindowTable& table, const gravcal::GgirBlockInfo& b) {

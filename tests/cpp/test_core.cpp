@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -305,6 +306,267 @@ static void test_r_sd_below() {
   CHECK(same.sd == 0 && gravcal::r_sd_below(same, thr) == 1);
 }
 
+// add_repeated() (r_arith.hpp): k additions of x to a long double in a few
+// steps, to the bit as the loop: sums growing and shrinking across
+// binades, through zero, x below half a step, ties (x half-way between
+// multiples of the grid of s), huge values.
+static void test_add_repeated() {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int bad = 0;
+  for (int t = 0; t < 40000; ++t) {
+    long double s = 0;
+    double x = 0;
+    switch (t % 7) {
+      case 0: s = 25.0L * (1 + U(rng)); x = 25 + U(rng); break;
+      case 1: s = 1e8L * U(rng); x = 30 * U(rng); break;
+      case 2: s = 0x1p20L - 50 * std::fabs(U(rng)); x = 0.7 + 0.1 * U(rng); break;
+      case 3: s = 0x1p20L + 50 * std::fabs(U(rng)); x = -0.7 - 0.1 * U(rng); break;
+      case 4: s = 3.0L * U(rng); x = static_cast<double>(-s / 7 * (1 + 1e-3 * U(rng))); break;
+      case 5: {  // x half-way between multiples of the grid of s
+        s = 1027.0L;
+        const long double q = std::ldexp(1.0L, 11 - std::numeric_limits<long double>::digits);
+        x = static_cast<double>(q * (std::floor(1000 * U(rng)) + 0.5L));
+        break;
+      }
+      default: s = 1e300L * U(rng); x = 1e290 * U(rng); break;
+    }
+    if (t % 97 == 0) s = 0;
+    const std::uint64_t k = 1 + rng() % (t % 3 == 0 ? 5000 : 50);
+    long double a = s, b = s;
+    for (std::uint64_t i = 0; i < k; ++i) a += x;
+    gravcal::add_repeated(b, x, k);
+    bad += !(a == b || (std::isnan(a) && std::isnan(b)));
+  }
+  // at a binade's edges: the last additions before 2^20 (from above) or
+  // 2^21 (from below) round on the next binade's grid
+  const int digits = std::numeric_limits<long double>::digits;
+  const long double q = std::ldexp(1.0L, 21 - digits);  // the grid of [2^20, 2^21)
+  for (int m = 1; m <= 12; ++m) {
+    for (int r = 1; r <= 3; ++r) {
+      for (int f = 1; f <= 4; ++f) {
+        for (int up = 0; up < 2; ++up) {
+          const long double s0 = up ? 0x1p21L - m * q : 0x1p20L + m * q;
+          const double x = static_cast<double>((up ? 1 : -1) * (r + f / 10.0L) * q);
+          long double a = s0, b = s0;
+          for (int i = 0; i < 20; ++i) a += x;
+          gravcal::add_repeated(b, x, 20);
+          bad += a != b;
+        }
+      }
+    }
+  }
+  CHECK(bad == 0);
+  // by runs, with the grid kept between calls
+  std::vector<double> v(20000);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = 25.3 + 0.29 * static_cast<double>((i / 120) % 37);
+  long double a = 0, b = 0;
+  for (double e : v) a += e;
+  gravcal::Binade g;
+  gravcal::add_in_order(b, v.data(), 7000, g);
+  gravcal::add_in_order(b, v.data() + 7000, v.size() - 7000, g);
+  CHECK(a == b);
+}
+
+// Segmenter::lazy_r_sd() against R's sds everywhere, through GGIR's block
+// rules: windows with sds near the rest threshold (1e-13 either side), at
+// rest, moving, repeated stretches (GGIR's duplicates), invalid samples
+// (windows without means) and idle-sleep zeros. Every other statistic is
+// the same, so are the rest flags and the rest windows' sds (to the bit),
+// and so are the ties GGIR's duplicate filter counts (a window's sd equal
+// to that of the last window with means).
+static void test_lazy_sd() {
+  using W = gravcal::WindowStats;
+  long long windows = 0, in_double = 0, ties = 0;
+  bool ok = true;
+  for (int seed = 0; seed < 60; ++seed) {
+    std::mt19937_64 pick(static_cast<std::uint64_t>(seed));
+    auto U = [&](int a, int b) { return std::uniform_int_distribution<int>(a, b)(pick); };
+    const int H = U(20, 400);
+    const double L = U(0, 2) ? static_cast<double>(U(2, 30)) : U(2, 30) + 0.5;
+    const double T = U(0, 1) ? 0.013 : 0.02;
+    std::vector<W> out[2];
+    for (int lazy = 0; lazy < 2; ++lazy) {
+      std::mt19937_64 g(static_cast<std::uint64_t>(seed) * 7 + 1);
+      auto G = [&](int a, int b) { return std::uniform_int_distribution<int>(a, b)(g); };
+      std::normal_distribution<double> nd(0, 1);
+      const std::size_t cap = 3 * (static_cast<std::size_t>(std::ceil(L)) + 1);
+      std::vector<double> buf(cap), held(cap);
+      gravcal::LazySd state;
+      gravcal::Segmenter seg(L, false);
+      CHECK(seg.use_r_arithmetic(buf.data(), buf.size()));
+      if (lazy) CHECK(seg.lazy_r_sd(T, &state, held.data(), held.size()));
+      gravcal::GgirBlocks gb(seg, H, true, true);
+      auto sink = [&](const W& w) { out[lazy].push_back(w); };
+      const int blocks = G(1, 5);
+      for (int b = 0; b < blocks; ++b) {
+        const int n = G(0, 4 * H);
+        std::vector<double> x(static_cast<std::size_t>(n)), y(x.size()), z(x.size()), t(x.size());
+        double noise = 0.01;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          if (i % static_cast<std::size_t>(std::ceil(L)) == 0) {
+            const int k = G(0, 9);
+            noise = k < 3 ? T * (1 + (G(0, 1) ? 1e-13 : -1e-13) * G(0, 3))
+                          : (k < 5 ? 0.003 : (k < 8 ? 0.2 : 0.0));
+          }
+          x[i] = 0.1 + noise * nd(g);
+          y[i] = -0.4 + noise * nd(g);
+          z[i] = 0.9 + noise * nd(g);
+          t[i] = 25 + static_cast<double>(i / 120) * 0.01;
+          if (G(0, 400) == 0) y[i] = NAN;
+          if (G(0, 300) == 0) x[i] = y[i] = z[i] = 0;
+        }
+        if (n > 200 && G(0, 1)) {  // a repeated stretch
+          const int len = G(1, 60), at = G(len, n - len - 1);
+          for (int i = 0; i < len; ++i) {
+            x[static_cast<std::size_t>(at + i)] = x[static_cast<std::size_t>(at - len + i)];
+            y[static_cast<std::size_t>(at + i)] = y[static_cast<std::size_t>(at - len + i)];
+            z[static_cast<std::size_t>(at + i)] = z[static_cast<std::size_t>(at - len + i)];
+          }
+        }
+        if (n > 100 && G(0, 3) == 0) {  // windows without means
+          const int at = G(0, n - 40);
+          for (int i = 0; i < 40; ++i) x[static_cast<std::size_t>(at + i)] = NAN;
+        }
+        gb.begin_block();
+        int i = 0;
+        while (i < n) {
+          const int k = std::min(n - i, G(1, 3 * H));
+          const std::size_t o = static_cast<std::size_t>(i);
+          gb.push(x.data() + o, y.data() + o, z.data() + o, t.data() + o,
+                  static_cast<std::size_t>(k), sink);
+          i += k;
+        }
+        gb.end_block(sink);
+      }
+    }
+    CHECK(out[0].size() == out[1].size());
+    if (out[0].size() != out[1].size()) continue;
+    gravcal::SdRestRule rule;
+    rule.max_sd = T;
+    std::size_t last = out[0].size();
+    for (std::size_t k = 0; k < out[0].size(); ++k) {
+      const W& e = out[0][k];
+      const W& a = out[1][k];
+      ++windows;
+      W u = a;
+      std::memcpy(u.sd, e.sd, sizeof u.sd);
+      ok = ok && std::memcmp(&u, &e, sizeof u) == 0;
+      const bool r = gravcal::is_rest(e, rule);
+      ok = ok && r == gravcal::is_rest(a, rule);
+      const bool same_sd = std::memcmp(a.sd, e.sd, sizeof a.sd) == 0;
+      ok = ok && (!r || same_sd);
+      if (!same_sd) ++in_double;
+      if (std::isnan(e.mean[2]) || std::isnan(e.mean_norm)) continue;
+      if (last < out[0].size()) {
+        for (int ax = 0; ax < 3; ++ax) {
+          const bool te = e.sd[ax] == out[0][last].sd[ax];
+          ties += te;
+          ok = ok && te == (a.sd[ax] == out[1][last].sd[ax]);
+        }
+      }
+      last = k;
+    }
+  }
+  CHECK(ok);
+  CHECK(windows > 3000 && in_double > 500 && ties > 100);  // all cases met
+}
+
+// lazy_r_sd() where it is put to the test: windows whose R sd is the rest
+// threshold to a few doubles, and windows that repeat the one before with
+// the samples permuted (R's long double sds then often tie while sds in
+// double do not). Rest flags and ties as with R's sds everywhere.
+static void test_lazy_sd_edges() {
+  using W = gravcal::WindowStats;
+  const std::size_t L = 1000;
+  const double T = 0.013;
+  std::mt19937_64 g(99);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::vector<double> x, y, z;
+  std::vector<double> a(L), b(L), c(L);
+  int at_threshold = 0;
+  for (int w = 0; w < 400; ++w) {
+    const int kind = w % 4;  // moving, permuted, at the threshold, moving
+    if (kind == 1) {
+      const std::size_t s0 = x.size() - L;
+      for (std::size_t i = 0; i < L; ++i) {
+        const std::size_t j = w % 8 < 4 ? L - 1 - i : (i + 1) % L;
+        a[i] = x[s0 + j];
+        b[i] = y[s0 + j];
+        c[i] = z[s0 + j];
+      }
+    } else {
+      const double noise = kind == 2 ? T : 0.05;
+      for (std::size_t i = 0; i < L; ++i) {
+        a[i] = (kind == 2 ? 0.0 : 1.3) + noise * nd(g);
+        b[i] = -0.2 + 0.004 * nd(g);
+        c[i] = 0.93 + 0.004 * nd(g);
+      }
+      if (kind == 2) {
+        // x scaled so that its R sd is the threshold's double, or one of
+        // the six either side (bisection on the scale)
+        const std::vector<double> d = a;
+        auto sd_at = [&](double f) {
+          for (std::size_t i = 0; i < L; ++i) a[i] = d[i] * f;
+          return gravcal::r_mean_sd([&](auto&& h) {
+            for (double v : a) h(v);
+          }).sd;
+        };
+        const int u = static_cast<int>((w / 4) % 13) - 6;
+        double goal = T;
+        for (int k = 0; k < (u < 0 ? -u : u); ++k) goal = std::nextafter(goal, u < 0 ? 0.0 : 1.0);
+        double lo = 0.5, hi = 2.0;
+        for (int it = 0; it < 200 && lo < hi; ++it) {
+          const double mid = lo + (hi - lo) / 2;
+          if (mid == lo || mid == hi) break;
+          (sd_at(mid) < goal ? lo : hi) = mid;
+        }
+        sd_at(std::fabs(sd_at(lo) - goal) < std::fabs(sd_at(hi) - goal) ? lo : hi);
+        ++at_threshold;
+      }
+    }
+    x.insert(x.end(), a.begin(), a.end());
+    y.insert(y.end(), b.begin(), b.end());
+    z.insert(z.end(), c.begin(), c.end());
+  }
+  std::vector<W> out[2];
+  for (int lazy = 0; lazy < 2; ++lazy) {
+    std::vector<double> buf(3 * (L + 1)), held(buf.size());
+    gravcal::LazySd state;
+    gravcal::Segmenter seg(static_cast<double>(L), false);
+    CHECK(seg.use_r_arithmetic(buf.data(), buf.size()));
+    if (lazy) CHECK(seg.lazy_r_sd(T, &state, held.data(), held.size()));
+    auto sink = [&](const W& w) { out[lazy].push_back(w); };
+    for (std::size_t i = 0; i < x.size(); i += 10 * L) {  // whole windows
+      const std::size_t n = std::min(10 * L, x.size() - i);
+      seg.push(x.data() + i, y.data() + i, z.data() + i, nullptr, n, sink);
+    }
+    seg.finish(sink);
+  }
+  CHECK(out[0].size() == 400 && out[1].size() == 400);
+  gravcal::SdRestRule rule;
+  rule.max_sd = T;
+  int rest = 0, not_rest = 0, ties = 0, bad = 0;
+  for (std::size_t k = 0; k < out[0].size() && k < out[1].size(); ++k) {
+    const W& e = out[0][k];
+    const W& l = out[1][k];
+    const bool r = gravcal::is_rest(e, rule);
+    if (k % 4 == 2) (r ? rest : not_rest) += 1;  // the threshold's windows
+    if (r != gravcal::is_rest(l, rule)) ++bad;
+    if (r && std::memcmp(e.sd, l.sd, sizeof e.sd) != 0) ++bad;
+    if (k > 0) {
+      for (int ax = 0; ax < 3; ++ax) {
+        const bool te = e.sd[ax] == out[0][k - 1].sd[ax];
+        ties += te;
+        if (te != (l.sd[ax] == out[1][k - 1].sd[ax])) ++bad;
+      }
+    }
+  }
+  CHECK(bad == 0);
+  // both sides of the threshold, and R's ties between permuted windows
+  CHECK(at_threshold == 100 && rest > 30 && not_rest > 30 && ties > 100);
+}
+
 // A digest of the windows of a fixed stream, printed so that the Makefile
 // can check that the SSE2 and the portable builds give the same bits.
 static void print_digest() {
@@ -333,6 +595,9 @@ int main(int argc, char** argv) {
   test_icp();
   test_r_arithmetic();
   test_r_sd_below();
+  test_add_repeated();
+  test_lazy_sd();
+  test_lazy_sd_edges();
   test_model();
   test_segmenter();
   test_bins();

@@ -4,7 +4,12 @@
 // are the same, to the bit, whether a block's samples are pushed at once,
 // pushed in the fuzzer's chunks, or written into the rules' own buffer a
 // few at a time (space() and commit(), as a decoder does); the counts add
-// up; a used block is whole hours.
+// up; a used block is whole hours. In compatible mode the segmenter may
+// give R's sds only where GGIR's rules see them (Segmenter::lazy_r_sd()):
+// then, against R's sds everywhere, every other statistic is the same, and
+// so are the rest windows (with their sds, to the bit) and the ties GGIR's
+// duplicate filter counts between a window and the last one with means.
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -34,6 +39,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const double L = 1 + in.byte() % 12 + (in.byte() & 1 ? 0.5 : 0.0);
   const bool compat = in.byte() & 1;
   const bool with_t = in.byte() & 1;
+  const std::uint8_t lazy_byte = in.byte();
+  const bool lazy = compat && (lazy_byte & 1);
+  const double max_sd = 0.001 + (lazy_byte >> 1) / 64.0;  // 0.001 to 2
   std::vector<std::size_t> chunks;
   for (int i = 0; i < 6; ++i) chunks.push_back(in.byte() % 50);  // 0: an empty write
   chunks.push_back(1 + in.byte() % 50);  // so that the samples go on
@@ -53,11 +61,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     blocks.push_back(b);
   }
-  Out out[3];
-  for (int way = 0; way < 3; ++way) {
-    std::vector<double> buf(3 * (static_cast<std::size_t>(L) + 3));
+  Out out[4];
+  for (int way = 0; way < 4; ++way) {
+    if (way == 3 && !lazy) break;
+    std::vector<double> buf(3 * (static_cast<std::size_t>(L) + 3)), held(buf.size());
+    gravcal::LazySd state;
     gravcal::Segmenter seg(L, false);
     if (compat && !seg.use_r_arithmetic(buf.data(), buf.size())) __builtin_trap();
+    // ways 0-2 lazy when asked; way 3: R's sds everywhere, as the reference
+    if (lazy && way < 3 && !seg.lazy_r_sd(max_sd, &state, held.data(), held.size())) __builtin_trap();
     gravcal::GgirBlocks gb(seg, per_hour, compat, with_t);
     auto sink = [&](const gravcal::WindowStats& w) { out[way].w.push_back(w); };
     std::size_t c = 0;
@@ -72,7 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       gb.begin_block();
       std::size_t i = 0;
-      if (way == 0) {
+      if (way == 0 || way == 3) {
         gb.push(x.data(), y.data(), z.data(), with_t ? t.data() : nullptr, n, sink);
         i = n;
       }
@@ -102,6 +114,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         __builtin_trap();
       }
       out[way].b.push_back(r);
+    }
+  }
+  if (lazy) {
+    const std::vector<gravcal::WindowStats>& a = out[0].w;  // lazy
+    const std::vector<gravcal::WindowStats>& e = out[3].w;  // R's sds
+    if (a.size() != e.size()) __builtin_trap();
+    gravcal::SdRestRule rule;
+    rule.max_sd = max_sd;
+    std::size_t last = a.size();  // the last window with means
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      gravcal::WindowStats u = a[k];
+      std::memcpy(u.sd, e[k].sd, sizeof u.sd);
+      if (std::memcmp(&u, &e[k], sizeof u) != 0) __builtin_trap();
+      const bool r = gravcal::is_rest(e[k], rule);
+      if (r != gravcal::is_rest(a[k], rule)) __builtin_trap();
+      if (r && std::memcmp(a[k].sd, e[k].sd, sizeof u.sd) != 0) __builtin_trap();
+      if (std::isnan(e[k].mean[2]) || std::isnan(e[k].mean_norm)) continue;
+      if (last < a.size()) {
+        for (int ax = 0; ax < 3; ++ax) {
+          if ((a[k].sd[ax] == a[last].sd[ax]) != (e[k].sd[ax] == e[last].sd[ax]))
+            __builtin_trap();
+        }
+      }
+      last = k;
     }
   }
   for (int way = 1; way < 3; ++way) {

@@ -14,6 +14,9 @@
 // as soon as its hour is complete. The last retained sample waits for the
 // next one (or the block's end), because of the first accident below.
 //
+// A block's last window may be held back by the segmenter
+// (Segmenter::lazy_r_sd()); end_block() has it given out with the block.
+//
 // GGIR-compatible mode keeps GGIR's accidents (see ?calibrate):
 // - a block that ends on a whole hour leaves the previous carry in place,
 //   and it is put in front of the next block again;
@@ -219,6 +222,7 @@ class GgirBlocks {
     }
     // otherwise the samples not used (all of them when use = 0) are the
     // carry, where they are
+    seg_.finish(sink);  // the window a lazy segmenter holds back
     info_.carried = static_cast<std::int64_t>(
         carry_in_hold_ ? tail_ - head_ : carry_[0].size());
     return info_;
@@ -307,27 +311,10 @@ class GgirBlocks {
       if (runs_.empty() || runs_.back().bits != bits) {
         runs_.push_back(Run{bits, t[i], 0});
       }
-      const std::size_t j = run_end(t, i, m, bits);
+      const std::size_t j = run_end(t, i, m);
       runs_.back().count += static_cast<std::int64_t>(j - i);
       i = j;
     }
-  }
-
-  // The end of the run of values with these bits that starts at t[i].
-  static std::size_t run_end(const double* t, std::size_t i, std::size_t m,
-                             std::uint64_t bits) {
-    std::size_t j = i + 1;
-#if defined(GRAVCAL_SSE2)
-    const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
-    for (; j + 4 <= m; j += 4) {
-      const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(t + j));
-      const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(t + j + 2));
-      const __m128i eq = _mm_and_si128(_mm_cmpeq_epi32(a0, b), _mm_cmpeq_epi32(a1, b));
-      if (_mm_movemask_epi8(eq) != 0xffff) break;
-    }
-#endif
-    while (j < m && std::memcmp(t + j, &bits, sizeof bits) == 0) ++j;
-    return j;
   }
 
   // The first k waiting samples go to the segmenter.

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace gravcal {
@@ -150,6 +151,84 @@ inline int r_sd_below(const RunsSd& r, double thr) {
   if (hi < t2 * (1.0L - 1e-15L)) return 1;
   if (lo > t2 * (1.0L + 1e-15L)) return 0;
   return -1;
+}
+
+// The long double grid around a value: |s| in [bottom, top) = [2^(e-1),
+// 2^e) has spacing q = 2^(e - digits).
+struct Binade {
+  long double q = 0, inv_q = 0, bottom = 0, top = 0;
+  bool holds(long double a) const { return a >= bottom && a < top; }
+  void set(long double s) {
+    constexpr int digits = std::numeric_limits<long double>::digits;
+    int e = 0;
+    std::frexp(s, &e);
+    q = std::ldexp(1.0L, e - digits);
+    inv_q = std::ldexp(1.0L, digits - e);
+    bottom = std::ldexp(1.0L, e - 1);
+    top = std::ldexp(1.0L, e);
+  }
+};
+
+// add_repeated()'s closed form (see there): adds x to s j times, 0 < j <=
+// k, as j additions would, and returns j; or returns 0 when the next
+// addition must be a plain one. b: the grid of s, kept between calls.
+inline std::uint64_t repeat_steps(long double& s, double x, std::uint64_t k, Binade& b) {
+  if (x == 0.0 || s == 0.0L || !std::isfinite(x) || !std::isfinite(s)) return 0;
+  const long double a = std::fabs(s);
+  if (!b.holds(a)) b.set(s);
+  const long double y = x * b.inv_q;  // exact: a power of 2
+  if (!(std::fabs(y) < 0x1p62L)) return 0;
+  const long double n = static_cast<long double>(std::llrint(y));
+  if (std::fabs(y - n) == 0.5L) return 0;  // a tie: the last bit of s decides
+  const long double r = n * b.q;              // x on the grid of s
+  // |s| may go from lo to hi (q inside the binade), in steps of |r|
+  const long double lo = b.bottom + b.q, hi = b.top - b.q;
+  if (r == 0.0L) return a >= lo && a <= hi ? k : 0;  // s does not move
+  const long double room = (s > 0) == (r > 0) ? hi - a : a - lo;
+  if (!(room > 0)) return 0;
+  const long double step = std::fabs(r);
+  std::uint64_t j = k;
+  if (static_cast<long double>(k) * step > room) {
+    j = static_cast<std::uint64_t>(std::floor(room / step));
+  }
+  // room / step rounded: step back until s + j r is inside (j r is exact:
+  // |j n| < 2^digits)
+  while (j > 0) {
+    const long double t = std::fabs(s + static_cast<long double>(j) * r);
+    if (t >= lo && t <= hi) break;
+    --j;
+  }
+  if (j > 0) s += static_cast<long double>(j) * r;  // exact, see add_repeated()
+  return j;
+}
+
+// s += x, k times, in long double, to the bit (as a loop of k additions
+// would give it), in a few steps. Each addition rounds the exact s + x to
+// the long double grid of s's binade: spacing q = 2^(e - digits) for |s| in
+// [2^(e-1), 2^e). s is on that grid, so while s + x stays inside the
+// binade the sum rounds to s + r, r = x rounded to the nearest multiple of
+// q (the grid is the same after a shift by s), unless x is exactly half-way
+// between two multiples, a tie that the last bit of s decides. So j
+// additions give s + j r, exactly (a multiple of q inside the binade is
+// representable, and so is j r), as long as |s + j r| stays in [2^(e-1) +
+// q, 2^e - q]: every exact sum on the way is then inside the binade
+// (|x - r| <= q / 2). At a tie, near the binade's edges, with s or x zero
+// or not finite, and for fewer than 4 additions: plain additions.
+inline void add_repeated(long double& s, double x, std::uint64_t k, Binade& b) {
+  while (k > 0) {
+    const std::uint64_t j = k < 4 ? 0 : repeat_steps(s, x, k, b);
+    if (j == 0) {
+      s += x;
+      --k;
+    } else {
+      k -= j;
+    }
+  }
+}
+
+inline void add_repeated(long double& s, double x, std::uint64_t k) {
+  Binade b;
+  add_repeated(s, x, k, b);
 }
 
 // R's mean() of n contiguous values (no NaN handling: R's mean without
