@@ -567,8 +567,9 @@ static void test_lazy_sd_edges() {
   CHECK(at_threshold == 100 && rest > 30 && not_rest > 30 && ties > 100);
 }
 
-// A digest of the windows of a fixed stream, printed so that the Makefile
-// can check that the SSE2 and the portable builds give the same bits.
+// A digest of the windows of a fixed stream and of ICP fits, printed so that
+// the Makefile can check that the SSE2 and the portable builds give the
+// same bits.
 static void print_digest() {
   std::mt19937 rng(77);
   std::normal_distribution<double> nd(0.0, 0.02);
@@ -584,6 +585,30 @@ static void print_digest() {
     const unsigned char* p = reinterpret_cast<const unsigned char*>(&w);
     for (std::size_t i = 0; i < sizeof(w); ++i) h = (h ^ p[i]) * 1099511628211ull;
   });
+  // and gravcal's ICP fit (its loops two points at a time with SSE2), with
+  // and without the temperature term, on noisy rest means
+  for (int temp = 0; temp < 2; ++temp) {
+    const std::size_t m = 2001;  // odd: the scalar tail too
+    std::vector<double> a(m), b(m), c(m), tt(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      double v[3] = {nd(rng) * 20, nd(rng) * 20, nd(rng) * 20};
+      const double r = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      a[i] = 1.01 * v[0] / r + 0.02 + nd(rng) * 0.1;
+      b[i] = 0.98 * v[1] / r - 0.01 + nd(rng) * 0.1;
+      c[i] = v[2] / r + 0.03 + nd(rng) * 0.1;
+      tt[i] = 25 + 200 * nd(rng);
+    }
+    gravcal::IcpConfig cfg;
+    cfg.stop = gravcal::StopRule::parameters;
+    const gravcal::IcpResult r =
+        gravcal::fit_icp(a.data(), b.data(), c.data(), temp ? tt.data() : nullptr, m, cfg);
+    const double out[10] = {r.scale[0], r.scale[1], r.scale[2], r.offset[0], r.offset[1],
+                            r.offset[2], r.tempoffset[0], r.tempoffset[1], r.tempoffset[2],
+                            r.statistic};
+    const unsigned char* p = reinterpret_cast<const unsigned char*>(out);
+    for (std::size_t i = 0; i < sizeof(out); ++i) h = (h ^ p[i]) * 1099511628211ull;
+    h ^= static_cast<std::uint64_t>(r.iterations);
+  }
   std::printf("digest %016llx\n", static_cast<unsigned long long>(h));
 }
 
