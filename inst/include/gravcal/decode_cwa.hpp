@@ -68,6 +68,12 @@
 
 #include "gravcal/decode.hpp"
 
+// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
+#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
+#define GRAVCAL_SSE2 1
+#include <emmintrin.h>
+#endif
+
 namespace gravcal {
 
 namespace cwa {
@@ -223,7 +229,54 @@ inline void scale_samples(const unsigned char* b, const Header& h, const Params&
   }
 }
 
-// A decoded block: header, index in the file, start time, samples.
+// Samples [from, from + n) of the block, scaled as scale_samples() does,
+// into three columns: packed ones four at a time with SSE2 (the same
+// integer and the same product per value, so the same doubles).
+inline void scale_columns(const unsigned char* b, const Header& h, const Params& p,
+                          double packed_scale, int from, int n, double* x, double* y,
+                          double* z) {
+  const unsigned char* d = b + data_offset;
+  if (h.packed) {
+    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
+    int i = 0;
+#if defined(GRAVCAL_SSE2)
+    const __m128i m10 = _mm_set1_epi32(0x3ff), sign = _mm_set1_epi32(0x200);
+    for (; i + 4 <= n; i += 4) {
+      const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + 4 * (from + i)));
+      alignas(16) std::int32_t e[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(e), _mm_srli_epi32(w, 30));
+      const __m128d m01 = _mm_set_pd(f[e[1]], f[e[0]]), m23 = _mm_set_pd(f[e[3]], f[e[2]]);
+      double* col[3] = {x + i, y + i, z + i};
+      for (int a = 0; a < 3; ++a) {
+        // signed10(v >> 10 a), four at a time
+        const __m128i u = a == 0 ? w : _mm_srli_epi32(w, 10 * a);
+        const __m128i v = _mm_sub_epi32(_mm_xor_si128(_mm_and_si128(u, m10), sign), sign);
+        _mm_storeu_pd(col[a], _mm_mul_pd(_mm_cvtepi32_pd(v), m01));
+        _mm_storeu_pd(col[a] + 2, _mm_mul_pd(_mm_cvtepi32_pd(_mm_shuffle_epi32(v, 0xee)), m23));
+      }
+    }
+#endif
+    for (; i < n; ++i) {
+      const std::uint32_t v = le32(d + 4 * (from + i));
+      const double m = f[v >> 30];
+      x[i] = signed10(v) * m;
+      y[i] = signed10(v >> 10) * m;
+      z[i] = signed10(v >> 20) * m;
+    }
+    return;
+  }
+  const int acc = p.axes == 6 ? 3 : 0;
+  double* col[3] = {x, y, z};
+  for (int i = 0; i < n; ++i) {
+    const unsigned char* s = d + 2 * ((from + i) * p.axes + acc);
+    for (int a = 0; a < 3; ++a) {
+      col[a][i] = static_cast<std::int16_t>(le16(s + 2 * a)) * p.accel_scale;
+    }
+  }
+}
+
+// A decoded block: header, index in the file, start time, samples (or,
+// for compat = 0, its bytes: the samples go straight to the output).
 struct Block {
   Header h;
   std::int64_t index = 0;
@@ -231,6 +284,7 @@ struct Block {
   double start = 0;  // the first sample's time
   double frequency = 0;
   double xyz[3 * max_samples];
+  unsigned char bytes[block_bytes];
 };
 
 }  // namespace cwa
@@ -253,7 +307,7 @@ class CwaDecoder : public Decoder {
   bool refill();
   Got next_good(std::int64_t& index, std::int64_t stop, cwa::Block& b, bool own, bool count);
   bool decode(const unsigned char* raw, std::int64_t index, const cwa::Params* p,
-              cwa::Block& b, bool count);
+              cwa::Block& b, bool count, bool keep_bytes = false);
   void skip(cwa::Status s, std::int64_t index);
   void check_time(const cwa::Block& b);
 
@@ -446,7 +500,7 @@ inline void CwaDecoder::skip(cwa::Status s, std::int64_t index) {
 // Decodes block `raw` with parameters p (null: its own), its time from the
 // calendar. False (counted when `count`) when it is unusable.
 inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, const cwa::Params* p,
-                               cwa::Block& b, bool count) {
+                               cwa::Block& b, bool count, bool keep_bytes) {
   cwa::Status s = cwa::parse_header(raw, b.h);
   const cwa::Params own = cwa::own_params(b.h);
   const cwa::Params& use = p != nullptr ? *p : own;
@@ -464,6 +518,10 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
   b.rtc = T;
   b.frequency = b.h.rate == 0 ? b.h.offset26 : use.frequency;
   b.start = cwa::block_start(T, b.h, use);
+  if (keep_bytes) {  // the caller scales the samples (scale_columns())
+    std::memcpy(b.bytes, raw, cwa::block_bytes);
+    return true;
+  }
   const double packed_scale = compat_ ? use.accel_scale : 1.0 / 256;
   cwa::scale_samples(raw, b.h, use, packed_scale, b.xyz);
   return true;
@@ -532,7 +590,7 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
       }
       ++units;
       const std::int64_t i = raw_index_++;
-      if (!decode(raw, i, nullptr, raw_, true)) continue;
+      if (!decode(raw, i, nullptr, raw_, true, true)) continue;
       check_time(raw_);
       raw_open_ = true;
       raw_next_ = 0;
@@ -540,16 +598,10 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
     const double dt = 1.0 / raw_.frequency;
     const int n = static_cast<int>(std::min<std::size_t>(
         out.room(), static_cast<std::size_t>(raw_.h.count - raw_next_)));
-    // column by column (what out.put() would write, sample by sample)
-    const double* v = raw_.xyz + 3 * raw_next_;
-    double* ox = out.x + out.n;
-    double* oy = out.y + out.n;
-    double* oz = out.z + out.n;
-    for (int k = 0; k < n; ++k) {
-      ox[k] = v[3 * k];
-      oy[k] = v[3 * k + 1];
-      oz[k] = v[3 * k + 2];
-    }
+    // straight from the block's bytes, column by column (what out.put()
+    // would write, sample by sample), at 1/256 g (see the top of the file)
+    cwa::scale_columns(raw_.bytes, raw_.h, cwa::own_params(raw_.h), 1.0 / 256, raw_next_, n,
+                       out.x + out.n, out.y + out.n, out.z + out.n);
     if (out.t != nullptr) std::fill(out.t + out.n, out.t + out.n + n, raw_.h.temperature);
     if (out.time != nullptr) {
       for (int k = 0; k < n; ++k) out.time[out.n + k] = raw_.start + (raw_next_ + k) * dt;
