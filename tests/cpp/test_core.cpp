@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "gravcal/decode_geneactiv.hpp"
 #include "gravcal/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
 #include "gravcal/icp.hpp"
@@ -567,6 +568,28 @@ static void test_lazy_sd_edges() {
   CHECK(at_threshold == 100 && rest > 30 && not_rest > 30 && ties > 100);
 }
 
+// The GENEActiv decoder's hex digits sixteen at a time (hex16()) against
+// its table, for every byte value in every position.
+static void test_hex16() {
+#if defined(GRAVCAL_SSE2)
+  const unsigned char* h = gravcal::geneactiv::hex_table().v;
+  bool ok = true;
+  for (int pos = 0; pos < 16; ++pos) {
+    for (int c = 0; c < 256; ++c) {
+      unsigned char s[16], v[16];
+      for (int k = 0; k < 16; ++k) s[k] = static_cast<unsigned char>("0123456789abcDEF"[k]);
+      s[pos] = static_cast<unsigned char>(c);
+      const int bad = gravcal::geneactiv::hex16(s, v);
+      for (int k = 0; k < 16; ++k) {
+        const bool digit = h[s[k]] < 16;
+        ok = ok && (((bad >> k) & 1) == !digit) && (!digit || v[k] == h[s[k]]);
+      }
+    }
+  }
+  CHECK(ok);
+#endif
+}
+
 // A digest of the windows of a fixed stream and of ICP fits, printed so that
 // the Makefile can check that the SSE2 and the portable builds give the
 // same bits.
@@ -620,6 +643,7 @@ int main(int argc, char** argv) {
   test_icp();
   test_r_arithmetic();
   test_r_sd_below();
+  test_hex16();
   test_add_repeated();
   test_lazy_sd();
   test_lazy_sd_edges();
