@@ -629,16 +629,35 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   std::size_t i = 0;
 #if defined(GRAVCAL_SSE2)
   // four samples (48 digits) at a time: the digits' values and whether each
-  // is a hex digit sixteen at a time (hex16()), then the 12-bit counts
+  // is a hex digit sixteen at a time (hex16()); then digit pairs p_j =
+  // d_2j d_2j+1 in 16-bit lanes, so that a sample's counts (digits 0-2,
+  // 3-5, 6-8 of its 12, pairs p_0..p_5 from its first) are x = p_0 p_1
+  // >> 4, y = (p_1 & 15) p_2 and z = p_3 p_4 >> 4: lanes 0 and 3 of q_j =
+  // p_j << 4 | p_j+1 >> 4 and lane 1 of r_j = (p_j & 15) << 8 | p_j+1
   alignas(16) unsigned char v[48];
   for (; i + 4 <= whole; i += 4, s += 4 * kDigitsPerSample) {
     if ((hex16(s, v) | hex16(s + 16, v + 16) | hex16(s + 32, v + 32)) != 0) bad |= 0x10u;
+    const __m128i lo8 = _mm_set1_epi16(0xff), lo4 = _mm_set1_epi16(0xf);
+    __m128i pr[4];  // p_0..p_23, and zeros after
+    for (int k = 0; k < 3; ++k) {
+      const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(v + 16 * k));
+      pr[k] = _mm_or_si128(_mm_slli_epi16(_mm_and_si128(w, lo8), 4), _mm_srli_epi16(w, 8));
+    }
+    pr[3] = _mm_setzero_si128();
+    alignas(16) std::uint16_t q[24], r[24];
+    for (int k = 0; k < 3; ++k) {
+      // p_j+1 in lane j: this vector one lane on, the next one's first last
+      const __m128i nx = _mm_or_si128(_mm_srli_si128(pr[k], 2), _mm_slli_si128(pr[k + 1], 14));
+      _mm_store_si128(reinterpret_cast<__m128i*>(q + 8 * k),
+                      _mm_or_si128(_mm_slli_epi16(pr[k], 4), _mm_srli_epi16(nx, 4)));
+      _mm_store_si128(reinterpret_cast<__m128i*>(r + 8 * k),
+                      _mm_or_si128(_mm_slli_epi16(_mm_and_si128(pr[k], lo4), 8), nx));
+    }
     for (int j = 0; j < 4; ++j) {
-      const unsigned char* d = v + 12 * j;
-      for (int a = 0; a < 3; ++a) {
-        next_->raw[i + static_cast<std::size_t>(j)][a] = static_cast<std::uint16_t>(
-            (d[3 * a] << 8) | (d[3 * a + 1] << 4) | d[3 * a + 2]);
-      }
+      std::uint16_t* o = next_->raw[i + static_cast<std::size_t>(j)];
+      o[0] = q[6 * j];
+      o[1] = r[6 * j + 1];
+      o[2] = q[6 * j + 3];
     }
   }
 #endif
