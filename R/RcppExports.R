@@ -37,8 +37,8 @@ gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight,
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }
 
-gc_blocks_new <- function(seg, per_hour, compat, temperature) {
-    .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature)
+gc_blocks_new <- function(seg, per_hour, compat, temperature, temp_min_sd) {
+    .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature, temp_min_sd)
 }
 
 gc_blocks_columns <- function(blocks, x, y, z, t, from, to, rule, par) {
@@ -47,6 +47,10 @@ gc_blocks_columns <- function(blocks, x, y, z, t, from, to, rule, par) {
 
 gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic = FALSE) {
     .Call(`_gravcal_gc_segmenter_new`, samples_per_window, skip_zero, r_arithmetic)
+}
+
+gc_segmenter_lazy_sd <- function(seg, max_sd) {
+    invisible(.Call(`_gravcal_gc_segmenter_lazy_sd`, seg, max_sd))
 }
 
 gc_segmenter_new_block <- function(seg) {

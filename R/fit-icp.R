@@ -91,10 +91,9 @@ fit_icp <- function(w, use_temp = TRUE, ggir_compat = FALSE, max_iter = 1000,
                                     "at least 10 are needed"), call = call)
     return(fit)
   }
-  r <- gc_fit_icp(as.double(w$mean_x), as.double(w$mean_y),
-                  as.double(w$mean_z), temp, use_temp,
-                  if (ggir_compat) "ggir_r" else "converge", as.integer(max_iter), tol,
-                  max_weight, trace)
+  r <- icp_means(as.double(w$mean_x), as.double(w$mean_y), as.double(w$mean_z),
+                 temp, use_temp, if (ggir_compat) "ggir_r" else "converge",
+                 max_iter, tol, max_weight, trace)
   if (use_temp && !r$temp_used) {
     msg <- "temperature does not vary over the windows, so the temperature term was not fitted"
   }
@@ -125,6 +124,25 @@ fit_icp <- function(w, use_temp = TRUE, ggir_compat = FALSE, max_iter = 1000,
     fit$trace <- tr
   }
   fit
+}
+
+# The ICP fit of n window means x, y, z (icp.hpp): the one way to it, for
+# fit_icp() and for the GGIR procedure (ggir_run(), which fits the rest
+# windows of its table after a block). temp: the windows' temperatures, or
+# NULL; use_temp: fit the temperature term. rule, the stopping rule:
+#   "converge": until no parameter moves by more than `tol` (gravcal's);
+#   "ggir_r": GGIR's statistic in GGIR's R arithmetic, least squares by R's
+#     own routine: GGIR's coefficients to the bit (compatible mode);
+#   "ggir": GGIR's statistic in gravcal's arithmetic, a cheap early stop
+#     (the GGIR procedure uses it to decide whether to read on).
+# Returns the core's list: scale, offset, tempoffset, meantemp, temp_used,
+# iterations, converged, finite, statistic and (trace = TRUE) the trace.
+icp_means <- function(x, y, z, temp, use_temp, rule = c("converge", "ggir_r", "ggir"),
+                      max_iter = ggir_constants$max_iter, tol = ggir_constants$tol,
+                      max_weight = ggir_constants$max_weight, trace = FALSE) {
+  rule <- match.arg(rule)
+  gc_fit_icp(x, y, z, if (use_temp) temp, use_temp, rule, as.integer(max_iter),
+             tol, max_weight, trace)
 }
 
 # Accept gravcal epochs or GGIR's spheredata.

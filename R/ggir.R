@@ -148,6 +148,9 @@ ggir_run <- function(src, compat = TRUE,
   }
   per_hour <- 3600 * sf
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
+  # compatible mode: R's sds only where GGIR's rules can see them (the rest
+  # rule, the duplicate filter): see Segmenter::lazy_r_sd()
+  if (compat) gc_segmenter_lazy_sd(seg, sdcriter)
   feats <- list()
   rests <- list()  # the core's rest flag of each window (GGIR's rule)
   n_feat <- 0
@@ -175,13 +178,15 @@ ggir_run <- function(src, compat = TRUE,
   feed <- function(i) {
     if (!is.null(src$native)) {
       temp <- isTRUE(src$temperature)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
+                                                  ggir_constants$temp_min_sd)
       r <- gc_blocks_decode(runner, src$native$ptr, src$block_units, 1L, rule_par)
     } else {
       blk <- src$read(i)
       if (is.null(blk)) return(NULL)
       temp <- block_has_temp(blk)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp)
+      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
+                                                  ggir_constants$temp_min_sd)
       P <- block_pieces(blk, temp)
       r <- gc_blocks_columns(runner, lapply(P, `[[`, "x"), lapply(P, `[[`, "y"),
                              lapply(P, `[[`, "z"), lapply(P, function(p) p$t),
@@ -312,9 +317,8 @@ ggir_run <- function(src, compat = TRUE,
       if (spherepopulated) {
         temp <- if (use.temp) ft[, 8] else NULL
         fit_ft <- function(rule) {
-          r <- gc_fit_icp(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
-                          as.integer(max_iter), tol,
-                          ggir_constants$max_weight, FALSE)
+          r <- icp_means(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
+                         max_iter, tol)
           r$meantemp <- if (use.temp) r$meantemp else 0
           r$error <- ggir_error(ft[, 2:4, drop = FALSE], r$scale, r$offset,
                                 r$tempoffset, temp, r$meantemp)

@@ -125,15 +125,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_blocks_new
-SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature);
-RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP) {
+SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature, double temp_min_sd);
+RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP, SEXP temp_min_sdSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
     Rcpp::traits::input_parameter< double >::type per_hour(per_hourSEXP);
     Rcpp::traits::input_parameter< bool >::type compat(compatSEXP);
     Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature));
+    Rcpp::traits::input_parameter< double >::type temp_min_sd(temp_min_sdSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature, temp_min_sd));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -165,6 +166,16 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< bool >::type r_arithmetic(r_arithmeticSEXP);
     rcpp_result_gen = Rcpp::wrap(gc_segmenter_new(samples_per_window, skip_zero, r_arithmetic));
     return rcpp_result_gen;
+END_RCPP
+}
+// gc_segmenter_lazy_sd
+void gc_segmenter_lazy_sd(SEXP seg, double max_sd);
+RcppExport SEXP _gravcal_gc_segmenter_lazy_sd(SEXP segSEXP, SEXP max_sdSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
+    Rcpp::traits::input_parameter< double >::type max_sd(max_sdSEXP);
+    gc_segmenter_lazy_sd(seg, max_sd);
+    return R_NilValue;
 END_RCPP
 }
 // gc_segmenter_new_block
@@ -273,9 +284,10 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_blocks_decode", (DL_FUNC) &_gravcal_gc_blocks_decode, 5},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
-    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 4},
+    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
     {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
+    {"_gravcal_gc_segmenter_lazy_sd", (DL_FUNC) &_gravcal_gc_segmenter_lazy_sd, 2},
     {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
     {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
     {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},

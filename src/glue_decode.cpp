@@ -181,6 +181,7 @@ Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
                               Rcpp::NumericVector par, bool use_temperature) {
   OpenFile* f = get(ptr);
   Rcpp::XPtr<gravcal_glue::SegmenterBox> box(seg);
+  if (box->lazy_max_sd > 0) Rcpp::stop("a lazy segmenter is for GGIR's blocks only");
   const gravcal_glue::RestRule is_rest(rule, par);
   ChunkBuffer cb(use_temperature && f->decoder->info().has_temperature);
   gravcal::SampleBuffer& out = cb.out;
@@ -207,17 +208,17 @@ Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
 }
 
 // One of GGIR's blocks, `max_units` format units, from the decoder through
-// GGIR's block rules (`blocks`, see gc_blocks_new()) into their segmenter,
-// through a fixed buffer. Returns the block's result (gc_blocks_columns())
-// with `units` and `done`.
+// GGIR's block rules (`blocks`, see gc_blocks_new()) into their segmenter.
+// The decoder writes straight into the block rules' buffer (no copy).
+// Returns the block's result (gc_blocks_columns()) with `units` and `done`.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
                             Rcpp::NumericVector par) {
   OpenFile* f = get(ptr);
   Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  gravcal_glue::check_lazy_rule(*box, rule, par);
   const gravcal_glue::RestRule is_rest(rule, par);
-  ChunkBuffer cb(box->temperature && f->decoder->info().has_temperature);
-  gravcal::SampleBuffer& out = cb.out;
+  const bool temperature = box->temperature && f->decoder->info().has_temperature;
   gravcal_glue::WindowTable table;
   auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
   box->blocks.begin_block();
@@ -225,11 +226,17 @@ Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
   std::int64_t units = 0;
   int rounds = 0;
   while (!f->decoder->done() && left != 0) {
-    out.n = 0;
+    const gravcal::BlockSpace s = box->blocks.space(ChunkBuffer::chunk);
+    gravcal::SampleBuffer out;
+    out.x = s.x;
+    out.y = s.y;
+    out.z = s.z;
+    out.t = temperature ? s.t : nullptr;
+    out.capacity = s.capacity;
     const std::int64_t u = f->decoder->read(out, left);
     units += u;
     if (left > 0) left -= u;
-    box->blocks.push(out.x, out.y, out.z, out.t, out.n, sink);
+    box->blocks.commit(out.n, out.t != nullptr, sink);
     if (out.n == 0 && u == 0) break;
     if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
   }

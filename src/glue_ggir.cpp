@@ -94,12 +94,15 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
       Rcpp::Named("trace") = tm);
 }
 
-// GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp).
+// GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp);
+// temp_min_sd: the threshold of the temperature's sd.
 // [[Rcpp::export(rng = false)]]
-SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature) {
+SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature,
+                   double temp_min_sd) {
   if (!(per_hour >= 1)) Rcpp::stop("per_hour must be at least 1");
   return Rcpp::XPtr<gravcal_glue::BlocksBox>(
-      new gravcal_glue::BlocksBox(seg, per_hour, compat, temperature), true);
+      new gravcal_glue::BlocksBox(seg, per_hour, compat, temperature, temp_min_sd),
+      true);
 }
 
 // One block from columns in memory: the pieces [from[k], to[k]) (0-based) of
@@ -111,6 +114,7 @@ Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List&
                              const Rcpp::NumericVector& to, int rule,
                              Rcpp::NumericVector par) {
   Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
+  gravcal_glue::check_lazy_rule(*box, rule, par);
   const gravcal_glue::RestRule is_rest(rule, par);
   const R_xlen_t np = x.size();
   if (y.size() != np || z.size() != np || t.size() != np || from.size() != np ||

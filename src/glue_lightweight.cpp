@@ -34,6 +34,18 @@ SEXP gc_segmenter_new(double samples_per_window, bool skip_zero,
   return p;
 }
 
+// GGIR's procedure: R's sds only where its rules can see them, the rest
+// rule's threshold max_sd (Segmenter::lazy_r_sd()); windows come one late,
+// the last at the end of each of GGIR's blocks (gc_blocks_*()).
+// [[Rcpp::export(rng = false)]]
+void gc_segmenter_lazy_sd(SEXP seg, double max_sd) {
+  Rcpp::XPtr<SegmenterBox> p(seg);
+  p->held.assign(p->buffer.size(), 0.0);
+  if (!p->seg.lazy_r_sd(max_sd, &p->lazy, p->held.data(), p->held.size()))
+    Rcpp::stop("lazy sds need R's arithmetic and a positive max_sd");
+  p->lazy_max_sd = max_sd;
+}
+
 // Restart GGIR's cumulative sums (a new block); only between windows.
 // [[Rcpp::export(rng = false)]]
 bool gc_segmenter_new_block(SEXP seg) {
@@ -52,6 +64,7 @@ Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x,
                              double from, double to, int rule,
                              Rcpp::NumericVector par) {
   Rcpp::XPtr<SegmenterBox> box(seg);
+  if (box->lazy_max_sd > 0) Rcpp::stop("a lazy segmenter is for GGIR's blocks only");
   Segmenter* s = &box->seg;
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");

@@ -85,6 +85,9 @@ struct SegmenterBox {
       : L(samples_per_window), seg(samples_per_window, skip_zero) {}
   double L;
   std::vector<double> buffer;
+  std::vector<double> held;    // Segmenter::lazy_r_sd()'s buffer and state
+  gravcal::LazySd lazy;
+  double lazy_max_sd = 0.0;    // > 0: lazy_r_sd() with this threshold
   gravcal::Segmenter seg;
 };
 
@@ -110,14 +113,24 @@ struct RestRule {
 // GGIR's block rules in front of a segmenter (ggir_blocks.hpp). Keeps the
 // segmenter's R object alive for as long as it is used.
 struct BlocksBox {
-  BlocksBox(SEXP seg, double per_hour, bool compat, bool temperature)
+  BlocksBox(SEXP seg, double per_hour, bool compat, bool temperature,
+            double temp_min_sd)
       : seg_keep(seg),
-        blocks(Rcpp::XPtr<SegmenterBox>(seg)->seg, per_hour, compat, temperature),
+        blocks(Rcpp::XPtr<SegmenterBox>(seg)->seg, per_hour, compat, temperature,
+               temp_min_sd),
         temperature(temperature) {}
   Rcpp::RObject seg_keep;
   gravcal::GgirBlocks blocks;
   bool temperature;
 };
+
+// A lazy segmenter (Segmenter::lazy_r_sd()) gives R's sds only where the
+// sd rule with its own threshold can see them: refuse any other rule.
+inline void check_lazy_rule(const BlocksBox& box, int rule, const Rcpp::NumericVector& par) {
+  const double m = Rcpp::XPtr<SegmenterBox>(box.seg_keep)->lazy_max_sd;
+  if (m > 0 && !(rule == 1 && par.size() >= 1 && par[0] == m))
+    Rcpp::stop("this segmenter gives R's sds for the sd rule with max_sd = %g only", m);
+}
 
 // A block's result for R: the windows and what the block rules saw.
 inline Rcpp::List block_result(const WindowTable& table, const gravcal::GgirBlockInfo& b) {
@@ -129,7 +142,8 @@ inline Rcpp::List block_result(const WindowTable& table, const gravcal::GgirBloc
       Rcpp::Named("used") = static_cast<double>(b.used),
       Rcpp::Named("carried") = static_cast<double>(b.carried),
       Rcpp::Named("first_mean") = b.first_mean,
-      Rcpp::Named("temp_sd") = b.temp_sd);
+      Rcpp::Named("temp_sd") = b.temp_sd,
+      Rcpp::Named("temp_sd_exact") = b.temp_sd_exact);
 }
 
 }  // namespace gravcal_glue

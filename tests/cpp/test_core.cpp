@@ -8,9 +8,12 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
+#include "gravcal/decode_geneactiv.hpp"
+#include "gravcal/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
 #include "gravcal/icp.hpp"
 
@@ -206,10 +209,390 @@ static void test_r_arithmetic() {
   }
   CHECK(same);
   CHECK(a[7].n_invalid == 1 && std::isnan(a[7].mean[2]) == false);
+
+  // min and max of whole windows (two samples at a time) against the
+  // sample-by-sample rule, where it matters: zeros of both signs as the
+  // extreme value, first at an even or an odd position
+  const double zs[2] = {0.0, -0.0};
+  for (int trial = 0; trial < 64; ++trial) {
+    const std::size_t m = 8 + static_cast<std::size_t>(trial % 5);
+    std::vector<double> u(3 * m);
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      u[i] = (trial & 1 ? 1.0 : -1.0) * (0.5 + 0.01 * static_cast<double>(i % 7));
+    }
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t i = static_cast<std::size_t>((trial >> 1) + 3 * k) % (3 * m);
+      u[i] = zs[(trial >> 2) & 1];
+      u[(i + 1 + static_cast<std::size_t>(trial % 3)) % (3 * m)] = zs[((trial >> 3) & 1) ^ 1];
+    }
+    std::vector<gravcal::WindowStats> wa, wb;
+    std::vector<double> ba(3 * (m + 2)), bb(3 * (m + 2));
+    gravcal::Segmenter sa(static_cast<double>(m), false), sb(static_cast<double>(m), false);
+    CHECK(sa.use_r_arithmetic(ba.data(), ba.size()));
+    CHECK(sb.use_r_arithmetic(bb.data(), bb.size()));
+    sa.push(u.data(), u.data() + m, u.data() + 2 * m, nullptr, m,
+            [&](const gravcal::WindowStats& w) { wa.push_back(w); });
+    for (std::size_t i = 0; i < m; ++i) {
+      sb.push(u.data() + i, u.data() + m + i, u.data() + 2 * m + i, nullptr, 1,
+              [&](const gravcal::WindowStats& w) { wb.push_back(w); });
+    }
+    CHECK(wa.size() == 1 && wb.size() == 1 &&
+          std::memcmp(&wa[0], &wb[0], sizeof(gravcal::WindowStats)) == 0);
+  }
 }
 
-// A digest of the windows of a fixed stream, printed so that the Makefile
-// can check that the SSE2 and the portable builds give the same bits.
+// The temperature check's fast sd (runs_sd(), r_sd_below()) decides as R's
+// sd() (r_mean_sd()) does, and leaves to R's arithmetic only what lies
+// within rounding of the threshold: values scaled so that their sd is the
+// threshold, then moved by a few doubles; and values clearly either side.
+static void test_r_sd_below() {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::uniform_int_distribution<int> runs_n(1, 60), count(1, 400), ulps(-3, 3);
+  const double thr = 0.01;
+  int decided = 0, near_exact = 0, disagree = 0, far_undecided = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int k = runs_n(rng);
+    std::vector<double> v(static_cast<std::size_t>(k));
+    std::vector<std::uint64_t> c(v.size());
+    const double centre = trial % 3 == 0 ? 0.0 : (trial % 3 == 1 ? 25.0 : -1e6);
+    for (std::size_t j = 0; j < v.size(); ++j) {
+      v[j] = centre + nd(rng);
+      c[j] = static_cast<std::uint64_t>(count(rng));
+    }
+    auto each_value = [&](auto&& f) {
+      for (std::size_t j = 0; j < v.size(); ++j)
+        for (std::uint64_t i = 0; i < c[j]; ++i) f(v[j]);
+    };
+    auto each_run = [&](auto&& f) {
+      for (std::size_t j = 0; j < v.size(); ++j) f(v[j], c[j]);
+    };
+    const gravcal::RMeanSd r0 = gravcal::r_mean_sd(each_value);
+    if (!(r0.sd > 0)) continue;
+    // scale the deviations to an sd of thr (near), or 0.5 or 2 times it (far)
+    const int kind = trial % 4;
+    const double target = kind == 0 ? 0.5 * thr : (kind == 1 ? 2 * thr : thr);
+    for (double& a : v) a = r0.mean + (a - r0.mean) * (target / r0.sd);
+    if (kind >= 2) {
+      for (double& a : v) {
+        const int u = ulps(rng);
+        for (int i = 0; i < (u < 0 ? -u : u); ++i)
+          a = std::nextafter(a, u < 0 ? -INFINITY : INFINITY);
+      }
+    }
+    const gravcal::RunsSd f = gravcal::runs_sd(each_run);
+    const int b = gravcal::r_sd_below(f, thr);
+    const double exact = gravcal::r_mean_sd(each_value).sd;
+    if (b >= 0) {
+      ++decided;
+      if ((exact < thr) != (b == 1)) ++disagree;
+    } else if (kind >= 2) {
+      ++near_exact;
+    }
+    if (kind < 2 && b < 0) ++far_undecided;
+  }
+  CHECK(disagree == 0);
+  CHECK(far_undecided == 0);
+  CHECK(decided > 1000);
+  CHECK(near_exact > 100);  // values at the threshold go to R's arithmetic
+  // outside the bounds' domain: always R's arithmetic
+  gravcal::RunsSd inf = gravcal::runs_sd([](auto&& f) {
+    f(1.0, 3);
+    f(INFINITY, 1);
+  });
+  CHECK(gravcal::r_sd_below(inf, thr) == -1);
+  gravcal::RunsSd one = gravcal::runs_sd([](auto&& f) { f(1.0, 1); });
+  CHECK(std::isnan(one.sd) && gravcal::r_sd_below(one, thr) == -1);
+  gravcal::RunsSd same = gravcal::runs_sd([](auto&& f) { f(25.5, 1000); });
+  CHECK(same.sd == 0 && gravcal::r_sd_below(same, thr) == 1);
+}
+
+// add_repeated() (r_arith.hpp): k additions of x to a long double in a few
+// steps, to the bit as the loop: sums growing and shrinking across
+// binades, through zero, x below half a step, ties (x half-way between
+// multiples of the grid of s), huge values.
+static void test_add_repeated() {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int bad = 0;
+  for (int t = 0; t < 40000; ++t) {
+    long double s = 0;
+    double x = 0;
+    switch (t % 7) {
+      case 0: s = 25.0L * (1 + U(rng)); x = 25 + U(rng); break;
+      case 1: s = 1e8L * U(rng); x = 30 * U(rng); break;
+      case 2: s = 0x1p20L - 50 * std::fabs(U(rng)); x = 0.7 + 0.1 * U(rng); break;
+      case 3: s = 0x1p20L + 50 * std::fabs(U(rng)); x = -0.7 - 0.1 * U(rng); break;
+      case 4: s = 3.0L * U(rng); x = static_cast<double>(-s / 7 * (1 + 1e-3 * U(rng))); break;
+      case 5: {  // x half-way between multiples of the grid of s
+        s = 1027.0L;
+        const long double q = std::ldexp(1.0L, 11 - std::numeric_limits<long double>::digits);
+        x = static_cast<double>(q * (std::floor(1000 * U(rng)) + 0.5L));
+        break;
+      }
+      default: s = 1e300L * U(rng); x = 1e290 * U(rng); break;
+    }
+    if (t % 97 == 0) s = 0;
+    const std::uint64_t k = 1 + rng() % (t % 3 == 0 ? 5000 : 50);
+    long double a = s, b = s;
+    for (std::uint64_t i = 0; i < k; ++i) a += x;
+    gravcal::add_repeated(b, x, k);
+    bad += !(a == b || (std::isnan(a) && std::isnan(b)));
+  }
+  // at a binade's edges: the last additions before 2^20 (from above) or
+  // 2^21 (from below) round on the next binade's grid
+  const int digits = std::numeric_limits<long double>::digits;
+  const long double q = std::ldexp(1.0L, 21 - digits);  // the grid of [2^20, 2^21)
+  for (int m = 1; m <= 12; ++m) {
+    for (int r = 1; r <= 3; ++r) {
+      for (int f = 1; f <= 4; ++f) {
+        for (int up = 0; up < 2; ++up) {
+          const long double s0 = up ? 0x1p21L - m * q : 0x1p20L + m * q;
+          const double x = static_cast<double>((up ? 1 : -1) * (r + f / 10.0L) * q);
+          long double a = s0, b = s0;
+          for (int i = 0; i < 20; ++i) a += x;
+          gravcal::add_repeated(b, x, 20);
+          bad += a != b;
+        }
+      }
+    }
+  }
+  CHECK(bad == 0);
+  // by runs, with the grid kept between calls
+  std::vector<double> v(20000);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = 25.3 + 0.29 * static_cast<double>((i / 120) % 37);
+  long double a = 0, b = 0;
+  for (double e : v) a += e;
+  gravcal::Binade g;
+  gravcal::add_in_order(b, v.data(), 7000, g);
+  gravcal::add_in_order(b, v.data() + 7000, v.size() - 7000, g);
+  CHECK(a == b);
+}
+
+// Segmenter::lazy_r_sd() against R's sds everywhere, through GGIR's block
+// rules: windows with sds near the rest threshold (1e-13 either side), at
+// rest, moving, repeated stretches (GGIR's duplicates), invalid samples
+// (windows without means) and idle-sleep zeros. Every other statistic is
+// the same, so are the rest flags and the rest windows' sds (to the bit),
+// and so are the ties GGIR's duplicate filter counts (a window's sd equal
+// to that of the last window with means).
+static void test_lazy_sd() {
+  using W = gravcal::WindowStats;
+  long long windows = 0, in_double = 0, ties = 0;
+  bool ok = true;
+  for (int seed = 0; seed < 60; ++seed) {
+    std::mt19937_64 pick(static_cast<std::uint64_t>(seed));
+    auto U = [&](int a, int b) { return std::uniform_int_distribution<int>(a, b)(pick); };
+    const int H = U(20, 400);
+    const double L = U(0, 2) ? static_cast<double>(U(2, 30)) : U(2, 30) + 0.5;
+    const double T = U(0, 1) ? 0.013 : 0.02;
+    std::vector<W> out[2];
+    for (int lazy = 0; lazy < 2; ++lazy) {
+      std::mt19937_64 g(static_cast<std::uint64_t>(seed) * 7 + 1);
+      auto G = [&](int a, int b) { return std::uniform_int_distribution<int>(a, b)(g); };
+      std::normal_distribution<double> nd(0, 1);
+      const std::size_t cap = 3 * (static_cast<std::size_t>(std::ceil(L)) + 1);
+      std::vector<double> buf(cap), held(cap);
+      gravcal::LazySd state;
+      gravcal::Segmenter seg(L, false);
+      CHECK(seg.use_r_arithmetic(buf.data(), buf.size()));
+      if (lazy) CHECK(seg.lazy_r_sd(T, &state, held.data(), held.size()));
+      gravcal::GgirBlocks gb(seg, H, true, true);
+      auto sink = [&](const W& w) { out[lazy].push_back(w); };
+      const int blocks = G(1, 5);
+      for (int b = 0; b < blocks; ++b) {
+        const int n = G(0, 4 * H);
+        std::vector<double> x(static_cast<std::size_t>(n)), y(x.size()), z(x.size()), t(x.size());
+        double noise = 0.01;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          if (i % static_cast<std::size_t>(std::ceil(L)) == 0) {
+            const int k = G(0, 9);
+            noise = k < 3 ? T * (1 + (G(0, 1) ? 1e-13 : -1e-13) * G(0, 3))
+                          : (k < 5 ? 0.003 : (k < 8 ? 0.2 : 0.0));
+          }
+          x[i] = 0.1 + noise * nd(g);
+          y[i] = -0.4 + noise * nd(g);
+          z[i] = 0.9 + noise * nd(g);
+          t[i] = 25 + static_cast<double>(i / 120) * 0.01;
+          if (G(0, 400) == 0) y[i] = NAN;
+          if (G(0, 300) == 0) x[i] = y[i] = z[i] = 0;
+        }
+        if (n > 200 && G(0, 1)) {  // a repeated stretch
+          const int len = G(1, 60), at = G(len, n - len - 1);
+          for (int i = 0; i < len; ++i) {
+            x[static_cast<std::size_t>(at + i)] = x[static_cast<std::size_t>(at - len + i)];
+            y[static_cast<std::size_t>(at + i)] = y[static_cast<std::size_t>(at - len + i)];
+            z[static_cast<std::size_t>(at + i)] = z[static_cast<std::size_t>(at - len + i)];
+          }
+        }
+        if (n > 100 && G(0, 3) == 0) {  // windows without means
+          const int at = G(0, n - 40);
+          for (int i = 0; i < 40; ++i) x[static_cast<std::size_t>(at + i)] = NAN;
+        }
+        gb.begin_block();
+        int i = 0;
+        while (i < n) {
+          const int k = std::min(n - i, G(1, 3 * H));
+          const std::size_t o = static_cast<std::size_t>(i);
+          gb.push(x.data() + o, y.data() + o, z.data() + o, t.data() + o,
+                  static_cast<std::size_t>(k), sink);
+          i += k;
+        }
+        gb.end_block(sink);
+      }
+    }
+    CHECK(out[0].size() == out[1].size());
+    if (out[0].size() != out[1].size()) continue;
+    gravcal::SdRestRule rule;
+    rule.max_sd = T;
+    std::size_t last = out[0].size();
+    for (std::size_t k = 0; k < out[0].size(); ++k) {
+      const W& e = out[0][k];
+      const W& a = out[1][k];
+      ++windows;
+      W u = a;
+      std::memcpy(u.sd, e.sd, sizeof u.sd);
+      ok = ok && std::memcmp(&u, &e, sizeof u) == 0;
+      const bool r = gravcal::is_rest(e, rule);
+      ok = ok && r == gravcal::is_rest(a, rule);
+      const bool same_sd = std::memcmp(a.sd, e.sd, sizeof a.sd) == 0;
+      ok = ok && (!r || same_sd);
+      if (!same_sd) ++in_double;
+      if (std::isnan(e.mean[2]) || std::isnan(e.mean_norm)) continue;
+      if (last < out[0].size()) {
+        for (int ax = 0; ax < 3; ++ax) {
+          const bool te = e.sd[ax] == out[0][last].sd[ax];
+          ties += te;
+          ok = ok && te == (a.sd[ax] == out[1][last].sd[ax]);
+        }
+      }
+      last = k;
+    }
+  }
+  CHECK(ok);
+  CHECK(windows > 3000 && in_double > 500 && ties > 100);  // all cases met
+}
+
+// lazy_r_sd() where it is put to the test: windows whose R sd is the rest
+// threshold to a few doubles, and windows that repeat the one before with
+// the samples permuted (R's long double sds then often tie while sds in
+// double do not). Rest flags and ties as with R's sds everywhere.
+static void test_lazy_sd_edges() {
+  using W = gravcal::WindowStats;
+  const std::size_t L = 1000;
+  const double T = 0.013;
+  std::mt19937_64 g(99);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::vector<double> x, y, z;
+  std::vector<double> a(L), b(L), c(L);
+  int at_threshold = 0;
+  for (int w = 0; w < 400; ++w) {
+    const int kind = w % 4;  // moving, permuted, at the threshold, moving
+    if (kind == 1) {
+      const std::size_t s0 = x.size() - L;
+      for (std::size_t i = 0; i < L; ++i) {
+        const std::size_t j = w % 8 < 4 ? L - 1 - i : (i + 1) % L;
+        a[i] = x[s0 + j];
+        b[i] = y[s0 + j];
+        c[i] = z[s0 + j];
+      }
+    } else {
+      const double noise = kind == 2 ? T : 0.05;
+      for (std::size_t i = 0; i < L; ++i) {
+        a[i] = (kind == 2 ? 0.0 : 1.3) + noise * nd(g);
+        b[i] = -0.2 + 0.004 * nd(g);
+        c[i] = 0.93 + 0.004 * nd(g);
+      }
+      if (kind == 2) {
+        // x scaled so that its R sd is the threshold's double, or one of
+        // the six either side (bisection on the scale)
+        const std::vector<double> d = a;
+        auto sd_at = [&](double f) {
+          for (std::size_t i = 0; i < L; ++i) a[i] = d[i] * f;
+          return gravcal::r_mean_sd([&](auto&& h) {
+            for (double v : a) h(v);
+          }).sd;
+        };
+        const int u = static_cast<int>((w / 4) % 13) - 6;
+        double goal = T;
+        for (int k = 0; k < (u < 0 ? -u : u); ++k) goal = std::nextafter(goal, u < 0 ? 0.0 : 1.0);
+        double lo = 0.5, hi = 2.0;
+        for (int it = 0; it < 200 && lo < hi; ++it) {
+          const double mid = lo + (hi - lo) / 2;
+          if (mid == lo || mid == hi) break;
+          (sd_at(mid) < goal ? lo : hi) = mid;
+        }
+        sd_at(std::fabs(sd_at(lo) - goal) < std::fabs(sd_at(hi) - goal) ? lo : hi);
+        ++at_threshold;
+      }
+    }
+    x.insert(x.end(), a.begin(), a.end());
+    y.insert(y.end(), b.begin(), b.end());
+    z.insert(z.end(), c.begin(), c.end());
+  }
+  std::vector<W> out[2];
+  for (int lazy = 0; lazy < 2; ++lazy) {
+    std::vector<double> buf(3 * (L + 1)), held(buf.size());
+    gravcal::LazySd state;
+    gravcal::Segmenter seg(static_cast<double>(L), false);
+    CHECK(seg.use_r_arithmetic(buf.data(), buf.size()));
+    if (lazy) CHECK(seg.lazy_r_sd(T, &state, held.data(), held.size()));
+    auto sink = [&](const W& w) { out[lazy].push_back(w); };
+    for (std::size_t i = 0; i < x.size(); i += 10 * L) {  // whole windows
+      const std::size_t n = std::min(10 * L, x.size() - i);
+      seg.push(x.data() + i, y.data() + i, z.data() + i, nullptr, n, sink);
+    }
+    seg.finish(sink);
+  }
+  CHECK(out[0].size() == 400 && out[1].size() == 400);
+  gravcal::SdRestRule rule;
+  rule.max_sd = T;
+  int rest = 0, not_rest = 0, ties = 0, bad = 0;
+  for (std::size_t k = 0; k < out[0].size() && k < out[1].size(); ++k) {
+    const W& e = out[0][k];
+    const W& l = out[1][k];
+    const bool r = gravcal::is_rest(e, rule);
+    if (k % 4 == 2) (r ? rest : not_rest) += 1;  // the threshold's windows
+    if (r != gravcal::is_rest(l, rule)) ++bad;
+    if (r && std::memcmp(e.sd, l.sd, sizeof e.sd) != 0) ++bad;
+    if (k > 0) {
+      for (int ax = 0; ax < 3; ++ax) {
+        const bool te = e.sd[ax] == out[0][k - 1].sd[ax];
+        ties += te;
+        if (te != (l.sd[ax] == out[1][k - 1].sd[ax])) ++bad;
+      }
+    }
+  }
+  CHECK(bad == 0);
+  // both sides of the threshold, and R's ties between permuted windows
+  CHECK(at_threshold == 100 && rest > 30 && not_rest > 30 && ties > 100);
+}
+
+// The GENEActiv decoder's hex digits sixteen at a time (hex16()) against
+// its table, for every byte value in every position.
+static void test_hex16() {
+#if defined(GRAVCAL_SSE2)
+  const unsigned char* h = gravcal::geneactiv::hex_table().v;
+  bool ok = true;
+  for (int pos = 0; pos < 16; ++pos) {
+    for (int c = 0; c < 256; ++c) {
+      unsigned char s[16], v[16];
+      for (int k = 0; k < 16; ++k) s[k] = static_cast<unsigned char>("0123456789abcDEF"[k]);
+      s[pos] = static_cast<unsigned char>(c);
+      const int bad = gravcal::geneactiv::hex16(s, v);
+      for (int k = 0; k < 16; ++k) {
+        const bool digit = h[s[k]] < 16;
+        ok = ok && (((bad >> k) & 1) == !digit) && (!digit || v[k] == h[s[k]]);
+      }
+    }
+  }
+  CHECK(ok);
+#endif
+}
+
+// A digest of the windows of a fixed stream and of ICP fits, printed so that
+// the Makefile can check that the SSE2 and the portable builds give the
+// same bits.
 static void print_digest() {
   std::mt19937 rng(77);
   std::normal_distribution<double> nd(0.0, 0.02);
@@ -225,6 +608,30 @@ static void print_digest() {
     const unsigned char* p = reinterpret_cast<const unsigned char*>(&w);
     for (std::size_t i = 0; i < sizeof(w); ++i) h = (h ^ p[i]) * 1099511628211ull;
   });
+  // and gravcal's ICP fit (its loops two points at a time with SSE2), with
+  // and without the temperature term, on noisy rest means
+  for (int temp = 0; temp < 2; ++temp) {
+    const std::size_t m = 2001;  // odd: the scalar tail too
+    std::vector<double> a(m), b(m), c(m), tt(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      double v[3] = {nd(rng) * 20, nd(rng) * 20, nd(rng) * 20};
+      const double r = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      a[i] = 1.01 * v[0] / r + 0.02 + nd(rng) * 0.1;
+      b[i] = 0.98 * v[1] / r - 0.01 + nd(rng) * 0.1;
+      c[i] = v[2] / r + 0.03 + nd(rng) * 0.1;
+      tt[i] = 25 + 200 * nd(rng);
+    }
+    gravcal::IcpConfig cfg;
+    cfg.stop = gravcal::StopRule::parameters;
+    const gravcal::IcpResult r =
+        gravcal::fit_icp(a.data(), b.data(), c.data(), temp ? tt.data() : nullptr, m, cfg);
+    const double out[10] = {r.scale[0], r.scale[1], r.scale[2], r.offset[0], r.offset[1],
+                            r.offset[2], r.tempoffset[0], r.tempoffset[1], r.tempoffset[2],
+                            r.statistic};
+    const unsigned char* p = reinterpret_cast<const unsigned char*>(out);
+    for (std::size_t i = 0; i < sizeof(out); ++i) h = (h ^ p[i]) * 1099511628211ull;
+    h ^= static_cast<std::uint64_t>(r.iterations);
+  }
   std::printf("digest %016llx\n", static_cast<unsigned long long>(h));
 }
 
@@ -235,6 +642,11 @@ int main(int argc, char** argv) {
   }
   test_icp();
   test_r_arithmetic();
+  test_r_sd_below();
+  test_hex16();
+  test_add_repeated();
+  test_lazy_sd();
+  test_lazy_sd_edges();
   test_model();
   test_segmenter();
   test_bins();

@@ -104,3 +104,21 @@ test_that("fit_icp(): iterations beyond an integer, text temperature", {
   expect_identical(coef(fl), coef(calibrate(rec[names(rec) != "temperature"],
                                             sf = 10)))
 })
+
+test_that("the GGIR procedure's fit is fit_icp()'s on its rest windows", {
+  # g.calibrate() and calibrate(method = "ggir") fit through the same
+  # internal as fit_icp() (icp_means()): refitting their spheredata with
+  # fit_icp() gives their coefficients to the bit
+  rec <- simulate_recording(hours = 30, sf = 10, seed = 4,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  C <- g.calibrate(rec, sf = 10, verbose = FALSE, minloadcrit = 12)
+  expect_true(C$use.temp)
+  f <- fit_icp(C$spheredata, ggir_compat = TRUE)
+  expect_identical(unname(diag(f$K)), C$scale)
+  expect_identical(unname(f$offset), C$offset)
+  expect_identical(unname(f$tempoffset), C$tempoffset)
+  own <- calibrate(rec, sf = 10, method = "ggir", minloadcrit = 12)
+  fo <- fit_icp(own$points)
+  expect_identical(coef(fo), coef(own))
+  expect_identical(fo$iterations, own$iterations)
+})

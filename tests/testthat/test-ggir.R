@@ -105,7 +105,7 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
   }
   for (compat in c(TRUE, FALSE)) {
     seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
-    run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE)
+    run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE, 0.01)
     feed <- function(b) {
       gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
                                   list(b$t), 0, nrow(b), 1L, c(0.013, 2))
@@ -118,13 +118,10 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     expect_identical(r1$used, as.numeric(nrow(e1$used)))
     expect_identical(r1$carried, as.numeric(nrow(e1$rest)))
     expect_identical(r1$first_mean, mean(e1$used$t[1:10], na.rm = TRUE))
-    # the temperature's sd only decides whether it varies: R's arithmetic in
-    # compatible mode, gravcal's (from the run-length code) to rounding
-    if (compat) {
-      expect_identical(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE))
-    } else {
-      expect_equal(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE), tolerance = 1e-13)
-    }
+    # the temperature's sd only decides whether it varies: from the
+    # run-length code, to rounding (compatible mode: R's decision, see the
+    # next test)
+    expect_equal(r1$temp_sd, stats::sd(e1$used$t, na.rm = TRUE), tolerance = 1e-13)
     expect_identical(length(r1$windows$mean_x), nrow(e1$used) %/% 10L)
     # window means as GGIR forms them (compatible mode): differences of the
     # block's cumulative sum; gravcal's own arithmetic: to rounding
@@ -138,11 +135,7 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     r2 <- feed(b2)
     e2 <- ref_block(rbind(e1$rest, b2), FALSE, compat)
     expect_identical(r2$used, as.numeric(nrow(e2$used)))
-    if (compat) {
-      expect_identical(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE))
-    } else {
-      expect_equal(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE), tolerance = 1e-13)
-    }
+    expect_equal(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE), tolerance = 1e-13)
     if (compat) {
       expect_identical(r2$windows$sd_y[1], stats::sd(e2$used$y[1:10]))
     } else {
@@ -153,7 +146,7 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
   # puts the previous carry in front once more
   for (compat in c(TRUE, FALSE)) {
     seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
-    run <- gravcal:::gc_blocks_new(seg, H, compat, FALSE)
+    run <- gravcal:::gc_blocks_new(seg, H, compat, FALSE, 0.01)
     feed <- function(b) {
       gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
                                   list(NULL), 0, nrow(b), 1L, c(0.013, 2))
@@ -164,6 +157,105 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     r <- feed(mk(H))
     expect_identical(r$ld, if (compat) H + 5 else H)
   }
+})
+
+test_that("the temperature check decides as R's sd() at the threshold", {
+  # Compatible mode takes the temperature's sd from its run-length code and
+  # repeats R's arithmetic only when that sd lies within rounding of
+  # temp_min_sd (r_sd_below() in r_arith.hpp). Blocks whose R sd() is the
+  # threshold itself, or one or two doubles either side of it, must go
+  # R's way, and those sds must be R's to the bit.
+  sf <- 1
+  H <- 3600 * sf
+  thr <- gravcal:::ggir_constants$temp_min_sd
+  # two temperatures in runs (as device files store them) whose sd is the
+  # threshold to about 1e-13; then the first value moved by whole doubles
+  # (one double of 25 is 2^-48) to where R's sd() crosses the threshold
+  d <- thr * sqrt((H - 1) / H)
+  base <- 25 + rep(c(-d, d), each = 5, length.out = H)
+  sd_of <- function(k) {
+    t <- base
+    t[1] <- t[1] + k * 2^-48
+    t
+  }
+  below <- function(k) stats::sd(sd_of(k)) < thr
+  lo <- 0
+  hi <- 2^20
+  expect_true(!below(lo) && below(hi))
+  while (hi - lo > 1) {
+    m <- (lo + hi) %/% 2
+    if (below(m)) hi <- m else lo <- m
+  }
+  near <- hi + (-3:2)
+  sds <- vapply(near, function(k) stats::sd(sd_of(k)), 0)
+  # both sides, and (here) the threshold itself
+  expect_true(any(sds < thr) && any(sds > thr) && any(sds == thr))
+  for (k in near) {
+    t <- sd_of(k)
+    for (compat in c(TRUE, FALSE)) {
+      seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
+      run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE, thr)
+      r <- gravcal:::gc_blocks_columns(run, list(rep(0.1, H)), list(rep(0.2, H)),
+                                       list(rep(0.97, H)), list(t), 0, H, 1L,
+                                       c(0.013, 2))
+      expect_identical(r$used, as.numeric(H))
+      if (compat) {
+        expect_true(r$temp_sd_exact)
+        expect_identical(r$temp_sd, stats::sd(t))
+      } else {
+        expect_equal(r$temp_sd, stats::sd(t), tolerance = 1e-13)
+      }
+    }
+  }
+  # far from the threshold the fast sd decides; R's decision all the same
+  for (spread in c(0, 1e-3, 0.5 * thr, 0.999999 * thr, 1.000001 * thr, 3)) {
+    t <- 25 + spread * rep(c(-1, 1), each = 7, length.out = H)
+    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, TRUE)
+    run <- gravcal:::gc_blocks_new(seg, H, TRUE, TRUE, thr)
+    r <- gravcal:::gc_blocks_columns(run, list(rep(0.1, H)), list(rep(0.2, H)),
+                                     list(rep(0.97, H)), list(t), 0, H, 1L,
+                                     c(0.013, 2))
+    expect_false(r$temp_sd_exact)
+    expect_identical(r$temp_sd < thr, stats::sd(t) < thr)
+    expect_equal(r$temp_sd, stats::sd(t), tolerance = 1e-13)
+  }
+})
+
+test_that("g.calibrate matches GGIR where its rules compare window sds", {
+  # Compatible mode computes a window's sds in R's arithmetic only where
+  # GGIR's rules can tell (Segmenter::lazy_r_sd()): at rest or near the
+  # rest threshold, and when the duplicate filter could find an sd equal to
+  # the previous window's. Windows that repeat the one before with their
+  # samples reversed or rotated (R's sds then often tie while sds in
+  # double do not), whole repeats, and windows scaled to the threshold:
+  # GGIR's answer to the bit.
+  skip_if_not_installed("GGIR")
+  sf <- 20
+  rec <- simulate_recording(hours = 26, sf = sf, seed = 44,
+                            params = known_params(),
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  n <- 10 * sf
+  set.seed(3)
+  for (k in sample(seq(2, nrow(rec) / n - 2), 1500)) {
+    a <- (k - 1) * n + seq_len(n)
+    b <- k * n + seq_len(n)
+    p <- switch(k %% 3 + 1, rev(seq_len(n)), c(2:n, 1), seq_len(n))
+    rec[b, c("x", "y", "z")] <- rec[a[p], c("x", "y", "z")]
+  }
+  # windows whose x sd is the threshold to about a double
+  thr <- 0.013
+  for (k in sample(seq(2, nrow(rec) / n - 2), 300)) {
+    b <- k * n + seq_len(n)
+    v <- rec$x[b]
+    rec$x[b] <- mean(v) + (v - mean(v)) * thr / stats::sd(v)
+  }
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- write_adhoc(rec, f, sf)
+  b <- run_both(f, c(pr, list(minloadcrit = 12)))
+  expect_same_as_ggir(b)
+  b <- run_both(f, pr)
+  expect_same_as_ggir(b)
 })
 
 test_that("g.calibrate matches GGIR when it cannot calibrate", {

@@ -68,6 +68,12 @@
 
 #include "gravcal/decode.hpp"
 
+// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
+#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
+#define GRAVCAL_SSE2 1
+#include <emmintrin.h>
+#endif
+
 namespace gravcal {
 
 namespace cwa {
@@ -163,7 +169,7 @@ inline Status parse_header(const unsigned char* b, Header& h) {
 inline Params own_params(const Header& h) {
   Params p;
   p.axes = h.axes;
-  p.accel_scale = 1.0 / std::pow(2.0, 8 + h.scale_code);
+  p.accel_scale = std::ldexp(1.0, -(8 + h.scale_code));  // 1 / 2^(8 + code), exactly
   p.frequency = h.own_frequency;
   p.fractional = h.rate != 0 && (h.ts_offset & 0x8000u) != 0;
   return p;
@@ -194,8 +200,7 @@ inline double block_start(double T, const Header& h, const Params& p) {
 }
 
 inline int signed10(std::uint32_t v) {
-  const int s = static_cast<int>(v & 0x3ffu);
-  return s >= 0x200 ? s - 0x400 : s;
+  return static_cast<int>((v & 0x3ffu) ^ 0x200u) - 0x200;
 }
 
 // The block's accelerometer samples in g, xyz interleaved.
@@ -203,12 +208,15 @@ inline void scale_samples(const unsigned char* b, const Header& h, const Params&
                           double packed_scale, double* xyz) {
   const unsigned char* d = b + data_offset;
   if (h.packed) {
+    // value * 2^exponent * scale: both factors are powers of two, so their
+    // product first gives the same (exact) result
+    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
     for (int i = 0; i < h.count; ++i) {
       const std::uint32_t v = le32(d + 4 * i);
-      const int mult = 1 << (v >> 30);
-      xyz[3 * i] = signed10(v) * mult * packed_scale;
-      xyz[3 * i + 1] = signed10(v >> 10) * mult * packed_scale;
-      xyz[3 * i + 2] = signed10(v >> 20) * mult * packed_scale;
+      const double m = f[v >> 30];
+      xyz[3 * i] = signed10(v) * m;
+      xyz[3 * i + 1] = signed10(v >> 10) * m;
+      xyz[3 * i + 2] = signed10(v >> 20) * m;
     }
     return;
   }
@@ -221,7 +229,54 @@ inline void scale_samples(const unsigned char* b, const Header& h, const Params&
   }
 }
 
-// A decoded block: header, index in the file, start time, samples.
+// Samples [from, from + n) of the block, scaled as scale_samples() does,
+// into three columns: packed ones four at a time with SSE2 (the same
+// integer and the same product per value, so the same doubles).
+inline void scale_columns(const unsigned char* b, const Header& h, const Params& p,
+                          double packed_scale, int from, int n, double* x, double* y,
+                          double* z) {
+  const unsigned char* d = b + data_offset;
+  if (h.packed) {
+    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
+    int i = 0;
+#if defined(GRAVCAL_SSE2)
+    const __m128i m10 = _mm_set1_epi32(0x3ff), sign = _mm_set1_epi32(0x200);
+    for (; i + 4 <= n; i += 4) {
+      const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + 4 * (from + i)));
+      alignas(16) std::int32_t e[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(e), _mm_srli_epi32(w, 30));
+      const __m128d m01 = _mm_set_pd(f[e[1]], f[e[0]]), m23 = _mm_set_pd(f[e[3]], f[e[2]]);
+      double* col[3] = {x + i, y + i, z + i};
+      for (int a = 0; a < 3; ++a) {
+        // signed10(v >> 10 a), four at a time
+        const __m128i u = a == 0 ? w : _mm_srli_epi32(w, 10 * a);
+        const __m128i v = _mm_sub_epi32(_mm_xor_si128(_mm_and_si128(u, m10), sign), sign);
+        _mm_storeu_pd(col[a], _mm_mul_pd(_mm_cvtepi32_pd(v), m01));
+        _mm_storeu_pd(col[a] + 2, _mm_mul_pd(_mm_cvtepi32_pd(_mm_shuffle_epi32(v, 0xee)), m23));
+      }
+    }
+#endif
+    for (; i < n; ++i) {
+      const std::uint32_t v = le32(d + 4 * (from + i));
+      const double m = f[v >> 30];
+      x[i] = signed10(v) * m;
+      y[i] = signed10(v >> 10) * m;
+      z[i] = signed10(v >> 20) * m;
+    }
+    return;
+  }
+  const int acc = p.axes == 6 ? 3 : 0;
+  double* col[3] = {x, y, z};
+  for (int i = 0; i < n; ++i) {
+    const unsigned char* s = d + 2 * ((from + i) * p.axes + acc);
+    for (int a = 0; a < 3; ++a) {
+      col[a][i] = static_cast<std::int16_t>(le16(s + 2 * a)) * p.accel_scale;
+    }
+  }
+}
+
+// A decoded block: header, index in the file, start time, samples (or,
+// for compat = 0, its bytes: the samples go straight to the output).
 struct Block {
   Header h;
   std::int64_t index = 0;
@@ -229,6 +284,7 @@ struct Block {
   double start = 0;  // the first sample's time
   double frequency = 0;
   double xyz[3 * max_samples];
+  unsigned char bytes[block_bytes];
 };
 
 }  // namespace cwa
@@ -251,7 +307,7 @@ class CwaDecoder : public Decoder {
   bool refill();
   Got next_good(std::int64_t& index, std::int64_t stop, cwa::Block& b, bool own, bool count);
   bool decode(const unsigned char* raw, std::int64_t index, const cwa::Params* p,
-              cwa::Block& b, bool count);
+              cwa::Block& b, bool count, bool keep_bytes = false);
   void skip(cwa::Status s, std::int64_t index);
   void check_time(const cwa::Block& b);
 
@@ -444,7 +500,7 @@ inline void CwaDecoder::skip(cwa::Status s, std::int64_t index) {
 // Decodes block `raw` with parameters p (null: its own), its time from the
 // calendar. False (counted when `count`) when it is unusable.
 inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, const cwa::Params* p,
-                               cwa::Block& b, bool count) {
+                               cwa::Block& b, bool count, bool keep_bytes) {
   cwa::Status s = cwa::parse_header(raw, b.h);
   const cwa::Params own = cwa::own_params(b.h);
   const cwa::Params& use = p != nullptr ? *p : own;
@@ -462,6 +518,10 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
   b.rtc = T;
   b.frequency = b.h.rate == 0 ? b.h.offset26 : use.frequency;
   b.start = cwa::block_start(T, b.h, use);
+  if (keep_bytes) {  // the caller scales the samples (scale_columns())
+    std::memcpy(b.bytes, raw, cwa::block_bytes);
+    return true;
+  }
   const double packed_scale = compat_ ? use.accel_scale : 1.0 / 256;
   cwa::scale_samples(raw, b.h, use, packed_scale, b.xyz);
   return true;
@@ -530,7 +590,7 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
       }
       ++units;
       const std::int64_t i = raw_index_++;
-      if (!decode(raw, i, nullptr, raw_, true)) continue;
+      if (!decode(raw, i, nullptr, raw_, true, true)) continue;
       check_time(raw_);
       raw_open_ = true;
       raw_next_ = 0;
@@ -538,10 +598,16 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
     const double dt = 1.0 / raw_.frequency;
     const int n = static_cast<int>(std::min<std::size_t>(
         out.room(), static_cast<std::size_t>(raw_.h.count - raw_next_)));
-    for (int k = 0; k < n; ++k, ++raw_next_) {
-      const double* v = raw_.xyz + 3 * raw_next_;
-      out.put(v[0], v[1], v[2], raw_.h.temperature, raw_.start + raw_next_ * dt);
+    // straight from the block's bytes, column by column (what out.put()
+    // would write, sample by sample), at 1/256 g (see the top of the file)
+    cwa::scale_columns(raw_.bytes, raw_.h, cwa::own_params(raw_.h), 1.0 / 256, raw_next_, n,
+                       out.x + out.n, out.y + out.n, out.z + out.n);
+    if (out.t != nullptr) std::fill(out.t + out.n, out.t + out.n + n, raw_.h.temperature);
+    if (out.time != nullptr) {
+      for (int k = 0; k < n; ++k) out.time[out.n + k] = raw_.start + (raw_next_ + k) * dt;
     }
+    out.n += static_cast<std::size_t>(n);
+    raw_next_ += n;
     report_.samples += n;
     if (raw_next_ == raw_.h.count) raw_open_ = false;
   }
@@ -795,42 +861,80 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
 }
 
 // Writes the open span's grid points into out; false when out filled first.
+// The loop keeps its state in locals (the output columns could alias the
+// members, so the compiler would store and reload them every sample) and
+// writes it back once; the arithmetic is grid() and out.put()'s.
 inline bool CwaDecoder::emit_span(SampleBuffer& out) {
   const cwa::Block& p = blk_[span_blk_];
   const int len = span_len_;
   const double lim = raw_t_[len];
-  std::int64_t given = 0;
+  const double temp = p.h.temperature;
+  const double start = start_ts_, step = step_, end = end_ts_;
+  const double il[3] = {ianchor_[0], ianchor_[1], ianchor_[2]};
+  const bool impute = impute_;
+  const std::int64_t last = last_;
+  std::int64_t pos = pos_;
+  int source = source_;
+  // the last output sample, in scalars (an array here ends up on the stack)
+  double a0 = anchor_[0], a1 = anchor_[1], a2 = anchor_[2];
+  double at = anchor_t_;
+  std::size_t n = out.n;
+  const std::size_t cap = out.capacity;
+  double* const ox = out.x;
+  double* const oy = out.y;
+  double* const oz = out.z;
+  double* const ot = out.t;
+  double* const otime = out.time;
+  const std::int64_t pos0 = pos;
   bool full = false;
-  while (pos_ <= last_) {
-    const double t = grid(pos_);
-    if (impute_ ? !(t < lim) : !(t <= lim)) break;
-    if (out.full()) {
+  while (pos <= last) {
+    volatile double e = static_cast<double>(pos) * step;  // as grid(): no fused multiply-add
+    double t = start + e;
+    t = t < end ? t : end;
+    if (impute ? !(t < lim) : !(t <= lim)) break;
+    if (n >= cap) {
       full = true;
       break;
     }
-    if (impute_) {
-      for (int a = 0; a < 3; ++a) anchor_[a] = imputed_[a];
+    if (impute) {
+      a0 = imputed_[0];
+      a1 = imputed_[1];
+      a2 = imputed_[2];
     } else {
-      while (source_ < len && raw_t_[source_] < t) ++source_;
-      const double w = (t - raw_t_[source_ - 1]) / (raw_t_[source_] - raw_t_[source_ - 1]);
-      const double* right = p.xyz + 3 * (source_ - 1);
-      const double* left = source_ == 1 ? ianchor_ : right - 3;
-      for (int a = 0; a < 3; ++a) anchor_[a] = w * (right[a] - left[a]) + left[a];
+      while (source < len && raw_t_[source] < t) ++source;
+      const double w = (t - raw_t_[source - 1]) / (raw_t_[source] - raw_t_[source - 1]);
+      const double* right = p.xyz + 3 * (source - 1);
+      const double* left = source == 1 ? il : right - 3;
+      a0 = w * (right[0] - left[0]) + left[0];
+      a1 = w * (right[1] - left[1]) + left[1];
+      a2 = w * (right[2] - left[2]) + left[2];
     }
-    out.put(anchor_[0], anchor_[1], anchor_[2], p.h.temperature, t);
-    anchor_t_ = t;
-    ++pos_;
-    ++given;
+    ox[n] = a0;
+    oy[n] = a1;
+    oz[n] = a2;
+    if (ot != nullptr) ot[n] = temp;
+    if (otime != nullptr) otime[n] = t;
+    ++n;
+    at = t;
+    ++pos;
   }
+  const std::int64_t given = pos - pos0;
+  out.n = n;
+  pos_ = pos;
+  source_ = source;
+  anchor_[0] = a0;
+  anchor_[1] = a1;
+  anchor_[2] = a2;
+  anchor_t_ = at;
   report_.samples += given;
   if (impute_) report_.count("imputed_samples", given);
   if (full) return false;
   if (impute_) {  // go on from the imputed output, not the raw samples
     ianchor_t_ = anchor_t_;
-    for (int a = 0; a < 3; ++a) ianchor_[a] = anchor_[a];
+    for (int c = 0; c < 3; ++c) ianchor_[c] = anchor_[c];
   } else {
     ianchor_t_ = lim;
-    for (int a = 0; a < 3; ++a) ianchor_[a] = p.xyz[3 * (len - 1) + a];
+    for (int c = 0; c < 3; ++c) ianchor_[c] = p.xyz[3 * (len - 1) + c];
   }
   span_open_ = false;
   return true;

@@ -75,6 +75,12 @@
 
 #include "decode.hpp"
 
+// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
+#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
+#define GRAVCAL_SSE2 1
+#include <emmintrin.h>
+#endif
+
 namespace gravcal {
 
 namespace geneactiv {
@@ -121,6 +127,27 @@ inline const HexTable& hex_table() {
   static const HexTable t;
   return t;
 }
+
+#if defined(GRAVCAL_SSE2)
+// hex_table() for 16 bytes at once: their values into v (any value for a
+// byte that is not a hex digit) and a mask, bit k set when byte k is not a
+// hex digit. Signed byte comparisons: bytes from 0x80 on are below '0'.
+inline int hex16(const unsigned char* s, unsigned char* v) {
+  const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s));
+  const __m128i dg = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('0' - 1)),
+                                   _mm_cmpgt_epi8(_mm_set1_epi8('9' + 1), c));
+  const __m128i up = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('A' - 1)),
+                                   _mm_cmpgt_epi8(_mm_set1_epi8('F' + 1), c));
+  const __m128i lo = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('a' - 1)),
+                                   _mm_cmpgt_epi8(_mm_set1_epi8('f' + 1), c));
+  // '0'-'9': c - '0'; 'A'-'F': c - '0' - 7; 'a'-'f': c - '0' - 39
+  const __m128i val = _mm_sub_epi8(
+      _mm_sub_epi8(_mm_sub_epi8(c, _mm_set1_epi8('0')), _mm_and_si128(up, _mm_set1_epi8(7))),
+      _mm_and_si128(lo, _mm_set1_epi8(39)));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(v), val);
+  return _mm_movemask_epi8(_mm_or_si128(_mm_or_si128(dg, up), lo)) ^ 0xffff;
+}
+#endif
 
 
 // A Page Time "YYYY-MM-DD HH:MM:SS:mmm" (":mmm" optional).
@@ -599,7 +626,42 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   if (complete ? n != kDigitsPerPage : n > kDigitsPerPage) return false;
   const std::size_t whole = n / kDigitsPerSample;
   unsigned bad = 0;
-  for (std::size_t i = 0; i < whole; ++i, s += kDigitsPerSample) {
+  std::size_t i = 0;
+#if defined(GRAVCAL_SSE2)
+  // four samples (48 digits) at a time: the digits' values and whether each
+  // is a hex digit sixteen at a time (hex16()); then digit pairs p_j =
+  // d_2j d_2j+1 in 16-bit lanes, so that a sample's counts (digits 0-2,
+  // 3-5, 6-8 of its 12, pairs p_0..p_5 from its first) are x = p_0 p_1
+  // >> 4, y = (p_1 & 15) p_2 and z = p_3 p_4 >> 4: lanes 0 and 3 of q_j =
+  // p_j << 4 | p_j+1 >> 4 and lane 1 of r_j = (p_j & 15) << 8 | p_j+1
+  alignas(16) unsigned char v[48];
+  for (; i + 4 <= whole; i += 4, s += 4 * kDigitsPerSample) {
+    if ((hex16(s, v) | hex16(s + 16, v + 16) | hex16(s + 32, v + 32)) != 0) bad |= 0x10u;
+    const __m128i lo8 = _mm_set1_epi16(0xff), lo4 = _mm_set1_epi16(0xf);
+    __m128i pr[4];  // p_0..p_23, and zeros after
+    for (int k = 0; k < 3; ++k) {
+      const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(v + 16 * k));
+      pr[k] = _mm_or_si128(_mm_slli_epi16(_mm_and_si128(w, lo8), 4), _mm_srli_epi16(w, 8));
+    }
+    pr[3] = _mm_setzero_si128();
+    alignas(16) std::uint16_t q[24], r[24];
+    for (int k = 0; k < 3; ++k) {
+      // p_j+1 in lane j: this vector one lane on, the next one's first last
+      const __m128i nx = _mm_or_si128(_mm_srli_si128(pr[k], 2), _mm_slli_si128(pr[k + 1], 14));
+      _mm_store_si128(reinterpret_cast<__m128i*>(q + 8 * k),
+                      _mm_or_si128(_mm_slli_epi16(pr[k], 4), _mm_srli_epi16(nx, 4)));
+      _mm_store_si128(reinterpret_cast<__m128i*>(r + 8 * k),
+                      _mm_or_si128(_mm_slli_epi16(_mm_and_si128(pr[k], lo4), 8), nx));
+    }
+    for (int j = 0; j < 4; ++j) {
+      std::uint16_t* o = next_->raw[i + static_cast<std::size_t>(j)];
+      o[0] = q[6 * j];
+      o[1] = r[6 * j + 1];
+      o[2] = q[6 * j + 3];
+    }
+  }
+#endif
+  for (; i < whole; ++i, s += kDigitsPerSample) {
     for (int a = 0; a < 3; ++a) {
       const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
       bad |= d0 | d1 | d2;

@@ -6,13 +6,16 @@
 // rest to the next block, checks the temperature, and restarts its
 // cumulative sums before cutting windows. GgirBlocks applies those rules to
 // samples pushed in chunks of any size, holding back only what the rules
-// need to see before a sample may go on (at most two hours), so that a block
-// never has to be held in memory whole.
+// need to see before a sample may go on (at most an hour and one sample), so
+// that a block never has to be held in memory whole.
 //
-// Why two hours are enough: the whole hours of a block are `use =
-// floor(LD / H) H` of its LD retained samples (H samples per hour), and
-// every sample but the last H can go on before LD is known, since
-// LD - H < use. The last samples stay until the block ends.
+// Why an hour is enough: the whole hours of a block are `use = floor(LD /
+// H) H` of its LD retained samples (H samples per hour), so a sample is used
+// as soon as its hour is complete. The last retained sample waits for the
+// next one (or the block's end), because of the first accident below.
+//
+// A block's last window may be held back by the segmenter
+// (Segmenter::lazy_r_sd()); end_block() has it given out with the block.
 //
 // GGIR-compatible mode keeps GGIR's accidents (see ?calibrate):
 // - a block that ends on a whole hour leaves the previous carry in place,
@@ -22,10 +25,21 @@
 //   sample takes the x, y, z of the one before it.
 // gravcal's own mode carries every leftover sample exactly once.
 //
+// The samples wait in one buffer per column, unflushed ones in [head_,
+// tail_). A caller that produces samples (a decoder) writes them straight
+// into it: space() gives where, commit() takes them, so that no sample is
+// copied on the way to the segmenter. space() ends a write at most one
+// sample past the current hour, so that when an hour goes on only a sample
+// or so waits behind it, and moving the waiting samples to the front of the
+// buffer costs nothing.
+//
 // The temperature checks need R's mean and sd of the block's used
-// temperatures (r_arith.hpp); they are kept run-length coded, in order, so
-// that they cost a few bytes per run of equal values (device files repeat
-// one temperature over a page or a block).
+// temperatures; they are kept run-length coded, in order, so that they cost
+// a few bytes per run of equal values (device files repeat one temperature
+// over a page or a block). The sd only decides whether the temperature
+// varies (sd >= temp_min_sd): computed from the runs, it is R's decision
+// except within rounding of the threshold, where compatible mode repeats
+// R's arithmetic (r_arith.hpp, r_sd_below()).
 #ifndef GRAVCAL_GGIR_BLOCKS_HPP
 #define GRAVCAL_GGIR_BLOCKS_HPP
 
@@ -52,22 +66,40 @@ struct GgirBlockInfo {
   double first_mean = std::numeric_limits<double>::quiet_NaN();  // mean of the
                              // first 10 used temperatures (R's, na.rm)
   double temp_sd = std::numeric_limits<double>::quiet_NaN();     // sd of the
-                             // used temperatures (R's, na.rm); NaN if < 2
+                             // used temperatures (na.rm); NaN if < 2. In
+                             // compatible mode on the same side of
+                             // temp_min_sd as R's sd(), and R's to the bit
+                             // when near it (temp_sd_exact)
+  bool temp_sd_exact = false;  // temp_sd was computed in R's arithmetic
+};
+
+// Where the caller writes samples for commit(): columns x, y, z and t
+// (null when the blocks have no temperature), room for `capacity` (>= 1).
+struct BlockSpace {
+  double* x = nullptr;
+  double* y = nullptr;
+  double* z = nullptr;
+  double* t = nullptr;
+  std::size_t capacity = 0;
 };
 
 class GgirBlocks {
  public:
   // per_hour: samples per hour (3600 sf); compat: GGIR's accidents;
-  // temperature: the stream has a temperature column.
-  GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature)
+  // temperature: the stream has a temperature column; temp_min_sd: the
+  // threshold the temperature's sd is compared with (GGIR: 0.01).
+  GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature,
+             double temp_min_sd = 0.01)
       : seg_(seg),
         H_(static_cast<std::int64_t>(std::floor(per_hour))),
         compat_(compat),
-        temp_(temperature) {
+        temp_(temperature),
+        temp_min_sd_(temp_min_sd) {
     if (H_ < 1) H_ = 1;
   }
 
-  // A new block from the reader: the carry goes in front.
+  // A new block from the reader: the carry goes in front. Each
+  // begin_block() is followed by end_block() before the next.
   void begin_block() {
     info_ = GgirBlockInfo();
     pushed_ = 0;
@@ -75,103 +107,217 @@ class GgirBlocks {
     last_zero_ = false;
     first_.clear();
     runs_.clear();
-    held_ = 0;
-    const std::size_t k = carry_[0].size();
-    reserve(k);
-    for (int c = 0; c < columns(); ++c) {
-      std::copy(carry_[c].begin(), carry_[c].end(), hold_[c].begin());
+    if (carry_in_hold_) {
+      // compatible mode may need this carry again after the block
+      if (compat_) {
+        for (int c = 0; c < columns(); ++c) {
+          carry_[c].assign(hold_[c].begin() + static_cast<std::ptrdiff_t>(head_),
+                           hold_[c].begin() + static_cast<std::ptrdiff_t>(tail_));
+        }
+      }
+    } else {
+      head_ = tail_ = 0;
+      const std::size_t k = carry_[0].size();
+      grow(k);
+      for (int c = 0; c < columns(); ++c) {
+        std::copy(carry_[c].begin(), carry_[c].end(), hold_[c].begin());
+      }
+      tail_ = k;
+      carry_in_hold_ = true;
     }
-    held_ = k;
-    if (temp_) note_temperatures(hold_[3].data(), k);
+    const std::size_t k = tail_ - head_;
+    if (temp_) note_temperatures(hold_[3].data() + head_, k);
     info_.ld = static_cast<std::int64_t>(k);
   }
 
-  // The block's samples, in chunks of any size; t may be null. sink(w) gets
-  // each window the segmenter completes.
+  // Room for at most `want` (>= 1) samples, to be written and then given
+  // to commit().
+  BlockSpace space(std::size_t want) {
+    if (want < 1) want = 1;
+    const std::size_t waiting = tail_ - head_;
+    // to one sample past the current hour (waiting <= H always)
+    const std::size_t rest = static_cast<std::size_t>(H_) + 1 - waiting;
+    const std::size_t k = std::min(want, rest);
+    if (tail_ + k > cap_) {
+      compact();
+      if (tail_ + k > cap_) grow(tail_ + k);
+    }
+    BlockSpace s;
+    s.x = hold_[0].data() + tail_;
+    s.y = hold_[1].data() + tail_;
+    s.z = hold_[2].data() + tail_;
+    s.t = temp_ ? hold_[3].data() + tail_ : nullptr;
+    s.capacity = k;
+    return s;
+  }
+
+  // The first n samples written at the last space() are the block's next
+  // samples (has_t: their temperatures were written; if not, they are NaN).
+  // sink(w) gets each window the segmenter completes.
+  template <class Sink>
+  void commit(std::size_t n, bool has_t, Sink&& sink) {
+    double* px = hold_[0].data() + tail_;
+    double* py = hold_[1].data() + tail_;
+    double* pz = hold_[2].data() + tail_;
+    double* pt = temp_ ? hold_[3].data() + tail_ : nullptr;
+    if (pt != nullptr && !has_t) {
+      std::fill(pt, pt + n, std::numeric_limits<double>::quiet_NaN());
+    }
+    if (n > 0) last_zero_ = is_zero(px[n - 1], py[n - 1], pz[n - 1]);
+    const std::size_t m = drop_zeros(px, py, pz, pt, n);
+    if (pt != nullptr) note_temperatures(pt, m);
+    tail_ += m;
+    info_.rows += static_cast<std::int64_t>(n);
+    info_.zeros += static_cast<std::int64_t>(n - m);
+    info_.ld += static_cast<std::int64_t>(m);
+    // the hours before the last retained sample's are complete
+    if (info_.ld >= 1) {
+      const std::int64_t ready = ((info_.ld - 1) / H_) * H_;
+      if (ready > pushed_) {
+        flush(static_cast<std::size_t>(ready - pushed_), sink);
+        // the next hour fits behind the few samples now waiting
+        if (cap_ - tail_ < static_cast<std::size_t>(H_) + 1 - (tail_ - head_)) compact();
+      }
+    }
+  }
+
+  // The block's samples from the caller's arrays, in chunks of any size; t
+  // may be null. sink(w) gets each window the segmenter completes.
   template <class Sink>
   void push(const double* x, const double* y, const double* z, const double* t,
             std::size_t n, Sink&& sink) {
-    reserve(held_ + n);
-    double* hx = hold_[0].data() + held_;
-    double* hy = hold_[1].data() + held_;
-    double* hz = hold_[2].data() + held_;
-    double* ht = temp_ ? hold_[3].data() + held_ : nullptr;
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    std::size_t m = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (x[i] == 0.0 && y[i] == 0.0 && z[i] == 0.0) {
-        ++info_.zeros;
-        last_zero_ = true;
-        continue;
-      }
-      last_zero_ = false;
-      hx[m] = x[i];
-      hy[m] = y[i];
-      hz[m] = z[i];
-      if (ht != nullptr) ht[m] = t != nullptr ? t[i] : nan;
-      ++m;
+    std::size_t i = 0;
+    while (i < n) {
+      const BlockSpace s = space(n - i);
+      const std::size_t k = s.capacity;
+      std::memcpy(s.x, x + i, k * sizeof(double));
+      std::memcpy(s.y, y + i, k * sizeof(double));
+      std::memcpy(s.z, z + i, k * sizeof(double));
+      if (s.t != nullptr && t != nullptr) std::memcpy(s.t, t + i, k * sizeof(double));
+      commit(k, t != nullptr, sink);
+      i += k;
     }
-    if (ht != nullptr) note_temperatures(ht, m);
-    held_ += m;
-    info_.rows += static_cast<std::int64_t>(n);
-    info_.ld += static_cast<std::int64_t>(m);
-    // everything but the last H samples may go on
-    const std::int64_t free = static_cast<std::int64_t>(held_) - H_;
-    if (free >= H_) flush(static_cast<std::size_t>(free), sink);
   }
 
   // The block ends: the whole hours go on, the rest is carried.
   template <class Sink>
   GgirBlockInfo end_block(Sink&& sink) {
-    const std::size_t n = held_;
-    if (compat_ && last_zero_ && info_.ld >= 2 && n >= 2) {
-      for (int c = 0; c < 3; ++c) hold_[c][n - 1] = hold_[c][n - 2];
-    }
     const std::int64_t use = (info_.ld / H_) * H_;
     info_.used = use;
+    // the last retained sample has not gone on (see commit()); the one
+    // before it may have
+    if (compat_ && last_zero_ && use > 0 && info_.ld >= 2 && H_ >= 2) {
+      const std::size_t last = tail_ - 1;
+      for (int c = 0; c < 3; ++c) {
+        hold_[c][last] = last > head_ ? hold_[c][last - 1] : before_[c];
+      }
+    }
     if (use > 0) {
       flush(static_cast<std::size_t>(use - pushed_), sink);
-      if (use != info_.ld) {
-        take_carry(held_);
-      } else if (!compat_) {
-        for (int c = 0; c < 4; ++c) carry_[c].clear();
-      }
+      // compatible mode: a block of whole hours leaves the previous carry
+      if (compat_ && use == info_.ld) drop_hold();
       temperature_stats(use);
-    } else if (!compat_) {
-      take_carry(held_);
+    } else if (compat_) {
+      drop_hold();  // less than an hour: dropped, the previous carry stays
     }
-    info_.carried = static_cast<std::int64_t>(carry_[0].size());
+    // otherwise the samples not used (all of them when use = 0) are the
+    // carry, where they are
+    seg_.finish(sink);  // the window a lazy segmenter holds back
+    info_.carried = static_cast<std::int64_t>(
+        carry_in_hold_ ? tail_ - head_ : carry_[0].size());
     return info_;
   }
 
  private:
   int columns() const { return temp_ ? 4 : 3; }
 
-  // Room for k held samples. The hold never exceeds two hours plus one
-  // chunk, so its storage stops growing after the first block.
-  void reserve(std::size_t k) {
-    if (hold_[0].size() >= k) return;
-    const std::size_t cap = std::max(k, 2 * hold_[0].size());
-    for (int c = 0; c < columns(); ++c) hold_[c].resize(cap);
+  static bool is_zero(double x, double y, double z) {
+    return x == 0.0 && y == 0.0 && z == 0.0;
+  }
+
+  // Where the first idle-sleep sample among n is (n if none): two samples
+  // per instruction with SSE2.
+  static std::size_t first_zero(const double* x, const double* y, const double* z,
+                                std::size_t n) {
+    std::size_t i = 0;
+#if defined(GRAVCAL_SSE2)
+    const __m128d zr = _mm_setzero_pd();
+    for (; i + 8 <= n; i += 8) {
+      __m128d any = zr;
+      for (std::size_t k = i; k < i + 8; k += 2) {
+        any = _mm_or_pd(any, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(_mm_loadu_pd(x + k), zr),
+                                                   _mm_cmpeq_pd(_mm_loadu_pd(y + k), zr)),
+                                        _mm_cmpeq_pd(_mm_loadu_pd(z + k), zr)));
+      }
+      if (_mm_movemask_pd(any) != 0) break;
+    }
+#endif
+    while (i < n && !is_zero(x[i], y[i], z[i])) ++i;
+    return i;
+  }
+
+  // Removes the idle-sleep samples among n in place; returns how many are
+  // left.
+  static std::size_t drop_zeros(double* x, double* y, double* z, double* t,
+                                std::size_t n) {
+    std::size_t i = first_zero(x, y, z, n);
+    if (i == n) return n;
+    std::size_t m = i;
+    for (; i < n; ++i) {
+      if (is_zero(x[i], y[i], z[i])) continue;
+      x[m] = x[i];
+      y[m] = y[i];
+      z[m] = z[i];
+      if (t != nullptr) t[m] = t[i];
+      ++m;
+    }
+    return m;
+  }
+
+  // Room for k samples in each column (doubling, so that the buffer stops
+  // growing after the first hour: it never needs more than H + 1).
+  void grow(std::size_t k) {
+    if (cap_ >= k) return;
+    const std::size_t most = std::max(k, static_cast<std::size_t>(H_) + 1);
+    cap_ = std::min(std::max(k, 2 * cap_), most);
+    for (int c = 0; c < columns(); ++c) hold_[c].resize(cap_);
+  }
+
+  // The waiting samples to the front of the buffer.
+  void compact() {
+    if (head_ == 0) return;
+    const std::size_t k = tail_ - head_;
+    for (int c = 0; c < columns(); ++c) {
+      std::memmove(hold_[c].data(), hold_[c].data() + head_, k * sizeof(double));
+    }
+    head_ = 0;
+    tail_ = k;
+  }
+
+  // The block's waiting samples are not the carry: the saved one is.
+  void drop_hold() {
+    head_ = tail_ = 0;
+    carry_in_hold_ = false;
   }
 
   // The block's temperatures in order: the first 10, and run-length coded.
   void note_temperatures(const double* t, std::size_t m) {
-    for (std::size_t i = 0; i < m && first_.size() < 10; ++i) first_.push_back(t[i]);
-    for (std::size_t i = 0; i < m; ++i) {
-      if (!runs_.empty() && same(runs_.back().value, t[i])) {
-        ++runs_.back().count;
-      } else {
-        runs_.push_back(Run{t[i], 1});
+    std::size_t i = 0;
+    for (; i < m && first_.size() < 10; ++i) first_.push_back(t[i]);
+    i = 0;
+    while (i < m) {
+      std::uint64_t bits;
+      std::memcpy(&bits, t + i, sizeof bits);
+      if (runs_.empty() || runs_.back().bits != bits) {
+        runs_.push_back(Run{bits, t[i], 0});
       }
+      const std::size_t j = run_end(t, i, m);
+      runs_.back().count += static_cast<std::int64_t>(j - i);
+      i = j;
     }
   }
 
-  static bool same(double a, double b) {
-    return std::memcmp(&a, &b, sizeof a) == 0;
-  }
-
-  // The first k held samples go to the segmenter.
+  // The first k waiting samples go to the segmenter.
   template <class Sink>
   void flush(std::size_t k, Sink& sink) {
     if (k == 0) return;
@@ -179,80 +325,56 @@ class GgirBlocks {
       seg_.new_block();  // GGIR restarts its sums with each block it reads
       started_ = true;
     }
-    seg_.push(hold_[0].data(), hold_[1].data(), hold_[2].data(),
-              temp_ ? hold_[3].data() : nullptr, k, sink);
+    seg_.push(hold_[0].data() + head_, hold_[1].data() + head_, hold_[2].data() + head_,
+              temp_ ? hold_[3].data() + head_ : nullptr, k, sink);
+    for (int c = 0; c < 3; ++c) before_[c] = hold_[c][head_ + k - 1];
+    head_ += k;
     pushed_ += static_cast<std::int64_t>(k);
-    for (int c = 0; c < columns(); ++c) {
-      std::memmove(hold_[c].data(), hold_[c].data() + k, (held_ - k) * sizeof(double));
-    }
-    held_ -= k;
   }
 
-  // The last k held samples become the carry.
-  void take_carry(std::size_t k) {
-    for (int c = 0; c < 4; ++c) {
-      carry_[c].clear();
-      if (c == 3 && !temp_) continue;
-      carry_[c].assign(hold_[c].begin() + static_cast<std::ptrdiff_t>(held_ - k),
-                       hold_[c].begin() + static_cast<std::ptrdiff_t>(held_));
+  // Calls f(value, count) for the runs of the first `use` temperatures.
+  template <class F>
+  void each_run(std::int64_t use, F&& f) const {
+    std::int64_t left = use;
+    for (const Run& r : runs_) {
+      if (left == 0) break;
+      const std::int64_t c = std::min(r.count, left);
+      left -= c;
+      f(r.value, static_cast<std::uint64_t>(c));
     }
   }
 
-  // R's mean of the first 10 and sd of the first `use` temperatures. The sd
-  // only decides whether the temperature varies (sd >= 0.01): gravcal's own
-  // mode takes it from the runs in one pass (exact sums of each run's count
-  // times its value, deviations around the mean); compatible mode repeats
-  // R's arithmetic value by value, so that a block at the threshold goes
-  // GGIR's way.
+  // R's mean of the first 10 and the sd of the first `use` temperatures.
+  // The sd comes from the runs in one pass (exact products of each run's
+  // count and value, deviations around the mean); gravcal's own mode takes
+  // it as it is, compatible mode only when it is clearly on one side of the
+  // threshold (r_sd_below()), and otherwise repeats R's arithmetic value by
+  // value, so that a block at the threshold goes GGIR's way.
   void temperature_stats(std::int64_t use) {
     if (!temp_) return;
     info_.first_mean = r_mean_sd([&](auto&& f) {
       for (double v : first_) f(v);
     }).mean;
+    const RunsSd fast = runs_sd([&](auto&& f) { each_run(use, f); });
     if (!compat_) {
-      info_.temp_sd = runs_sd(use);
+      info_.temp_sd = fast.sd;
+      return;
+    }
+    const int below = r_sd_below(fast, temp_min_sd_);
+    if (below >= 0 && (fast.sd < temp_min_sd_) == (below == 1)) {
+      info_.temp_sd = fast.sd;
       return;
     }
     info_.temp_sd = r_mean_sd([&](auto&& f) {
-      std::int64_t left = use;
-      for (const Run& r : runs_) {
-        for (std::int64_t i = 0; i < r.count && left > 0; ++i, --left) f(r.value);
-        if (left == 0) break;
-      }
+      each_run(use, [&](double v, std::uint64_t c) {
+        for (std::uint64_t i = 0; i < c; ++i) f(v);
+      });
     }).sd;
-  }
-
-  // sd of the first `use` run-coded temperatures, NaN ones left out (as
-  // R's na.rm); NaN when fewer than 2.
-  double runs_sd(std::int64_t use) const {
-    long double sum = 0;
-    std::int64_t n = 0, left = use;
-    for (const Run& r : runs_) {
-      const std::int64_t c = std::min(r.count, left);
-      left -= c;
-      if (!std::isnan(r.value)) {
-        sum += static_cast<long double>(r.value) * c;
-        n += c;
-      }
-      if (left == 0) break;
-    }
-    if (n < 2) return std::numeric_limits<double>::quiet_NaN();
-    const long double mean = sum / n;
-    long double ss = 0;
-    left = use;
-    for (const Run& r : runs_) {
-      const std::int64_t c = std::min(r.count, left);
-      left -= c;
-      if (!std::isnan(r.value)) {
-        const long double d = r.value - mean;
-        ss += d * d * c;
-      }
-      if (left == 0) break;
-    }
-    return static_cast<double>(std::sqrt(ss / (n - 1)));
+    info_.temp_sd_exact = true;
   }
 
   struct Run {
+    std::uint64_t bits;  // the value's bits (runs of the same bits)
     double value;
     std::int64_t count;
   };
@@ -261,13 +383,19 @@ class GgirBlocks {
   std::int64_t H_;
   bool compat_;
   bool temp_;
+  double temp_min_sd_;
   GgirBlockInfo info_;
-  std::int64_t pushed_ = 0;
+  std::int64_t pushed_ = 0;    // the block's samples given to the segmenter
   bool started_ = false;
   bool last_zero_ = false;
-  std::size_t held_ = 0;          // samples in hold_
-  std::vector<double> hold_[4];   // retained, not yet given on (held_ used)
-  std::vector<double> carry_[4];  // carried to the next block
+  std::size_t head_ = 0;       // waiting samples: [head_, tail_) of hold_
+  std::size_t tail_ = 0;
+  std::size_t cap_ = 0;        // size of each hold_ column
+  double before_[3] = {0.0, 0.0, 0.0};  // x, y, z of the last sample given on
+  bool carry_in_hold_ = true;  // the carry is the waiting samples (else carry_)
+  std::vector<double> hold_[4];   // x, y, z, temperature
+  std::vector<double> carry_[4];  // compatible mode: the carry in front of
+                                  // the block, kept for the next block
   std::vector<double> first_;     // the block's first 10 temperatures
   std::vector<Run> runs_;         // the block's temperatures, run-length coded
 };

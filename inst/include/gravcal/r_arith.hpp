@@ -15,6 +15,8 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace gravcal {
@@ -57,6 +59,176 @@ RMeanSd r_mean_sd(Each&& each) {
     r.sd = std::sqrt(static_cast<double>(ss / static_cast<long double>(n - 1)));
   }
   return r;
+}
+
+// The sd of values given as runs (value, count), in one pass over the runs:
+// the mean from the exact counts times the values, then the squared
+// deviations times the counts, in long double (not R's bits). `each(f)`
+// calls f(value, count) for every run in order; NaN values are left out
+// (na.rm). sd is NaN with fewer than 2 values.
+struct RunsSd {
+  double sd = std::numeric_limits<double>::quiet_NaN();
+  long double var = 0.0L;    // sd's square before rounding: ss / (n - 1)
+  std::uint64_t n = 0;       // values that are not NaN
+  std::uint64_t runs = 0;    // runs that are not NaN
+  double max_abs = 0.0;      // largest |value|
+  bool finite = true;        // no infinite value
+};
+
+template <class EachRun>
+RunsSd runs_sd(EachRun&& each) {
+  RunsSd r;
+  long double sum = 0.0L;
+  each([&](double v, std::uint64_t c) {
+    if (std::isnan(v) || c == 0) return;
+    sum += static_cast<long double>(v) * c;
+    r.n += c;
+    ++r.runs;
+    if (!std::isfinite(v)) r.finite = false;
+    if (std::fabs(v) > r.max_abs) r.max_abs = std::fabs(v);
+  });
+  if (r.n < 2) return r;
+  const long double mean = sum / r.n;
+  long double ss = 0.0L;
+  each([&](double v, std::uint64_t c) {
+    if (std::isnan(v) || c == 0) return;
+    const long double d = v - mean;
+    ss += d * d * c;
+  });
+  r.var = ss / (r.n - 1);
+  r.sd = static_cast<double>(std::sqrt(r.var));
+  return r;
+}
+
+// Whether R's sd() of the same values is below `thr` (1), not below (0), or
+// too close to tell (-1), from runs_sd()'s result alone. Only when this is
+// -1 need R's arithmetic be repeated (r_mean_sd()).
+//
+// Why the answer is R's. Let the n values a_i have true mean mu, true
+// variance s2 = sum (a_i - mu)^2 / (n - 1) and M = max |a_i|, all finite;
+// u = 2^-64 (long double), v = 2^-53 (double); standard bounds for
+// recursive summation (Higham, Accuracy and Stability of Numerical
+// Algorithms, 2nd ed., sec. 4.2; gamma_k = k u / (1 - k u)).
+// - R's mean (r_mean_sd()): the sum is off by at most gamma_(n-1) n M, so
+//   s / n by about n u M; the correction pass brings it to within
+//   (2.1 n + 2) u M of mu, and rounding to double adds 1.01 v M (plus
+//   2^-1075 when subnormal). So R's xm is within dR = (2 v + (4 n + 8) u) M
+//   + 1e-300 of mu.
+// - R's ss = sum (a_i - xm)^2 (non-negative terms, each with 2 roundings)
+//   is within gamma_(n+2) of the exact sum, which is (n - 1) s2 + n (mu -
+//   xm)^2; dividing by n - 1, rounding to double, sqrt() and squaring back
+//   add u + 3 v. So sd_R^2 = (s2 + n / (n - 1) dR'^2) (1 + e), |dR'| <= dR,
+//   |e| <= (n + 3) u + 3 v (times 1.02), n / (n - 1) <= 2.
+// - runs_sd(): the mean is within (K + 1) u M (times 1.05) of mu, K runs;
+//   the squared deviations times counts have 3 roundings each, their sum
+//   K, the division 1: var = (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (K +
+//   2) u M, |f| <= (K + 5) u (times 1.02).
+// With eps = 4 (n + K + 16) u + 16 v >= |e|, |f| (and room for the rounding
+// of the bounds themselves) and d2 = 2 max(dR, dF)^2:
+//   s2 in [var / (1 + eps) - d2, var / (1 - eps)], so
+//   sd_R^2 <= (var / (1 - eps) + d2) (1 + eps) = hi and
+//   sd_R^2 >= (var / (1 + eps) - d2) (1 - eps) = lo.
+// hi < thr^2 (1 - 1e-15) means sd_R < thr; lo > thr^2 (1 + 1e-15) means
+// sd_R > thr; otherwise -1. The bounds need n u small, M and thr within
+// [1e-100, 1e100] (M = 0 too), and no infinite value; outside that, -1.
+// The margins are far wider than the errors seen in practice (about 1e-12
+// relative for 4e6 values), so -1 happens only within about 1e-12 of thr.
+inline int r_sd_below(const RunsSd& r, double thr) {
+  if (r.n < 2 || !r.finite) return -1;
+  if (!(thr >= 1e-100 && thr <= 1e100)) return -1;
+  if (r.max_abs > 1e100 || (r.max_abs != 0.0 && r.max_abs < 1e-100)) return -1;
+  if (r.n > (std::uint64_t(1) << 40) || r.runs > (std::uint64_t(1) << 40)) return -1;
+  const long double u = std::ldexp(1.0L, -64), v = std::ldexp(1.0L, -53);
+  const long double n = static_cast<long double>(r.n);
+  const long double k = static_cast<long double>(r.runs);
+  const long double M = r.max_abs;
+  const long double eps = 4.0L * (n + k + 16.0L) * u + 16.0L * v;
+  const long double dm = (2.0L * v + (4.0L * n + 4.0L * k + 16.0L) * u) * M + 1e-300L;
+  const long double d2 = 2.0L * dm * dm;
+  const long double hi = (r.var / (1.0L - eps) + d2) * (1.0L + eps) + 1e-300L;
+  const long double lo = (r.var / (1.0L + eps) - d2) * (1.0L - eps) - 1e-300L;
+  const long double t2 = static_cast<long double>(thr) * thr;
+  if (hi < t2 * (1.0L - 1e-15L)) return 1;
+  if (lo > t2 * (1.0L + 1e-15L)) return 0;
+  return -1;
+}
+
+// The long double grid around a value: |s| in [bottom, top) = [2^(e-1),
+// 2^e) has spacing q = 2^(e - digits).
+struct Binade {
+  long double q = 0, inv_q = 0, bottom = 0, top = 0;
+  bool holds(long double a) const { return a >= bottom && a < top; }
+  void set(long double s) {
+    constexpr int digits = std::numeric_limits<long double>::digits;
+    int e = 0;
+    std::frexp(s, &e);
+    q = std::ldexp(1.0L, e - digits);
+    inv_q = std::ldexp(1.0L, digits - e);
+    bottom = std::ldexp(1.0L, e - 1);
+    top = std::ldexp(1.0L, e);
+  }
+};
+
+// add_repeated()'s closed form (see there): adds x to s j times, 0 < j <=
+// k, as j additions would, and returns j; or returns 0 when the next
+// addition must be a plain one. b: the grid of s, kept between calls.
+inline std::uint64_t repeat_steps(long double& s, double x, std::uint64_t k, Binade& b) {
+  if (x == 0.0 || s == 0.0L || !std::isfinite(x) || !std::isfinite(s)) return 0;
+  const long double a = std::fabs(s);
+  if (!b.holds(a)) b.set(s);
+  const long double y = x * b.inv_q;  // exact: a power of 2
+  if (!(std::fabs(y) < 0x1p62L)) return 0;
+  const long double n = static_cast<long double>(std::llrint(y));
+  if (std::fabs(y - n) == 0.5L) return 0;  // a tie: the last bit of s decides
+  const long double r = n * b.q;              // x on the grid of s
+  // |s| may go from lo to hi (q inside the binade), in steps of |r|
+  const long double lo = b.bottom + b.q, hi = b.top - b.q;
+  if (r == 0.0L) return a >= lo && a <= hi ? k : 0;  // s does not move
+  const long double room = (s > 0) == (r > 0) ? hi - a : a - lo;
+  if (!(room > 0)) return 0;
+  const long double step = std::fabs(r);
+  std::uint64_t j = k;
+  if (static_cast<long double>(k) * step > room) {
+    j = static_cast<std::uint64_t>(std::floor(room / step));
+  }
+  // room / step rounded: step back until s + j r is inside (j r is exact:
+  // |j n| < 2^digits)
+  while (j > 0) {
+    const long double t = std::fabs(s + static_cast<long double>(j) * r);
+    if (t >= lo && t <= hi) break;
+    --j;
+  }
+  if (j > 0) s += static_cast<long double>(j) * r;  // exact, see add_repeated()
+  return j;
+}
+
+// s += x, k times, in long double, to the bit (as a loop of k additions
+// would give it), in a few steps. Each addition rounds the exact s + x to
+// the long double grid of s's binade: spacing q = 2^(e - digits) for |s| in
+// [2^(e-1), 2^e). s is on that grid, so while s + x stays inside the
+// binade the sum rounds to s + r, r = x rounded to the nearest multiple of
+// q (the grid is the same after a shift by s), unless x is exactly half-way
+// between two multiples, a tie that the last bit of s decides. So j
+// additions give s + j r, exactly (a multiple of q inside the binade is
+// representable, and so is j r), as long as |s + j r| stays in [2^(e-1) +
+// q, 2^e - q]: every exact sum on the way is then inside the binade
+// (|x - r| <= q / 2). At a tie, near the binade's edges, with s or x zero
+// or not finite, and for fewer than 4 additions: plain additions.
+inline void add_repeated(long double& s, double x, std::uint64_t k, Binade& b) {
+  while (k > 0) {
+    const std::uint64_t j = k < 4 ? 0 : repeat_steps(s, x, k, b);
+    if (j == 0) {
+      s += x;
+      --k;
+    } else {
+      k -= j;
+    }
+  }
+}
+
+inline void add_repeated(long double& s, double x, std::uint64_t k) {
+  Binade b;
+  add_repeated(s, x, k, b);
 }
 
 // R's mean() of n contiguous values (no NaN handling: R's mean without

@@ -31,6 +31,11 @@
 //   is R's var(): a two-pass mean with a correction pass, then the sum of
 //   squared deviations, all in long double. The caller lends the buffer that
 //   holds the open window's samples, so the core still allocates nothing.
+//   GGIR's procedure only compares the sds with its rest threshold and
+//   with the previous window's (its duplicate filter): lazy_r_sd() keeps
+//   R's arithmetic for those sds that such a comparison could tell from an
+//   sd in double, with bounds on both (fast_sd()), and the temperature's
+//   running sum goes by runs of equal values (add_in_order()).
 //
 // Header-only, standard headers only, no heap.
 #ifndef GRAVCAL_SEGMENTER_HPP
@@ -39,6 +44,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+
+#include "r_arith.hpp"
 // GRAVCAL_NO_SIMD: the portable loop only (the results are the same bits)
 #if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
 #define GRAVCAL_SSE2 1
@@ -68,6 +76,64 @@ struct WindowStats {
   double temperature;  // mean of finite temperatures, NaN if none
 };
 
+// The end of the run of values with the same bits as v[i], from i on (two
+// at a time with SSE2).
+inline std::size_t run_end(const double* v, std::size_t i, std::size_t n) {
+  std::uint64_t bits;
+  std::memcpy(&bits, v + i, sizeof bits);
+  std::size_t j = i + 1;
+#if defined(GRAVCAL_SSE2)
+  const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
+  for (; j + 4 <= n; j += 4) {
+    const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j));
+    const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j + 2));
+    const __m128i eq = _mm_and_si128(_mm_cmpeq_epi32(a0, b), _mm_cmpeq_epi32(a1, b));
+    if (_mm_movemask_epi8(eq) != 0xffff) break;
+  }
+#endif
+  while (j < n && std::memcmp(v + j, &bits, sizeof bits) == 0) ++j;
+  return j;
+}
+
+// for (k < n) s += v[k], in long double, to the bit, by runs of equal values
+// (add_repeated(), r_arith.hpp): a temperature repeats over a page or a
+// block of the file. b: the grid of s, kept between calls.
+inline void add_in_order(long double& s, const double* v, std::size_t n, Binade& b) {
+  std::size_t i = 0;
+  while (i < n) {
+    const std::size_t j = run_end(v, i, n);
+    add_repeated(s, v[i], static_cast<std::uint64_t>(j - i), b);
+    i = j;
+  }
+}
+
+// The state of Segmenter::lazy_r_sd(), which the caller keeps (the core
+// allocates nothing, and a segmenter without it stays small): the window
+// held back, the window being closed, and the last window given out with
+// means when the held one has none.
+struct LazySd {
+  // A window on its way to the sink, with what is known of its sds: R's
+  // sd^2 of axis a lies in [lo2[a], hi2[a]] (one point when the sd is R's).
+  struct Window {
+    WindowStats s;
+    bool fast = false;         // s.sd are in double, not R's (yet)
+    bool na = false;           // no mean z or mean norm: GGIR's filter skips it
+    double sd[3] = {0, 0, 0};  // the sds in double (fast_sd())
+    long double lo2[3] = {0, 0, 0}, hi2[3] = {0, 0, 0};
+    const double* col[3] = {nullptr, nullptr, nullptr};  // its samples
+    std::size_t m = 0;
+    long double w[3] = {0, 0, 0};  // their long double sums (R's first pass)
+    bool has_w = false;
+  };
+  double max_sd = 0.0;     // the rest rule's threshold
+  double* buf = nullptr;   // the held window's samples (ceil(L) + 1 per axis)
+  Window cand;             // the window being closed
+  Window held;             // the window held back
+  bool held_on = false;
+  long double ref_lo2[3] = {0, 0, 0}, ref_hi2[3] = {0, 0, 0};
+  bool ref_on = false;     // the last window given out with means
+};
+
 class Segmenter {
  public:
   // samples_per_window: L = duration (s) * sampling rate (Hz), at least 1.
@@ -91,6 +157,38 @@ class Segmenter {
   }
   bool r_arithmetic() const { return rbuf_ != nullptr; }
 
+  // R-compatible arithmetic for what GGIR's procedure can see of the sds
+  // (call after use_r_arithmetic(); state: see LazySd): the sd of a window is R's to the bit
+  // when the window may be at rest (its R sd below max_sd on every axis,
+  // the rest rule's threshold), and when GGIR's duplicate filter could find
+  // it equal to the sd of the window before (the last one with a mean z and
+  // a mean norm); otherwise it is an sd in double whose distance from R's
+  // is bounded (fast_sd()), and which is on the same side of max_sd and of
+  // the neighbours' sds as R's. Means are always R's. Windows then reach
+  // the sink one window late: finish() gives the last one (call it at the
+  // end of each of GGIR's blocks). `buffer` (3 * (ceil(L) + 1) doubles,
+  // outliving the segmenter) keeps the samples of the window held back.
+  // Returns false (and changes nothing) when the buffer is too small, the
+  // arithmetic is not R's, or max_sd is not positive and finite.
+  bool lazy_r_sd(double max_sd, LazySd* state, double* buffer, std::size_t capacity) {
+    if (rbuf_ == nullptr || !(max_sd > 0) || !std::isfinite(max_sd)) return false;
+    if (state == nullptr || buffer == nullptr || capacity < 3u * rcap_) return false;
+    *state = LazySd();
+    state->max_sd = max_sd;
+    state->buf = buffer;
+    lz_ = state;
+    return true;
+  }
+
+  // Gives the window held back by lazy_r_sd() (a no-op otherwise).
+  template <class Sink>
+  void finish(Sink&& sink) {
+    if (lz_ == nullptr || !lz_->held_on) return;
+    if (!lz_->held.na) keep_as_reference(lz_->held);
+    lz_->held_on = false;
+    sink(lz_->held.s);
+  }
+
   // Restart the cumulative sums, as GGIR does at each block it reads. Only at
   // a window boundary (no open window); returns false otherwise.
   bool new_block() {
@@ -112,6 +210,10 @@ class Segmenter {
     seen_ = 0;
     skipped_zero_ = 0;
     next_boundary_ = boundary(1);
+    if (lz_ != nullptr) {
+      lz_->held_on = false;
+      lz_->ref_on = false;
+    }
     clear_window();
   }
 
@@ -144,6 +246,8 @@ class Segmenter {
       if (step(x[i], y[i], z[i], t ? t[i] : NAN, sink)) try_whole = true;
       ++i;
     }
+    // the held window's samples are the caller's: keep a copy
+    if (lz_ != nullptr && lz_->held_on && lz_->held.fast) keep_samples(lz_->held);
   }
 
   // Samples in the open (incomplete) window; these are dropped at the end.
@@ -169,9 +273,15 @@ class Segmenter {
     add(xi, yi, zi, ti);
     ++retained_;
     if (retained_ != next_boundary_) return false;
-    WindowStats s;
-    close(s, nullptr);
-    sink(s);
+    if (lz_ != nullptr) {
+      LazySd::Window& h = lz_->cand;
+      close(h.s, nullptr);  // close_r() fills in h
+      deliver(h, sink);
+    } else {
+      WindowStats s;
+      close(s, nullptr);
+      sink(s);
+    }
     return true;
   }
 
@@ -185,6 +295,7 @@ class Segmenter {
     const double h0 = x[0], h1 = y[0], h2 = z[0];
     StreamScan a;
     RScan r;
+    bool fast = false;
     if (rbuf_ == nullptr) {
       scan_stream(x, y, z, t, m, a);
       double all = lanes(a.nrm);
@@ -195,19 +306,33 @@ class Segmenter {
       }
     } else {
       for (int k = 0; k < 5; ++k) r.c[k] = csum_[k];
-      scan_r(x, y, z, t, m, r);
+      scan_r(x, y, z, m, r);
       // the running sums stay finite through windows of finite samples
       // (add() leaves out non-finite ones), so a non-finite sum here means
       // this window holds a non-finite value
       if ((skip_zero_ && r.zero) ||
-          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3])) ||
-          (t != nullptr && !std::isfinite(static_cast<double>(r.c[4])))) {
+          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3]))) {
         return false;
       }
+      const double* cols[3] = {x, y, z};
+      // lazy_r_sd(): an sd in double where R's cannot matter
+      fast = lz_ != nullptr && fast_sd(cols, m, r.w, r.lo, r.hi, lz_->cand);
+      // the sds (R's var()), with the temperature's running sum riding
+      // along their second pass (a single chain of additions is cheaper
+      // there); for a window left with the sd in double, the temperature's
+      // sum by runs (add_in_order()); all before anything changes: a
+      // non-finite temperature still sends the window to the
+      // sample-by-sample path
+      if (!fast && m > 1) {
+        r_sd3(cols, m, r.w, t, &r.c[4], wsd_);
+      } else if (t != nullptr) {
+        Binade b;
+        add_in_order(r.c[4], t, m, b);
+      }
+      if (t != nullptr && !std::isfinite(static_cast<double>(r.c[4]))) return false;
       for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
       a = StreamScan();  // sums replaced by close_r()
       for (int k = 0; k < 3; ++k) {
-        wsum_[k] = r.w[k];
         a.lo[k] = r.lo[k];
         a.hi[k] = r.hi[k];
       }
@@ -234,9 +359,24 @@ class Segmenter {
       sum_temp_[l] = a.st[l];
     }
     const double* cols[3] = {x, y, z};
-    WindowStats s;
-    close(s, cols);
-    sink(s);
+    if (lz_ == nullptr) {
+      WindowStats s;
+      close(s, cols);
+      sink(s);
+      return true;
+    }
+    LazySd::Window& h = lz_->cand;
+    h.fast = fast;
+    close(h.s, cols);
+    if (fast) {
+      for (int k = 0; k < 3; ++k) {
+        h.col[k] = cols[k];
+        h.w[k] = r.w[k];
+      }
+      h.m = m;
+      h.has_w = true;
+    }
+    deliver(h, sink);
     return true;
   }
 
@@ -373,10 +513,10 @@ class Segmenter {
   // R's cumsum(), one column at a time, continuing o.c, and the norm as
   // add() forms it; the window's own long double sums (the first pass of
   // R's sd) ride along. Scalar accumulators, so that they stay in x87
-  // registers; min, max and temperature in a second loop.
+  // registers (seven of the eight); min, max and the zero test two samples
+  // at a time in a second loop (the temperature's sum: r_sd3()).
   GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
-                                      const double* z, const double* t,
-                                      std::size_t m, RScan& o) {
+                                      const double* z, std::size_t m, RScan& o) {
     long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
     long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
     for (std::size_t k = 0; k < m; ++k) {
@@ -397,29 +537,226 @@ class Segmenter {
     o.w[0] = w0;
     o.w[1] = w1;
     o.w[2] = w2;
-    const double h0 = x[0], h1 = y[0], h2 = z[0];
-    double lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+    min_max(x, y, z, m, o);
+  }
+
+  // min, max and whether some sample is all zeros. min and max are those of
+  // the sequential rule (v < lo ? v : lo from the first sample, as add()):
+  // the same value in any order, except that a zero minimum (maximum) is
+  // the first zero met, with its sign, which a second look finds.
+  static void min_max(const double* x, const double* y, const double* z,
+                      std::size_t m, RScan& o) {
+    const double* col[3] = {x, y, z};
+    double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
     bool zero = false;
-    long double c4 = o.c[4];
-    for (std::size_t k = 0; k < m; ++k) {
-      const double xi = x[k], yi = y[k], zi = z[k];
-      zero |= (xi == 0.0) & (yi == 0.0) & (zi == 0.0);
-      lo0 = xi < lo0 ? xi : lo0;
-      lo1 = yi < lo1 ? yi : lo1;
-      lo2 = zi < lo2 ? zi : lo2;
-      hi0 = xi > hi0 ? xi : hi0;
-      hi1 = yi > hi1 ? yi : hi1;
-      hi2 = zi > hi2 ? zi : hi2;
-      if (t != nullptr) c4 += t[k];
+    std::size_t k = 0;
+#if defined(GRAVCAL_SSE2)
+    {
+      const __m128d zr = _mm_setzero_pd();
+      __m128d lo0 = _mm_set1_pd(lo[0]), lo1 = _mm_set1_pd(lo[1]), lo2 = _mm_set1_pd(lo[2]);
+      __m128d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
+      for (; k + 2 <= m; k += 2) {
+        const __m128d a = _mm_loadu_pd(x + k), b = _mm_loadu_pd(y + k),
+                      c = _mm_loadu_pd(z + k);
+        lo0 = _mm_min_pd(a, lo0);
+        lo1 = _mm_min_pd(b, lo1);
+        lo2 = _mm_min_pd(c, lo2);
+        hi0 = _mm_max_pd(a, hi0);
+        hi1 = _mm_max_pd(b, hi1);
+        hi2 = _mm_max_pd(c, hi2);
+        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(a, zr),
+                                                     _mm_cmpeq_pd(b, zr)),
+                                          _mm_cmpeq_pd(c, zr)));
+      }
+      const __m128d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
+      for (int a = 0; a < 3; ++a) {
+        double e[2];
+        _mm_storeu_pd(e, lov[a]);
+        lo[a] = e[0] < e[1] ? e[0] : e[1];
+        _mm_storeu_pd(e, hiv[a]);
+        hi[a] = e[0] > e[1] ? e[0] : e[1];
+      }
+      zero = _mm_movemask_pd(zacc) != 0;
     }
-    o.c[4] = c4;
-    o.lo[0] = lo0;
-    o.lo[1] = lo1;
-    o.lo[2] = lo2;
-    o.hi[0] = hi0;
-    o.hi[1] = hi1;
-    o.hi[2] = hi2;
+#endif
+    for (; k < m; ++k) {
+      zero = zero || (x[k] == 0.0 && y[k] == 0.0 && z[k] == 0.0);
+      for (int a = 0; a < 3; ++a) {
+        const double v = col[a][k];
+        lo[a] = v < lo[a] ? v : lo[a];
+        hi[a] = v > hi[a] ? v : hi[a];
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (lo[a] == 0.0 || hi[a] == 0.0) {
+        std::size_t j = 0;
+        while (j < m && col[a][j] != 0.0) ++j;
+        if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
+        if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
+      }
+      o.lo[a] = lo[a];
+      o.hi[a] = hi[a];
+    }
     o.zero = zero;
+  }
+
+  // The sds of n (>= 2) samples in double, for lazy_r_sd(): about the mean
+  // w / n rounded to double (w: the long double sums of R's first pass),
+  // the squared deviations summed in four lanes by position (two SSE2
+  // registers per axis; the portable loop adds the same lanes), so the same
+  // samples give the same bits on either path. Error bounds as
+  // r_sd_below()'s (r_arith.hpp), with u = 2^-53 and M = max |x|: this
+  // sd^2 is (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (u + (n + 2) 2^-64) M,
+  // |f| <= (n + 4) u (times 1.01); R's is (s2 + n / (n - 1) dR^2) (1 + e),
+  // |dR| <= (2 u + (4 n + 8) 2^-64) M, |e| <= (n + 3) 2^-64 + 3 u. With eps
+  // = 4 (n + 16) u and dm = 4 (n + 8) u M + 1e-300 (covering either side),
+  // R's sd^2 lies in [(v / (1 + eps) - 2 dm^2) (1 - eps), (v / (1 - eps) +
+  // 2 dm^2) (1 + eps)], v this sd^2. Returns true (the sds in double may
+  // stand) only when some axis is surely above max_sd (the window is not at
+  // rest, whatever else) and the bounds apply (n u small, M within [1e-100,
+  // 1e100] or 0); deliver() then checks the neighbour.
+  bool fast_sd(const double* const* v, std::size_t n, const long double* w,
+               const double* lo, const double* hi, LazySd::Window& h) const {
+    if (n < 2 || n > (std::size_t(1) << 30)) return false;
+    double M[3];
+    for (int a = 0; a < 3; ++a) {
+      M[a] = std::fmax(std::fabs(lo[a]), std::fabs(hi[a]));
+      if (!(M[a] <= 1e100) || (M[a] != 0.0 && M[a] < 1e-100)) return false;
+    }
+    const long double ln = static_cast<long double>(n);
+    const double mu[3] = {static_cast<double>(w[0] / ln), static_cast<double>(w[1] / ln),
+                          static_cast<double>(w[2] / ln)};
+    double q[3][4] = {};
+    std::size_t k = 0;
+#if defined(GRAVCAL_SSE2)
+    {
+      const __m128d m0 = _mm_set1_pd(mu[0]), m1 = _mm_set1_pd(mu[1]), m2 = _mm_set1_pd(mu[2]);
+      const __m128d zr = _mm_setzero_pd();
+      __m128d q0a = zr, q0b = zr, q1a = zr, q1b = zr, q2a = zr, q2b = zr;
+      const double* x = v[0];
+      const double* y = v[1];
+      const double* z = v[2];
+      for (; k + 4 <= n; k += 4) {
+        __m128d d = _mm_sub_pd(_mm_loadu_pd(x + k), m0);
+        q0a = _mm_add_pd(q0a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(_mm_loadu_pd(x + k + 2), m0);
+        q0b = _mm_add_pd(q0b, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(_mm_loadu_pd(y + k), m1);
+        q1a = _mm_add_pd(q1a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(_mm_loadu_pd(y + k + 2), m1);
+        q1b = _mm_add_pd(q1b, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(_mm_loadu_pd(z + k), m2);
+        q2a = _mm_add_pd(q2a, _mm_mul_pd(d, d));
+        d = _mm_sub_pd(_mm_loadu_pd(z + k + 2), m2);
+        q2b = _mm_add_pd(q2b, _mm_mul_pd(d, d));
+      }
+      _mm_storeu_pd(q[0], q0a);
+      _mm_storeu_pd(q[0] + 2, q0b);
+      _mm_storeu_pd(q[1], q1a);
+      _mm_storeu_pd(q[1] + 2, q1b);
+      _mm_storeu_pd(q[2], q2a);
+      _mm_storeu_pd(q[2] + 2, q2b);
+    }
+#endif
+    for (; k < n; ++k) {
+      for (int a = 0; a < 3; ++a) {
+        const double d = v[a][k] - mu[a];
+        q[a][k & 3] += d * d;
+      }
+    }
+    const long double u = std::ldexp(1.0L, -53);
+    const long double eps = 4.0L * (ln + 16.0L) * u;
+    const long double t2 = static_cast<long double>(lz_->max_sd) * lz_->max_sd;
+    bool above = false;
+    for (int a = 0; a < 3; ++a) {
+      const double var = lanes(q[a]) / static_cast<double>(n - 1);
+      h.sd[a] = std::sqrt(var);
+      const long double dm = 4.0L * (ln + 8.0L) * u * M[a] + 1e-300L;
+      const long double d2 = 2.0L * dm * dm;
+      h.hi2[a] = (var / (1.0L - eps) + d2) * (1.0L + eps);
+      h.lo2[a] = (var / (1.0L + eps) - d2) * (1.0L - eps);
+      if (h.lo2[a] > t2 * (1.0L + 1e-12L)) above = true;
+    }
+    return above;
+  }
+
+  // R's sds for a window kept in double.
+  static void make_exact(LazySd::Window& h) {
+    if (!h.fast) return;
+    r_sd3(h.col, h.m, h.has_w ? h.w : nullptr, nullptr, nullptr, h.s.sd);
+    h.fast = false;
+    point_bounds(h);
+  }
+
+  static void point_bounds(LazySd::Window& h) {
+    for (int a = 0; a < 3; ++a) {
+      h.lo2[a] = h.hi2[a] = static_cast<long double>(h.s.sd[a]) * h.s.sd[a];
+    }
+  }
+
+  // Whether R's sds of two windows could be equal on some axis (their
+  // ranges touch, with room for the rounding of the values given out).
+  static bool may_tie(const long double* lo_a, const long double* hi_a,
+                      const long double* lo_b, const long double* hi_b) {
+    for (int k = 0; k < 3; ++k) {
+      const bool apart = hi_a[k] < lo_b[k] * (1.0L - 1e-12L) ||
+                         hi_b[k] < lo_a[k] * (1.0L - 1e-12L);
+      if (!apart) return true;
+    }
+    return false;
+  }
+
+  // The window kept as the one the next is compared with after it is
+  // given out: its sds become R's.
+  void keep_as_reference(LazySd::Window& h) {
+    make_exact(h);
+    for (int a = 0; a < 3; ++a) {
+      lz_->ref_lo2[a] = h.lo2[a];
+      lz_->ref_hi2[a] = h.hi2[a];
+    }
+    lz_->ref_on = true;
+  }
+
+  // A window kept in double whose samples are not the segmenter's to keep
+  // (the caller's, or the open window's buffer): copied.
+  void keep_samples(LazySd::Window& h) {
+    if (h.col[0] == lz_->buf) return;
+    for (int a = 0; a < 3; ++a) {
+      double* d = lz_->buf + static_cast<std::size_t>(a) * rcap_;
+      std::memcpy(d, h.col[a], h.m * sizeof(double));
+      h.col[a] = d;
+    }
+  }
+
+  // lazy_r_sd(): a completed window, held back one window, so that a tie
+  // with the next can still make the sds of both R's.
+  template <class Sink>
+  void deliver(LazySd::Window& h, Sink& sink) {
+    LazySd& z = *lz_;
+    h.na = std::isnan(h.s.mean[2]) || std::isnan(h.s.mean_norm);
+    if (!h.fast) point_bounds(h);
+    if (!h.na) {
+      // its neighbour in GGIR's filter: the held window, or the last one
+      // given out with means (R's sds, see keep_as_reference())
+      if (z.held_on && !z.held.na) {
+        if (may_tie(z.held.lo2, z.held.hi2, h.lo2, h.hi2)) {
+          make_exact(z.held);
+          make_exact(h);
+        }
+      } else if (z.ref_on && may_tie(z.ref_lo2, z.ref_hi2, h.lo2, h.hi2)) {
+        make_exact(h);
+      }
+    }
+    if (z.held_on) {
+      // a window without means: the held one stays the neighbour
+      if (h.na && !z.held.na) keep_as_reference(z.held);
+      sink(z.held.s);
+    }
+    if (!h.na) z.ref_on = false;
+    z.held = h;
+    z.held_on = true;
+    // samples in the open window's buffer: keep a copy
+    if (z.held.fast && z.held.col[0] == rbuf_) keep_samples(z.held);
   }
 
   void clear_window() {
@@ -537,9 +874,36 @@ class Segmenter {
         v[a] = cols != nullptr ? cols[a]
                                : rbuf_ + static_cast<std::size_t>(a) * rcap_;
       }
-      r_sd3(v, static_cast<std::size_t>(n_valid_), cols != nullptr ? wsum_ : nullptr,
-            s.sd);
+      if (cols != nullptr) {
+        // whole_window()'s: R's, or in double (lazy_r_sd())
+        const bool fast = lz_ != nullptr && lz_->cand.fast;
+        for (int a = 0; a < 3; ++a) s.sd[a] = fast ? lz_->cand.sd[a] : wsd_[a];
+      } else if (lz_ != nullptr) {
+        LazySd::Window& h = lz_->cand;
+        // the same choice as whole_window() makes, on the same values
+        const std::size_t nv = static_cast<std::size_t>(n_valid_);
+        // R's first pass, as whole_window()'s
+        long double w[3] = {0.0L, 0.0L, 0.0L};
+        for (std::size_t k = 0; k < nv; ++k) {
+          for (int a = 0; a < 3; ++a) w[a] += v[a][k];
+        }
+        h.fast = fast_sd(v, nv, w, min_, max_, h);
+        for (int a = 0; a < 3; ++a) h.w[a] = w[a];
+        if (h.fast) {
+          for (int a = 0; a < 3; ++a) {
+            s.sd[a] = h.sd[a];
+            h.col[a] = v[a];
+          }
+          h.m = nv;
+          h.has_w = true;
+        } else {
+          r_sd3(v, nv, w, nullptr, nullptr, s.sd);
+        }
+      } else {
+        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, nullptr, s.sd);
+      }
     } else {
+      if (lz_ != nullptr) lz_->cand.fast = false;
       for (int a = 0; a < 3; ++a) s.sd[a] = NAN;
     }
   }
@@ -548,9 +912,12 @@ class Segmenter {
   // correction pass, then the sum of squared deviations, in long double. The
   // three columns go through each pass together (independent sums, so the
   // result is that of three separate calls). sum1: the first pass's sums
-  // when the caller has them already, or null.
-  static void r_sd3(const double* const* v, std::size_t n,
-                    const long double* sum1, double* out) {
+  // when the caller has them already, or null. t, tsum: when not null, the
+  // n temperatures are added to *tsum in order during the second pass (an
+  // independent chain, nearly free there).
+  GRAVCAL_NOINLINE static void r_sd3(const double* const* v, std::size_t n,
+                                     const long double* sum1, const double* t,
+                                     long double* tsum, double* out) {
     const long double ln = static_cast<long double>(n);
     const double* a = v[0];
     const double* b = v[1];
@@ -574,10 +941,21 @@ class Segmenter {
     sa = sb = sc = 0.0L;
     {
       const long double m0 = m[0], m1 = m[1], m2 = m[2];
-      for (std::size_t k = 0; k < n; ++k) {
-        sa += (a[k] - m0);
-        sb += (b[k] - m1);
-        sc += (c[k] - m2);
+      if (t != nullptr && tsum != nullptr) {
+        long double st = *tsum;
+        for (std::size_t k = 0; k < n; ++k) {
+          sa += (a[k] - m0);
+          sb += (b[k] - m1);
+          sc += (c[k] - m2);
+          st += t[k];
+        }
+        *tsum = st;  // out of the registers before the third pass
+      } else {
+        for (std::size_t k = 0; k < n; ++k) {
+          sa += (a[k] - m0);
+          sb += (b[k] - m1);
+          sc += (c[k] - m2);
+        }
       }
     }
     if (fin[0]) m[0] = m[0] + sa / ln;
@@ -604,7 +982,8 @@ class Segmenter {
   double* rbuf_ = nullptr;
   std::size_t rcap_ = 0;
   long double csum_[5];
-  long double wsum_[3] = {0.0L, 0.0L, 0.0L};  // see whole_window()
+  double wsd_[3] = {0.0, 0.0, 0.0};  // the sds whole_window() computed
+  LazySd* lz_ = nullptr;      // lazy_r_sd()'s state, or null
   double cprev_[5];
   std::int64_t window_, retained_, seen_, skipped_zero_, next_boundary_, first_;
   std::int64_t n_, n_invalid_, n_valid_, n_temp_;
