@@ -9,6 +9,11 @@
 // every value in order, so that they can lie anywhere (pieces of vectors,
 // runs of a run-length code) without being copied.
 //
+// Also: an sd from runs of equal values and when it is sure to be on the
+// same side of a threshold as R's (runs_sd(), r_sd_below()), and repeated
+// long double additions in closed form (add_repeated()), so that R's
+// arithmetic runs only where its bits can matter.
+//
 // Header-only, standard headers only.
 #ifndef GRAVCAL_R_ARITH_HPP
 #define GRAVCAL_R_ARITH_HPP
