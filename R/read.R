@@ -462,7 +462,10 @@ source_native <- function(file, format, sf, chunksize, compat, arg) {
            b <- native_block(h, B - units, cap, TRUE, FALSE)
            if (b$to > 0) parts[[length(parts) + 1]] <- b
            units <- units + b$units
-           if (b$done || units >= B || (b$to == 0 && b$units == 0)) break
+           # a full buffer may end part-way through the block's last unit:
+           # the next call (with no units left) gives the rest of it
+           if (b$done || (units >= B && b$to < cap) ||
+               (b$to == 0 && b$units == 0)) break
          }
          if (!length(parts)) return(NULL)
          list(parts = parts, last = b$done)

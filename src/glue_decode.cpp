@@ -190,7 +190,7 @@ Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
   std::int64_t units = 0;
   double samples = 0;
   int rounds = 0;
-  while (!f->decoder->done() && left != 0) {
+  while (!f->decoder->done()) {
     out.n = 0;
     const std::int64_t u = f->decoder->read(out, left);
     units += u;
@@ -199,6 +199,8 @@ Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
                   [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); });
     samples += static_cast<double>(out.n);
     if (out.n == 0 && u == 0) break;  // nothing more this call
+    // every unit read and all its samples given (see gc_blocks_decode())
+    if (left == 0 && !out.full()) break;
     if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
   }
   return Rcpp::List::create(Rcpp::Named("windows") = table.to_list(),
@@ -225,7 +227,7 @@ Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
   std::int64_t left = max_units < 0 ? -1 : static_cast<std::int64_t>(max_units);
   std::int64_t units = 0;
   int rounds = 0;
-  while (!f->decoder->done() && left != 0) {
+  while (!f->decoder->done()) {
     const gravcal::BlockSpace s = box->blocks.space(ChunkBuffer::chunk);
     gravcal::SampleBuffer out;
     out.x = s.x;
@@ -238,6 +240,10 @@ Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
     if (left > 0) left -= u;
     box->blocks.commit(out.n, out.t != nullptr, sink);
     if (out.n == 0 && u == 0) break;
+    // the units are all read and their samples all given (out has room
+    // left), or out filled part-way through the last unit: then the next
+    // call, with left == 0, gives the rest of it
+    if (left == 0 && !out.full()) break;
     if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
   }
   Rcpp::List res = gravcal_glue::block_result(table, box->blocks.end_block(sink));

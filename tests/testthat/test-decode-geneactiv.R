@@ -359,3 +359,41 @@ test_that("trailing garbage and stray lines are skipped and counted", {
   expect_identical(rep$counters[["stray_lines"]], 3)
   expect_identical(rep$skipped, 0)
 })
+
+# A block of whole pages whose last page does not fit the glue's fixed
+# 65,536-sample buffer: 219 pages are 65,700 samples, so the buffer fills
+# 164 samples into the 219th. Every sample of the block's pages must come
+# with the block (before the fix the block ended where the buffer filled,
+# and in GGIR's procedure a block short of its pages ends the recording:
+# on a 28-day .bin the fit then used 38 of 56 blocks).
+test_that("a block gives every sample of its pages when the buffer fills inside the last", {
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(ga_sim(700 * 300, 100), f, sf = 100)
+  for (compat in 0:1) {
+    h <- gravcal:::native_open(f, "geneactiv", list(compat = compat))
+    seg <- gravcal:::gc_segmenter_new(1000, FALSE, compat == 1)
+    got <- list()
+    repeat {
+      r <- gravcal:::gc_decoder_segment(h$ptr, seg, 219, 0L, c(0.05, 7), TRUE)
+      got[[length(got) + 1]] <- c(r$units, r$samples)
+      if (r$done || r$units == 0) break
+    }
+    gravcal:::gc_decoder_close(h$ptr)
+    got <- do.call(rbind, got)
+    expect_identical(got[, 1], c(219, 219, 219, 43))
+    expect_identical(got[, 2], got[, 1] * 300)
+    # GGIR's blocks: the block rules' rows are the block's pages' samples
+    h <- gravcal:::native_open(f, "geneactiv", list(compat = compat))
+    seg <- gravcal:::gc_segmenter_new(1000, FALSE, compat == 1)
+    run <- gravcal:::gc_blocks_new(seg, 360000, compat == 1, TRUE, 0.1)
+    rows <- numeric(0)
+    repeat {
+      r <- gravcal:::gc_blocks_decode(run, h$ptr, 219, 1L, c(0.013, 2))
+      rows <- c(rows, r$rows)
+      if (r$done || r$units == 0) break
+    }
+    gravcal:::gc_decoder_close(h$ptr)
+    expect_identical(rows, c(219, 219, 219, 43) * 300)
+  }
+})
