@@ -146,14 +146,25 @@ missing_bins <- function(pts) {
         collapse = ", ")
 }
 
+# One key per row of the means m: which cube of side `cell` it lies in. A
+# number (17 bits a coordinate, exact in a double) while every cube index
+# fits, which any mean within 3000 g does; text otherwise.
+cell_keys <- function(m, cell) {
+  i <- round(m / cell)
+  if (all(abs(i) < 65535)) {
+    (i[, 1] + 65536) * 2^34 + (i[, 2] + 65536) * 2^17 + (i[, 3] + 65536)
+  } else {
+    paste(i[, 1], i[, 2], i[, 3])
+  }
+}
+
 # gravcal's selection: the stillest rest window of each cube of side `cell`
 # g that holds rest means, in time order.
 select_cells <- function(w, cell) {
   check_number(cell, "cell", min = 0.001, max = 1)
   rows <- rest_rows(w)
   m <- cbind(w$mean_x[rows], w$mean_y[rows], w$mean_z[rows])
-  key <- paste(round(m[, 1] / cell), round(m[, 2] / cell),
-               round(m[, 3] / cell))
+  key <- cell_keys(m, cell)
   stillness <- function(prefix) {
     cols <- paste0(prefix, c("x", "y", "z"))
     if (!all(cols %in% names(w))) return(NULL)
@@ -164,7 +175,7 @@ select_cells <- function(w, cell) {
   still <- stillness("range_")
   if (is.null(still)) still <- stillness("sd_")
   if (is.null(still)) still <- rep(0, length(rows))
-  o <- order(key, still, rows)
+  o <- order(key, still, rows, method = "radix")
   pick <- sort(o[!duplicated(key[o])])
   kept <- rows[pick]
   pts <- w[kept, , drop = FALSE]

@@ -118,3 +118,34 @@ test_that("select_points() in a device's arithmetic rounds as the device does", 
                    select_points(cand)$row)
   expect_error(select_points(cand, arithmetic = "int8"), "`arithmetic` must be one of")
 })
+
+test_that("cells: numeric cube keys pick what text keys pick, and far means still work", {
+  # an independent reference: one key per cube as text, the stillest window
+  # of each (ties to the earlier), in time order
+  ref_cells <- function(w, cell) {
+    k <- paste(round(w$mean_x / cell), round(w$mean_y / cell), round(w$mean_z / cell))
+    s <- pmax(w$range_x, w$range_y, w$range_z)
+    keep <- vapply(seq_along(k), function(i) {
+      same <- which(k == k[i])
+      best <- same[s[same] == min(s[same])]
+      i == best[1]
+    }, logical(1))
+    which(keep)
+  }
+  set.seed(3)
+  n <- 400
+  u <- matrix(stats::rnorm(3 * n), n)
+  u <- u / sqrt(rowSums(u^2))
+  w <- data.frame(mean_x = u[, 1], mean_y = u[, 2], mean_z = u[, 3],
+                  range_x = stats::runif(n, 0, 0.01), range_y = stats::runif(n, 0, 0.01),
+                  range_z = round(stats::runif(n, 0, 0.01), 3), rest = TRUE)
+  for (cell in c(0.05, 0.2, 0.5)) {
+    expect_identical(select_points(w, selection = "cells", cell = cell)$row,
+                     ref_cells(w, cell))
+  }
+  # a mean beyond the numeric keys' reach (3000 g) falls back to text keys
+  far <- w
+  far$mean_x[1:3] <- c(5000, 5000, -7000)
+  expect_identical(select_points(far, selection = "cells", cell = 0.05)$row,
+                   ref_cells(far, 0.05))
+})
