@@ -107,8 +107,22 @@ static bool plain(const std::string& s, bool compat, double& v) {
   const std::string t = s + "\n";
   csv::PlainNumber n;
   const char* e = csv::scan_plain_number(t.data(), '.', n);
+  // the fixed-offset scan for one digit and 1-3 decimals: the same
+  csv::PlainNumber n3;
+  const char* e3 = csv::scan_plain_number_3(t.data(), '.', n3);
+  CHECK(e3 == e, s + " (scan_plain_number_3 end)");
+  if (e != nullptr && e3 == e) {
+    CHECK(n3.acc == n.acc && n3.frac == n.frac && n3.neg == n.neg, s + " (scan_plain_number_3)");
+  }
   if (e == nullptr || e != t.data() + s.size()) return false;
-  return csv::plain_value(n, t.data(), e, '.', compat, v);
+  const bool ok = csv::plain_value(n, t.data(), e, '.', compat, v);
+  // the look-up table of 1-3 decimals, where it applies: the same bits
+  const csv::Decimals& d = csv::decimals(compat);
+  if (ok && n.frac >= 1 && n.frac <= 3 && n.acc < d.limit[n.frac]) {
+    const double w = d.value[n.frac][n.acc] * (n.neg ? -1.0 : 1.0);
+    CHECK(same_bits(v, w), s + " (decimals table)");
+  }
+  return ok;
 }
 
 // What is a number is fread's in both modes; its value fread's (compat = 1)

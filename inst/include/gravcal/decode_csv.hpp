@@ -493,7 +493,7 @@ class CsvDecoder : public Decoder {
     }
     if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return;
     plain_ = nfields_ == 3 && role_[0] == kX && role_[1] == kY && role_[2] == kZ ? 2 : 1;
-    thousandths_ = csv_text::thousandths(compat_);
+    decimals_ = &csv_text::decimals(compat_);
   }
 
   std::int64_t read_plain(SampleBuffer& out, std::int64_t max_lines) {
@@ -556,13 +556,13 @@ class CsvDecoder : public Decoder {
   // byte's address, or nullptr.
   GRAVCAL_CSV_INLINE const char* plain_number(const char* p, char a, char b, double& v) const {
     csv_text::PlainNumber pn;
-    const char* e = csv_text::scan_plain_number(p, dec_, pn);
+    const char* e = csv_text::scan_plain_number_3(p, dec_, pn);
     if (e == nullptr || (*e != a && *e != b)) return nullptr;
-    if (pn.frac == 3 && pn.acc < csv_text::kThousandths) {
+    if (pn.frac >= 1 && pn.frac <= 3 && pn.acc < decimals_->limit[pn.frac]) {
       // a look-up instead of a long double product or a division; the sign
       // by a product with -1: exact, and -(+0) is -0, as above
       static constexpr double kSign[2] = {1.0, -1.0};
-      v = thousandths_[pn.acc] * kSign[pn.neg];
+      v = decimals_->value[pn.frac][pn.acc] * kSign[pn.neg];
       return e;
     }
     return csv_text::plain_value(pn, p, e, dec_, compat_, v) ? e : nullptr;
@@ -724,7 +724,7 @@ class CsvDecoder : public Decoder {
   int col_x_ = -1, col_y_ = -1, col_z_ = -1, col_time_ = -1, col_temp_ = -1;
   bool time_text_ = true;
   double step_ = 0;
-  const double* thousandths_ = nullptr;  // csv_text::thousandths(compat_)
+  const csv_text::Decimals* decimals_ = nullptr;  // csv_text::decimals(compat_)
   unsigned char role_[kMaxFields] = {};  // a Role for each field
   int plain_ = 0;  // lines parsed in place: 0 no, 1 yes, 2 yes and they are x, y, z
   // position

@@ -235,6 +235,48 @@ GRAVCAL_CSV_INLINE const char* scan_plain_number(const char* p, char dec, PlainN
   return p;
 }
 
+// scan_plain_number() for the shapes most samples have, [-]D<dec>D,
+// [-]D<dec>DD and [-]D<dec>DDD (one digit before the decimal separator, one
+// to three after), by fixed offsets rather than a loop; any other shape
+// goes to scan_plain_number(). Same result and same end as
+// scan_plain_number(). Reads no byte past the first that breaks the shape
+// (so never past the line's end).
+GRAVCAL_CSV_INLINE const char* scan_plain_number_3(const char* p, char dec, PlainNumber& n) {
+  const bool neg = *p == '-';
+  const char* s = p + (neg ? 1 : 0);
+  const unsigned d0 = digit_of(s[0]);
+  if (d0 <= 9 && s[1] == dec) {
+    const unsigned d1 = digit_of(s[2]);
+    if (d1 <= 9) {
+      const unsigned d2 = digit_of(s[3]);
+      if (d2 > 9) {
+        if (s[3] != dec) {
+          n.neg = neg;
+          n.acc = d0 * 10 + d1;
+          n.frac = 1;
+          return s + 3;
+        }
+      } else {
+        const unsigned d3 = digit_of(s[4]);
+        if (d3 > 9) {
+          if (s[4] != dec) {
+            n.neg = neg;
+            n.acc = (d0 * 10 + d1) * 10 + d2;
+            n.frac = 2;
+            return s + 4;
+          }
+        } else if (digit_of(s[5]) > 9 && s[5] != dec) {
+          n.neg = neg;
+          n.acc = ((d0 * 10 + d1) * 10 + d2) * 10 + d3;
+          n.frac = 3;
+          return s + 5;
+        }
+      }
+    }
+  }
+  return scan_plain_number(p, dec, n);
+}
+
 // The value parse_number gives for [b, e), the text scan_plain_number read
 // as `n` (every digit kept, exp10 = -frac): fread_value() or exact_value(),
 // as parse_number computes it, else parse_number itself.
@@ -288,26 +330,40 @@ GRAVCAL_CSV_INLINE const char* field_end(const char* p, char sep) {
   }
 }
 
-// The values of the numbers with 3 decimals and fewer than 5 digits
-// (ActiLife's, to 16.383 g), by their digits: t[1234] is the value of
-// "1.234", fread's (compat) or correctly rounded. Computed once per
-// process, on first use, by fread_value / exact_value (128 KiB each).
+// The values of the numbers with 1, 2 or 3 decimals below 16.384 (ActiLife
+// writes up to 3 decimals, dropping trailing zeros), by their digits as one
+// integer k: decimals(compat).value[f][k] is the value of k / 10^f, fread's
+// (compat) or correctly rounded, for k < decimals().limit[f]. Computed once
+// per process, on first use, by fread_value / exact_value, the functions
+// parse_number uses (the three tables: about 150 KiB a mode).
 constexpr std::size_t kThousandths = 16384;
-inline std::vector<double> thousandths_values(bool compat) {
-  std::vector<double> t(kThousandths);
-  for (std::uint64_t k = 0; k < kThousandths; ++k) {
-    if (compat) t[k] = fread_value(k, -3, false);
-    else exact_value(k, -3, false, t[k]);  // (exact for every k here)
+struct Decimals {
+  std::vector<double> table[4];
+  const double* value[4] = {nullptr, nullptr, nullptr, nullptr};
+  std::uint64_t limit[4] = {0, 0, 0, 0};
+};
+inline Decimals decimals_values(bool compat) {
+  Decimals d;
+  std::uint64_t lim = kThousandths;
+  for (int f = 3; f >= 1; --f, lim = (lim + 9) / 10) {
+    std::vector<double>& t = d.table[f];
+    t.resize(lim);
+    for (std::uint64_t k = 0; k < lim; ++k) {
+      if (compat) t[k] = fread_value(k, -f, false);
+      else exact_value(k, -f, false, t[k]);  // (exact for every k here)
+    }
+    d.value[f] = t.data();
+    d.limit[f] = lim;
   }
-  return t;
+  return d;
 }
-inline const double* thousandths(bool compat) {
+inline const Decimals& decimals(bool compat) {
   if (compat) {
-    static const std::vector<double> t = thousandths_values(true);
-    return t.data();
+    static const Decimals t = decimals_values(true);
+    return t;
   }
-  static const std::vector<double> t = thousandths_values(false);
-  return t.data();
+  static const Decimals t = decimals_values(false);
+  return t;
 }
 
 inline unsigned days_in_month(std::int64_t y, unsigned m) {
