@@ -40,6 +40,21 @@ ggir_constants <- list(
   refit_growth = 1.25     # gravcal's own mode: refit once the table grew by this
 )
 
+# The memory in use, in MB, for GGIR's bsc_qc record: the process's
+# resident memory where the system says it without cost (Linux's
+# /proc/self/status, which counts the decoders' buffers too), else R's
+# vector heap after a minor collection (GGIR's figure is that after a full
+# one).
+memory_in_use_mb <- function() {
+  status <- "/proc/self/status"
+  if (file.exists(status)) {
+    l <- grep("^VmRSS:", readLines(status, warn = FALSE), value = TRUE)
+    kb <- suppressWarnings(as.numeric(gsub("[^0-9]", "", l)))
+    if (length(kb) == 1 && is.finite(kb)) return(kb / 1024)
+  }
+  gc(full = FALSE)[2, 2]
+}
+
 ggir_messages <- c(
   done = "recalibration done, no problems detected",
   done_no_temp = "recalibration done, but temperature values not used",
@@ -233,9 +248,9 @@ ggir_run <- function(src, compat = TRUE,
       feats[[length(feats) + 1]] <- f
       added <- TRUE
       blocks <- blocks + 1
-      # memory in use after the block, as GGIR records it (a minor
-      # collection: GGIR's full one costs more than the block itself)
-      mem <- gc(full = FALSE)[2, 2]
+      # memory in use after the block (GGIR records R's heap from a full
+      # gc(), which costs about as much as decoding the block)
+      mem <- memory_in_use_mb()
       bsc_qc <- rbind(bsc_qc, data.frame(time = format(Sys.time()),
                                          size = mem,
                                          stringsAsFactors = FALSE))
@@ -450,7 +465,9 @@ ggir_run <- function(src, compat = TRUE,
 #'   `spheredata` (the rest windows: `Euclidean Norm, meanx, meany, meanz,
 #'   sdx, sdy, sdz` and `temperature` when used), `npoints`, `nhoursused`,
 #'   `QCmessage`, `use.temp`, `meantempcal` and `bsc_qc` (time and memory
-#'   in MB after each block). Invisibly, as GGIR.
+#'   in MB after each block: the process's resident memory where the system
+#'   reports it, as on Linux, else R's heap; GGIR records R's heap). Invisibly,
+#'   as GGIR.
 #' @seealso [calibrate()] (`method = "ggir"`) for a `gravcal_fit`,
 #'   [write_ggir_coefs()] to hand coefficients to GGIR.
 #' @export

@@ -49,6 +49,10 @@ test_that("g.calibrate matches GGIR on synthetic ActiGraph csv files", {
   expect_same_as_ggir(b12)
   expect_identical(b12$gravcal$QCmessage, "recalibration done, no problems detected")
   expect_equal(nrow(b12$gravcal$bsc_qc), 2L)
+  # the memory record: MB in use after each block, at least R's own heap
+  # (at least 10 MB with gravcal loaded) and far below the machine's size
+  mb <- b12$gravcal$bsc_qc$size
+  expect_true(all(is.finite(mb) & mb > 10 & mb < 1e6))
   # the same samples held in memory (blocks as ranges of the caller's
   # columns, idle-sleep blocks through the copying path): GGIR's answer
   samples <- rec[, c("x", "y", "z")]
