@@ -111,7 +111,8 @@ RunsSd runs_sd(EachRun&& each) {
 //
 // Why the answer is R's. Let the n values a_i have true mean mu, true
 // variance s2 = sum (a_i - mu)^2 / (n - 1) and M = max |a_i|, all finite;
-// u = 2^-64 (long double), v = 2^-53 (double); standard bounds for
+// u = the unit roundoff of long double (2^-64 on x87; 2^-53 where long
+// double is double), v = 2^-53 (double); standard bounds for
 // recursive summation (Higham, Accuracy and Stability of Numerical
 // Algorithms, 2nd ed., sec. 4.2; gamma_k = k u / (1 - k u)).
 // - R's mean (r_mean_sd()): the sum is off by at most gamma_(n-1) n M, so
@@ -143,7 +144,10 @@ inline int r_sd_below(const RunsSd& r, double thr) {
   if (!(thr >= 1e-100 && thr <= 1e100)) return -1;
   if (r.max_abs > 1e100 || (r.max_abs != 0.0 && r.max_abs < 1e-100)) return -1;
   if (r.n > (std::uint64_t(1) << 40) || r.runs > (std::uint64_t(1) << 40)) return -1;
-  const long double u = std::ldexp(1.0L, -64), v = std::ldexp(1.0L, -53);
+  // u: the unit roundoff of R's long double, 2^-64 where it is the x87's
+  // 80-bit format, 2^-53 where long double is double (MSVC, macOS arm64)
+  const long double u = std::numeric_limits<long double>::epsilon() / 2;
+  const long double v = std::ldexp(1.0L, -53);
   const long double n = static_cast<long double>(r.n);
   const long double k = static_cast<long double>(r.runs);
   const long double M = r.max_abs;

@@ -507,7 +507,22 @@ class Segmenter {
       o.lo[a] = lo[a];
       o.hi[a] = hi[a];
     }
+    zero_signs(col, m, o.lo, o.hi);
     o.zero = zero;
+  }
+
+  // A zero minimum (maximum) as add()'s sequential rule leaves it: the
+  // first zero of the column, with its sign (lanes may have kept the other
+  // one). Any other value is the same in any order.
+  static void zero_signs(const double* const* col, std::size_t m, double* lo, double* hi) {
+    for (int a = 0; a < 3; ++a) {
+      if (lo[a] == 0.0 || hi[a] == 0.0) {
+        std::size_t j = 0;
+        while (j < m && col[a][j] != 0.0) ++j;
+        if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
+        if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
+      }
+    }
   }
 
   // R's cumsum(), one column at a time, continuing o.c, and the norm as
@@ -587,13 +602,8 @@ class Segmenter {
         hi[a] = v > hi[a] ? v : hi[a];
       }
     }
+    zero_signs(col, m, lo, hi);
     for (int a = 0; a < 3; ++a) {
-      if (lo[a] == 0.0 || hi[a] == 0.0) {
-        std::size_t j = 0;
-        while (j < m && col[a][j] != 0.0) ++j;
-        if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
-        if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
-      }
       o.lo[a] = lo[a];
       o.hi[a] = hi[a];
     }
