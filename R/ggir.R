@@ -33,6 +33,7 @@ ggir_constants <- list(
   temp_min_sd = 0.01,     # temperature ignored when its sd is below
   temp_first_n = 10,      # how many first values are looked at
   temp_missing = 99999,   # GGIR's fill for an unused temperature column
+  fill = 99999,           # GGIR's fill of its window table: such rows are dropped
   max_iter = 1000,        # ICP iterations (g.calibrate)
   tol = 1e-10,            # ICP stopping tolerance (g.calibrate)
   max_weight = 100,       # ICP weights capped at 1 / 0.01 (g.calibrate)
@@ -65,7 +66,11 @@ ggir_messages <- c(
   no_sphere = "recalibration not done because not enough points on all sides of the sphere",
   no_rest = "recalibration not done because no non-movement data available",
   no_data = paste0("recalibration not done because not enough data in the ",
-                   "file or because file is corrupt")
+                   "file or because file is corrupt"),
+  # gravcal's own: where GGIR's fit fails with an error
+  not_finite = paste0("recalibration not done because the fit did not stay ",
+                      "finite (the rest windows do not determine every ",
+                      "coefficient)")
 )
 
 # GGIR's calibration error: mean | |a| - 1 | over the rest windows' means m
@@ -153,7 +158,7 @@ ggir_run <- function(src, compat = TRUE,
                      minloadcrit = ggir_constants$minloadcrit,
                      sdcriter = ggir_constants$max_sd, verbose = FALSE,
                      printsummary = FALSE, max_iter = ggir_constants$max_iter,
-                     tol = ggir_constants$tol) {
+                     tol = ggir_constants$tol, lazy = TRUE) {
   sf <- src$sf
   if (!(10 * sf >= 1 && 10 * sf < 1e7)) {
     abort("`sf` must give 1 to 1e7 samples in a 10 s window, not ",
@@ -165,7 +170,7 @@ ggir_run <- function(src, compat = TRUE,
   seg <- gc_segmenter_new(10 * sf, FALSE, compat)
   # compatible mode: R's sds only where GGIR's rules can see them (the rest
   # rule, the duplicate filter): see Segmenter::lazy_r_sd()
-  if (compat) gc_segmenter_lazy_sd(seg, sdcriter)
+  if (compat && lazy) gc_segmenter_lazy_sd(seg, sdcriter)
   feats <- list()
   rests <- list()  # the core's rest flag of each window (GGIR's rule)
   n_feat <- 0
@@ -284,6 +289,9 @@ ggir_run <- function(src, compat = TRUE,
         matrix(numeric(0), 0, if (temp.available) 8 else 7)
       full_rest <- unlist(rests, use.names = FALSE)
       idx <- which(!is.na(full[, 4]) & !is.na(full[, 1]))
+      # GGIR also drops a window whose mean norm equals the value its
+      # window table is filled with (99999)
+      if (compat) idx <- idx[full[idx, 1] != ggir_constants$fill]
       n <- length(idx)
       if (n > 1) {
         # consecutive windows equal in 3 (GGIR) or all 6 of means and sds
@@ -340,8 +348,8 @@ ggir_run <- function(src, compat = TRUE,
           r
         }
         judge <- function(r) {
-          r$error < cal.error.start && r$error < ggir_constants$max_error &&
-            nhoursused > minloadcrit
+          isTRUE(r$error < cal.error.start && r$error < ggir_constants$max_error &&
+                   nhoursused > minloadcrit)
         }
         # compatible mode fits as GGIR does; gravcal's own mode decides
         # whether to read on with GGIR's cheap early stop, and fits to
@@ -370,7 +378,16 @@ ggir_run <- function(src, compat = TRUE,
     i <- i + 1
   }
   check_source_read(src, n_read)
-  if (length(cal.error.end) > 0 && cal.error.end > cal.error.start) {
+  if (!is.null(icp) && !isTRUE(icp$finite)) {
+    # the last fit did not stay finite (a temperature term the rest windows
+    # cannot determine, for one): GGIR stops with an error here; gravcal
+    # returns no correction and says why
+    scale <- c(1, 1, 1)
+    offset <- c(0, 0, 0)
+    tempoffset <- if (use.temp) c(0, 0, 0) else NULL
+    cal.error.end <- cal.error.start
+    QC <- ggir_messages[["not_finite"]]
+  } else if (length(cal.error.end) > 0 && isTRUE(cal.error.end > cal.error.start)) {
     QC <- ggir_messages[["no_decrease"]]
   }
   spheredata <- NULL
@@ -408,6 +425,20 @@ ggir_run <- function(src, compat = TRUE,
   out
 }
 
+# ggir_run() on `src`, then, in compatible mode, once more without the lazy
+# sds (on a source from open()) when the result's spheredata holds windows
+# that are not at rest: GGIR returns every window when the recording is too
+# short to use, and only rest windows are sure to carry R's sds otherwise.
+ggir_run_exact <- function(src, open, compat, ...) {
+  out <- ggir_run(src, compat = compat, ...)
+  if (compat && identical(out$QCmessage, ggir_messages[["no_data"]]) &&
+      length(out$spheredata) > 0) {
+    if (isTRUE(list(...)$verbose)) cat("\nReading again for R's sds of every window\n")
+    out <- ggir_run(open(), compat = compat, ..., lazy = FALSE)
+  }
+  out
+}
+
 #' Auto-calibration as GGIR's g.calibrate, on gravcal's core
 #'
 #' A drop-in replacement for `GGIR::g.calibrate()`: same arguments, same
@@ -432,6 +463,17 @@ ggir_run <- function(src, compat = TRUE,
 #' from a file, one block at a time. Figures: `bench/results/speed.md` in
 #' the package sources.
 #'
+#' Where GGIR itself does not give a result, or gives one by accident, this
+#' function departs from it, and says so: when a fit does not stay finite
+#' (a temperature term the rest windows cannot determine), GGIR stops with
+#' an error and `g.calibrate()` returns no correction with a QC message
+#' that says why; GGIR's fits after intermediate blocks that cannot stop
+#' the reading are skipped, so an error in one of those does not stop it
+#' either. A missing (`NA`) or infinite sample in a data frame is left out
+#' of its window (in GGIR's cumulative sums it would empty the rest of its
+#' block). For a data frame, `rmc.noise` sets
+#' the rest threshold as for an ad hoc csv file (`1.2 * rmc.noise`).
+#'
 #' Unlike GGIR's, this function does not need `inspectfileobject` (it finds
 #' the format and sampling rate itself) but accepts GGIR's; and `datafile`
 #' may also be a data frame of raw samples (columns `x`, `y`, `z` in g,
@@ -449,8 +491,8 @@ ggir_run <- function(src, compat = TRUE,
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
 #'   lists (as from `GGIR::load_params()`); gravcal uses `chunksize`,
-#'   `spherecrit`, `minloadcrit`, `printsummary` and, for ad hoc data,
-#'   `rmc.noise`, and ignores the rest. Missing entries take GGIR's defaults
+#'   `spherecrit`, `minloadcrit`, `printsummary` and, for ad hoc csv files
+#'   and data frames, `rmc.noise`, and ignores the rest. Missing entries take GGIR's defaults
 #'   (`chunksize = 1`, `spherecrit = 0.3`, `minloadcrit = 168`,
 #'   `printsummary = FALSE`).
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
@@ -491,18 +533,22 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     sf <- inspectfileobject$sf
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
-  src <- open_source(datafile, sf = sf, chunksize = pr$chunksize,
-                     reader = pr$reader, compat = TRUE)
-  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor)
-  sdcriter <- if (identical(src$format, "csv") && !is.null(pr$rmc.noise)) {
+  open <- function() {
+    open_source(datafile, sf = sf, chunksize = pr$chunksize,
+                reader = pr$reader, compat = TRUE)
+  }
+  src <- open()
+  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor);
+  # samples in a data frame, which GGIR does not take, are treated alike
+  sdcriter <- if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
     pr$rmc.noise * 1.2
   } else {
     ggir_constants$max_sd
   }
-  out <- ggir_run(src, compat = TRUE, spherecrit = pr$spherecrit,
-                  minloadcrit = pr$minloadcrit,
-                  sdcriter = sdcriter, verbose = verbose,
-                  printsummary = pr$printsummary)
+  out <- ggir_run_exact(src, open, compat = TRUE, spherecrit = pr$spherecrit,
+                        minloadcrit = pr$minloadcrit,
+                        sdcriter = sdcriter, verbose = verbose,
+                        printsummary = pr$printsummary)
   attr(out, "gravcal") <- NULL
   invisible(out)
 }
@@ -563,15 +609,19 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
       !("time" %in% tolower(colnames(x)))) {
     abort("`sf` (sampling frequency in Hz) is missing.")
   }
-  src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
-                     reader = a$reader, compat = compat)
-  if (!a$use_temp) {
-    src$read <- drop_temperature(src$read)
-    src$temperature <- FALSE
+  open <- function() {
+    src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
+                       reader = a$reader, compat = compat)
+    if (!a$use_temp) {
+      src$read <- drop_temperature(src$read)
+      src$temperature <- FALSE
+    }
+    src
   }
-  res <- ggir_run(src, compat = compat, spherecrit = a$spherecrit,
-                  minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
-                  verbose = a$verbose, max_iter = a$max_iter, tol = a$tol)
+  src <- open()
+  res <- ggir_run_exact(src, open, compat = compat, spherecrit = a$spherecrit,
+                        minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
+                        verbose = a$verbose, max_iter = a$max_iter, tol = a$tol)
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
@@ -617,7 +667,8 @@ ggir_fit <- function(res, compat, call, minloadcrit) {
     no_decrease = "no_improvement",
     no_sphere = "sphere_not_covered",
     no_rest = "no_rest",
-    no_data = "too_short")
+    no_data = "too_short",
+    not_finite = "diverged")
   if (!is.null(icp) && !isTRUE(icp$finite)) status <- "diverged"
   detail <- switch(status,
     ok = if (identical(key, "attempted")) sprintf(

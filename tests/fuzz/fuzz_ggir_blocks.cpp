@@ -4,7 +4,8 @@
 // are the same, to the bit, whether a block's samples are pushed at once,
 // pushed in the fuzzer's chunks, or written into the rules' own buffer a
 // few at a time (space() and commit(), as a decoder does); the counts add
-// up; a used block is whole hours. In compatible mode the segmenter may
+// up; a used block is whole hours (also when the hour is one double below
+// a whole number of samples). In compatible mode the segmenter may
 // give R's sds only where GGIR's rules see them (Segmenter::lazy_r_sd()):
 // then, against R's sds everywhere, every other statistic is the same, and
 // so are the rest windows (with their sds, to the bit) and the ties GGIR's
@@ -35,7 +36,12 @@ bool same_info(const gravcal::GgirBlockInfo& a, const gravcal::GgirBlockInfo& b)
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzInput in{data, size};
-  const double per_hour = 1 + in.byte() % 60;
+  const std::uint8_t hour_byte = in.byte();
+  double per_hour = 1 + hour_byte % 60;
+  // one double below a whole number, as 3600 * 33.3 is: GGIR's fractional
+  // `use` and the carry R's `:` then takes (GgirBlocks::shift_carry())
+  if (hour_byte & 128) per_hour = std::nextafter(per_hour, 0.0);
+  const std::int64_t hour = static_cast<std::int64_t>(per_hour + 1.1920928955078125e-07);
   const double L = 1 + in.byte() % 12 + (in.byte() & 1 ? 0.5 : 0.0);
   const bool compat = in.byte() & 1;
   const bool with_t = in.byte() & 1;
@@ -109,7 +115,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         i += m;
       }
       const gravcal::GgirBlockInfo r = gb.end_block(sink);
-      if (r.used % static_cast<std::int64_t>(per_hour) != 0 || r.used > r.ld ||
+      if (r.used % hour != 0 || r.used > r.ld ||
           r.zeros > r.rows || r.carried < 0) {
         __builtin_trap();
       }

@@ -22,7 +22,11 @@
 //   and it is put in front of the next block again;
 // - a block with less than an hour is dropped, the carry left in place;
 // - when a block's last sample is an idle-sleep zero, the last retained
-//   sample takes the x, y, z of the one before it.
+//   sample takes the x, y, z of the one before it;
+// - when 3600 sf is just below a whole number in double (33.3 Hz), the
+//   hours are still whole numbers of samples (R's `1:use`), but the carry
+//   is R's data[(use + 1):LD, ] from a fractional use: it starts with the
+//   last used sample again and leaves out the block's last (shift_carry()).
 // gravcal's own mode carries every leftover sample exactly once.
 //
 // The samples wait in one buffer per column, unflushed ones in [head_,
@@ -91,11 +95,17 @@ class GgirBlocks {
   GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature,
              double temp_min_sd = 0.01)
       : seg_(seg),
-        H_(static_cast<std::int64_t>(std::floor(per_hour))),
+        Hd_(per_hour),
+        H_(static_cast<std::int64_t>(per_hour + kRColonFuzz)),
         compat_(compat),
         temp_(temperature),
         temp_min_sd_(temp_min_sd) {
     if (H_ < 1) H_ = 1;
+    // 3600 sf just below a whole number in double (33.3 Hz: 119879.99...):
+    // R's `1:use` still takes the whole number of rows (H_), and GGIR's
+    // carry then starts at the last used row again (see end_block())
+    // (H_ >= 2: the carry is then at most H_ samples, as space() needs)
+    below_ = compat_ && per_hour < static_cast<double>(H_) && H_ >= 2;
   }
 
   // A new block from the reader: the carry goes in front. Each
@@ -204,6 +214,17 @@ class GgirBlocks {
   GgirBlockInfo end_block(Sink&& sink) {
     const std::int64_t use = (info_.ld / H_) * H_;
     info_.used = use;
+    // GGIR's use = floor(LD / (3600 sf)) * (3600 sf) in double: below a
+    // whole number when 3600 sf is (below_), and then its carry is
+    // data[(use + 1):LD, ]: from the last used row, without the last row
+    // (R's `:` from a fraction; down to row use - 1 when LD is use)
+    bool shifted = false;
+    double use_d = 0.0;
+    if (below_ && use > 0) {
+      use_d = std::floor(static_cast<double>(info_.ld) / Hd_) * Hd_;
+      shifted = use_d < static_cast<double>(use) &&
+                static_cast<std::int64_t>(use_d + kRColonFuzz) == use;
+    }
     // the last retained sample has not gone on (see commit()); the one
     // before it may have
     if (compat_ && last_zero_ && use > 0 && info_.ld >= 2 && H_ >= 2) {
@@ -214,8 +235,12 @@ class GgirBlocks {
     }
     if (use > 0) {
       flush(static_cast<std::size_t>(use - pushed_), sink);
-      // compatible mode: a block of whole hours leaves the previous carry
-      if (compat_ && use == info_.ld) drop_hold();
+      if (shifted) {
+        shift_carry(use_d, use);
+      } else if (compat_ && use == info_.ld) {
+        // compatible mode: a block of whole hours leaves the previous carry
+        drop_hold();
+      }
       temperature_stats(use);
     } else if (compat_) {
       drop_hold();  // less than an hour: dropped, the previous carry stays
@@ -294,6 +319,43 @@ class GgirBlocks {
     tail_ = k;
   }
 
+  // GGIR's carry when its `use` is a fraction just below the rows used
+  // (see end_block()): data[(use + 1):LD, ], R's `:` from a fraction, so
+  // the values from + j (or from - j when from > LD) in double, each
+  // truncated to a row. The rows are the last two given on (use - 1, use)
+  // and the waiting ones (use + 1 ... LD).
+  void shift_carry(double use_d, std::int64_t use) {
+    const int nc = columns();
+    const std::int64_t ld = info_.ld;
+    const double from = use_d + 1.0, to = static_cast<double>(ld);
+    const bool up = from <= to;
+    const std::int64_t n =
+        static_cast<std::int64_t>(std::fabs(to - from) + 1.0 + kRColonFuzz);
+    std::vector<double> out[4];
+    for (int c = 0; c < nc; ++c) out[c].resize(static_cast<std::size_t>(n));
+    for (std::int64_t j = 0; j < n; ++j) {
+      const double v = up ? from + static_cast<double>(j) : from - static_cast<double>(j);
+      const std::int64_t row = static_cast<std::int64_t>(v);  // 1-based
+      for (int c = 0; c < nc; ++c) {
+        double x;
+        if (row >= use + 1 && row <= ld) {
+          x = hold_[c][head_ + static_cast<std::size_t>(row - use - 1)];
+        } else if (row == use) {
+          x = before_[c];
+        } else {
+          x = before2_[c];  // row use - 1 (from > LD only)
+        }
+        out[c][static_cast<std::size_t>(j)] = x;
+      }
+    }
+    head_ = tail_ = 0;
+    grow(static_cast<std::size_t>(n));
+    for (int c = 0; c < nc; ++c) {
+      std::copy(out[c].begin(), out[c].end(), hold_[c].begin());
+    }
+    tail_ = static_cast<std::size_t>(n);
+  }
+
   // The block's waiting samples are not the carry: the saved one is.
   void drop_hold() {
     head_ = tail_ = 0;
@@ -327,7 +389,10 @@ class GgirBlocks {
     }
     seg_.push(hold_[0].data() + head_, hold_[1].data() + head_, hold_[2].data() + head_,
               temp_ ? hold_[3].data() + head_ : nullptr, k, sink);
-    for (int c = 0; c < 3; ++c) before_[c] = hold_[c][head_ + k - 1];
+    for (int c = 0; c < columns(); ++c) {
+      before2_[c] = k >= 2 ? hold_[c][head_ + k - 2] : before_[c];
+      before_[c] = hold_[c][head_ + k - 1];
+    }
     head_ += k;
     pushed_ += static_cast<std::int64_t>(k);
   }
@@ -379,8 +444,12 @@ class GgirBlocks {
     std::int64_t count;
   };
 
+  // R's `:` takes floor(to - from + 1 + FLT_EPSILON) values
+  static constexpr double kRColonFuzz = 1.1920928955078125e-07;
+
   Segmenter& seg_;
-  std::int64_t H_;
+  double Hd_;                  // 3600 sf, in double
+  std::int64_t H_;             // whole samples an hour, as R's `1:use` takes them
   bool compat_;
   bool temp_;
   double temp_min_sd_;
@@ -391,7 +460,9 @@ class GgirBlocks {
   std::size_t head_ = 0;       // waiting samples: [head_, tail_) of hold_
   std::size_t tail_ = 0;
   std::size_t cap_ = 0;        // size of each hold_ column
-  double before_[3] = {0.0, 0.0, 0.0};  // x, y, z of the last sample given on
+  double before_[4] = {0.0, 0.0, 0.0, 0.0};   // x, y, z, t of the last sample given on
+  double before2_[4] = {0.0, 0.0, 0.0, 0.0};  // and of the one before it
+  bool below_ = false;         // compatible mode, 3600 sf just below H_
   bool carry_in_hold_ = true;  // the carry is the waiting samples (else carry_)
   std::vector<double> hold_[4];   // x, y, z, temperature
   std::vector<double> carry_[4];  // compatible mode: the carry in front of
