@@ -28,6 +28,27 @@ static int failures = 0;
 
 using gravcal::Vec3;
 
+// Whether long double arithmetic really has the precision its type says
+// (64 bits on x87). Valgrind's CPU emulation computes x87 operations in
+// double precision, so there the checks that compare the core's proven
+// shortcuts with a plain long double loop (R's arithmetic) cannot hold and
+// are reported, not failed; `make core` runs them on the real CPU.
+static bool long_double_as_declared() {
+  volatile long double one = 1.0L;
+  volatile long double tiny = std::numeric_limits<long double>::epsilon();
+  return one + tiny != one;
+}
+static bool ld_ok = long_double_as_declared();
+#define CHECK_LD(cond)                                                          \
+  do {                                                                          \
+    if (ld_ok) {                                                                \
+      CHECK(cond);                                                              \
+    } else if (!(cond)) {                                                       \
+      std::printf("note %s:%d: %s does not hold with emulated long double\n",   \
+                  __FILE__, __LINE__, #cond);                                   \
+    }                                                                           \
+  } while (0)
+
 static void test_model() {
   const double p[9] = {1.05, 0.95, 1.02, 0.03, -0.04, 0.02, 0.08, -0.06, 0.05};
   const Vec3<double> a{0.3, 0.5, std::sqrt(1 - 0.34)};
@@ -295,8 +316,8 @@ static void test_r_sd_below() {
     }
     if (kind < 2 && b < 0) ++far_undecided;
   }
-  CHECK(disagree == 0);
-  CHECK(far_undecided == 0);
+  CHECK_LD(disagree == 0);
+  CHECK_LD(far_undecided == 0);
   CHECK(decided > 1000);
   CHECK(near_exact > 100);  // values at the threshold go to R's arithmetic
   // outside the bounds' domain: always R's arithmetic
@@ -361,7 +382,7 @@ static void test_add_repeated() {
       }
     }
   }
-  CHECK(bad == 0);
+  CHECK_LD(bad == 0);
   // by runs, with the grid kept between calls
   std::vector<double> v(20000);
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = 25.3 + 0.29 * static_cast<double>((i / 120) % 37);
@@ -370,7 +391,7 @@ static void test_add_repeated() {
   gravcal::Binade g;
   gravcal::add_in_order(b, v.data(), 7000, g);
   gravcal::add_in_order(b, v.data() + 7000, v.size() - 7000, g);
-  CHECK(a == b);
+  CHECK_LD(a == b);
 }
 
 // Segmenter::lazy_r_sd() against R's sds everywhere, through GGIR's block
@@ -473,7 +494,7 @@ static void test_lazy_sd() {
       last = k;
     }
   }
-  CHECK(ok);
+  CHECK_LD(ok);
   CHECK(windows > 3000 && in_double > 500 && ties > 100);  // all cases met
 }
 
