@@ -74,6 +74,7 @@
 #include <string>
 
 #include "decode.hpp"
+#include "simd.hpp"
 
 // GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
 #if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
@@ -146,6 +147,55 @@ inline int hex16(const unsigned char* s, unsigned char* v) {
       _mm_and_si128(lo, _mm_set1_epi8(39)));
   _mm_storeu_si128(reinterpret_cast<__m128i*>(v), val);
   return _mm_movemask_epi8(_mm_or_si128(_mm_or_si128(dg, up), lo)) ^ 0xffff;
+}
+#endif
+
+#if defined(GRAVCAL_AVX2)
+// The counts x, y, z of k samples (k even) from their hex digits at s, two
+// samples at a time (one in each 128-bit lane): each lane holds a sample's
+// 12 digits and the next sample's first 4, which are not used (so s must
+// have 12 k + 4 readable bytes). The digits' values as hex16()'s; then a
+// sample's counts are (d0 << 8) | (16 d1 + d2), (d3 << 8) | (16 d4 + d5)
+// and (d6 << 8) | (16 d7 + d8): the pairs by one multiply-add of bytes, the
+// high digits by a shuffle into the high bytes. Each sample's three counts
+// are stored as 8 bytes at raw[i], so raw must have room for k + 1 samples
+// (the last 2 bytes land on raw[k][0]). Returns nonzero when some digit of
+// the k samples' 12 is not a hex digit.
+GRAVCAL_TARGET_AVX2 inline unsigned hex_xyz_avx2(const unsigned char* s, std::size_t k,
+                                                 std::uint16_t (*raw)[3]) {
+  const __m256i below0 = _mm256_set1_epi8('0' - 1), above9 = _mm256_set1_epi8('9' + 1);
+  const __m256i belowA = _mm256_set1_epi8('A' - 1), aboveF = _mm256_set1_epi8('F' + 1);
+  const __m256i belowa = _mm256_set1_epi8('a' - 1), abovef = _mm256_set1_epi8('f' + 1);
+  const __m256i zero = _mm256_set1_epi8('0'), seven = _mm256_set1_epi8(7),
+                thirty9 = _mm256_set1_epi8(39);
+  // bytes (d1, d2), (d4, d5), (d7, d8) into 16-bit lanes 0-2, times (16, 1)
+  const __m256i pairs = _mm256_setr_epi8(1, 2, 4, 5, 7, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                         1, 2, 4, 5, 7, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+  // d0, d3, d6 into the high bytes of lanes 0-2
+  const __m256i highs = _mm256_setr_epi8(-1, 0, -1, 3, -1, 6, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                         -1, 0, -1, 3, -1, 6, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+  const __m256i weights = _mm256_set1_epi16(0x0110);  // bytes 16, 1
+  unsigned bad = 0;
+  for (std::size_t j = 0; j < k; j += 2, s += 2 * kDigitsPerSample) {
+    const __m256i c = _mm256_inserti128_si256(
+        _mm256_castsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(s))),
+        _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + kDigitsPerSample)), 1);
+    const __m256i dg = _mm256_and_si256(_mm256_cmpgt_epi8(c, below0), _mm256_cmpgt_epi8(above9, c));
+    const __m256i up = _mm256_and_si256(_mm256_cmpgt_epi8(c, belowA), _mm256_cmpgt_epi8(aboveF, c));
+    const __m256i lo = _mm256_and_si256(_mm256_cmpgt_epi8(c, belowa), _mm256_cmpgt_epi8(abovef, c));
+    const __m256i val = _mm256_sub_epi8(
+        _mm256_sub_epi8(_mm256_sub_epi8(c, zero), _mm256_and_si256(up, seven)),
+        _mm256_and_si256(lo, thirty9));
+    const unsigned ok = static_cast<unsigned>(
+        _mm256_movemask_epi8(_mm256_or_si256(_mm256_or_si256(dg, up), lo)));
+    bad |= ~ok & 0x0fff0fffu;  // each lane's own 12 digits
+    const __m256i r = _mm256_or_si256(
+        _mm256_maddubs_epi16(_mm256_shuffle_epi8(val, pairs), weights),
+        _mm256_shuffle_epi8(val, highs));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(raw[j]), _mm256_castsi256_si128(r));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(raw[j + 1]), _mm256_extracti128_si256(r, 1));
+  }
+  return bad;
 }
 #endif
 
@@ -627,6 +677,19 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   const std::size_t whole = n / kDigitsPerSample;
   unsigned bad = 0;
   std::size_t i = 0;
+#if defined(GRAVCAL_AVX2)
+  if (use_avx2()) {
+    // the samples whose 16-digit loads stay inside the n digits and whose
+    // 8-byte stores stay inside raw, an even number of them
+    std::size_t k = whole;
+    if (k > 0 && k * kDigitsPerSample + 4 > n) --k;
+    if (k > kSamplesPerPage - 1) k = kSamplesPerPage - 1;
+    k &= ~std::size_t(1);
+    if (hex_xyz_avx2(s, k, next_->raw) != 0) bad |= 0x10u;
+    i = k;
+    s += k * kDigitsPerSample;
+  }
+#endif
 #if defined(GRAVCAL_SSE2)
   // four samples (48 digits) at a time: the digits' values and whether each
   // is a hex digit sixteen at a time (hex16()); then digit pairs p_j =
