@@ -742,6 +742,46 @@ static void print_digest() {
     const unsigned char* p = reinterpret_cast<const unsigned char*>(&w);
     for (std::size_t i = 0; i < sizeof(w); ++i) h = (h ^ p[i]) * 1099511628211ull;
   });
+  // and GGIR-compatible windows (R's arithmetic, sds in double where R's
+  // cannot matter) through GGIR's block rules, with rest windows, windows
+  // near the sd threshold, idle-sleep zeros and missing values
+  {
+    std::mt19937_64 g(99);
+    std::normal_distribution<double> unit(0, 1);
+    const double L = 257;  // odd: every loop's scalar tail
+    std::vector<double> buf(3 * 258), held(3 * 258);
+    gravcal::LazySd state;
+    gravcal::Segmenter seg(L, false);
+    seg.use_r_arithmetic(buf.data(), buf.size());
+    seg.lazy_r_sd(0.013, &state, held.data(), held.size());
+    gravcal::GgirBlocks gb(seg, 257 * 40, true, true);
+    auto sink = [&](const gravcal::WindowStats& w) {
+      const unsigned char* p = reinterpret_cast<const unsigned char*>(&w);
+      for (std::size_t i = 0; i < sizeof(w); ++i) h = (h ^ p[i]) * 1099511628211ull;
+    };
+    std::vector<double> a(n), b(n), c(n), tt(n);
+    double noise = 0.01;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i % 257 == 0) {
+        const int k = static_cast<int>(g() % 10);
+        noise = k < 3 ? 0.013 * (1 + 1e-13 * static_cast<double>(g() % 7) - 3e-13)
+                      : (k < 5 ? 0.003 : (k < 8 ? 0.2 : 0.0));
+      }
+      a[i] = 0.1 + noise * unit(g);
+      b[i] = -0.4 + noise * unit(g);
+      c[i] = 0.9 + noise * unit(g);
+      tt[i] = 25 + static_cast<double>(i / 300) * 0.01;
+      if (g() % 500 == 0) b[i] = NAN;
+      if (g() % 400 == 0) a[i] = b[i] = c[i] = 0;
+    }
+    for (std::size_t at = 0; at < n;) {
+      gb.begin_block();
+      const std::size_t len = std::min<std::size_t>(n - at, 20000 + g() % 30000);
+      gb.push(a.data() + at, b.data() + at, c.data() + at, tt.data() + at, len, sink);
+      gb.end_block(sink);
+      at += len;
+    }
+  }
   // and gravcal's ICP fit (its loops two points at a time with SSE2), with
   // and without the temperature term, on noisy rest means
   for (int temp = 0; temp < 2; ++temp) {
@@ -771,6 +811,8 @@ static void print_digest() {
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::strcmp(argv[1], "--digest") == 0) {
+    // --digest baseline: without the AVX2 paths
+    if (argc > 2 && std::strcmp(argv[2], "baseline") == 0) gravcal::set_avx2(false);
     print_digest();
     return 0;
   }

@@ -47,6 +47,7 @@
 #include <cstring>
 
 #include "r_arith.hpp"
+#include "simd.hpp"
 // GRAVCAL_NO_SIMD: the portable loop only (the results are the same bits)
 #if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
 #define GRAVCAL_SSE2 1
@@ -405,6 +406,11 @@ class Segmenter {
     std::size_t k = 0;
     double lo[3] = {h[0], h[1], h[2]}, hi[3] = {h[0], h[1], h[2]};
     bool zero = false;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) {
+      k = scan_stream_avx2(x, y, z, t, m, h, o, lo, hi, zero);
+    } else
+#endif
 #if defined(GRAVCAL_SSE2)
     {
       // named registers, not arrays, so that all of them stay in registers;
@@ -511,6 +517,127 @@ class Segmenter {
     o.zero = zero;
   }
 
+#if defined(GRAVCAL_AVX2)
+  // scan_stream()'s loop with the four lanes in one AVX2 register each:
+  // the same operations on the same lanes (no fused multiply-add), so the
+  // same bits. Returns the samples done (a multiple of 4).
+  GRAVCAL_TARGET_AVX2 static std::size_t scan_stream_avx2(
+      const double* x, const double* y, const double* z, const double* t, std::size_t m,
+      const double* h, StreamScan& o, double* lo, double* hi, bool& zero) {
+    const __m256d zr = _mm256_setzero_pd();
+    const __m256d h0 = _mm256_set1_pd(h[0]), h1 = _mm256_set1_pd(h[1]),
+                  h2 = _mm256_set1_pd(h[2]);
+    __m256d s0 = zr, s1 = zr, s2 = zr, q0 = zr, q1 = zr, q2 = zr, n = zr, st = zr, zacc = zr;
+    __m256d lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
+    std::size_t k = 0;
+    for (; k + 4 <= m; k += 4) {
+      const __m256d xa = _mm256_loadu_pd(x + k), ya = _mm256_loadu_pd(y + k),
+                    za = _mm256_loadu_pd(z + k);
+      __m256d d = _mm256_sub_pd(xa, h0);
+      s0 = _mm256_add_pd(s0, d);
+      q0 = _mm256_add_pd(q0, _mm256_mul_pd(d, d));
+      d = _mm256_sub_pd(ya, h1);
+      s1 = _mm256_add_pd(s1, d);
+      q1 = _mm256_add_pd(q1, _mm256_mul_pd(d, d));
+      d = _mm256_sub_pd(za, h2);
+      s2 = _mm256_add_pd(s2, d);
+      q2 = _mm256_add_pd(q2, _mm256_mul_pd(d, d));
+      lo0 = _mm256_min_pd(lo0, xa);
+      hi0 = _mm256_max_pd(hi0, xa);
+      lo1 = _mm256_min_pd(lo1, ya);
+      hi1 = _mm256_max_pd(hi1, ya);
+      lo2 = _mm256_min_pd(lo2, za);
+      hi2 = _mm256_max_pd(hi2, za);
+      n = _mm256_add_pd(n, _mm256_sqrt_pd(_mm256_add_pd(
+                               _mm256_add_pd(_mm256_mul_pd(xa, xa), _mm256_mul_pd(ya, ya)),
+                               _mm256_mul_pd(za, za))));
+      zacc = _mm256_or_pd(
+          zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(xa, zr, _CMP_EQ_OQ),
+                                            _mm256_cmp_pd(ya, zr, _CMP_EQ_OQ)),
+                              _mm256_cmp_pd(za, zr, _CMP_EQ_OQ)));
+      if (t != nullptr) st = _mm256_add_pd(st, _mm256_loadu_pd(t + k));
+    }
+    _mm256_storeu_pd(o.s[0], s0);
+    _mm256_storeu_pd(o.s[1], s1);
+    _mm256_storeu_pd(o.s[2], s2);
+    _mm256_storeu_pd(o.q[0], q0);
+    _mm256_storeu_pd(o.q[1], q1);
+    _mm256_storeu_pd(o.q[2], q2);
+    _mm256_storeu_pd(o.nrm, n);
+    _mm256_storeu_pd(o.st, st);
+    const __m256d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
+    for (int c = 0; c < 3; ++c) {
+      double e[4];
+      _mm256_storeu_pd(e, lov[c]);
+      for (int l = 0; l < 4; ++l) lo[c] = e[l] < lo[c] ? e[l] : lo[c];
+      _mm256_storeu_pd(e, hiv[c]);
+      for (int l = 0; l < 4; ++l) hi[c] = e[l] > hi[c] ? e[l] : hi[c];
+    }
+    zero = _mm256_movemask_pd(zacc) != 0;
+    return k;
+  }
+
+  // min_max()'s loop, four samples at a time.
+  GRAVCAL_TARGET_AVX2 static std::size_t min_max_avx2(const double* x, const double* y,
+                                                      const double* z, std::size_t m,
+                                                      double* lo, double* hi, bool& zero) {
+    const __m256d zr = _mm256_setzero_pd();
+    __m256d lo0 = _mm256_set1_pd(lo[0]), lo1 = _mm256_set1_pd(lo[1]), lo2 = _mm256_set1_pd(lo[2]);
+    __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
+    std::size_t k = 0;
+    for (; k + 4 <= m; k += 4) {
+      const __m256d a = _mm256_loadu_pd(x + k), b = _mm256_loadu_pd(y + k),
+                    c = _mm256_loadu_pd(z + k);
+      lo0 = _mm256_min_pd(a, lo0);
+      lo1 = _mm256_min_pd(b, lo1);
+      lo2 = _mm256_min_pd(c, lo2);
+      hi0 = _mm256_max_pd(a, hi0);
+      hi1 = _mm256_max_pd(b, hi1);
+      hi2 = _mm256_max_pd(c, hi2);
+      zacc = _mm256_or_pd(
+          zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a, zr, _CMP_EQ_OQ),
+                                            _mm256_cmp_pd(b, zr, _CMP_EQ_OQ)),
+                              _mm256_cmp_pd(c, zr, _CMP_EQ_OQ)));
+    }
+    const __m256d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
+    for (int a = 0; a < 3; ++a) {
+      double e[4];
+      _mm256_storeu_pd(e, lov[a]);
+      for (int l = 0; l < 4; ++l) lo[a] = e[l] < lo[a] ? e[l] : lo[a];
+      _mm256_storeu_pd(e, hiv[a]);
+      for (int l = 0; l < 4; ++l) hi[a] = e[l] > hi[a] ? e[l] : hi[a];
+    }
+    zero = _mm256_movemask_pd(zacc) != 0;
+    return k;
+  }
+
+  // fast_sd()'s loop: the squared deviations of the four lanes by position
+  // in one register per axis (the SSE2 loop's two), the same bits.
+  GRAVCAL_TARGET_AVX2 static std::size_t sq_dev_avx2(const double* const* v, std::size_t n,
+                                                     const double* mu, double (*q)[4]) {
+    const __m256d m0 = _mm256_set1_pd(mu[0]), m1 = _mm256_set1_pd(mu[1]),
+                  m2 = _mm256_set1_pd(mu[2]);
+    const __m256d zr = _mm256_setzero_pd();
+    __m256d q0 = zr, q1 = zr, q2 = zr;
+    const double* x = v[0];
+    const double* y = v[1];
+    const double* z = v[2];
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+      __m256d d = _mm256_sub_pd(_mm256_loadu_pd(x + k), m0);
+      q0 = _mm256_add_pd(q0, _mm256_mul_pd(d, d));
+      d = _mm256_sub_pd(_mm256_loadu_pd(y + k), m1);
+      q1 = _mm256_add_pd(q1, _mm256_mul_pd(d, d));
+      d = _mm256_sub_pd(_mm256_loadu_pd(z + k), m2);
+      q2 = _mm256_add_pd(q2, _mm256_mul_pd(d, d));
+    }
+    _mm256_storeu_pd(q[0], q0);
+    _mm256_storeu_pd(q[1], q1);
+    _mm256_storeu_pd(q[2], q2);
+    return k;
+  }
+#endif
+
   // A zero minimum (maximum) as add()'s sequential rule leaves it: the
   // first zero of the column, with its sign (lanes may have kept the other
   // one). Any other value is the same in any order.
@@ -565,6 +692,11 @@ class Segmenter {
     double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
     bool zero = false;
     std::size_t k = 0;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) {
+      k = min_max_avx2(x, y, z, m, lo, hi, zero);
+    } else
+#endif
 #if defined(GRAVCAL_SSE2)
     {
       const __m128d zr = _mm_setzero_pd();
@@ -638,6 +770,11 @@ class Segmenter {
                           static_cast<double>(w[2] / ln)};
     double q[3][4] = {};
     std::size_t k = 0;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) {
+      k = sq_dev_avx2(v, n, mu, q);
+    } else
+#endif
 #if defined(GRAVCAL_SSE2)
     {
       const __m128d m0 = _mm_set1_pd(mu[0]), m1 = _mm_set1_pd(mu[1]), m2 = _mm_set1_pd(mu[2]);
