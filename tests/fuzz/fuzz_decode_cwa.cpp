@@ -4,7 +4,8 @@
 // past the checksum. Checks, besides the sanitizers' findings: no read past
 // the buffer's capacity, the report's counts agree with what was given, the
 // decoder always makes progress, and the samples are the same, to the bit,
-// whether pulled through a large buffer or a 7-sample one.
+// whether pulled through a large buffer or a 7-sample one, and with or
+// without the AVX2 paths.
 #include <cstring>
 #include <vector>
 
@@ -98,6 +99,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t cap = 4096;
   const bool ok = run(file, compat, window, cap, big);
   if (run(file, compat, window, 7, small) != ok) __builtin_trap();
+  // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
+  if (gravcal::use_avx2()) {
+    Run base;
+    gravcal::set_avx2(false);
+    const bool ok2 = run(file, compat, window, cap, base);
+    gravcal::set_avx2(true);
+    if (ok2 != ok || base.v.size() != big.v.size() || base.units != big.units ||
+        base.report.skipped != big.report.skipped || !same(big, base)) {
+      __builtin_trap();
+    }
+  }
   if (!ok) return 0;
   check(big, compat, blocks);
   check(small, compat, blocks);

@@ -2,7 +2,8 @@
 // byte picks compat, the block size (max_units) and the buffer; when its low
 // bit is set a valid header goes before the rest, so the fuzzer works on
 // pages. Checks: no crash, no call past the buffer, progress on every call,
-// finite values, report counts consistent with what was given.
+// finite values, report counts consistent with what was given, and the
+// same bits with and without the AVX2 paths.
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -29,12 +30,9 @@ static const char kHeader[] =
     "x gain:25875\r\nx offset:439\r\ny gain:25734\r\ny offset:-662\r\nz gain:25538\r\n"
     "z offset:-3056\r\nVolts:300\r\nLux:800\r\n\r\nMemory Status\r\nNumber of Pages:2\r\n\r\n";
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  FuzzInput in{data, size};
-  const std::uint8_t mode = in.byte();
-  std::vector<unsigned char> bytes;
-  if (mode & 1) bytes.assign(kHeader, kHeader + sizeof kHeader - 1);
-  bytes.insert(bytes.end(), in.p, in.p + in.n);
+// Decodes `bytes` (mode as below), checks the invariants and returns a
+// digest of every sample, time and temperature and of the report's counts.
+static std::uint64_t decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mode) {
   gravcal::MemorySource src(bytes.data(), bytes.size());
   gravcal::Options opts;
   opts.set("compat", (mode & 2) ? 0.0 : 1.0);
@@ -43,6 +41,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     CHECK(!(dec.error().empty()));
     return 0;
   }
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, std::size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  };
   const std::int64_t max_units = (mode & 4) ? -1 : 1 + ((mode >> 3) & 3);
   const std::size_t cap = (mode & 32) ? 7 : 600;
   std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
@@ -61,9 +64,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < out.n; ++i) {
       CHECK(std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(z[i]) &&
             std::isfinite(t[i]) && std::isfinite(tm[i]));
+      const double v[5] = {x[i], y[i], z[i], t[i], tm[i]};
+      mix(v, sizeof v);
     }
     samples += static_cast<std::int64_t>(out.n);
     units += u;
+    mix(&u, sizeof u);
     CHECK(!(calls > 10000000));
   }
   const gravcal::Report& r = dec.report();
@@ -72,6 +78,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   CHECK(!(r.samples > r.units * static_cast<std::int64_t>(gravcal::geneactiv::kSamplesPerPage)));
   CHECK(!(r.gaps < 0 || !(r.gap_seconds >= 0) || !std::isfinite(r.gap_seconds)));
   CHECK(!(r.notes.size() > gravcal::Report::max_notes));
+  for (const auto& c : r.counters) mix(&c.second, sizeof c.second);
   // a further read gives nothing
   gravcal::SampleBuffer out;
   out.x = x.data();
@@ -79,5 +86,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   out.z = z.data();
   out.capacity = cap;
   CHECK(!(dec.read(out, -1) != 0 || out.n != 0));
+  return h;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzInput in{data, size};
+  const std::uint8_t mode = in.byte();
+  std::vector<unsigned char> bytes;
+  if (mode & 1) bytes.assign(kHeader, kHeader + sizeof kHeader - 1);
+  bytes.insert(bytes.end(), in.p, in.p + in.n);
+  const std::uint64_t h = decode_all(bytes, mode);
+  // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
+  if (gravcal::use_avx2()) {
+    gravcal::set_avx2(false);
+    const std::uint64_t b = decode_all(bytes, mode);
+    gravcal::set_avx2(true);
+    CHECK(b == h);
+  }
   return 0;
 }

@@ -67,6 +67,7 @@
 #include <string>
 
 #include "gravcal/decode.hpp"
+#include "gravcal/simd.hpp"
 
 // GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
 #if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
@@ -203,33 +204,7 @@ inline int signed10(std::uint32_t v) {
   return static_cast<int>((v & 0x3ffu) ^ 0x200u) - 0x200;
 }
 
-// The block's accelerometer samples in g, xyz interleaved.
-inline void scale_samples(const unsigned char* b, const Header& h, const Params& p,
-                          double packed_scale, double* xyz) {
-  const unsigned char* d = b + data_offset;
-  if (h.packed) {
-    // value * 2^exponent * scale: both factors are powers of two, so their
-    // product first gives the same (exact) result
-    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
-    for (int i = 0; i < h.count; ++i) {
-      const std::uint32_t v = le32(d + 4 * i);
-      const double m = f[v >> 30];
-      xyz[3 * i] = signed10(v) * m;
-      xyz[3 * i + 1] = signed10(v >> 10) * m;
-      xyz[3 * i + 2] = signed10(v >> 20) * m;
-    }
-    return;
-  }
-  const int acc = p.axes == 6 ? 3 : 0;  // AX6: gyro first, then accelerometer
-  for (int i = 0; i < h.count; ++i) {
-    const unsigned char* s = d + 2 * (i * p.axes + acc);
-    for (int a = 0; a < 3; ++a) {
-      xyz[3 * i + a] = static_cast<std::int16_t>(le16(s + 2 * a)) * p.accel_scale;
-    }
-  }
-}
-
-// Samples [from, from + n) of the block, scaled as scale_samples() does,
+// Samples [from, from + n) of the block, in g,
 // into three columns: packed ones four at a time with SSE2 (the same
 // integer and the same product per value, so the same doubles).
 inline void scale_columns(const unsigned char* b, const Header& h, const Params& p,
@@ -283,7 +258,9 @@ struct Block {
   double rtc = 0;    // the RTC time, whole seconds since 1970
   double start = 0;  // the first sample's time
   double frequency = 0;
-  double xyz[3 * max_samples];
+  // samples by axis: xyz[a][i + 1] is sample i's; xyz[a][0] is free for
+  // the value interpolation starts from (emit_span())
+  double xyz[3][max_samples + 1];
   unsigned char bytes[block_bytes];
 };
 
@@ -325,6 +302,13 @@ class CwaDecoder : public Decoder {
   void begin_span(double next_time, bool alone, bool final_block, bool seq_break);
   bool emit_span(SampleBuffer& out);
   double grid(std::int64_t k) const;
+#if defined(GRAVCAL_AVX2)
+  std::int64_t emit_avx2(std::int64_t pos, std::int64_t end_pos, int& source, int len,
+                         double lim, double temp, const double (*xyz)[cwa::max_samples + 1],
+                         double* ox, double* oy, double* oz, double* ot, double* otime,
+                         double* a, double& at) const;
+  static void span_times_avx2(double* dst, int len, double start, double spacing);
+#endif
 
   ByteSource& src_;
   bool compat_;
@@ -523,7 +507,8 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
     return true;
   }
   const double packed_scale = compat_ ? use.accel_scale : 1.0 / 256;
-  cwa::scale_samples(raw, b.h, use, packed_scale, b.xyz);
+  cwa::scale_columns(raw, b.h, use, packed_scale, 0, b.h.count, b.xyz[0] + 1, b.xyz[1] + 1,
+                     b.xyz[2] + 1);
   return true;
 }
 
@@ -809,13 +794,20 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   const int len = prev_len_;
   const double spacing = alone ? 1.0 / p.frequency : (next_time - prev_start_) / len;
   raw_t_[1] = prev_start_;
-  for (int i = 1; i < len; ++i) {
+  int from = 1;
+#if defined(GRAVCAL_AVX2)
+  if (use_avx2()) {
+    span_times_avx2(raw_t_, len, prev_start_, spacing);
+    from = len;
+  }
+#endif
+  for (int i = from; i < len; ++i) {
     volatile double elapsed = i * spacing;  // rounded before the addition, as R's seq()
     raw_t_[i + 1] = prev_start_ + elapsed;
   }
   raw_t_[len + 1] = next_time;
   if (first_iter_) {
-    for (int a = 0; a < 3; ++a) anchor_[a] = ianchor_[a] = p.xyz[a];
+    for (int a = 0; a < 3; ++a) anchor_[a] = ianchor_[a] = p.xyz[a][1];
     anchor_t_ = ianchor_t_ = prev_start_ - cwa::anchor_dt;
     first_iter_ = false;
   }
@@ -860,12 +852,91 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   span_open_ = true;
 }
 
+#if defined(GRAVCAL_AVX2)
+// begin_span()'s sample times raw_t_[i + 1] = start + i * spacing, i = 1 ..
+// len - 1, four at a time: the product rounded, then the sum (no fused
+// multiply-add), as the scalar loop.
+GRAVCAL_TARGET_AVX2 inline void CwaDecoder::span_times_avx2(double* dst, int len, double start,
+                                                            double spacing) {
+  const __m256d st = _mm256_set1_pd(start), sp = _mm256_set1_pd(spacing);
+  const __m256d step = _mm256_setr_pd(0, 1, 2, 3);
+  int i = 1;
+  for (; i + 4 <= len; i += 4) {
+    const __m256d iv = _mm256_add_pd(_mm256_set1_pd(static_cast<double>(i)), step);
+    _mm256_storeu_pd(dst + i + 1, _mm256_add_pd(st, _mm256_mul_pd(iv, sp)));
+  }
+  for (; i < len; ++i) {
+    const __m128d e = _mm_mul_sd(_mm_set_sd(static_cast<double>(i)), _mm_set_sd(spacing));
+    _mm_store_sd(dst + i + 1, _mm_add_sd(_mm_set_sd(start), e));
+  }
+}
+
+// Grid points pos, pos + 1, ... (before end_pos) of a span that is not
+// imputed, four at a time while they lie in consecutive intervals (the usual
+// case: grid and samples at the same rate): their times as grid(), the
+// intervals as emit_span()'s search, the weights and values with
+// emit_span()'s operations, four lanes at a time. Stops, with nothing of
+// the four written, at four of which any is otherwise (past the span's end,
+// in the same or a skipped interval), so that emit_span() takes the next
+// one alone. Returns how many it wrote (a multiple of 4); source, a (the
+// last values) and at (the last time) follow.
+GRAVCAL_TARGET_AVX2 inline std::int64_t CwaDecoder::emit_avx2(
+    std::int64_t pos, std::int64_t end_pos, int& source, int len, double lim, double temp,
+    const double (*xyz)[cwa::max_samples + 1], double* ox, double* oy, double* oz, double* ot,
+    double* otime, double* a, double& at) const {
+  const __m256d start = _mm256_set1_pd(start_ts_), step = _mm256_set1_pd(step_),
+                end = _mm256_set1_pd(end_ts_), limit = _mm256_set1_pd(lim),
+                lanes = _mm256_setr_pd(0, 1, 2, 3), tv = _mm256_set1_pd(temp);
+  const std::int64_t pos0 = pos;
+  int s = source;
+  __m256d last[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+  __m256d t = _mm256_setzero_pd();
+  for (; pos + 4 <= end_pos; pos += 4) {
+    const __m256d pv = _mm256_add_pd(_mm256_set1_pd(static_cast<double>(pos)), lanes);
+    __m256d u = _mm256_add_pd(start, _mm256_mul_pd(pv, step));
+    u = _mm256_min_pd(u, end);  // u < end ? u : end
+    if (_mm256_movemask_pd(_mm256_cmp_pd(u, limit, _CMP_LE_OQ)) != 0xf) break;
+    const double u0 = _mm256_cvtsd_f64(u);
+    int k = s;
+    while (k < len && raw_t_[k] < u0) ++k;
+    if (k + 3 > len) break;
+    // point j in (raw_t_[k + j - 1], raw_t_[k + j]]: the search from point
+    // j - 1's interval moves exactly one on
+    const __m256d T1 = _mm256_loadu_pd(raw_t_ + k), T0 = _mm256_loadu_pd(raw_t_ + k - 1);
+    if (_mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) != 0) break;
+    if ((_mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) & 0xe) != 0xe) break;
+    const __m256d w = _mm256_div_pd(_mm256_sub_pd(u, T0), _mm256_sub_pd(T1, T0));
+    double* o[3] = {ox, oy, oz};
+    for (int c = 0; c < 3; ++c) {
+      const __m256d L = _mm256_loadu_pd(xyz[c] + k - 1), R = _mm256_loadu_pd(xyz[c] + k);
+      last[c] = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
+      _mm256_storeu_pd(o[c] + (pos - pos0), last[c]);
+    }
+    if (ot != nullptr) _mm256_storeu_pd(ot + (pos - pos0), tv);
+    if (otime != nullptr) _mm256_storeu_pd(otime + (pos - pos0), u);
+    s = k + 3;
+    t = u;
+  }
+  if (pos > pos0) {
+    double e[4];
+    for (int c = 0; c < 3; ++c) {
+      _mm256_storeu_pd(e, last[c]);
+      a[c] = e[3];
+    }
+    _mm256_storeu_pd(e, t);
+    at = e[3];
+    source = s;
+  }
+  return pos - pos0;
+}
+#endif
+
 // Writes the open span's grid points into out; false when out filled first.
 // The loop keeps its state in locals (the output columns could alias the
 // members, so the compiler would store and reload them every sample) and
 // writes it back once; the arithmetic is grid() and out.put()'s.
 inline bool CwaDecoder::emit_span(SampleBuffer& out) {
-  const cwa::Block& p = blk_[span_blk_];
+  cwa::Block& p = blk_[span_blk_];
   const int len = span_len_;
   const double lim = raw_t_[len];
   const double temp = p.h.temperature;
@@ -887,7 +958,38 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
   double* const otime = out.time;
   const std::int64_t pos0 = pos;
   bool full = false;
+  // an interval's left end is the sample before, or for the first the
+  // value the span starts from
+  for (int c = 0; c < 3; ++c) p.xyz[c][0] = il[c];
+  const double* X = p.xyz[0];
+  const double* Y = p.xyz[1];
+  const double* Z = p.xyz[2];
+#if defined(GRAVCAL_AVX2)
+  const bool vec = !impute && use_avx2();
+#endif
   while (pos <= last) {
+#if defined(GRAVCAL_AVX2)
+    if (vec) {
+      // as many as fit in out and lie in the span's grid
+      const std::int64_t room = static_cast<std::int64_t>(cap - n);
+      const std::int64_t stop = std::min(last + 1, pos + room);
+      if (stop - pos >= 4) {
+        double av[3];
+        const std::int64_t k =
+            emit_avx2(pos, stop, source, len, lim, temp, p.xyz, ox + n, oy + n, oz + n,
+                      ot != nullptr ? ot + n : nullptr, otime != nullptr ? otime + n : nullptr,
+                      av, at);
+        if (k > 0) {
+          a0 = av[0];
+          a1 = av[1];
+          a2 = av[2];
+          n += static_cast<std::size_t>(k);
+          pos += k;
+        }
+      }
+    }
+    if (pos > last) break;
+#endif
     volatile double e = static_cast<double>(pos) * step;  // as grid(): no fused multiply-add
     double t = start + e;
     t = t < end ? t : end;
@@ -903,11 +1005,9 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     } else {
       while (source < len && raw_t_[source] < t) ++source;
       const double w = (t - raw_t_[source - 1]) / (raw_t_[source] - raw_t_[source - 1]);
-      const double* right = p.xyz + 3 * (source - 1);
-      const double* left = source == 1 ? il : right - 3;
-      a0 = w * (right[0] - left[0]) + left[0];
-      a1 = w * (right[1] - left[1]) + left[1];
-      a2 = w * (right[2] - left[2]) + left[2];
+      a0 = w * (X[source] - X[source - 1]) + X[source - 1];
+      a1 = w * (Y[source] - Y[source - 1]) + Y[source - 1];
+      a2 = w * (Z[source] - Z[source - 1]) + Z[source - 1];
     }
     ox[n] = a0;
     oy[n] = a1;
@@ -934,7 +1034,7 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     for (int c = 0; c < 3; ++c) ianchor_[c] = anchor_[c];
   } else {
     ianchor_t_ = lim;
-    for (int c = 0; c < 3; ++c) ianchor_[c] = p.xyz[3 * (len - 1) + c];
+    for (int c = 0; c < 3; ++c) ianchor_[c] = p.xyz[c][len];
   }
   span_open_ = false;
   return true;
