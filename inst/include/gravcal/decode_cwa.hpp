@@ -207,6 +207,33 @@ inline int signed10(std::uint32_t v) {
 // Samples [from, from + n) of the block, in g,
 // into three columns: packed ones four at a time with SSE2 (the same
 // integer and the same product per value, so the same doubles).
+#if defined(GRAVCAL_AVX2)
+// scale_columns()'s packed samples eight at a time: signed10(v) << e, an
+// exact integer, times packed_scale is signed10(v) times 2^e packed_scale
+// (both products exact scalings of the same value), so the same doubles.
+// Returns the samples done (a multiple of 8).
+GRAVCAL_TARGET_AVX2 inline int scale_packed_avx2(const unsigned char* d, double packed_scale,
+                                                 int n, double* x, double* y, double* z) {
+  const __m256i m10 = _mm256_set1_epi32(0x3ff), sign = _mm256_set1_epi32(0x200);
+  const __m256d ps = _mm256_set1_pd(packed_scale);
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d + 4 * i));
+    const __m256i e = _mm256_srli_epi32(w, 30);
+    double* col[3] = {x + i, y + i, z + i};
+    for (int a = 0; a < 3; ++a) {
+      const __m256i u = a == 0 ? w : _mm256_srli_epi32(w, 10 * a);
+      const __m256i v = _mm256_sllv_epi32(
+          _mm256_sub_epi32(_mm256_xor_si256(_mm256_and_si256(u, m10), sign), sign), e);
+      _mm256_storeu_pd(col[a], _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(v)), ps));
+      _mm256_storeu_pd(col[a] + 4,
+                       _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(v, 1)), ps));
+    }
+  }
+  return i;
+}
+#endif
+
 inline void scale_columns(const unsigned char* b, const Header& h, const Params& p,
                           double packed_scale, int from, int n, double* x, double* y,
                           double* z) {
@@ -214,6 +241,9 @@ inline void scale_columns(const unsigned char* b, const Header& h, const Params&
   if (h.packed) {
     const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
     int i = 0;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) i = scale_packed_avx2(d + 4 * from, packed_scale, n, x, y, z);
+#endif
 #if defined(GRAVCAL_SSE2)
     const __m128i m10 = _mm_set1_epi32(0x3ff), sign = _mm_set1_epi32(0x200);
     for (; i + 4 <= n; i += 4) {
