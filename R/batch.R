@@ -647,7 +647,15 @@ lock_stale <- function(owner, host) {
       pid == Sys.getpid()) {
     return(FALSE)
   }
-  if (dir.exists("/proc/self")) return(!dir.exists(file.path("/proc", pid)))
+  if (dir.exists("/proc/self")) {
+    if (!dir.exists(file.path("/proc", pid))) return(TRUE)
+    # a process that has ended but is not yet reaped by its parent (a
+    # zombie) holds nothing: its state, after the name in parentheses
+    stat <- tryCatch(readLines(file.path("/proc", pid, "stat"), n = 1L, warn = FALSE),
+                     error = function(e) character(0))
+    state <- sub("^.*\\) ([A-Za-z]).*$", "\\1", stat)
+    return(length(state) == 1L && state %in% c("Z", "X"))
+  }
   !isTRUE(suppressWarnings(tools::pskill(pid, 0)))
 }
 

@@ -130,6 +130,32 @@ test_that("an interrupted run resumes without redoing finished recordings", {
   expect_length(list.files(out, pattern = "tmp$|part$", recursive = TRUE, all.files = TRUE), 0)
 })
 
+test_that("a lock is stale once its process has ended, also before it is reaped", {
+  skip_on_os("windows")  # fork
+  skip_if_not(dir.exists("/proc/self"), "no /proc: liveness by signal 0")
+  host <- "here"
+  owner <- function(pid) c(pid = as.character(pid), host = host)
+  # a child killed and not yet collected: a zombie, /proc/<pid> stays
+  job <- parallel::mcparallel(Sys.sleep(60), silent = TRUE)
+  tools::pskill(job$pid, tools::SIGKILL)
+  t0 <- Sys.time()
+  zombie <- function() {
+    st <- tryCatch(readLines(file.path("/proc", job$pid, "stat"), warn = FALSE),
+                   error = function(e) "")
+    grepl("\\) Z ", st)
+  }
+  while (!zombie() && difftime(Sys.time(), t0, units = "secs") < 30) Sys.sleep(0.02)
+  expect_true(dir.exists(file.path("/proc", job$pid)))
+  expect_true(lock_stale(owner(job$pid), host))
+  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 10))
+  expect_true(lock_stale(owner(job$pid), host))  # reaped: gone
+  # a live process is not stale; nor is a lock of another host
+  live <- parallel::mcparallel(Sys.sleep(30), silent = TRUE)
+  on.exit(tools::pskill(live$pid, tools::SIGKILL), add = TRUE)
+  expect_false(lock_stale(owner(live$pid), host))
+  expect_false(lock_stale(c(pid = as.character(job$pid), host = "elsewhere"), host))
+})
+
 test_that("calibrate_files() and calibrate_cli() reject bad input clearly", {
   expect_error(calibrate_files(character(0), outdir = tempdir()), "`files`")
   expect_error(calibrate_files(tempfile(), outdir = tempdir()), "do not exist")
