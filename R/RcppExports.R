@@ -37,6 +37,10 @@ gc_set_avx2 <- function(on) {
     .Call(`_gravcal_gc_set_avx2`, on)
 }
 
+gc_use_avx2 <- function() {
+    .Call(`_gravcal_gc_use_avx2`)
+}
+
 gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace) {
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }

@@ -115,6 +115,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_use_avx2
+bool gc_use_avx2();
+RcppExport SEXP _gravcal_gc_use_avx2() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(gc_use_avx2());
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fit_icp
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
 RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
@@ -294,6 +303,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_blocks_decode", (DL_FUNC) &_gravcal_gc_blocks_decode, 5},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},
+    {"_gravcal_gc_use_avx2", (DL_FUNC) &_gravcal_gc_use_avx2, 0},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
     {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},

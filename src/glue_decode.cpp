@@ -280,3 +280,9 @@ double gc_decoder_drain(SEXP ptr) {
 bool gc_set_avx2(bool on) {
   return gravcal::set_avx2(on);
 }
+
+// Whether the core's AVX2 paths run in this process.
+// [[Rcpp::export(rng = false)]]
+bool gc_use_avx2() {
+  return gravcal::use_avx2();
+}

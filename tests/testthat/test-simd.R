@@ -30,6 +30,23 @@ test_that("the switch turns the AVX2 paths off and back on", {
   expect_true(gc_set_avx2(TRUE))
 })
 
+test_that("GRAVCAL_NO_AVX2 in the environment turns them off for the process", {
+  skip_if_no_avx2()
+  ask <- function(value) {
+    env <- if (is.null(value)) character(0) else paste0("GRAVCAL_NO_AVX2=", value)
+    out <- system2(file.path(R.home("bin"), "Rscript"),
+                   c("-e", shQuote("cat(gravcal:::gc_use_avx2())")),
+                   stdout = TRUE, stderr = FALSE, env = env)
+    utils::tail(out, 1)
+  }
+  old <- Sys.getenv("GRAVCAL_NO_AVX2", unset = NA)
+  Sys.unsetenv("GRAVCAL_NO_AVX2")
+  on.exit(if (!is.na(old)) Sys.setenv(GRAVCAL_NO_AVX2 = old))
+  expect_identical(ask(NULL), "TRUE")
+  expect_identical(ask("0"), "TRUE")
+  expect_identical(ask("1"), "FALSE")
+})
+
 test_that(".cwa: compatible and raw decoding are the same bits with and without AVX2", {
   skip_if_no_avx2()
   files <- c(system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread"),

@@ -8,12 +8,16 @@
 // same order, never fused), and the tests compare the two
 // (set_avx2(false) forces the baseline).
 //
-// GRAVCAL_NO_SIMD or GRAVCAL_NO_AVX2: no AVX2 code at all. Only with GCC or
-// clang on x86.
+// GRAVCAL_NO_SIMD or GRAVCAL_NO_AVX2 defined when compiling: no AVX2 code
+// at all. Only with GCC or clang on x86. The environment variable
+// GRAVCAL_NO_AVX2 set to anything but "" or "0" when the process first asks
+// turns the AVX2 paths off (to compare, or to rule them out).
 //
 // Header-only, standard headers only.
 #ifndef GRAVCAL_SIMD_HPP
 #define GRAVCAL_SIMD_HPP
+
+#include <cstdlib>
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && defined(__SSE2__) && \
     !defined(GRAVCAL_NO_SIMD) && !defined(GRAVCAL_NO_AVX2)
@@ -38,13 +42,17 @@ inline bool cpu_has_avx2() {
   return false;
 #endif
 }
+inline bool env_says_no() {
+  const char* e = std::getenv("GRAVCAL_NO_AVX2");
+  return e != nullptr && e[0] != '\0' && !(e[0] == '0' && e[1] == '\0');
+}
 }  // namespace simd_detail
 
-// Whether the AVX2 paths run: the processor has AVX2 and set_avx2(false)
-// was not called.
+// Whether the AVX2 paths run: the processor has AVX2, GRAVCAL_NO_AVX2 was
+// not set and set_avx2(false) was not called.
 inline bool use_avx2() {
   int& s = simd_detail::avx2_state();
-  if (s < 0) s = simd_detail::cpu_has_avx2() ? 1 : 0;
+  if (s < 0) s = simd_detail::cpu_has_avx2() && !simd_detail::env_says_no() ? 1 : 0;
   return s == 1;
 }
 
