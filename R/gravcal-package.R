@@ -7,6 +7,14 @@
 #'
 #' The numeric core is header-only C++ in `inst/include/gravcal` with no R
 #' dependency, usable in firmware.
+#'
+#' @section Speed on x86 processors:
+#' The device-file decoders and the window statistics have AVX2 versions,
+#' used when the processor has AVX2. They give the same results, to the
+#' last bit, as the baseline versions, which every x86-64 processor runs.
+#' Set the environment variable `GRAVCAL_NO_AVX2=1` before gravcal is first
+#' used in an R session to run the baseline versions only (for comparisons,
+#' or to rule the AVX2 versions out when chasing a problem).
 #' @keywords internal
 #' @useDynLib gravcal, .registration = TRUE
 #' @importFrom Rcpp evalCpp
