@@ -700,7 +700,7 @@ static DecodedGa decode_geneactiv(const std::string& file, bool compat) {
 
 static void test_avx2_geneactiv() {
   if (!gravcal::set_avx2(true)) {
-    std::printf("note: no AVX2 on this processor; the AVX2 paths are not compared here\n");
+    std::printf("note: no AVX2 paths (not in this build, or not on this processor): none compared\n");
     return;
   }
   std::mt19937 rng(2026);

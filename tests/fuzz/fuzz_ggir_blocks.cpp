@@ -10,6 +10,7 @@
 // then, against R's sds everywhere, every other statistic is the same, and
 // so are the rest windows (with their sds, to the bit) and the ties GGIR's
 // duplicate filter counts between a window and the last one with means.
+// And all of it is the same bits without the AVX2 paths (gravcal/simd.hpp).
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -67,15 +68,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     blocks.push_back(b);
   }
-  Out out[4];
-  for (int way = 0; way < 4; ++way) {
-    if (way == 3 && !lazy) break;
+  Out out[5];
+  for (int way = 0; way < 5; ++way) {
+    if (way == 3 && !lazy) continue;
+    // way 4: as way 0 without the AVX2 paths (gravcal/simd.hpp)
+    if (way == 4 && !gravcal::use_avx2()) break;
+    struct Avx2Off {
+      bool on;
+      ~Avx2Off() {
+        if (on) gravcal::set_avx2(true);
+      }
+    } restore{way == 4};
+    if (way == 4) gravcal::set_avx2(false);
     std::vector<double> buf(3 * (static_cast<std::size_t>(L) + 3)), held(buf.size());
     gravcal::LazySd state;
     gravcal::Segmenter seg(L, false);
     if (compat && !seg.use_r_arithmetic(buf.data(), buf.size())) __builtin_trap();
     // ways 0-2 lazy when asked; way 3: R's sds everywhere, as the reference
-    if (lazy && way < 3 && !seg.lazy_r_sd(max_sd, &state, held.data(), held.size())) __builtin_trap();
+    if (lazy && way != 3 && !seg.lazy_r_sd(max_sd, &state, held.data(), held.size())) __builtin_trap();
     gravcal::GgirBlocks gb(seg, per_hour, compat, with_t);
     auto sink = [&](const gravcal::WindowStats& w) { out[way].w.push_back(w); };
     std::size_t c = 0;
@@ -90,7 +100,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       gb.begin_block();
       std::size_t i = 0;
-      if (way == 0 || way == 3) {
+      if (way == 0 || way == 3 || way == 4) {
         gb.push(x.data(), y.data(), z.data(), with_t ? t.data() : nullptr, n, sink);
         i = n;
       }
@@ -146,7 +156,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       last = k;
     }
   }
-  for (int way = 1; way < 3; ++way) {
+  for (int way = 1; way < 5; ++way) {
+    if (way == 3 || (way == 4 && !gravcal::use_avx2())) continue;
     if (out[way].w.size() != out[0].w.size() || out[way].b.size() != out[0].b.size())
       __builtin_trap();
     for (std::size_t k = 0; k < out[0].w.size(); ++k) {
