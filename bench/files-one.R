@@ -58,6 +58,15 @@ run <- switch(contender,
     n <- gravcal:::gc_decoder_drain(h$ptr)
     list(coef = n, status = "decoded")
   },
+  # the same in GGIR-compatible mode (what g.calibrate reads: for .cwa with
+  # GGIRread's resampling onto a regular grid)
+  "decode, compatible mode" = function() {
+    fmt <- gravcal:::file_format(file)
+    h <- gravcal:::native_open(file, fmt, list(compat = 1))
+    on.exit(gravcal:::gc_decoder_close(h$ptr))
+    n <- gravcal:::gc_decoder_drain(h$ptr)
+    list(coef = n, status = "decoded")
+  },
   stop("unknown contender ", contender))
 
 st <- system.time(v <- run(), gcFirst = FALSE)
