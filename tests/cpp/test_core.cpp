@@ -268,6 +268,94 @@ static void test_r_arithmetic() {
   }
 }
 
+// r_var_mean_avx2() (r_arith.hpp) decides R's var() mean without R's two
+// long double passes only when its bound allows, and is then R's double
+// (r_mean(), the plain two-pass loop): on ordinary windows, on windows whose
+// exact mean is a midpoint between two doubles or next to one (half the
+// values d, half the next double; then one value moved by one ulp), on
+// values crossing zero or spread wide about a small mean (where R's own
+// rounding moves its mean off the exact one: with no bound, W = 0, this
+// test fails), on values with few bits and on huge and tiny ones.
+static void test_r_var_mean() {
+#if defined(GRAVCAL_AVX2) && defined(__x86_64__)
+  if (!gravcal::use_avx2()) {
+    std::printf("note: no AVX2, r_var_mean_avx2() not tested\n");
+    return;
+  }
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::uniform_real_distribution<double> ud(0.0, 1.0);
+  long decided = 0, tried = 0, wrong = 0, ordinary = 0, ordinary_decided = 0;
+  for (int trial = 0; trial < 40000; ++trial) {
+    const int kind = trial % 8;
+    const std::size_t n = kind == 7 ? 2 + static_cast<std::size_t>(trial % 9)
+                                    : 2 + static_cast<std::size_t>(ud(rng) * 1500);
+    std::vector<double> x(n);
+    const double centre = std::ldexp(0.5 + ud(rng), static_cast<int>(ud(rng) * 12) - 8);
+    const double sd = std::ldexp(1.0, -static_cast<int>(ud(rng) * 30) - 3);
+    switch (kind) {
+      case 0:  // near a value, with noise
+      case 1:
+        for (auto& v : x) v = centre + sd * nd(rng);
+        break;
+      case 2: {  // mean exactly half-way between two doubles
+        const double d = centre, e = std::nextafter(d, 2 * d);
+        for (std::size_t i = 0; i < n; ++i) x[i] = i < n / 2 ? d : e;
+        if (n % 2) x[n - 1] = std::nextafter(e, 2 * e) == e ? e : d;
+        break;
+      }
+      case 3: {  // the same, one value moved by an ulp either way
+        const double d = centre, e = std::nextafter(d, 2 * d);
+        for (std::size_t i = 0; i < n; ++i) x[i] = i < n / 2 ? d : e;
+        x[trial % n] = std::nextafter(x[trial % n], (trial & 8) ? 0.0 : 4 * d);
+        break;
+      }
+      case 4:  // crossing zero, or spread wide about a small mean (so that
+               // R's own rounding moves its mean)
+        for (auto& v : x) v = (trial & 8) ? sd * nd(rng) : centre + 300 * centre * nd(rng);
+        break;
+      case 5:  // few bits (multiples of 2^-8), as raw counts give
+        for (auto& v : x) v = std::ldexp(std::round(std::ldexp(centre + 0.01 * nd(rng), 8)), -8);
+        break;
+      case 6: {  // huge, tiny, or both signs at a scale
+        const double sc = std::ldexp(1.0, (trial & 16 ? 1 : -1) * static_cast<int>(ud(rng) * 400));
+        for (auto& v : x) v = sc * (centre + sd * nd(rng)) * ((trial & 32) ? -1.0 : 1.0);
+        break;
+      }
+      default:  // short windows
+        for (auto& v : x) v = centre + 0.01 * nd(rng);
+    }
+    double m = 0;
+    ++tried;
+    const bool ok = gravcal::r_var_mean_avx2(x.data(), n, &m);
+    if (kind <= 1 && sd <= 0x1p-7 && n >= 100) {
+      ++ordinary;
+      ordinary_decided += ok;
+    }
+    if (!ok) continue;
+    ++decided;
+    const double r = gravcal::r_mean(x.data(), n);
+    if (std::memcmp(&r, &m, sizeof m) != 0) {
+      if (wrong < 5) std::printf("r_var_mean: n %zu kind %d: %a, R %a\n", n, kind, m, r);
+      ++wrong;
+    }
+  }
+  CHECK_LD(wrong == 0);
+  // the shortcut is taken for most windows of a sensor at rest (sd at most
+  // 8 mg about a value), else it would save nothing
+  CHECK(ordinary > 1000 && ordinary_decided > 0.9 * static_cast<double>(ordinary));
+  CHECK(decided < tried);  // and left alone somewhere (the midpoints)
+  // non-finite values and sizes outside the bound's range are left to R
+  double m = 0;
+  const double bad[4] = {1.0, NAN, 1.0, 1.0}, inf[4] = {1.0, INFINITY, 1.0, 1.0};
+  const double one[1] = {1.0}, zero[4] = {0.0, 0.0, 0.0, 0.0};
+  CHECK(!gravcal::r_var_mean_avx2(bad, 4, &m));
+  CHECK(!gravcal::r_var_mean_avx2(inf, 4, &m));
+  CHECK(!gravcal::r_var_mean_avx2(one, 1, &m));
+  CHECK(!gravcal::r_var_mean_avx2(zero, 4, &m));
+#endif
+}
+
 // The temperature check's fast sd (runs_sd(), r_sd_below()) decides as R's
 // sd() (r_mean_sd()) does, and leaves to R's arithmetic only what lies
 // within rounding of the threshold: values scaled so that their sd is the
@@ -818,6 +906,7 @@ int main(int argc, char** argv) {
   }
   test_icp();
   test_r_arithmetic();
+  test_r_var_mean();
   test_r_sd_below();
   test_hex16();
   test_avx2_geneactiv();

@@ -24,6 +24,8 @@
 #include <cstring>
 #include <limits>
 
+#include "simd.hpp"
+
 namespace gravcal {
 
 struct RMeanSd {
@@ -238,6 +240,128 @@ inline void add_repeated(long double& s, double x, std::uint64_t k, Binade& b) {
 inline void add_repeated(long double& s, double x, std::uint64_t k) {
   Binade b;
   add_repeated(s, x, k, b);
+}
+
+// The mean R's var() subtracts (two passes in long double, then rounded to
+// double), decided without those passes where a bound allows: the exact
+// mean is had to about 2^-76 relative by compensated sums (Knuth's
+// two-sum, error-free, in four lanes), and R's long double mean can lie
+// only within W of it. When every value in [xbar - W, xbar + W] rounds to
+// the same double, that double is R's.
+//
+// The bound (v = 2^-64, the long double unit roundoff; u = 2^-53; n
+// values, M the largest |x|). R's first pass m1 = fl(fl(sum x) / n) has
+// |m1 - xbar| <= D1 = (n + 1) v M (1.01). Its second pass sums d_i =
+// fl(x_i - m1) = (x_i - m1)(1 + e_i), |e_i| <= v, in order, so t = n (xbar
+// - m1) + E with |E| <= n v (1.01) sum |x_i - m1| (a recursive sum's
+// bound); sum |x_i - m1| <= sum |x_i - xb| + n |xb - m1|, the first summed
+// here in double (within (n + 8) u of it), xb the compensated mean in
+// double. R's mean is fl(m1 + fl(t / n)) = xbar + E / n plus two roundings:
+// within (1 + v)^2 (v (1.01) sum |x_i - m1| + v D1) + v M of xbar. The
+// compensated mean: lanes of Sum2 (Ogita, Rump & Oishi 2005, Prop. 4.5:
+// within gamma_n^2 sum |x| before its final rounding), lanes joined by
+// two-sums and a sum of the small parts (6 additions), then the long double
+// sum and the division by n: within 3 (n u)^2 n M + 20 n u^2 M + 2.1 v M of
+// xbar. W is the sum of both, times 1.25, and the two ends are widened for
+// their own rounding. Requires 2 <= n <= 2^24 and M in [1e-100, 1e100];
+// anything else (or a non-finite value): false, and the caller does R's
+// passes. tests/cpp/test_core.cpp compares it with R's passes.
+#if defined(GRAVCAL_AVX2) && defined(__x86_64__)
+GRAVCAL_TARGET_AVX2 inline bool r_var_mean_avx2(const double* x, std::size_t n, double* mean) {
+  static_assert(std::numeric_limits<long double>::digits == 64, "x87 long double");
+  if (n < 2 || n > (std::size_t(1) << 24)) return false;
+  __m256d s = _mm256_setzero_pd(), c = s;
+  __m256d lo = _mm256_set1_pd(x[0]), hi = lo;
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const __m256d a = _mm256_loadu_pd(x + k);
+    const __m256d t = _mm256_add_pd(s, a);
+    const __m256d z = _mm256_sub_pd(t, s);
+    const __m256d e = _mm256_add_pd(_mm256_sub_pd(s, _mm256_sub_pd(t, z)), _mm256_sub_pd(a, z));
+    c = _mm256_add_pd(c, e);
+    s = t;
+    lo = _mm256_min_pd(lo, a);
+    hi = _mm256_max_pd(hi, a);
+  }
+  double sl[4], cl[4], lol[4], hil[4];
+  _mm256_storeu_pd(sl, s);
+  _mm256_storeu_pd(cl, c);
+  _mm256_storeu_pd(lol, lo);
+  _mm256_storeu_pd(hil, hi);
+  double mn = lol[0], mx = hil[0];
+  for (int l = 1; l < 4; ++l) {
+    mn = lol[l] < mn ? lol[l] : mn;
+    mx = hil[l] > mx ? hil[l] : mx;
+  }
+  for (; k < n; ++k) {
+    const double a = x[k];
+    double& sk = sl[k & 3];
+    const double t = sk + a;
+    const double z = t - sk;
+    cl[k & 3] += (sk - (t - z)) + (a - z);
+    sk = t;
+    mn = a < mn ? a : mn;
+    mx = a > mx ? a : mx;
+  }
+  double h = sl[0], r = (cl[0] + cl[1]) + (cl[2] + cl[3]);
+  for (int l = 1; l < 4; ++l) {
+    const double t = h + sl[l];
+    const double z = t - h;
+    r += (h - (t - z)) + (sl[l] - z);
+    h = t;
+  }
+  if (!std::isfinite(h) || !std::isfinite(r) || !std::isfinite(mn) || !std::isfinite(mx)) {
+    return false;
+  }
+  const double M = std::fmax(std::fabs(mn), std::fabs(mx));
+  if (!(M <= 1e100) || M < 1e-100) return false;
+  const long double N = static_cast<long double>(n);
+  const long double v = std::ldexp(1.0L, -64), u = std::ldexp(1.0L, -53);
+  const long double LM = M;
+  const long double xbar = (static_cast<long double>(h) + r) / N;
+  const long double Wc = 3.0L * (N * u) * (N * u) * N * LM + 20.0L * N * u * u * LM + 2.1L * v * LM;
+  // sum |x_i - xb| in double, four lanes: each term and the sum of
+  // nonnegative terms within (n + 8) u (relative)
+  const double xb = static_cast<double>(xbar);
+  const __m256d xbv = _mm256_set1_pd(xb);
+  const __m256d absm = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+  __m256d da = _mm256_setzero_pd();
+  k = 0;
+  for (; k + 4 <= n; k += 4) {
+    da = _mm256_add_pd(da, _mm256_and_pd(_mm256_sub_pd(_mm256_loadu_pd(x + k), xbv), absm));
+  }
+  double dl[4];
+  _mm256_storeu_pd(dl, da);
+  for (; k < n; ++k) dl[k & 3] += std::fabs(x[k] - xb);
+  const long double sabs = static_cast<long double>((dl[0] + dl[1]) + (dl[2] + dl[3]));
+  const long double D1 = (N + 1.0L) * v * LM * 1.01L;
+  // sum |x_i - m1| <= sum |x_i - xb| + n |xb - m1|, |xb - m1| <= u M + Wc + D1
+  const long double dev = sabs * (1.0L + (N + 8.0L) * u * 1.01L) + N * (u * LM + Wc + D1);
+  const long double Wr = v * 1.01L * dev + v * D1 + 1.01L * v * LM;
+  long double W = 1.25L * (Wr + Wc);
+  W += 2.1L * v * (std::fabs(xbar) + W);
+  const double a = static_cast<double>(xbar - W), b = static_cast<double>(xbar + W);
+  if (a != b) return false;
+  *mean = a;
+  return true;
+}
+#endif
+
+// R's var() means of three columns of n values (see r_var_mean_avx2()):
+// true with all three decided, false when R's passes must run.
+inline bool r_var_means3(const double* const* v, std::size_t n, double* mean) {
+#if defined(GRAVCAL_AVX2) && defined(__x86_64__)
+  if (use_avx2()) {
+    for (int a = 0; a < 3; ++a) {
+      if (!r_var_mean_avx2(v[a], n, &mean[a])) return false;
+    }
+    return true;
+  }
+#endif
+  (void)v;
+  (void)n;
+  (void)mean;
+  return false;
 }
 
 // R's mean() of n contiguous values (no NaN handling: R's mean without

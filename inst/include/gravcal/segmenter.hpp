@@ -29,7 +29,9 @@
 //   window boundary (R's cumsum() followed by diff()), restarted by
 //   new_block() where GGIR restarts its cumsum (each block it reads); the sd
 //   is R's var(): a two-pass mean with a correction pass, then the sum of
-//   squared deviations, all in long double. The caller lends the buffer that
+//   squared deviations, all in long double (the two-pass mean decided
+//   without its passes where a bound allows: r_var_means3(), r_arith.hpp).
+//   The caller lends the buffer that
 //   holds the open window's samples, so the core still allocates nothing.
 //   GGIR's procedure only compares the sds with its rest threshold and
 //   with the previous window's (its duplicate filter): lazy_r_sd() keeps
@@ -123,8 +125,6 @@ struct LazySd {
     long double lo2[3] = {0, 0, 0}, hi2[3] = {0, 0, 0};
     const double* col[3] = {nullptr, nullptr, nullptr};  // its samples
     std::size_t m = 0;
-    long double w[3] = {0, 0, 0};  // their long double sums (R's first pass)
-    bool has_w = false;
   };
   double max_sd = 0.0;     // the rest rule's threshold
   double* buf = nullptr;   // the held window's samples (ceil(L) + 1 per axis)
@@ -317,7 +317,7 @@ class Segmenter {
       }
       const double* cols[3] = {x, y, z};
       // lazy_r_sd(): an sd in double where R's cannot matter
-      fast = lz_ != nullptr && fast_sd(cols, m, r.w, r.lo, r.hi, lz_->cand);
+      fast = lz_ != nullptr && fast_sd(cols, m, r.lo, r.hi, r.ls, lz_->cand);
       // the sds (R's var()), with the temperature's running sum riding
       // along their second pass (a single chain of additions is cheaper
       // there); for a window left with the sd in double, the temperature's
@@ -325,7 +325,7 @@ class Segmenter {
       // non-finite temperature still sends the window to the
       // sample-by-sample path
       if (!fast && m > 1) {
-        r_sd3(cols, m, r.w, t, &r.c[4], wsd_);
+        r_sd3(cols, m, t, &r.c[4], wsd_);
       } else if (t != nullptr) {
         Binade b;
         add_in_order(r.c[4], t, m, b);
@@ -370,12 +370,8 @@ class Segmenter {
     h.fast = fast;
     close(h.s, cols);
     if (fast) {
-      for (int k = 0; k < 3; ++k) {
-        h.col[k] = cols[k];
-        h.w[k] = r.w[k];
-      }
+      for (int k = 0; k < 3; ++k) h.col[k] = cols[k];
       h.m = m;
-      h.has_w = true;
     }
     deliver(h, sink);
     return true;
@@ -389,8 +385,8 @@ class Segmenter {
     bool zero = false;
   };
   struct RScan {
-    long double c[5], w[3];
-    double lo[3], hi[3];
+    long double c[5];
+    double lo[3], hi[3], ls[3][4];
     bool zero;
   };
 
@@ -577,17 +573,23 @@ class Segmenter {
     return k;
   }
 
-  // min_max()'s loop, four samples at a time.
+  // min_max()'s loop, four samples at a time, with lane_sums()'s sums (the
+  // same lanes in the same order).
   GRAVCAL_TARGET_AVX2 static std::size_t min_max_avx2(const double* x, const double* y,
                                                       const double* z, std::size_t m,
-                                                      double* lo, double* hi, bool& zero) {
+                                                      double* lo, double* hi, bool& zero,
+                                                      double (*ls)[4]) {
     const __m256d zr = _mm256_setzero_pd();
     __m256d lo0 = _mm256_set1_pd(lo[0]), lo1 = _mm256_set1_pd(lo[1]), lo2 = _mm256_set1_pd(lo[2]);
     __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
+    __m256d s0 = _mm256_loadu_pd(ls[0]), s1 = _mm256_loadu_pd(ls[1]), s2 = _mm256_loadu_pd(ls[2]);
     std::size_t k = 0;
     for (; k + 4 <= m; k += 4) {
       const __m256d a = _mm256_loadu_pd(x + k), b = _mm256_loadu_pd(y + k),
                     c = _mm256_loadu_pd(z + k);
+      s0 = _mm256_add_pd(s0, a);
+      s1 = _mm256_add_pd(s1, b);
+      s2 = _mm256_add_pd(s2, c);
       lo0 = _mm256_min_pd(a, lo0);
       lo1 = _mm256_min_pd(b, lo1);
       lo2 = _mm256_min_pd(c, lo2);
@@ -608,6 +610,9 @@ class Segmenter {
       for (int l = 0; l < 4; ++l) hi[a] = e[l] > hi[a] ? e[l] : hi[a];
     }
     zero = _mm256_movemask_pd(zacc) != 0;
+    _mm256_storeu_pd(ls[0], s0);
+    _mm256_storeu_pd(ls[1], s1);
+    _mm256_storeu_pd(ls[2], s2);
     return k;
   }
 
@@ -653,22 +658,17 @@ class Segmenter {
   }
 
   // R's cumsum(), one column at a time, continuing o.c, and the norm as
-  // add() forms it; the window's own long double sums (the first pass of
-  // R's sd) ride along. Scalar accumulators, so that they stay in x87
-  // registers (seven of the eight); min, max and the zero test two samples
-  // at a time in a second loop (the temperature's sum: r_sd3()).
+  // add() forms it. Scalar accumulators, so that they stay in x87
+  // registers; min, max and the zero test in a second loop (the
+  // temperature's sum: r_sd3() or add_in_order()).
   GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
                                       const double* z, std::size_t m, RScan& o) {
     long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
-    long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
     for (std::size_t k = 0; k < m; ++k) {
       const double xi = x[k], yi = y[k], zi = z[k];
       c0 += xi;
       c1 += yi;
       c2 += zi;
-      w0 += xi;
-      w1 += yi;
-      w2 += zi;
       const double sq = xi * xi + yi * yi;
       c3 += std::sqrt(sq + zi * zi);
     }
@@ -676,25 +676,29 @@ class Segmenter {
     o.c[1] = c1;
     o.c[2] = c2;
     o.c[3] = c3;
-    o.w[0] = w0;
-    o.w[1] = w1;
-    o.w[2] = w2;
     min_max(x, y, z, m, o);
   }
 
   // min, max and whether some sample is all zeros. min and max are those of
   // the sequential rule (v < lo ? v : lo from the first sample, as add()):
   // the same value in any order, except that a zero minimum (maximum) is
-  // the first zero met, with its sign, which a second look finds.
+  // the first zero met, with its sign, which a second look finds. Also the
+  // columns' sums by lanes for fast_sd() (lane_sums()).
   static void min_max(const double* x, const double* y, const double* z,
                       std::size_t m, RScan& o) {
     const double* col[3] = {x, y, z};
     double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
     bool zero = false;
     std::size_t k = 0;
+    for (int a = 0; a < 3; ++a) {
+      for (int l = 0; l < 4; ++l) o.ls[a][l] = 0.0;
+    }
 #if defined(GRAVCAL_AVX2)
     if (use_avx2()) {
-      k = min_max_avx2(x, y, z, m, lo, hi, zero);
+      k = min_max_avx2(x, y, z, m, lo, hi, zero, o.ls);
+      for (std::size_t j = k; j < m; ++j) {
+        for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
+      }
     } else
 #endif
 #if defined(GRAVCAL_SSE2)
@@ -740,15 +744,49 @@ class Segmenter {
       o.hi[a] = hi[a];
     }
     o.zero = zero;
+#if defined(GRAVCAL_AVX2)
+    if (!use_avx2())
+#endif
+      lane_sums(col, m, o.ls);
+  }
+
+  // The sums of three columns in four lanes by position k & 3 (added to
+  // s); the AVX2 loop adds the same lanes in the same order.
+#if defined(GRAVCAL_AVX2)
+  GRAVCAL_TARGET_AVX2 static std::size_t lane_sums_avx2(const double* const* v, std::size_t n,
+                                                        double (*s)[4]) {
+    __m256d s0 = _mm256_loadu_pd(s[0]), s1 = _mm256_loadu_pd(s[1]), s2 = _mm256_loadu_pd(s[2]);
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+      s0 = _mm256_add_pd(s0, _mm256_loadu_pd(v[0] + k));
+      s1 = _mm256_add_pd(s1, _mm256_loadu_pd(v[1] + k));
+      s2 = _mm256_add_pd(s2, _mm256_loadu_pd(v[2] + k));
+    }
+    _mm256_storeu_pd(s[0], s0);
+    _mm256_storeu_pd(s[1], s1);
+    _mm256_storeu_pd(s[2], s2);
+    return k;
+  }
+#endif
+  static void lane_sums(const double* const* v, std::size_t n, double (*s)[4]) {
+    std::size_t k = 0;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) k = lane_sums_avx2(v, n, s);
+#endif
+    for (; k < n; ++k) {
+      for (int a = 0; a < 3; ++a) s[a][k & 3] += v[a][k];
+    }
   }
 
   // The sds of n (>= 2) samples in double, for lazy_r_sd(): about the mean
-  // w / n rounded to double (w: the long double sums of R's first pass),
-  // the squared deviations summed in four lanes by position (two SSE2
-  // registers per axis; the portable loop adds the same lanes), so the same
-  // samples give the same bits on either path. Error bounds as
+  // in double (ls: the values summed in four lanes by position,
+  // lane_sums(); lanes() of them, over n), the squared deviations summed in four lanes by position
+  // (two SSE2 registers per axis; the portable loop adds the same lanes),
+  // so the same samples give the same bits on every path. Error bounds as
   // r_sd_below()'s (r_arith.hpp), with u = 2^-53 and M = max |x|: this
-  // sd^2 is (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (u + (n + 2) 2^-64) M,
+  // sd^2 is (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (n / 4 + 4) u M (each
+  // lane a recursive sum of at most n / 4 + 1 values, two levels joining
+  // the lanes, one division),
   // |f| <= (n + 4) u (times 1.01); R's is (s2 + n / (n - 1) dR^2) (1 + e),
   // |dR| <= (2 u + (4 n + 8) 2^-64) M, |e| <= (n + 3) 2^-64 + 3 u. With eps
   // = 4 (n + 16) u and dm = 4 (n + 8) u M + 1e-300 (covering either side),
@@ -757,8 +795,8 @@ class Segmenter {
   // stand) only when some axis is surely above max_sd (the window is not at
   // rest, whatever else) and the bounds apply (n u small, M within [1e-100,
   // 1e100] or 0); deliver() then checks the neighbour.
-  bool fast_sd(const double* const* v, std::size_t n, const long double* w,
-               const double* lo, const double* hi, LazySd::Window& h) const {
+  bool fast_sd(const double* const* v, std::size_t n, const double* lo, const double* hi,
+               const double (*ls)[4], LazySd::Window& h) const {
     if (n < 2 || n > (std::size_t(1) << 30)) return false;
     double M[3];
     for (int a = 0; a < 3; ++a) {
@@ -766,8 +804,8 @@ class Segmenter {
       if (!(M[a] <= 1e100) || (M[a] != 0.0 && M[a] < 1e-100)) return false;
     }
     const long double ln = static_cast<long double>(n);
-    const double mu[3] = {static_cast<double>(w[0] / ln), static_cast<double>(w[1] / ln),
-                          static_cast<double>(w[2] / ln)};
+    const double dn = static_cast<double>(n);
+    const double mu[3] = {lanes(ls[0]) / dn, lanes(ls[1]) / dn, lanes(ls[2]) / dn};
     double q[3][4] = {};
     std::size_t k = 0;
 #if defined(GRAVCAL_AVX2)
@@ -830,7 +868,7 @@ class Segmenter {
   // R's sds for a window kept in double.
   static void make_exact(LazySd::Window& h) {
     if (!h.fast) return;
-    r_sd3(h.col, h.m, h.has_w ? h.w : nullptr, nullptr, nullptr, h.s.sd);
+    r_sd3(h.col, h.m, nullptr, nullptr, h.s.sd);
     h.fast = false;
     point_bounds(h);
   }
@@ -1029,25 +1067,20 @@ class Segmenter {
         LazySd::Window& h = lz_->cand;
         // the same choice as whole_window() makes, on the same values
         const std::size_t nv = static_cast<std::size_t>(n_valid_);
-        // R's first pass, as whole_window()'s
-        long double w[3] = {0.0L, 0.0L, 0.0L};
-        for (std::size_t k = 0; k < nv; ++k) {
-          for (int a = 0; a < 3; ++a) w[a] += v[a][k];
-        }
-        h.fast = fast_sd(v, nv, w, min_, max_, h);
-        for (int a = 0; a < 3; ++a) h.w[a] = w[a];
+        double ls[3][4] = {};
+        lane_sums(v, nv, ls);
+        h.fast = fast_sd(v, nv, min_, max_, ls, h);
         if (h.fast) {
           for (int a = 0; a < 3; ++a) {
             s.sd[a] = h.sd[a];
             h.col[a] = v[a];
           }
           h.m = nv;
-          h.has_w = true;
         } else {
-          r_sd3(v, nv, w, nullptr, nullptr, s.sd);
+          r_sd3(v, nv, nullptr, nullptr, s.sd);
         }
       } else {
-        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, nullptr, s.sd);
+        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, s.sd);
       }
     } else {
       if (lz_ != nullptr) lz_->cand.fast = false;
@@ -1058,35 +1091,35 @@ class Segmenter {
   // R's sd() of three columns of n (>= 2) values: the mean with R's
   // correction pass, then the sum of squared deviations, in long double. The
   // three columns go through each pass together (independent sums, so the
-  // result is that of three separate calls). sum1: the first pass's sums
-  // when the caller has them already, or null. t, tsum: when not null, the
-  // n temperatures are added to *tsum in order during the second pass (an
-  // independent chain, nearly free there).
+  // result is that of three separate calls). The means come without R's
+  // two passes where r_var_means3() can decide them (the same doubles).
+  // t, tsum: when not null, the n temperatures are added to *tsum in order
+  // (in the second pass, an independent chain nearly free there, or by runs
+  // with add_in_order()).
   GRAVCAL_NOINLINE static void r_sd3(const double* const* v, std::size_t n,
-                                     const long double* sum1, const double* t,
-                                     long double* tsum, double* out) {
+                                     const double* t, long double* tsum, double* out) {
     const long double ln = static_cast<long double>(n);
     const double* a = v[0];
     const double* b = v[1];
     const double* c = v[2];
-    long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
-    if (sum1 != nullptr) {
-      sa = sum1[0];
-      sb = sum1[1];
-      sc = sum1[2];
+    double mean[3];
+    if (r_var_means3(v, n, mean)) {
+      if (t != nullptr && tsum != nullptr) {
+        Binade bt;
+        add_in_order(*tsum, t, n, bt);
+      }
     } else {
+      long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
       for (std::size_t k = 0; k < n; ++k) {
         sa += a[k];
         sb += b[k];
         sc += c[k];
       }
-    }
-    long double m[3] = {sa / ln, sb / ln, sc / ln};
-    const bool fin[3] = {std::isfinite(static_cast<double>(m[0])),
-                         std::isfinite(static_cast<double>(m[1])),
-                         std::isfinite(static_cast<double>(m[2]))};
-    sa = sb = sc = 0.0L;
-    {
+      long double m[3] = {sa / ln, sb / ln, sc / ln};
+      const bool fin[3] = {std::isfinite(static_cast<double>(m[0])),
+                           std::isfinite(static_cast<double>(m[1])),
+                           std::isfinite(static_cast<double>(m[2]))};
+      sa = sb = sc = 0.0L;
       const long double m0 = m[0], m1 = m[1], m2 = m[2];
       if (t != nullptr && tsum != nullptr) {
         long double st = *tsum;
@@ -1104,14 +1137,13 @@ class Segmenter {
           sc += (c[k] - m2);
         }
       }
+      if (fin[0]) m[0] = m[0] + sa / ln;
+      if (fin[1]) m[1] = m[1] + sb / ln;
+      if (fin[2]) m[2] = m[2] + sc / ln;
+      for (int k = 0; k < 3; ++k) mean[k] = static_cast<double>(m[k]);
     }
-    if (fin[0]) m[0] = m[0] + sa / ln;
-    if (fin[1]) m[1] = m[1] + sb / ln;
-    if (fin[2]) m[2] = m[2] + sc / ln;
-    const long double ma = static_cast<double>(m[0]);
-    const long double mb = static_cast<double>(m[1]);
-    const long double mc = static_cast<double>(m[2]);
-    sa = sb = sc = 0.0L;
+    const long double ma = mean[0], mb = mean[1], mc = mean[2];
+    long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
     for (std::size_t k = 0; k < n; ++k) {
       const long double da = a[k] - ma, db = b[k] - mb, dc = c[k] - mc;
       sa += da * da;
