@@ -268,7 +268,7 @@ static void test_r_arithmetic() {
   }
 }
 
-// r_var_mean_avx2() (r_arith.hpp) decides R's var() mean without R's two
+// r_var_mean_avx2() (r_var_means3_avx2(), r_arith.hpp) decides R's var() mean without R's two
 // long double passes only when its bound allows, and is then R's double
 // (r_mean(), the plain two-pass loop): on ordinary windows, on windows whose
 // exact mean is a midpoint between two doubles or next to one (half the

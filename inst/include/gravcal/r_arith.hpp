@@ -267,72 +267,15 @@ inline void add_repeated(long double& s, double x, std::uint64_t k) {
 // anything else (or a non-finite value): false, and the caller does R's
 // passes. tests/cpp/test_core.cpp compares it with R's passes.
 #if defined(GRAVCAL_AVX2) && defined(__x86_64__)
-GRAVCAL_TARGET_AVX2 inline bool r_var_mean_avx2(const double* x, std::size_t n, double* mean) {
-  static_assert(std::numeric_limits<long double>::digits == 64, "x87 long double");
-  if (n < 2 || n > (std::size_t(1) << 24)) return false;
-  __m256d s = _mm256_setzero_pd(), c = s;
-  __m256d lo = _mm256_set1_pd(x[0]), hi = lo;
-  std::size_t k = 0;
-  for (; k + 4 <= n; k += 4) {
-    const __m256d a = _mm256_loadu_pd(x + k);
-    const __m256d t = _mm256_add_pd(s, a);
-    const __m256d z = _mm256_sub_pd(t, s);
-    const __m256d e = _mm256_add_pd(_mm256_sub_pd(s, _mm256_sub_pd(t, z)), _mm256_sub_pd(a, z));
-    c = _mm256_add_pd(c, e);
-    s = t;
-    lo = _mm256_min_pd(lo, a);
-    hi = _mm256_max_pd(hi, a);
-  }
-  double sl[4], cl[4], lol[4], hil[4];
-  _mm256_storeu_pd(sl, s);
-  _mm256_storeu_pd(cl, c);
-  _mm256_storeu_pd(lol, lo);
-  _mm256_storeu_pd(hil, hi);
-  double mn = lol[0], mx = hil[0];
-  for (int l = 1; l < 4; ++l) {
-    mn = lol[l] < mn ? lol[l] : mn;
-    mx = hil[l] > mx ? hil[l] : mx;
-  }
-  for (; k < n; ++k) {
-    const double a = x[k];
-    double& sk = sl[k & 3];
-    const double t = sk + a;
-    const double z = t - sk;
-    cl[k & 3] += (sk - (t - z)) + (a - z);
-    sk = t;
-    mn = a < mn ? a : mn;
-    mx = a > mx ? a : mx;
-  }
-  double h = sl[0], r = (cl[0] + cl[1]) + (cl[2] + cl[3]);
-  for (int l = 1; l < 4; ++l) {
-    const double t = h + sl[l];
-    const double z = t - h;
-    r += (h - (t - z)) + (sl[l] - z);
-    h = t;
-  }
-  if (!std::isfinite(h) || !std::isfinite(r) || !std::isfinite(mn) || !std::isfinite(mx)) {
-    return false;
-  }
-  const double M = std::fmax(std::fabs(mn), std::fabs(mx));
-  if (!(M <= 1e100) || M < 1e-100) return false;
+namespace r_arith_detail {
+// The decision of r_var_means3_avx2() from the compensated sum (h + r: the
+// lanes joined), M and the sum of |x_i - xb| by lanes, for n values.
+inline bool decide_mean(long double xbar, double M, const double* dl, std::size_t n,
+                        double* mean) {
   const long double N = static_cast<long double>(n);
   const long double v = std::ldexp(1.0L, -64), u = std::ldexp(1.0L, -53);
   const long double LM = M;
-  const long double xbar = (static_cast<long double>(h) + r) / N;
   const long double Wc = 3.0L * (N * u) * (N * u) * N * LM + 20.0L * N * u * u * LM + 2.1L * v * LM;
-  // sum |x_i - xb| in double, four lanes: each term and the sum of
-  // nonnegative terms within (n + 8) u (relative)
-  const double xb = static_cast<double>(xbar);
-  const __m256d xbv = _mm256_set1_pd(xb);
-  const __m256d absm = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
-  __m256d da = _mm256_setzero_pd();
-  k = 0;
-  for (; k + 4 <= n; k += 4) {
-    da = _mm256_add_pd(da, _mm256_and_pd(_mm256_sub_pd(_mm256_loadu_pd(x + k), xbv), absm));
-  }
-  double dl[4];
-  _mm256_storeu_pd(dl, da);
-  for (; k < n; ++k) dl[k & 3] += std::fabs(x[k] - xb);
   const long double sabs = static_cast<long double>((dl[0] + dl[1]) + (dl[2] + dl[3]));
   const long double D1 = (N + 1.0L) * v * LM * 1.01L;
   // sum |x_i - m1| <= sum |x_i - xb| + n |xb - m1|, |xb - m1| <= u M + Wc + D1
@@ -345,18 +288,123 @@ GRAVCAL_TARGET_AVX2 inline bool r_var_mean_avx2(const double* x, std::size_t n, 
   *mean = a;
   return true;
 }
+
+// Sum2's lanes joined: h + r, the small parts summed (6 additions).
+inline long double join_lanes(const double* sl, const double* cl) {
+  double h = sl[0], r = (cl[0] + cl[1]) + (cl[2] + cl[3]);
+  for (int l = 1; l < 4; ++l) {
+    const double t = h + sl[l];
+    const double z = t - h;
+    r += (h - (t - z)) + (sl[l] - z);
+    h = t;
+  }
+  if (!std::isfinite(h) || !std::isfinite(r)) return std::numeric_limits<long double>::quiet_NaN();
+  return static_cast<long double>(h) + r;
+}
+}  // namespace r_arith_detail
+
+// The three columns at once (independent chains, so that the additions'
+// latencies overlap): true with all three means decided.
+GRAVCAL_TARGET_AVX2 inline bool r_var_means3_avx2(const double* const* v, std::size_t n,
+                                                  double* mean) {
+  static_assert(std::numeric_limits<long double>::digits == 64, "x87 long double");
+  if (n < 2 || n > (std::size_t(1) << 24)) return false;
+  // named registers (arrays of them indexed in a loop end up on the stack)
+  __m256d s0 = _mm256_setzero_pd(), s1 = s0, s2 = s0, c0 = s0, c1 = s0, c2 = s0;
+  __m256d lo0 = _mm256_set1_pd(v[0][0]), lo1 = _mm256_set1_pd(v[1][0]),
+          lo2 = _mm256_set1_pd(v[2][0]);
+  __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2;
+#define GRAVCAL_TWO_SUM_STEP(A, S, C, LO, HI)                                            \
+  {                                                                                      \
+    const __m256d x = _mm256_loadu_pd(v[A] + k);                                         \
+    const __m256d t = _mm256_add_pd(S, x);                                               \
+    const __m256d z = _mm256_sub_pd(t, S);                                               \
+    C = _mm256_add_pd(C, _mm256_add_pd(_mm256_sub_pd(S, _mm256_sub_pd(t, z)),            \
+                                       _mm256_sub_pd(x, z)));                            \
+    S = t;                                                                               \
+    LO = _mm256_min_pd(LO, x);                                                           \
+    HI = _mm256_max_pd(HI, x);                                                           \
+  }
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    GRAVCAL_TWO_SUM_STEP(0, s0, c0, lo0, hi0)
+    GRAVCAL_TWO_SUM_STEP(1, s1, c1, lo1, hi1)
+    GRAVCAL_TWO_SUM_STEP(2, s2, c2, lo2, hi2)
+  }
+#undef GRAVCAL_TWO_SUM_STEP
+  const __m256d s[3] = {s0, s1, s2}, c[3] = {c0, c1, c2}, lo[3] = {lo0, lo1, lo2},
+                hi[3] = {hi0, hi1, hi2};
+  const std::size_t kv = k;
+  long double xbar[3];
+  double M[3], xb[3];
+  for (int a = 0; a < 3; ++a) {
+    double sl[4], cl[4], lol[4], hil[4];
+    _mm256_storeu_pd(sl, s[a]);
+    _mm256_storeu_pd(cl, c[a]);
+    _mm256_storeu_pd(lol, lo[a]);
+    _mm256_storeu_pd(hil, hi[a]);
+    double mn = lol[0], mx = hil[0];
+    for (int l = 1; l < 4; ++l) {
+      mn = lol[l] < mn ? lol[l] : mn;
+      mx = hil[l] > mx ? hil[l] : mx;
+    }
+    for (std::size_t j = kv; j < n; ++j) {
+      const double x = v[a][j];
+      double& sk = sl[j & 3];
+      const double t = sk + x;
+      const double z = t - sk;
+      cl[j & 3] += (sk - (t - z)) + (x - z);
+      sk = t;
+      mn = x < mn ? x : mn;
+      mx = x > mx ? x : mx;
+    }
+    const long double S = r_arith_detail::join_lanes(sl, cl);
+    if (!std::isfinite(S) || !std::isfinite(mn) || !std::isfinite(mx)) return false;
+    M[a] = std::fmax(std::fabs(mn), std::fabs(mx));
+    if (!(M[a] <= 1e100) || M[a] < 1e-100) return false;
+    xbar[a] = S / static_cast<long double>(n);
+    xb[a] = static_cast<double>(xbar[a]);
+  }
+  // sum |x_i - xb| in double, four lanes: each term and the sum of
+  // nonnegative terms within (n + 8) u (relative)
+  const __m256d absm = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+  const __m256d b0 = _mm256_set1_pd(xb[0]), b1 = _mm256_set1_pd(xb[1]), b2 = _mm256_set1_pd(xb[2]);
+  __m256d d0 = _mm256_setzero_pd(), d1 = d0, d2 = d0;
+  for (k = 0; k + 4 <= n; k += 4) {
+    d0 = _mm256_add_pd(d0, _mm256_and_pd(_mm256_sub_pd(_mm256_loadu_pd(v[0] + k), b0), absm));
+    d1 = _mm256_add_pd(d1, _mm256_and_pd(_mm256_sub_pd(_mm256_loadu_pd(v[1] + k), b1), absm));
+    d2 = _mm256_add_pd(d2, _mm256_and_pd(_mm256_sub_pd(_mm256_loadu_pd(v[2] + k), b2), absm));
+  }
+  double dl[3][4];
+  _mm256_storeu_pd(dl[0], d0);
+  _mm256_storeu_pd(dl[1], d1);
+  _mm256_storeu_pd(dl[2], d2);
+  for (int a = 0; a < 3; ++a) {
+    for (std::size_t j = k; j < n; ++j) dl[a][j & 3] += std::fabs(v[a][j] - xb[a]);
+  }
+  double out[3];
+  for (int a = 0; a < 3; ++a) {
+    if (!r_arith_detail::decide_mean(xbar[a], M[a], dl[a], n, &out[a])) return false;
+  }
+  for (int a = 0; a < 3; ++a) mean[a] = out[a];
+  return true;
+}
+
+// One column (the tests' entry): r_var_means3_avx2() with it three times.
+inline bool r_var_mean_avx2(const double* x, std::size_t n, double* mean) {
+  const double* v[3] = {x, x, x};
+  double m[3];
+  if (!r_var_means3_avx2(v, n, m)) return false;
+  *mean = m[0];
+  return true;
+}
 #endif
 
-// R's var() means of three columns of n values (see r_var_mean_avx2()):
+// R's var() means of three columns of n values (see r_var_means3_avx2()):
 // true with all three decided, false when R's passes must run.
 inline bool r_var_means3(const double* const* v, std::size_t n, double* mean) {
 #if defined(GRAVCAL_AVX2) && defined(__x86_64__)
-  if (use_avx2()) {
-    for (int a = 0; a < 3; ++a) {
-      if (!r_var_mean_avx2(v[a], n, &mean[a])) return false;
-    }
-    return true;
-  }
+  if (use_avx2()) return r_var_means3_avx2(v, n, mean);
 #endif
   (void)v;
   (void)n;
