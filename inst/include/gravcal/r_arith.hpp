@@ -400,6 +400,16 @@ inline bool r_var_mean_avx2(const double* x, std::size_t n, double* mean) {
 }
 #endif
 
+// Whether r_var_means3() can decide means here (AVX2 on x86-64); where it
+// cannot, callers keep R's first pass with other long double sums.
+inline bool r_var_means_available() {
+#if defined(GRAVCAL_AVX2) && defined(__x86_64__)
+  return use_avx2();
+#else
+  return false;
+#endif
+}
+
 // R's var() means of three columns of n values (see r_var_means3_avx2()):
 // true with all three decided, false when R's passes must run.
 inline bool r_var_means3(const double* const* v, std::size_t n, double* mean) {

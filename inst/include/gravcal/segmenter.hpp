@@ -125,6 +125,8 @@ struct LazySd {
     long double lo2[3] = {0, 0, 0}, hi2[3] = {0, 0, 0};
     const double* col[3] = {nullptr, nullptr, nullptr};  // its samples
     std::size_t m = 0;
+    long double w[3] = {0, 0, 0};  // their long double sums (R's first pass)
+    bool has_w = false;
   };
   double max_sd = 0.0;     // the rest rule's threshold
   double* buf = nullptr;   // the held window's samples (ceil(L) + 1 per axis)
@@ -325,7 +327,7 @@ class Segmenter {
       // non-finite temperature still sends the window to the
       // sample-by-sample path
       if (!fast && m > 1) {
-        r_sd3(cols, m, t, &r.c[4], wsd_);
+        r_sd3(cols, m, r.has_w ? r.w : nullptr, t, &r.c[4], wsd_);
       } else if (t != nullptr) {
         Binade b;
         add_in_order(r.c[4], t, m, b);
@@ -370,8 +372,12 @@ class Segmenter {
     h.fast = fast;
     close(h.s, cols);
     if (fast) {
-      for (int k = 0; k < 3; ++k) h.col[k] = cols[k];
+      for (int k = 0; k < 3; ++k) {
+        h.col[k] = cols[k];
+        h.w[k] = r.w[k];
+      }
       h.m = m;
+      h.has_w = r.has_w;
     }
     deliver(h, sink);
     return true;
@@ -385,8 +391,9 @@ class Segmenter {
     bool zero = false;
   };
   struct RScan {
-    long double c[5];
+    long double c[5], w[3];
     double lo[3], hi[3], ls[3][4];
+    bool has_w;  // w holds the window's sums (scan_r() without r_var_means3())
     bool zero;
   };
 
@@ -660,17 +667,38 @@ class Segmenter {
   // R's cumsum(), one column at a time, continuing o.c, and the norm as
   // add() forms it. Scalar accumulators, so that they stay in x87
   // registers; min, max and the zero test in a second loop (the
-  // temperature's sum: r_sd3() or add_in_order()).
+  // temperature's sum: r_sd3() or add_in_order()). Where r_var_means3()
+  // cannot decide R's means, the window's own long double sums (the first
+  // pass of R's sd) ride along, nearly free in this loop.
   GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
                                       const double* z, std::size_t m, RScan& o) {
     long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
-    for (std::size_t k = 0; k < m; ++k) {
-      const double xi = x[k], yi = y[k], zi = z[k];
-      c0 += xi;
-      c1 += yi;
-      c2 += zi;
-      const double sq = xi * xi + yi * yi;
-      c3 += std::sqrt(sq + zi * zi);
+    o.has_w = !r_var_means_available();
+    if (o.has_w) {
+      long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
+      for (std::size_t k = 0; k < m; ++k) {
+        const double xi = x[k], yi = y[k], zi = z[k];
+        c0 += xi;
+        c1 += yi;
+        c2 += zi;
+        w0 += xi;
+        w1 += yi;
+        w2 += zi;
+        const double sq = xi * xi + yi * yi;
+        c3 += std::sqrt(sq + zi * zi);
+      }
+      o.w[0] = w0;
+      o.w[1] = w1;
+      o.w[2] = w2;
+    } else {
+      for (std::size_t k = 0; k < m; ++k) {
+        const double xi = x[k], yi = y[k], zi = z[k];
+        c0 += xi;
+        c1 += yi;
+        c2 += zi;
+        const double sq = xi * xi + yi * yi;
+        c3 += std::sqrt(sq + zi * zi);
+      }
     }
     o.c[0] = c0;
     o.c[1] = c1;
@@ -706,9 +734,22 @@ class Segmenter {
       const __m128d zr = _mm_setzero_pd();
       __m128d lo0 = _mm_set1_pd(lo[0]), lo1 = _mm_set1_pd(lo[1]), lo2 = _mm_set1_pd(lo[2]);
       __m128d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
+      // lane_sums()'s sums: lanes 0 and 1 in one register, 2 and 3 in another
+      __m128d s0a = zr, s0b = zr, s1a = zr, s1b = zr, s2a = zr, s2b = zr;
+      bool odd = false;  // whether lanes 2 and 3 come next
       for (; k + 2 <= m; k += 2) {
         const __m128d a = _mm_loadu_pd(x + k), b = _mm_loadu_pd(y + k),
                       c = _mm_loadu_pd(z + k);
+        if (odd) {
+          s0b = _mm_add_pd(s0b, a);
+          s1b = _mm_add_pd(s1b, b);
+          s2b = _mm_add_pd(s2b, c);
+        } else {
+          s0a = _mm_add_pd(s0a, a);
+          s1a = _mm_add_pd(s1a, b);
+          s2a = _mm_add_pd(s2a, c);
+        }
+        odd = !odd;
         lo0 = _mm_min_pd(a, lo0);
         lo1 = _mm_min_pd(b, lo1);
         lo2 = _mm_min_pd(c, lo2);
@@ -728,7 +769,18 @@ class Segmenter {
         hi[a] = e[0] > e[1] ? e[0] : e[1];
       }
       zero = _mm_movemask_pd(zacc) != 0;
+      _mm_storeu_pd(o.ls[0], s0a);
+      _mm_storeu_pd(o.ls[0] + 2, s0b);
+      _mm_storeu_pd(o.ls[1], s1a);
+      _mm_storeu_pd(o.ls[1] + 2, s1b);
+      _mm_storeu_pd(o.ls[2], s2a);
+      _mm_storeu_pd(o.ls[2] + 2, s2b);
+      for (std::size_t j = k; j < m; ++j) {
+        for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
+      }
     }
+#else
+    lane_sums(col, m, o.ls);
 #endif
     for (; k < m; ++k) {
       zero = zero || (x[k] == 0.0 && y[k] == 0.0 && z[k] == 0.0);
@@ -744,10 +796,6 @@ class Segmenter {
       o.hi[a] = hi[a];
     }
     o.zero = zero;
-#if defined(GRAVCAL_AVX2)
-    if (!use_avx2())
-#endif
-      lane_sums(col, m, o.ls);
   }
 
   // The sums of three columns in four lanes by position k & 3 (added to
@@ -773,8 +821,23 @@ class Segmenter {
 #if defined(GRAVCAL_AVX2)
     if (use_avx2()) k = lane_sums_avx2(v, n, s);
 #endif
-    for (; k < n; ++k) {
-      for (int a = 0; a < 3; ++a) s[a][k & 3] += v[a][k];
+    // each lane in a local of its own (sums kept in the array would wait
+    // on their own stores), four samples a step, in the same order
+    for (int a = 0; a < 3; ++a) {
+      const double* x = v[a];
+      double l0 = s[a][0], l1 = s[a][1], l2 = s[a][2], l3 = s[a][3];
+      std::size_t j = k;
+      for (; j + 4 <= n; j += 4) {
+        l0 += x[j];
+        l1 += x[j + 1];
+        l2 += x[j + 2];
+        l3 += x[j + 3];
+      }
+      s[a][0] = l0;
+      s[a][1] = l1;
+      s[a][2] = l2;
+      s[a][3] = l3;
+      for (; j < n; ++j) s[a][j & 3] += x[j];
     }
   }
 
@@ -868,7 +931,7 @@ class Segmenter {
   // R's sds for a window kept in double.
   static void make_exact(LazySd::Window& h) {
     if (!h.fast) return;
-    r_sd3(h.col, h.m, nullptr, nullptr, h.s.sd);
+    r_sd3(h.col, h.m, h.has_w ? h.w : nullptr, nullptr, nullptr, h.s.sd);
     h.fast = false;
     point_bounds(h);
   }
@@ -1076,11 +1139,12 @@ class Segmenter {
             h.col[a] = v[a];
           }
           h.m = nv;
+          h.has_w = false;
         } else {
-          r_sd3(v, nv, nullptr, nullptr, s.sd);
+          r_sd3(v, nv, nullptr, nullptr, nullptr, s.sd);
         }
       } else {
-        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, s.sd);
+        r_sd3(v, static_cast<std::size_t>(n_valid_), nullptr, nullptr, nullptr, s.sd);
       }
     } else {
       if (lz_ != nullptr) lz_->cand.fast = false;
@@ -1093,11 +1157,13 @@ class Segmenter {
   // three columns go through each pass together (independent sums, so the
   // result is that of three separate calls). The means come without R's
   // two passes where r_var_means3() can decide them (the same doubles).
+  // sum1: the first pass's sums when the caller has them already, or null.
   // t, tsum: when not null, the n temperatures are added to *tsum in order
   // (in the second pass, an independent chain nearly free there, or by runs
   // with add_in_order()).
   GRAVCAL_NOINLINE static void r_sd3(const double* const* v, std::size_t n,
-                                     const double* t, long double* tsum, double* out) {
+                                     const long double* sum1, const double* t,
+                                     long double* tsum, double* out) {
     const long double ln = static_cast<long double>(n);
     const double* a = v[0];
     const double* b = v[1];
@@ -1110,10 +1176,16 @@ class Segmenter {
       }
     } else {
       long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
-      for (std::size_t k = 0; k < n; ++k) {
-        sa += a[k];
-        sb += b[k];
-        sc += c[k];
+      if (sum1 != nullptr) {
+        sa = sum1[0];
+        sb = sum1[1];
+        sc = sum1[2];
+      } else {
+        for (std::size_t k = 0; k < n; ++k) {
+          sa += a[k];
+          sb += b[k];
+          sc += c[k];
+        }
       }
       long double m[3] = {sa / ln, sb / ln, sc / ln};
       const bool fin[3] = {std::isfinite(static_cast<double>(m[0])),

@@ -1,0 +1,28 @@
+#!/bin/bash
+# Two builds of gravcal on the same files, their runs interleaved (A, B, A,
+# B, ...), so that a machine whose speed drifts (shared cores, frequency)
+# affects both alike. Each run is bench/files-one.R in a process of its own.
+#
+#   bash bench/ab.sh <lib A> <lib B> <runs> <contender> <file>...
+#
+# <lib A>, <lib B>: R libraries holding the two builds (R CMD INSTALL -l).
+# Prints, per file, the median CPU seconds of each and B's time over A's,
+# and whether the two gave the same coefficients (exact hexadecimal).
+set -euo pipefail
+libA=$1; libB=$2; runs=$3; contender=$4; shift 4
+here=$(cd "$(dirname "$0")" && pwd)
+median() { sort -n | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+printf "| file | A (s) | B (s) | B / A | same coefficients |\n|---|---|---|---|---|\n"
+for f in "$@"; do
+  ta=(); tb=(); ca=""; cb=""
+  for ((i = 0; i < runs; i++)); do
+    la=$(R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
+    lb=$(R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
+    ta+=("$(cut -f 8 <<< "$la")"); tb+=("$(cut -f 8 <<< "$lb")")
+    ca=$(cut -f 6 <<< "$la"); cb=$(cut -f 6 <<< "$lb")
+  done
+  ma=$(printf "%s\n" "${ta[@]}" | median); mb=$(printf "%s\n" "${tb[@]}" | median)
+  same=no; [ "$ca" = "$cb" ] && same=yes
+  printf "| %s | %.3f | %.3f | %.2f | %s |\n" "$(basename "$f")" "$ma" "$mb" \
+    "$(awk -v a="$ma" -v b="$mb" 'BEGIN {print b / a}')" "$same"
+done
