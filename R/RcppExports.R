@@ -45,6 +45,10 @@ gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight,
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }
 
+gc_ggir_duplicates <- function(table, rows, need) {
+    .Call(`_gravcal_gc_ggir_duplicates`, table, rows, need)
+}
+
 gc_blocks_new <- function(seg, per_hour, compat, temperature, temp_min_sd) {
     .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature, temp_min_sd)
 }

@@ -295,14 +295,8 @@ ggir_run <- function(src, compat = TRUE,
       n <- length(idx)
       if (n > 1) {
         # consecutive windows equal in 3 (GGIR) or all 6 of means and sds
-        same <- integer(n - 1)
-        for (j in 2:7) {
-          col <- full[idx, j]
-          same <- same + (col[-n] == col[-1])
-        }
-        cut <- which(same == if (compat) 3 else 6)
+        cut <- gc_ggir_duplicates(full, idx, if (compat) 3L else 6L)
         if (length(cut)) idx <- idx[-cut]
-        same <- col <- NULL
       }
       ft <- NULL
       nhoursused <- 0

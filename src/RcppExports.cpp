@@ -143,6 +143,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_ggir_duplicates
+Rcpp::IntegerVector gc_ggir_duplicates(const Rcpp::NumericMatrix& table, const Rcpp::IntegerVector& rows, int need);
+RcppExport SEXP _gravcal_gc_ggir_duplicates(SEXP tableSEXP, SEXP rowsSEXP, SEXP needSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type table(tableSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type rows(rowsSEXP);
+    Rcpp::traits::input_parameter< int >::type need(needSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_duplicates(table, rows, need));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_blocks_new
 SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature, double temp_min_sd);
 RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP, SEXP temp_min_sdSEXP) {
@@ -305,6 +317,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},
     {"_gravcal_gc_use_avx2", (DL_FUNC) &_gravcal_gc_use_avx2, 0},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
+    {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
     {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
     {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
     {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},

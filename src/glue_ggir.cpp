@@ -8,6 +8,7 @@
 
 #include <R_ext/Applic.h>
 
+#include "gravcal/ggir_blocks.hpp"
 #include "gravcal/icp.hpp"
 #include "windows_glue.h"
 
@@ -92,6 +93,31 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
       Rcpp::Named("finite") = r.finite,
       Rcpp::Named("statistic") = r.statistic,
       Rcpp::Named("trace") = tm);
+}
+
+// GGIR's duplicate filter: the positions i (1-based) in `rows` (1-based row
+// numbers of `table`) where rows i and i + 1 are equal in exactly `need` of
+// the table's columns 2 to 7 (R's which(same == need), NA never counted).
+// [[Rcpp::export(rng = false)]]
+Rcpp::IntegerVector gc_ggir_duplicates(const Rcpp::NumericMatrix& table,
+                                       const Rcpp::IntegerVector& rows, int need) {
+  const std::size_t nr = static_cast<std::size_t>(table.nrow());
+  if (table.ncol() < 7) Rcpp::stop("the window table needs at least 7 columns");
+  const std::size_t n = static_cast<std::size_t>(rows.size());
+  std::vector<std::size_t> r(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int v = rows[static_cast<R_xlen_t>(i)];
+    if (v == NA_INTEGER || v < 1 || static_cast<std::size_t>(v) > nr)
+      Rcpp::stop("row numbers out of range");
+    r[i] = static_cast<std::size_t>(v - 1);
+  }
+  std::vector<int> same(n > 0 ? n - 1 : 0);
+  gravcal::consecutive_equal(table.begin(), nr, r.data(), n, 1, 7, same.data());
+  std::vector<int> cut;
+  for (std::size_t i = 0; i < same.size(); ++i) {
+    if (same[i] == need) cut.push_back(static_cast<int>(i + 1));
+  }
+  return Rcpp::IntegerVector(cut.begin(), cut.end());
 }
 
 // GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp);

@@ -262,6 +262,39 @@ test_that("g.calibrate matches GGIR where its rules compare window sds", {
   expect_same_as_ggir(b)
 })
 
+test_that("the duplicate filter cuts the windows R's comparisons cut", {
+  # GGIR's own expression on its window table (columns 2 to 7: means and
+  # sds): a window goes when it equals the next in exactly 3 of them
+  # (gravcal's own mode: all 6); a comparison with NA or NaN makes the count
+  # NA, which never matches
+  r_cut <- function(full, idx, need) {
+    n <- length(idx)
+    same <- integer(n - 1)
+    for (j in 2:7) {
+      col <- full[idx, j]
+      same <- same + (col[-n] == col[-1])
+    }
+    which(same == need)
+  }
+  set.seed(12)
+  vals <- c(0, -0, 1, 0.5, NA, NaN, 2^-1074, -1)
+  for (rep in 1:40) {
+    nr <- sample(2:300, 1)
+    full <- matrix(sample(vals, nr * 8, replace = TRUE,
+                          prob = c(4, 2, 4, 4, 1, 1, 1, 2)), nr, 8)
+    idx <- sort(sample(nr, sample(2:nr, 1)))
+    for (need in c(3L, 6L, 0L)) {
+      expect_identical(gravcal:::gc_ggir_duplicates(full, idx, need),
+                       r_cut(full, idx, need))
+    }
+  }
+  expect_length(gravcal:::gc_ggir_duplicates(matrix(0, 3, 8), 2L, 3L), 0)
+  expect_error(gravcal:::gc_ggir_duplicates(matrix(0, 3, 8), c(1L, 4L), 3L),
+               "out of range")
+  expect_error(gravcal:::gc_ggir_duplicates(matrix(0, 3, 6), 1:2, 3L),
+               "7 columns")
+})
+
 test_that("g.calibrate matches GGIR when it cannot calibrate", {
   skip_if_not_installed("GGIR")
   f <- tempfile(fileext = ".csv")

@@ -919,40 +919,65 @@ GRAVCAL_TARGET_AVX2 inline std::int64_t CwaDecoder::emit_avx2(
                 lanes = _mm256_setr_pd(0, 1, 2, 3), tv = _mm256_set1_pd(temp);
   const std::int64_t pos0 = pos;
   int s = source;
-  __m256d last[3] = {_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
-  __m256d t = _mm256_setzero_pd();
+  const double* X = xyz[0];
+  const double* Y = xyz[1];
+  const double* Z = xyz[2];
+  __m256d lx = _mm256_setzero_pd(), ly = lx, lz = lx, t = lx;
   for (; pos + 4 <= end_pos; pos += 4) {
     const __m256d pv = _mm256_add_pd(_mm256_set1_pd(static_cast<double>(pos)), lanes);
     __m256d u = _mm256_add_pd(start, _mm256_mul_pd(pv, step));
     u = _mm256_min_pd(u, end);  // u < end ? u : end
     if (_mm256_movemask_pd(_mm256_cmp_pd(u, limit, _CMP_LE_OQ)) != 0xf) break;
-    const double u0 = _mm256_cvtsd_f64(u);
-    int k = s;
-    while (k < len && raw_t_[k] < u0) ++k;
-    if (k + 3 > len) break;
-    // point j in (raw_t_[k + j - 1], raw_t_[k + j]]: the search from point
-    // j - 1's interval moves exactly one on
-    const __m256d T1 = _mm256_loadu_pd(raw_t_ + k), T0 = _mm256_loadu_pd(raw_t_ + k - 1);
-    if (_mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) != 0) break;
-    if ((_mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) & 0xe) != 0xe) break;
-    const __m256d w = _mm256_div_pd(_mm256_sub_pd(u, T0), _mm256_sub_pd(T1, T0));
-    double* o[3] = {ox, oy, oz};
-    for (int c = 0; c < 3; ++c) {
-      const __m256d L = _mm256_loadu_pd(xyz[c] + k - 1), R = _mm256_loadu_pd(xyz[c] + k);
-      last[c] = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
-      _mm256_storeu_pd(o[c] + (pos - pos0), last[c]);
+    // point j in (raw_t_[k + j - 1], raw_t_[k + j]]. Usually the search
+    // from s moves exactly one on (k = s + 1): raw_t_[s] < u0 <=
+    // raw_t_[s + 1], which is lane 0 of the checks below, so the guess is
+    // taken when all eight hold; otherwise the search runs as emit_span()'s
+    int k = s + 1;
+    __m256d T1, T0;
+    bool fits = k + 3 <= len;
+    if (fits) {
+      T1 = _mm256_loadu_pd(raw_t_ + k);
+      T0 = _mm256_loadu_pd(raw_t_ + k - 1);
+      fits = _mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) == 0 &&
+             _mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) == 0xf;
     }
-    if (ot != nullptr) _mm256_storeu_pd(ot + (pos - pos0), tv);
-    if (otime != nullptr) _mm256_storeu_pd(otime + (pos - pos0), u);
+    if (!fits) {
+      const double u0 = _mm256_cvtsd_f64(u);
+      k = s;
+      while (k < len && raw_t_[k] < u0) ++k;
+      if (k + 3 > len) break;
+      // and then each of the next three moves exactly one on
+      T1 = _mm256_loadu_pd(raw_t_ + k);
+      T0 = _mm256_loadu_pd(raw_t_ + k - 1);
+      if (_mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) != 0) break;
+      if ((_mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) & 0xe) != 0xe) break;
+    }
+    const __m256d w = _mm256_div_pd(_mm256_sub_pd(u, T0), _mm256_sub_pd(T1, T0));
+    const std::int64_t o = pos - pos0;
+    __m256d L = _mm256_loadu_pd(X + k - 1), R = _mm256_loadu_pd(X + k);
+    lx = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
+    _mm256_storeu_pd(ox + o, lx);
+    L = _mm256_loadu_pd(Y + k - 1);
+    R = _mm256_loadu_pd(Y + k);
+    ly = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
+    _mm256_storeu_pd(oy + o, ly);
+    L = _mm256_loadu_pd(Z + k - 1);
+    R = _mm256_loadu_pd(Z + k);
+    lz = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
+    _mm256_storeu_pd(oz + o, lz);
+    if (ot != nullptr) _mm256_storeu_pd(ot + o, tv);
+    if (otime != nullptr) _mm256_storeu_pd(otime + o, u);
     s = k + 3;
     t = u;
   }
   if (pos > pos0) {
     double e[4];
-    for (int c = 0; c < 3; ++c) {
-      _mm256_storeu_pd(e, last[c]);
-      a[c] = e[3];
-    }
+    _mm256_storeu_pd(e, lx);
+    a[0] = e[3];
+    _mm256_storeu_pd(e, ly);
+    a[1] = e[3];
+    _mm256_storeu_pd(e, lz);
+    a[2] = e[3];
     _mm256_storeu_pd(e, t);
     at = e[3];
     source = s;

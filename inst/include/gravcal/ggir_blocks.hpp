@@ -260,11 +260,41 @@ class GgirBlocks {
     return x == 0.0 && y == 0.0 && z == 0.0;
   }
 
-  // Where the first idle-sleep sample among n is (n if none): two samples
-  // per instruction with SSE2.
+#if defined(GRAVCAL_AVX2)
+  // first_zero()'s scan, four samples per instruction: where to go on from
+  // (a multiple of 8 before the first idle-sleep sample, or less than 8
+  // from the end).
+  GRAVCAL_TARGET_AVX2 static std::size_t zero_scan_avx2(const double* x, const double* y,
+                                                        const double* z, std::size_t n) {
+    std::size_t i = 0;
+    const __m256d zr = _mm256_setzero_pd();
+    for (; i + 8 <= n; i += 8) {
+      const __m256d a = _mm256_and_pd(
+          _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
+                        _mm256_cmp_pd(_mm256_loadu_pd(y + i), zr, _CMP_EQ_OQ)),
+          _mm256_cmp_pd(_mm256_loadu_pd(z + i), zr, _CMP_EQ_OQ));
+      const __m256d b = _mm256_and_pd(
+          _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ),
+                        _mm256_cmp_pd(_mm256_loadu_pd(y + i + 4), zr, _CMP_EQ_OQ)),
+          _mm256_cmp_pd(_mm256_loadu_pd(z + i + 4), zr, _CMP_EQ_OQ));
+      if (_mm256_movemask_pd(_mm256_or_pd(a, b)) != 0) break;
+    }
+    return i;
+  }
+#endif
+
+  // Where the first idle-sleep sample among n is (n if none): four samples
+  // per instruction with AVX2, two with SSE2.
   static std::size_t first_zero(const double* x, const double* y, const double* z,
                                 std::size_t n) {
     std::size_t i = 0;
+#if defined(GRAVCAL_AVX2)
+    if (use_avx2()) {
+      i = zero_scan_avx2(x, y, z, n);
+      while (i < n && !is_zero(x[i], y[i], z[i])) ++i;
+      return i;
+    }
+#endif
 #if defined(GRAVCAL_SSE2)
     const __m128d zr = _mm_setzero_pd();
     for (; i + 8 <= n; i += 8) {
@@ -299,12 +329,14 @@ class GgirBlocks {
     return m;
   }
 
-  // Room for k samples in each column (doubling, so that the buffer stops
-  // growing after the first hour: it never needs more than H + 1).
+  // Room for k samples in each column, doubling, so that the buffer stops
+  // growing after the first hour: it never needs more than H + 1. The
+  // first step goes to 2^19 samples at once (all of an hour up to 145 Hz):
+  // each step copies the samples and touches fresh memory.
   void grow(std::size_t k) {
     if (cap_ >= k) return;
     const std::size_t most = std::max(k, static_cast<std::size_t>(H_) + 1);
-    cap_ = std::min(std::max(k, 2 * cap_), most);
+    cap_ = std::min(std::max({k, 2 * cap_, std::size_t(1) << 19}), most);
     for (int c = 0; c < columns(); ++c) hold_[c].resize(cap_);
   }
 
@@ -470,6 +502,27 @@ class GgirBlocks {
   std::vector<double> first_;     // the block's first 10 temperatures
   std::vector<Run> runs_;         // the block's temperatures, run-length coded
 };
+
+// GGIR's duplicate filter on its window table (column-major, n_row rows):
+// for each pair of consecutive selected rows rows[i], rows[i + 1] (0-based),
+// i < n - 1, how many of the columns [c0, c1) hold equal values, or -1
+// when a compared value is NaN (R's NA: the count is then NA, never equal
+// to anything). The caller guarantees rows[i] < n_row.
+inline void consecutive_equal(const double* table, std::size_t n_row, const std::size_t* rows,
+                              std::size_t n, std::size_t c0, std::size_t c1, int* out) {
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    int same = 0;
+    for (std::size_t c = c0; c < c1; ++c) {
+      const double a = table[c * n_row + rows[i]], b = table[c * n_row + rows[i + 1]];
+      if (std::isnan(a) || std::isnan(b)) {
+        same = -1;
+        break;
+      }
+      same += a == b;
+    }
+    out[i] = same;
+  }
+}
 
 }  // namespace gravcal
 

@@ -79,12 +79,34 @@ struct WindowStats {
   double temperature;  // mean of finite temperatures, NaN if none
 };
 
-// The end of the run of values with the same bits as v[i], from i on (two
-// at a time with SSE2).
+#if defined(GRAVCAL_AVX2)
+// run_end()'s scan from j, eight values at a time.
+GRAVCAL_TARGET_AVX2 inline std::size_t run_scan_avx2(const double* v, std::size_t j,
+                                                     std::size_t n, std::uint64_t bits) {
+  const __m256i b = _mm256_set1_epi64x(static_cast<long long>(bits));
+  for (; j + 8 <= n; j += 8) {
+    const __m256i a0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(v + j));
+    const __m256i a1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(v + j + 4));
+    const __m256i eq = _mm256_and_si256(_mm256_cmpeq_epi64(a0, b), _mm256_cmpeq_epi64(a1, b));
+    if (_mm256_movemask_epi8(eq) != -1) break;
+  }
+  return j;
+}
+#endif
+
+// The end of the run of values with the same bits as v[i], from i on (eight
+// at a time with AVX2, four with SSE2).
 inline std::size_t run_end(const double* v, std::size_t i, std::size_t n) {
   std::uint64_t bits;
   std::memcpy(&bits, v + i, sizeof bits);
   std::size_t j = i + 1;
+#if defined(GRAVCAL_AVX2)
+  if (use_avx2()) {
+    j = run_scan_avx2(v, j, n, bits);
+    while (j < n && std::memcmp(v + j, &bits, sizeof bits) == 0) ++j;
+    return j;
+  }
+#endif
 #if defined(GRAVCAL_SSE2)
   const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
   for (; j + 4 <= n; j += 4) {
