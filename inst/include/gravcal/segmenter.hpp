@@ -603,19 +603,44 @@ class Segmenter {
   }
 
   // min_max()'s loop, four samples at a time, with lane_sums()'s sums (the
-  // same lanes in the same order).
+  // same lanes in the same order). Sums: also scan_r()'s cumulative sums
+  // (sum: x, y, z and the norm, long double, in sample order), the four
+  // norms of a step by one square root instruction: the cumulative sums are
+  // bound by the latency of their additions, which leaves room for the rest
+  // of the loop, so the pass costs about what the sums alone did.
+  template <bool Sums>
   GRAVCAL_TARGET_AVX2 static std::size_t min_max_avx2(const double* x, const double* y,
                                                       const double* z, std::size_t m,
                                                       double* lo, double* hi, bool& zero,
-                                                      double (*ls)[4]) {
+                                                      double (*ls)[4],
+                                                      long double* sum = nullptr) {
     const __m256d zr = _mm256_setzero_pd();
     __m256d lo0 = _mm256_set1_pd(lo[0]), lo1 = _mm256_set1_pd(lo[1]), lo2 = _mm256_set1_pd(lo[2]);
     __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
     __m256d s0 = _mm256_loadu_pd(ls[0]), s1 = _mm256_loadu_pd(ls[1]), s2 = _mm256_loadu_pd(ls[2]);
+    long double c0 = 0.0L, c1 = 0.0L, c2 = 0.0L, c3 = 0.0L;
+    if (Sums) {
+      c0 = sum[0];
+      c1 = sum[1];
+      c2 = sum[2];
+      c3 = sum[3];
+    }
+    alignas(32) double nrm[4];
     std::size_t k = 0;
     for (; k + 4 <= m; k += 4) {
       const __m256d a = _mm256_loadu_pd(x + k), b = _mm256_loadu_pd(y + k),
                     c = _mm256_loadu_pd(z + k);
+      if (Sums) {
+        // scan_r()'s norm: x^2 + y^2, then + z^2, then the square root
+        const __m256d sq = _mm256_add_pd(_mm256_mul_pd(a, a), _mm256_mul_pd(b, b));
+        _mm256_store_pd(nrm, _mm256_sqrt_pd(_mm256_add_pd(sq, _mm256_mul_pd(c, c))));
+        for (int j = 0; j < 4; ++j) {
+          c0 += x[k + j];
+          c1 += y[k + j];
+          c2 += z[k + j];
+          c3 += nrm[j];
+        }
+      }
       s0 = _mm256_add_pd(s0, a);
       s1 = _mm256_add_pd(s1, b);
       s2 = _mm256_add_pd(s2, c);
@@ -629,6 +654,12 @@ class Segmenter {
           zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a, zr, _CMP_EQ_OQ),
                                             _mm256_cmp_pd(b, zr, _CMP_EQ_OQ)),
                               _mm256_cmp_pd(c, zr, _CMP_EQ_OQ)));
+    }
+    if (Sums) {
+      sum[0] = c0;
+      sum[1] = c1;
+      sum[2] = c2;
+      sum[3] = c3;
     }
     const __m256d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
     for (int a = 0; a < 3; ++a) {
@@ -694,8 +725,14 @@ class Segmenter {
   // pass of R's sd) ride along, nearly free in this loop.
   GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
                                       const double* z, std::size_t m, RScan& o) {
-    long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
     o.has_w = !r_var_means_available();
+#if defined(GRAVCAL_AVX2)
+    if (!o.has_w && use_avx2()) {
+      min_max(x, y, z, m, o, o.c);  // the sums ride in min_max()'s loop
+      return;
+    }
+#endif
+    long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
     if (o.has_w) {
       long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
       for (std::size_t k = 0; k < m; ++k) {
@@ -733,9 +770,10 @@ class Segmenter {
   // the sequential rule (v < lo ? v : lo from the first sample, as add()):
   // the same value in any order, except that a zero minimum (maximum) is
   // the first zero met, with its sign, which a second look finds. Also the
-  // columns' sums by lanes for fast_sd() (lane_sums()).
+  // columns' sums by lanes for fast_sd() (lane_sums()). sum: where AVX2 runs,
+  // scan_r()'s four cumulative sums go on in the same loop (else null).
   static void min_max(const double* x, const double* y, const double* z,
-                      std::size_t m, RScan& o) {
+                      std::size_t m, RScan& o, long double* sum = nullptr) {
     const double* col[3] = {x, y, z};
     double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
     bool zero = false;
@@ -743,9 +781,27 @@ class Segmenter {
     for (int a = 0; a < 3; ++a) {
       for (int l = 0; l < 4; ++l) o.ls[a][l] = 0.0;
     }
+    (void)sum;  // only given where AVX2 runs
 #if defined(GRAVCAL_AVX2)
     if (use_avx2()) {
-      k = min_max_avx2(x, y, z, m, lo, hi, zero, o.ls);
+      if (sum != nullptr) {
+        k = min_max_avx2<true>(x, y, z, m, lo, hi, zero, o.ls, sum);
+        long double c0 = sum[0], c1 = sum[1], c2 = sum[2], c3 = sum[3];
+        for (std::size_t j = k; j < m; ++j) {
+          const double xi = x[j], yi = y[j], zi = z[j];
+          c0 += xi;
+          c1 += yi;
+          c2 += zi;
+          const double sq = xi * xi + yi * yi;
+          c3 += std::sqrt(sq + zi * zi);
+        }
+        sum[0] = c0;
+        sum[1] = c1;
+        sum[2] = c2;
+        sum[3] = c3;
+      } else {
+        k = min_max_avx2<false>(x, y, z, m, lo, hi, zero, o.ls);
+      }
       for (std::size_t j = k; j < m; ++j) {
         for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
       }
