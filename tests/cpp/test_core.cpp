@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/decode_cwa.hpp"
 #include "gravcal/decode_geneactiv.hpp"
 #include "gravcal/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
@@ -897,6 +898,30 @@ static void print_digest() {
   std::printf("digest %016llx\n", static_cast<unsigned long long>(h));
 }
 
+// The .cwa checksum's word sum (SSE2 lanes of 16 bits where built with
+// them) against the word-by-word sum, on random blocks and on blocks made
+// to sum to 0 (a good checksum) or to each single-bit error of one.
+static void test_cwa_word_sum() {
+  std::mt19937_64 g(7);
+  std::vector<unsigned char> b(gravcal::cwa::block_bytes);
+  int bad = 0;
+  for (int rep = 0; rep < 20000; ++rep) {
+    for (auto& c : b) c = static_cast<unsigned char>(rep % 3 == 0 ? 0xff : g());
+    unsigned ref = 0;
+    for (std::size_t i = 0; i < b.size(); i += 2) ref += gravcal::le16(b.data() + i);
+    bad += gravcal::cwa::word_sum(b.data()) != (ref & 0xffffu);
+    // make the block's sum 0 with its last word, then flip one bit
+    const unsigned fix = (0x10000u - ((ref - gravcal::le16(b.data() + 510)) & 0xffffu)) & 0xffffu;
+    b[510] = static_cast<unsigned char>(fix & 0xff);
+    b[511] = static_cast<unsigned char>(fix >> 8);
+    bad += gravcal::cwa::word_sum(b.data()) != 0;
+    const std::size_t bit = g() % (8 * b.size());
+    b[bit / 8] ^= static_cast<unsigned char>(1u << (bit % 8));
+    bad += gravcal::cwa::word_sum(b.data()) == 0;
+  }
+  CHECK(bad == 0);
+}
+
 int main(int argc, char** argv) {
   if (argc > 1 && std::strcmp(argv[1], "--digest") == 0) {
     // --digest baseline: without the AVX2 paths
@@ -909,6 +934,7 @@ int main(int argc, char** argv) {
   test_r_var_mean();
   test_r_sd_below();
   test_hex16();
+  test_cwa_word_sum();
   test_avx2_geneactiv();
   test_add_repeated();
   test_lazy_sd();

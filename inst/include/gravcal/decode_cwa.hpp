@@ -141,14 +141,33 @@ inline double rate_frequency(int rate) {
   return 3200.0 / static_cast<double>(1u << (15 - (rate & 15)));
 }
 
+// The sum of a block's 256 little-endian 16-bit words, modulo 2^16 (eight
+// lanes of 16 bits with SSE2: the sum wraps the same way).
+inline unsigned word_sum(const unsigned char* b) {
+#if defined(GRAVCAL_SSE2) && (defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+  __m128i a = _mm_setzero_si128(), c = a;
+  for (std::size_t i = 0; i < block_bytes; i += 32) {
+    a = _mm_add_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i)));
+    c = _mm_add_epi16(c, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i + 16)));
+  }
+  alignas(16) std::uint16_t w[8];
+  _mm_store_si128(reinterpret_cast<__m128i*>(w), _mm_add_epi16(a, c));
+  unsigned sum = 0;
+  for (int l = 0; l < 8; ++l) sum += w[l];
+  return sum & 0xffffu;
+#else
+  unsigned sum = 0;
+  for (std::size_t i = 0; i < block_bytes; i += 2) sum += le16(b + i);
+  return sum & 0xffffu;
+#endif
+}
+
 // Checks a block and reads its header fields (GGIRread's order: checksum
 // first, unless the rate byte is 0, then the "AX" tag and length).
 inline Status parse_header(const unsigned char* b, Header& h) {
   h.rate = b[24];
   if (h.rate != 0) {
-    unsigned sum = 0;
-    for (std::size_t i = 0; i < block_bytes; i += 2) sum += le16(b + i);
-    if ((sum & 0xffffu) != 0) return Status::bad_checksum;
+    if (word_sum(b) != 0) return Status::bad_checksum;
   }
   if (b[0] != 'A' || b[1] != 'X' || le16(b + 2) != block_bytes - 4) return Status::bad_header;
   const int packing = b[25] & 15;
@@ -220,15 +239,20 @@ GRAVCAL_TARGET_AVX2 inline int scale_packed_avx2(const unsigned char* d, double 
   for (; i + 8 <= n; i += 8) {
     const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d + 4 * i));
     const __m256i e = _mm256_srli_epi32(w, 30);
-    double* col[3] = {x + i, y + i, z + i};
-    for (int a = 0; a < 3; ++a) {
-      const __m256i u = a == 0 ? w : _mm256_srli_epi32(w, 10 * a);
-      const __m256i v = _mm256_sllv_epi32(
-          _mm256_sub_epi32(_mm256_xor_si256(_mm256_and_si256(u, m10), sign), sign), e);
-      _mm256_storeu_pd(col[a], _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(v)), ps));
-      _mm256_storeu_pd(col[a] + 4,
-                       _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(v, 1)), ps));
-    }
+    // the three axes written out (an array of the column pointers ends up
+    // on the stack)
+#define GRAVCAL_CWA_AXIS(U, OUT)                                                            \
+  {                                                                                       \
+    const __m256i v = _mm256_sllv_epi32(                                                  \
+        _mm256_sub_epi32(_mm256_xor_si256(_mm256_and_si256(U, m10), sign), sign), e);     \
+    _mm256_storeu_pd(OUT, _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(v)), ps)); \
+    _mm256_storeu_pd(OUT + 4,                                                             \
+                     _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(v, 1)), ps)); \
+  }
+    GRAVCAL_CWA_AXIS(w, x + i)
+    GRAVCAL_CWA_AXIS(_mm256_srli_epi32(w, 10), y + i)
+    GRAVCAL_CWA_AXIS(_mm256_srli_epi32(w, 20), z + i)
+#undef GRAVCAL_CWA_AXIS
   }
   return i;
 }
