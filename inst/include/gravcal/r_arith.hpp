@@ -336,7 +336,7 @@ GRAVCAL_TARGET_AVX2 inline bool r_var_means3_avx2(const double* const* v, std::s
                 hi[3] = {hi0, hi1, hi2};
   const std::size_t kv = k;
   long double xbar[3];
-  double M[3], xb[3];
+  double M[3], xb[3], mnv[3], mxv[3];
   for (int a = 0; a < 3; ++a) {
     double sl[4], cl[4], lol[4], hil[4];
     _mm256_storeu_pd(sl, s[a]);
@@ -360,12 +360,30 @@ GRAVCAL_TARGET_AVX2 inline bool r_var_means3_avx2(const double* const* v, std::s
     }
     const long double S = r_arith_detail::join_lanes(sl, cl);
     if (!std::isfinite(S) || !std::isfinite(mn) || !std::isfinite(mx)) return false;
+    mnv[a] = mn;
+    mxv[a] = mx;
     M[a] = std::fmax(std::fabs(mn), std::fabs(mx));
     if (!(M[a] <= 1e100) || M[a] < 1e-100) return false;
     xbar[a] = S / static_cast<long double>(n);
     xb[a] = static_cast<double>(xbar[a]);
   }
-  // sum |x_i - xb| in double, four lanes: each term and the sum of
+  // first with sum |x_i - xb| bounded by n max(xb - min, max - xb) (the
+  // spread of the window, no pass over it; rounded up by (1 + 4 u)): most
+  // windows at rest are decided so
+  {
+    double out[3];
+    bool all = true;
+    for (int a = 0; a < 3 && all; ++a) {
+      const double dev = std::fmax(xb[a] - mnv[a], mxv[a] - xb[a]);
+      const double dl[4] = {static_cast<double>(n) * dev * (1.0 + 0x1p-51), 0.0, 0.0, 0.0};
+      all = dev >= 0.0 && r_arith_detail::decide_mean(xbar[a], M[a], dl, n, &out[a]);
+    }
+    if (all) {
+      for (int a = 0; a < 3; ++a) mean[a] = out[a];
+      return true;
+    }
+  }
+  // else summed, in double, four lanes: each term and the sum of
   // nonnegative terms within (n + 8) u (relative)
   const __m256d absm = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
   const __m256d b0 = _mm256_set1_pd(xb[0]), b1 = _mm256_set1_pd(xb[1]), b2 = _mm256_set1_pd(xb[2]);
