@@ -862,6 +862,11 @@ static void print_digest() {
       tt[i] = 25 + static_cast<double>(i / 300) * 0.01;
       if (g() % 500 == 0) b[i] = NAN;
       if (g() % 400 == 0) a[i] = b[i] = c[i] = 0;
+      // samples zero on some axes only (not idle sleep): the zero scans
+      // look at x first
+      if (g() % 90 == 0) a[i] = 0;
+      if (g() % 300 == 0) a[i] = b[i] = 0;
+      if (g() % 300 == 0) a[i] = c[i] = 0;
     }
     for (std::size_t at = 0; at < n;) {
       gb.begin_block();

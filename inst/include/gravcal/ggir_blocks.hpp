@@ -261,23 +261,40 @@ class GgirBlocks {
   }
 
 #if defined(GRAVCAL_AVX2)
+  // Whether one of the eight samples at i is all zeros.
+  GRAVCAL_TARGET_AVX2 static bool zero_in8_avx2(const double* x, const double* y,
+                                                const double* z, std::size_t i) {
+    const __m256d zr = _mm256_setzero_pd();
+    const __m256d a = _mm256_and_pd(
+        _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
+                      _mm256_cmp_pd(_mm256_loadu_pd(y + i), zr, _CMP_EQ_OQ)),
+        _mm256_cmp_pd(_mm256_loadu_pd(z + i), zr, _CMP_EQ_OQ));
+    const __m256d b = _mm256_and_pd(
+        _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ),
+                      _mm256_cmp_pd(_mm256_loadu_pd(y + i + 4), zr, _CMP_EQ_OQ)),
+        _mm256_cmp_pd(_mm256_loadu_pd(z + i + 4), zr, _CMP_EQ_OQ));
+    return _mm256_movemask_pd(_mm256_or_pd(a, b)) != 0;
+  }
+
   // first_zero()'s scan, four samples per instruction: where to go on from
   // (a multiple of 8 before the first idle-sleep sample, or less than 8
-  // from the end).
+  // from the end). Sixteen samples' x first: only where some x is 0 can a
+  // sample be all zeros, and then their eights are checked whole.
   GRAVCAL_TARGET_AVX2 static std::size_t zero_scan_avx2(const double* x, const double* y,
                                                         const double* z, std::size_t n) {
     std::size_t i = 0;
     const __m256d zr = _mm256_setzero_pd();
+    for (; i + 16 <= n; i += 16) {
+      const __m256d a = _mm256_or_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
+                                     _mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ));
+      const __m256d b = _mm256_or_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 8), zr, _CMP_EQ_OQ),
+                                     _mm256_cmp_pd(_mm256_loadu_pd(x + i + 12), zr, _CMP_EQ_OQ));
+      if (_mm256_movemask_pd(_mm256_or_pd(a, b)) == 0) continue;
+      if (zero_in8_avx2(x, y, z, i)) return i;
+      if (zero_in8_avx2(x, y, z, i + 8)) return i + 8;
+    }
     for (; i + 8 <= n; i += 8) {
-      const __m256d a = _mm256_and_pd(
-          _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
-                        _mm256_cmp_pd(_mm256_loadu_pd(y + i), zr, _CMP_EQ_OQ)),
-          _mm256_cmp_pd(_mm256_loadu_pd(z + i), zr, _CMP_EQ_OQ));
-      const __m256d b = _mm256_and_pd(
-          _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ),
-                        _mm256_cmp_pd(_mm256_loadu_pd(y + i + 4), zr, _CMP_EQ_OQ)),
-          _mm256_cmp_pd(_mm256_loadu_pd(z + i + 4), zr, _CMP_EQ_OQ));
-      if (_mm256_movemask_pd(_mm256_or_pd(a, b)) != 0) break;
+      if (zero_in8_avx2(x, y, z, i)) break;
     }
     return i;
   }
