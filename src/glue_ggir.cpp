@@ -111,13 +111,12 @@ Rcpp::IntegerVector gc_ggir_duplicates(const Rcpp::NumericMatrix& table,
       Rcpp::stop("row numbers out of range");
     r[i] = static_cast<std::size_t>(v - 1);
   }
-  std::vector<int> same(n > 0 ? n - 1 : 0);
-  gravcal::consecutive_equal(table.begin(), nr, r.data(), n, 1, 7, same.data());
-  std::vector<int> cut;
-  for (std::size_t i = 0; i < same.size(); ++i) {
-    if (same[i] == need) cut.push_back(static_cast<int>(i + 1));
+  const std::vector<std::size_t> cut = gravcal::duplicate_cuts(table.begin(), nr, r.data(), n, need);
+  Rcpp::IntegerVector out(static_cast<R_xlen_t>(cut.size()));
+  for (std::size_t i = 0; i < cut.size(); ++i) {
+    out[static_cast<R_xlen_t>(i)] = static_cast<int>(cut[i] + 1);
   }
-  return Rcpp::IntegerVector(cut.begin(), cut.end());
+  return out;
 }
 
 // GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp);

@@ -520,25 +520,28 @@ class GgirBlocks {
   std::vector<Run> runs_;         // the block's temperatures, run-length coded
 };
 
-// GGIR's duplicate filter on its window table (column-major, n_row rows):
-// for each pair of consecutive selected rows rows[i], rows[i + 1] (0-based),
-// i < n - 1, how many of the columns [c0, c1) hold equal values, or -1
-// when a compared value is NaN (R's NA: the count is then NA, never equal
-// to anything). The caller guarantees rows[i] < n_row.
-inline void consecutive_equal(const double* table, std::size_t n_row, const std::size_t* rows,
-                              std::size_t n, std::size_t c0, std::size_t c1, int* out) {
+// GGIR's duplicate filter on its window table (column-major, n_row rows,
+// columns 1 to 6, 0-based, its means and sds): for each pair of consecutive
+// selected rows rows[i], rows[i + 1] (0-based), i < n - 1, how many of the
+// six hold equal values, the count taken as R's sum of logicals (NA when a
+// compared value is NaN, and then equal to nothing). Returns the positions
+// i where the count is `need` (GGIR drops those windows: 3 in compatible
+// mode). The caller guarantees rows[i] < n_row and at least 7 columns.
+inline std::vector<std::size_t> duplicate_cuts(const double* table, std::size_t n_row,
+                                               const std::size_t* rows, std::size_t n,
+                                               int need) {
+  std::vector<std::size_t> cut;
   for (std::size_t i = 0; i + 1 < n; ++i) {
     int same = 0;
-    for (std::size_t c = c0; c < c1; ++c) {
+    bool na = false;
+    for (std::size_t c = 1; c < 7 && !na; ++c) {
       const double a = table[c * n_row + rows[i]], b = table[c * n_row + rows[i + 1]];
-      if (std::isnan(a) || std::isnan(b)) {
-        same = -1;
-        break;
-      }
+      na = std::isnan(a) || std::isnan(b);
       same += a == b;
     }
-    out[i] = same;
+    if (!na && same == need) cut.push_back(i);
   }
+  return cut;
 }
 
 }  // namespace gravcal
