@@ -21,14 +21,6 @@ gc_decoder_close <- function(ptr) {
     invisible(.Call(`_gravcal_gc_decoder_close`, ptr))
 }
 
-gc_decoder_segment <- function(ptr, seg, max_units, rule, par, use_temperature) {
-    .Call(`_gravcal_gc_decoder_segment`, ptr, seg, max_units, rule, par, use_temperature)
-}
-
-gc_blocks_decode <- function(blocks, ptr, max_units, rule, par) {
-    .Call(`_gravcal_gc_blocks_decode`, blocks, ptr, max_units, rule, par)
-}
-
 gc_decoder_drain <- function(ptr) {
     .Call(`_gravcal_gc_decoder_drain`, ptr)
 }
@@ -49,34 +41,6 @@ gc_ggir_duplicates <- function(table, rows, need) {
     .Call(`_gravcal_gc_ggir_duplicates`, table, rows, need)
 }
 
-gc_blocks_new <- function(seg, per_hour, compat, temperature, temp_min_sd) {
-    .Call(`_gravcal_gc_blocks_new`, seg, per_hour, compat, temperature, temp_min_sd)
-}
-
-gc_blocks_columns <- function(blocks, x, y, z, t, from, to, rule, par) {
-    .Call(`_gravcal_gc_blocks_columns`, blocks, x, y, z, t, from, to, rule, par)
-}
-
-gc_segmenter_new <- function(samples_per_window, skip_zero, r_arithmetic = FALSE) {
-    .Call(`_gravcal_gc_segmenter_new`, samples_per_window, skip_zero, r_arithmetic)
-}
-
-gc_segmenter_lazy_sd <- function(seg, max_sd) {
-    invisible(.Call(`_gravcal_gc_segmenter_lazy_sd`, seg, max_sd))
-}
-
-gc_segmenter_new_block <- function(seg) {
-    .Call(`_gravcal_gc_segmenter_new_block`, seg)
-}
-
-gc_segmenter_push <- function(seg, x, y, z, temp, from, to, rule, par) {
-    .Call(`_gravcal_gc_segmenter_push`, seg, x, y, z, temp, from, to, rule, par)
-}
-
-gc_segmenter_state <- function(seg) {
-    .Call(`_gravcal_gc_segmenter_state`, seg)
-}
-
 gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic = "double") {
     .Call(`_gravcal_gc_select_points`, x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic)
 }
@@ -91,5 +55,21 @@ gc_read_once <- function(cols) {
 
 gc_release_memory <- function() {
     .Call(`_gravcal_gc_release_memory`)
+}
+
+gc_source_decoder <- function(file) {
+    .Call(`_gravcal_gc_source_decoder`, file)
+}
+
+gc_source_columns <- function(x, y, z, temperature) {
+    .Call(`_gravcal_gc_source_columns`, x, y, z, temperature)
+}
+
+gc_source_blocks <- function(first, fetch) {
+    .Call(`_gravcal_gc_source_blocks`, first, fetch)
+}
+
+gc_pump <- function(src, stage, opts, on_block = NULL) {
+    .Call(`_gravcal_gc_pump`, src, stage, opts, on_block)
 }
 

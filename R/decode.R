@@ -36,28 +36,18 @@ native_report <- function(h) gc_decoder_report(h$ptr)
 # file has them), with attributes `sf`, `info` and `report`. For tests and
 # read_recording(); calibration streams instead.
 native_read_all <- function(file, format, options = list(), time = TRUE,
-                            chunk = 1e6, arg = "file") {
+                            chunk = 65536, arg = "file") {
   h <- native_open(file, format, options, arg)
   on.exit(gc_decoder_close(h$ptr))
-  parts <- list()
-  repeat {
-    b <- native_block(h, NULL, chunk, TRUE, time)
-    n <- b$to
-    if (n > 0) {
-      cl <- b$cols
-      keep <- Filter(Negate(is.null), cl)
-      parts[[length(parts) + 1]] <- lapply(keep, function(v) v[seq_len(n)])
-    }
-    if (b$done) break
-    if (n == 0 && b$units == 0) break
-  }
-  cols <- c("x", "y", "z", "temperature", "time")
-  out <- lapply(stats::setNames(cols, cols), function(nm) {
-    unlist(lapply(parts, `[[`, nm), use.names = FALSE)
-  })
-  out <- Filter(Negate(is.null), out)
-  if (!length(out)) out <- list(x = numeric(0), y = numeric(0), z = numeric(0))
-  d <- as.data.frame(out)
+  native_samples(h, time, chunk)
+}
+
+# Every sample of an open decoder `h`, through the pump (`chunk` samples a
+# write), as native_read_all() gives them.
+native_samples <- function(h, time = TRUE, chunk = 65536) {
+  d <- as.data.frame(gc_pump(gc_source_decoder(h$ptr), "samples",
+                             list(time = as.numeric(time && isTRUE(h$info$time)),
+                                  chunk = chunk)))
   attr(d, "sf") <- h$info$sf
   attr(d, "info") <- h$info
   attr(d, "report") <- native_report(h)

@@ -87,72 +87,15 @@ ggir_error <- function(m, scale, offset, tempoffset = NULL, temp = NULL,
   round(mean(abs(e - 1)), digits = ggir_constants$error_digits)
 }
 
-# A block of samples is handled as a list of "pieces": ranges [from, to)
-# (0-based) of columns x, y, z and t (temperature, or NULL) that stay where
-# they are (the caller's vectors for data in memory, the reader's for
-# files), so that no sample is copied on the way to the core.
-piece <- function(x, y, z, t, from, to) {
-  list(x = x, y = y, z = z, t = t, from = from, to = to)
-}
-
-# A block from a source as a list of pieces (see open_source() for its
-# forms: parts read by a native decoder, columns in memory, or a data frame).
-block_pieces <- function(blk, temp) {
-  if (!is.null(blk$parts)) {
-    return(lapply(blk$parts, function(b) {
-      cl <- b$cols
-      piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, b$from, b$to)
-    }))
-  }
-  if (!is.null(blk$cols)) {
-    cl <- blk$cols
-    return(list(piece(cl$x, cl$y, cl$z, if (temp) cl$temperature, blk$from,
-                      blk$to)))
-  }
-  d <- blk$data
-  col <- function(v) {
-    if (!is.numeric(v)) abort("The recording has a non-numeric acceleration or temperature column.")
-    as.double(v)
-  }
-  list(piece(col(d$x), col(d$y), col(d$z), if (temp) col(d$temperature), 0,
-             nrow(d)))
-}
-
-block_rows <- function(blk) {
-  if (!is.null(blk$parts)) return(sum(vapply(blk$parts, `[[`, 0, "to")))
-  if (!is.null(blk$cols)) blk$to - blk$from else NROW(blk$data)
-}
-
-block_has_temp <- function(blk) {
-  if (!is.null(blk$parts)) return(!is.null(blk$parts[[1]]$cols$temperature))
-  if (!is.null(blk$cols)) !is.null(blk$cols$temperature) else
-    "temperature" %in% names(blk$data)
-}
-
 ggir_feature_names <- function(temp) {
   c("Euclidean Norm", "meanx", "meany", "meanz", "sdx", "sdy", "sdz",
     if (temp) "temperature")
 }
 
-# GGIR's temperature checks on a block's used samples (the block rules give
-# R's mean of the first 10 and sd of all): FALSE, with a warning, when the
-# temperature cannot be used.
-ggir_temperature_usable <- function(r) {
-  k <- ggir_constants
-  why <- if (isTRUE(r$first_mean > k$temp_max_first)) {
-    "its first values exceed 120 (not degrees C?)"
-  } else if (is.na(r$temp_sd)) {
-    "it has fewer than 2 values"
-  } else if (r$temp_sd < k$temp_min_sd) {
-    "it does not vary (sd < 0.01)"
-  }
-  if (is.null(why)) return(TRUE)
-  warning("temperature not used for calibration: ", why, call. = FALSE)
-  FALSE
-}
-
-# Run the procedure on a source (see open_source()). Returns GGIR's list plus,
-# in attribute "gravcal", what calibrate() needs.
+# Run the procedure on a source (see open_source()): one call into the core
+# (ggir_procedure.hpp), which reads the source block by block through the
+# pump. Returns GGIR's list plus, in attribute "gravcal", what calibrate()
+# needs.
 ggir_run <- function(src, compat = TRUE,
                      spherecrit = ggir_constants$spherecrit,
                      minloadcrit = ggir_constants$minloadcrit,
@@ -166,257 +109,75 @@ ggir_run <- function(src, compat = TRUE,
           if (isTRUE(!is.na(src$filename))) paste0(", from \"", src$filename, "\""),
           ").")
   }
-  per_hour <- 3600 * sf
-  seg <- gc_segmenter_new(10 * sf, FALSE, compat)
-  # compatible mode: R's sds only where GGIR's rules can see them (the rest
-  # rule, the duplicate filter): see Segmenter::lazy_r_sd()
-  if (compat && lazy) gc_segmenter_lazy_sd(seg, sdcriter)
-  feats <- list()
-  rests <- list()  # the core's rest flag of each window (GGIR's rule)
-  n_feat <- 0
-  use.temp <- temp.available <- FALSE
-  scale <- c(1, 1, 1)
-  offset <- c(0, 0, 0)
-  tempoffset <- NULL
-  cal.error.start <- cal.error.end <- npoints <- NULL
-  nhoursused <- 0
-  QC <- NULL
-  ft <- NULL
-  ft_id <- integer(0)
-  bsc_qc <- data.frame()
-  icp <- NULL
-  meantemp <- 0
-  blocks <- 0
-  pending <- FALSE
-  next_fit <- 0
-  n_read <- 0
-  rule_par <- c(sdcriter, ggir_constants$max_abs_mean)
-  runner <- NULL
-  # The next block through GGIR's block rules (ggir_blocks.hpp) into the
-  # segmenter: from a native decoder without R vectors, else from the
-  # source's columns. NULL when the source has no more blocks.
-  feed <- function(i) {
-    if (!is.null(src$native)) {
-      temp <- isTRUE(src$temperature)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
-                                                  ggir_constants$temp_min_sd)
-      r <- gc_blocks_decode(runner, src$native$ptr, src$block_units, 1L, rule_par)
-    } else {
-      blk <- src$read(i)
-      if (is.null(blk)) return(NULL)
-      temp <- block_has_temp(blk)
-      if (is.null(runner)) runner <<- gc_blocks_new(seg, per_hour, compat, temp,
-                                                  ggir_constants$temp_min_sd)
-      P <- block_pieces(blk, temp)
-      r <- gc_blocks_columns(runner, lapply(P, `[[`, "x"), lapply(P, `[[`, "y"),
-                             lapply(P, `[[`, "z"), lapply(P, function(p) p$t),
-                             vapply(P, `[[`, 0, "from"), vapply(P, `[[`, 0, "to"),
-                             1L, rule_par)
-      r$done <- isTRUE(blk$last)
-    }
-    r$temperature <- temp
-    r
+  k <- ggir_constants
+  opts <- list(compat = compat, sf = sf, block_units = src$units,
+               short_block_rows = src$short_rows %||% 0,
+               temperature = isTRUE(src$temperature),
+               lazy = lazy, spherecrit = spherecrit, minloadcrit = minloadcrit,
+               max_sd = sdcriter, max_abs_mean = k$max_abs_mean,
+               min_rest = k$min_rest, enough_offset = k$enough_offset,
+               min_hours = k$min_hours, max_error = k$max_error,
+               error_digits = k$error_digits, temp_max_first = k$temp_max_first,
+               temp_min_sd = k$temp_min_sd, temp_missing = k$temp_missing,
+               fill = k$fill, max_iter = max_iter, tol = tol,
+               max_weight = k$max_weight, refit_growth = k$refit_growth,
+               verbose = verbose)
+  opts <- lapply(opts, as.numeric)
+  # memory in use after each block (GGIR records R's heap from a full gc(),
+  # which costs about as much as decoding the block)
+  bsc <- list()
+  record <- function(i) {
+    bsc[[length(bsc) + 1]] <<- data.frame(time = format(Sys.time()),
+                                          size = memory_in_use_mb(),
+                                          stringsAsFactors = FALSE)
+    NULL
   }
-  i <- 1
-  repeat {
-    if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
-    if (i > 1 && isTRUE(src$from_file) && is.null(src$native)) {
-      # the previous block is garbage now: collect it before reading the
-      # next, so that memory stays at about one block
-      invisible(gc(full = TRUE))
-    }
-    r <- feed(i)
-    present <- !is.null(r) && r$rows > 0
-    last <- !present || isTRUE(r$done) ||
-      (!is.null(src$short_block) && src$short_block(r$rows))
-    if (present) {
-      n_read <- n_read + r$rows
-      if (r$rows < per_hour * 2 + 1) {
-        # GGIR: a short block is the last one; a short first block means the
-        # file is too short to use
-        last <- TRUE
-        if (i == 1) present <- FALSE
-      }
-    }
-    if (i == 1) use.temp <- temp.available <- present && r$temperature
-    added <- FALSE
-    if (present && r$used > 0) {
-      if (use.temp) use.temp <- ggir_temperature_usable(r)
-      w <- r$windows
-      f <- cbind(w$mean_norm, w$mean_x, w$mean_y, w$mean_z, w$sd_x, w$sd_y,
-                 w$sd_z)
-      if (temp.available) {
-        f <- cbind(f, if (use.temp) w$temperature else ggir_constants$temp_missing)
-      }
-      rests[[length(rests) + 1]] <- as.logical(w$rest)
-      n_feat <- n_feat + nrow(f)
-      feats[[length(feats) + 1]] <- f
-      added <- TRUE
-      blocks <- blocks + 1
-      # memory in use after the block (GGIR records R's heap from a full
-      # gc(), which costs about as much as decoding the block)
-      mem <- memory_in_use_mb()
-      bsc_qc <- rbind(bsc_qc, data.frame(time = format(Sys.time()),
-                                         size = mem,
-                                         stringsAsFactors = FALSE))
-    }
-    rm(r)
-    stop_loading <- FALSE
-    # GGIR fits after every block, but only the fit after the last block, or
-    # one that can stop the loading (more than minloadcrit hours), decides
-    # the result: the others are skipped (the window table only grows, so
-    # the last fit is the same either way).
-    # gravcal's own mode refits before the last block only once the window
-    # table has grown by a quarter since the previous fit: the fits then
-    # cost a bounded multiple of the last one, so time grows linearly with
-    # the recording even when the error target is never reached (GGIR
-    # refits after every block, which grows with its square).
-    due <- added || i == 1
-    if (due && !last && (n_feat * 10 / 3600 <= minloadcrit ||
-                         (!compat && n_feat < next_fit))) {
-      pending <- TRUE
-      due <- FALSE
-    }
-    if (last && pending) due <- TRUE
-    if (due) {
-      pending <- FALSE
-      next_fit <- n_feat * ggir_constants$refit_growth
-      spherepopulated <- FALSE
-      # GGIR's table rules as one index into the whole window table (its row
-      # numbers are GGIR's row names), so that the table is copied once
-      # however many rules apply
-      full <- if (length(feats)) do.call(rbind, feats) else
-        matrix(numeric(0), 0, if (temp.available) 8 else 7)
-      full_rest <- unlist(rests, use.names = FALSE)
-      idx <- which(!is.na(full[, 4]) & !is.na(full[, 1]))
-      # GGIR also drops a window whose mean norm equals the value its
-      # window table is filled with (99999)
-      if (compat) idx <- idx[full[idx, 1] != ggir_constants$fill]
-      n <- length(idx)
-      if (n > 1) {
-        # consecutive windows equal in 3 (GGIR) or all 6 of means and sds
-        cut <- gc_ggir_duplicates(full, idx, if (compat) 3L else 6L)
-        if (length(cut)) idx <- idx[-cut]
-      }
-      ft <- NULL
-      nhoursused <- 0
-      enough <- if (compat) {
-        length(idx) > (minloadcrit - ggir_constants$enough_offset)
-      } else {
-        length(idx) * ggir_constants$window >= ggir_constants$min_hours * 3600
-      }
-      if (enough) {
-        nhoursused <- (length(idx) * 10) / 3600
-        # the first window is left out, then the windows at rest
-        idx <- idx[-1]
-        idx <- idx[full_rest[idx]]
-        if (length(idx) < ggir_constants$min_rest) {
-          QC <- ggir_messages[["no_rest"]]
-        } else {
-          ft <- full[idx, , drop = FALSE]
-          ft_id <- idx
-          npoints <- nrow(ft)
-          cal.error.start <- ggir_error(ft[, 2:4, drop = FALSE], c(1, 1, 1),
-                                        c(0, 0, 0))
-          tel <- 0
-          for (a in 2:4) {
-            if (min(ft[, a]) < -spherecrit && max(ft[, a]) > spherecrit) tel <- tel + 1
-          }
-          spherepopulated <- tel == 3
-          if (!spherepopulated) QC <- ggir_messages[["no_sphere"]]
-        }
-      } else {
-        QC <- ggir_messages[["no_data"]]
-        ft <- full[idx, , drop = FALSE]
-        ft_id <- idx
-      }
-      rm(full, full_rest)
-      if (spherepopulated) {
-        temp <- if (use.temp) ft[, 8] else NULL
-        fit_ft <- function(rule) {
-          r <- icp_means(ft[, 2], ft[, 3], ft[, 4], temp, use.temp, rule,
-                         max_iter, tol)
-          r$meantemp <- if (use.temp) r$meantemp else 0
-          r$error <- ggir_error(ft[, 2:4, drop = FALSE], r$scale, r$offset,
-                                r$tempoffset, temp, r$meantemp)
-          r
-        }
-        judge <- function(r) {
-          isTRUE(r$error < cal.error.start && r$error < ggir_constants$max_error &&
-                   nhoursused > minloadcrit)
-        }
-        # compatible mode fits as GGIR does; gravcal's own mode decides
-        # whether to read on with GGIR's cheap early stop, and fits to
-        # convergence only for a result it keeps
-        icp <- fit_ft(if (compat) "ggir_r" else if (last) "converge" else "ggir")
-        if (!compat && !last && judge(icp)) icp <- fit_ft("converge")
-        scale <- icp$scale
-        offset <- icp$offset
-        tempoffset <- icp$tempoffset
-        meantemp <- icp$meantemp
-        cal.error.end <- icp$error
-        if (judge(icp)) {
-          QC <- if (use.temp == temp.available) ggir_messages[["done"]] else
-            ggir_messages[["done_no_temp"]]
-          stop_loading <- TRUE
-        } else {
-          if (nhoursused > minloadcrit && verbose) {
-            cat(paste0("\nnew calibration error: ", cal.error.end, " g"))
-            cat(paste0("\nnpoints around sphere: ", npoints))
-          }
-          QC <- ggir_messages[["attempted"]]
-        }
-      }
-    }
-    if (last || stop_loading) break
-    i <- i + 1
-  }
-  check_source_read(src, n_read)
-  if (!is.null(icp) && !isTRUE(icp$finite)) {
-    # the last fit did not stay finite (a temperature term the rest windows
-    # cannot determine, for one): GGIR stops with an error here; gravcal
-    # returns no correction and says why
-    scale <- c(1, 1, 1)
-    offset <- c(0, 0, 0)
-    tempoffset <- if (use.temp) c(0, 0, 0) else NULL
-    cal.error.end <- cal.error.start
-    QC <- ggir_messages[["not_finite"]]
-  } else if (length(cal.error.end) > 0 && isTRUE(cal.error.end > cal.error.start)) {
-    QC <- ggir_messages[["no_decrease"]]
-  }
+  r <- gc_pump(src$pump(), "ggir", opts, record)
+  for (w in r$warnings) warning(w, call. = FALSE)
+  check_source_read(src, r$samples)
+  QC <- if (nzchar(r$qc)) ggir_messages[[r$qc]]
   spheredata <- NULL
+  ft <- r$table
   if (!is.null(ft) && nrow(ft) > 0 && ncol(ft) > 0) {
     spheredata <- as.data.frame(unname(ft))
-    attr(spheredata, "row.names") <- ft_id
-    nm <- ggir_feature_names(use.temp)
+    attr(spheredata, "row.names") <- r$rows
+    nm <- ggir_feature_names(r$use.temp)
     names(spheredata) <- c(nm, rep(NA_character_, ncol(ft) - length(nm)))
   }
+  use.temp <- r$use.temp
   meantempcal <- if (use.temp && length(spheredata) > 0) mean(spheredata[, 8], na.rm = TRUE) else NULL
-  if (printsummary && verbose) {
-    cat("\nSummary of autocalibration procedure:\n")
-    cat(paste0("\nStatus: ", QC))
-    cat(paste0("\nCalibration error (g) before: ", cal.error.start))
-    cat(paste0("\nCalibration error (g) after: ", cal.error.end))
-    cat(paste0("\nOffset correction ", c("x", "y", "z"), ": ", offset))
-    cat(paste0("\nScale correction ", c("x", "y", "z"), ": ", scale))
-    cat(paste0("\nNumber of hours used: ", nhoursused))
-    cat(paste0("\nNumber of 10 second windows around the sphere: ", npoints))
-    cat(paste0("\nTemperature used (if available): ", use.temp))
-    cat(paste0("\nTemperature offset (if temperature is available) ",
-               c("x", "y", "z"), ": ", tempoffset))
-    cat("\n")
-  }
+  out <- list(scale = r$scale, offset = r$offset, tempoffset = r$tempoffset,
+              cal.error.start = r$cal.error.start, cal.error.end = r$cal.error.end,
+              spheredata = spheredata, npoints = r$npoints,
+              nhoursused = r$nhoursused, QCmessage = QC, use.temp = use.temp,
+              meantempcal = meantempcal,
+              bsc_qc = if (length(bsc)) do.call(rbind, bsc) else data.frame())
+  if (printsummary && verbose) ggir_print_summary(out)
   if (verbose) cat("\n")
-  out <- list(scale = scale, offset = offset, tempoffset = tempoffset,
-              cal.error.start = cal.error.start, cal.error.end = cal.error.end,
-              spheredata = spheredata, npoints = npoints,
-              nhoursused = nhoursused, QCmessage = QC, use.temp = use.temp,
-              meantempcal = meantempcal, bsc_qc = bsc_qc)
-  attr(out, "gravcal") <- list(icp = icp, meantemp = meantemp, blocks = blocks,
-                               input = source_input(src, n_read),
-                               temp.available = temp.available,
-                               windows = n_feat)
+  icp <- r$icp
+  if (!is.null(icp)) icp$meantemp <- r$meantemp
+  attr(out, "gravcal") <- list(icp = icp, meantemp = r$meantemp,
+                               blocks = r$blocks,
+                               input = source_input(src, r$samples),
+                               temp.available = r$temp.available,
+                               windows = r$windows)
   out
+}
+
+# GGIR's summary of the procedure (printsummary = TRUE).
+ggir_print_summary <- function(out) {
+  cat("\nSummary of autocalibration procedure:\n")
+  cat(paste0("\nStatus: ", out$QCmessage))
+  cat(paste0("\nCalibration error (g) before: ", out$cal.error.start))
+  cat(paste0("\nCalibration error (g) after: ", out$cal.error.end))
+  cat(paste0("\nOffset correction ", c("x", "y", "z"), ": ", out$offset))
+  cat(paste0("\nScale correction ", c("x", "y", "z"), ": ", out$scale))
+  cat(paste0("\nNumber of hours used: ", out$nhoursused))
+  cat(paste0("\nNumber of 10 second windows around the sphere: ", out$npoints))
+  cat(paste0("\nTemperature used (if available): ", out$use.temp))
+  cat(paste0("\nTemperature offset (if temperature is available) ",
+             c("x", "y", "z"), ": ", out$tempoffset))
+  cat("\n")
 }
 
 # ggir_run() on `src`, then, in compatible mode, once more without the lazy
@@ -606,10 +367,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   open <- function() {
     src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
                        reader = a$reader, compat = compat)
-    if (!a$use_temp) {
-      src$read <- drop_temperature(src$read)
-      src$temperature <- FALSE
-    }
+    if (!a$use_temp) src$temperature <- FALSE
     src
   }
   src <- open()
@@ -620,17 +378,6 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
   fit
-}
-
-drop_temperature <- function(read) {
-  force(read)
-  function(i) {
-    b <- read(i)
-    if (!is.null(b$cols)) b$cols$temperature <- NULL
-    for (k in seq_along(b$parts)) b$parts[[k]]$cols$temperature <- NULL
-    if (!is.null(b$data)) b$data$temperature <- NULL
-    b
-  }
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.

@@ -175,8 +175,8 @@ read_native <- function(file, format, sf, arg = "file") {
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)
   }
-  gc_decoder_close(h$ptr)
-  d <- native_read_all(file, format, opts, time = TRUE, arg = arg)
+  on.exit(gc_decoder_close(h$ptr))
+  d <- native_samples(h, time = TRUE)
   if (!is.null(d$time)) d$time <- as.POSIXct(d$time, origin = "1970-01-01", tz = "UTC")
   if (isTRUE(is.finite(attr(d, "sf")) && attr(d, "sf") > 0)) sf <- attr(d, "sf")
   attr(d, "sf") <- sf
@@ -199,21 +199,12 @@ is_actigraph_csv <- function(file) {
   grepl("ActiGraph", rawToChar(b), ignore.case = TRUE)
 }
 
-# A whole .cwa, .bin or ActiGraph csv file, from its blocks.
+# A whole .cwa, .bin or ActiGraph csv file through GGIR's readers, block by
+# block through the pump.
 read_blocks <- function(file, sf = NULL, reader = "reference") {
   src <- open_source(file, sf = sf, arg = "file", reader = reader)
-  parts <- list()
-  i <- 1
-  repeat {
-    b <- src$read(i)
-    if (is.null(b)) break
-    parts[[i]] <- b$data
-    if (isTRUE(b$last)) break
-    i <- i + 1
-  }
-  if (!length(parts)) abort("`file` holds no samples: \"", file, "\".")
-  out <- do.call(rbind, parts)
-  rownames(out) <- NULL
+  out <- as.data.frame(gc_pump(src$pump(), "samples", list(time = 0)))
+  if (!nrow(out)) abort("`file` holds no samples: \"", file, "\".")
   attr(out, "sf") <- src$sf
   out
 }
@@ -285,13 +276,14 @@ gravcal_example <- function() {
 }
 
 # ---------------------------------------------------------------------------
-# Block readers. A source is a list with `format`, `sf`, `filename`,
-# `temperature` (does it carry a temperature column) and `read(i)`, which
-# returns block i (1, 2, ... in order), or NULL when there is nothing more,
-# in one of two forms: list(data = data frame with x, y, z and maybe
-# temperature, last = logical) for blocks read from a file, or list(cols =
-# list of double vectors x, y, z and maybe temperature, from, to, last) for
-# rows [from, to) (0-based) of data held in memory.
+# Sources. A source is a list with `format`, `sf`, `filename`, `temperature`
+# (does it carry a temperature column), `units` (the source's units in one
+# of GGIR's blocks), `short_rows` (GENEActiv in compatible mode: a block
+# with fewer rows is the last) and `pump()`, which makes the core's source
+# for the one pump (gc_pump(), pipeline.hpp): an open decoder, the columns
+# of a data frame, or the blocks that GGIR's own readers give (`read(i)`:
+# block i, 1, 2, ... in order, as list(data = data frame with x, y, z and
+# maybe temperature, last = logical), or NULL at the end; one block a unit).
 # Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
 # file where GGIR does: `chunksize` scales them (1 = about 12 hours).
 
@@ -328,11 +320,42 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
       geneactiv = source_geneactiv(datafile, chunksize))
   }
   src$filename <- basename(datafile)
-  # blocks read from the file (not views of data already in memory): the
-  # block loops collect each one's garbage before reading the next, so that
-  # memory stays at about one block
-  src$from_file <- !identical(src$format, "data.frame") &&
-    !identical(src$format, "csv")
+  if (is.null(src$pump)) src <- reference_source(src)
+  src
+}
+
+# A source whose blocks GGIR's own readers give (`read(i)`): one block a
+# unit. The previous block is garbage once the next is asked for: it is
+# collected before the next is read, so that memory stays at about one
+# block.
+reference_source <- function(src) {
+  read <- src$read
+  columns <- function(blk) {
+    if (is.null(blk)) return(NULL)
+    d <- blk$data
+    col <- function(v) {
+      if (!is.numeric(v)) abort("The recording has a non-numeric acceleration or temperature column.")
+      as.double(v)
+    }
+    list(x = col(d$x), y = col(d$y), z = col(d$z),
+         temperature = if ("temperature" %in% names(d)) col(d$temperature),
+         last = isTRUE(blk$last))
+  }
+  src$units <- 1
+  src$pump <- function() {
+    i <- 1
+    first <- columns(read(1))
+    if (is.null(first)) {
+      first <- list(x = numeric(0), y = numeric(0), z = numeric(0),
+                    temperature = NULL, last = TRUE)
+    }
+    gc_source_blocks(first, function() {
+      first <<- NULL
+      invisible(gc(full = TRUE))
+      i <<- i + 1
+      columns(read(i))
+    })
+  }
   src
 }
 
@@ -445,35 +468,14 @@ source_native <- function(file, format, sf, chunksize, compat, arg) {
   }
   check_sf(sf)
   B <- native_block_units[[format]](sf, chunksize)
-  per_unit <- gc_decoder_unit_samples(h$ptr)
-  cap <- max(1, min(B * per_unit, 2^28))
   # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
   # pages hold for the last one; after its resampling of a rate that rounds
   # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
-  short <- if (format == "geneactiv" && isTRUE(compat)) {
-    function(rows) rows < B * 300
-  }
+  short <- if (format == "geneactiv" && isTRUE(compat)) B * 300 else 0
   list(format = format, sf = sf, temperature = isTRUE(h$info$temperature),
-       info = h$info, native = h, block_units = B, short_block = short,
-       read = function(i) {
-         parts <- list()
-         units <- 0
-         repeat {
-           b <- native_block(h, B - units, cap, TRUE, FALSE)
-           if (b$to > 0) parts[[length(parts) + 1]] <- b
-           units <- units + b$units
-           # a full buffer may end part-way through the block's last unit:
-           # the next call (with no units left) gives the rest of it
-           if (b$done || (units >= B && b$to < cap) ||
-               (b$to == 0 && b$units == 0)) break
-         }
-         if (!length(parts)) return(NULL)
-         list(parts = parts, last = b$done)
-       },
+       info = h$info, native = h, units = B, short_rows = short,
        report = function() native_report(h),
-       segment = function(seg, rule, par, temperature = TRUE) {
-         gc_decoder_segment(h$ptr, seg, B, rule, par, temperature)
-       })
+       pump = function() gc_source_decoder(h$ptr))
 }
 
 `%||%` <- function(a, b) if (is.null(a)) b else a
@@ -484,17 +486,10 @@ source_frame <- function(x, sf, chunksize, arg) {
   if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
   if (is.null(sf)) abort("The sampling frequency of `", arg, "` is unknown: give `sf`.")
   check_sf(sf)
-  B <- ggir_rows_per_block(sf, chunksize)
-  n <- s$n
   list(format = "data.frame", sf = sf, filename = NA_character_,
-       temperature = !is.null(s$temperature), n = n,
-       read = function(i) {
-         from <- (i - 1) * B
-         if (from >= n) return(NULL)
-         to <- min(i * B, n)
-         # the block as a range of the caller's columns: nothing is copied
-         list(cols = s, from = from, to = to, last = to >= n)
-       })
+       temperature = !is.null(s$temperature), n = s$n, time = s$time,
+       units = ggir_rows_per_block(sf, chunksize), short_rows = 0,
+       pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
 }
 
 # ActiGraph csv export (10 header lines, optional column-name line, then

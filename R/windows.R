@@ -137,29 +137,28 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   if (!is.null(s$time) && length(s$time) != s$n) {
     abort("Column `time` of `x` must have one value per sample.")
   }
-  seg <- gc_segmenter_new(window * sf, skip_zero, FALSE)
-  halt <- NULL
-  if (!is.null(stop)) {
-    # called with the chunks so far and the samples read: builds the
-    # windows and asks `stop` every `stop_every` hours
-    next_check <- stop_every * 3600 * sf
-    halt <- function(chunks, n) {
-      if (n < next_check) return(FALSE)
-      next_check <<- n + stop_every * 3600 * sf
-      isTRUE(stop(windows_frame(chunks, s, sf)))
-    }
-  }
   if (is.null(src)) {
-    out <- segment_chunks(seg, s, rule, par, chunk_size, progress, halt)
+    pump_src <- gc_source_columns(s$x, s$y, s$z, s$temperature)
+    units <- chunk_size
+    blocks <- ceiling(s$n / chunk_size)
   } else {
-    out <- segment_source(seg, src, rule, par, progress, halt)
-    s$n <- attr(out, "samples")
+    pump_src <- src$pump()
+    units <- src$units
+    blocks <- NA
   }
-  w <- windows_frame(out, s, sf)
-  attr(w, "stopped") <- isTRUE(attr(out, "stopped"))
+  out <- gc_pump(pump_src, "windows",
+                 list(window_samples = window * sf, skip_zero = as.numeric(skip_zero),
+                      r_arithmetic = 0, temperature = 1, rule = rule, par = par,
+                      block_units = units, want_table = as.numeric(!is.null(stop))),
+                 window_progress(src, s, sf, stop, stop_every, progress, blocks))
+  if (!is.null(src)) {
+    check_source_read(src, out$samples)
+    s$n <- out$samples
+  }
+  w <- windows_frame(out$windows, s, sf)
+  attr(w, "stopped") <- isTRUE(out$stopped)
   attr(w, "samples_total") <- if (is.null(src)) s$n else NA_real_
-  if (is.null(src) && isTRUE(attr(out, "stopped"))) s$n <- attr(out, "samples")
-  state <- gc_segmenter_state(seg)
+  if (is.null(src) && isTRUE(out$stopped)) s$n <- out$samples
   attr(w, "sf") <- sf
   attr(w, "method") <- method
   attr(w, "window") <- window
@@ -169,8 +168,8 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     list(max_sd = max_sd, max_abs_mean = max_abs_mean)
   }
   attr(w, "samples") <- s$n
-  attr(w, "skipped_zero") <- unname(state["skipped_zero"])
-  attr(w, "dropped_tail") <- unname(state["pending"])
+  attr(w, "skipped_zero") <- out$skipped_zero
+  attr(w, "dropped_tail") <- out$pending
   attr(w, "input") <- source_input(src, s$n)
   n_bad <- sum(w$n_invalid)
   if (n_bad > 0) {
@@ -182,83 +181,38 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   w
 }
 
-# Push the samples through the segmenter chunk by chunk; returns the list of
-# per-chunk column lists.
-segment_chunks <- function(seg, s, rule, par, chunk_size, progress,
-                           halt = NULL) {
-  n <- s$n
-  starts <- seq(0, max(n - 1, 0), by = chunk_size)
-  if (n == 0) starts <- numeric(0)
-  if (is.null(progress)) progress <- interactive() && length(starts) > 20
+# The pump's callback after each block but the last (see gc_pump()): shows
+# progress (a bar over the blocks of samples in memory, the hours read from
+# a file) and, every `stop_every` hours, asks `stop` with the windows so far
+# whether to stop. NULL when there is nothing to do.
+window_progress <- function(src, s, sf, stop, stop_every, progress, blocks) {
+  if (is.null(progress)) {
+    progress <- interactive() && (!is.null(src) || blocks > 20)
+  }
+  if (!isTRUE(progress) && is.null(stop)) return(NULL)
   bar <- NULL
-  if (isTRUE(progress) && length(starts) > 1) {
-    bar <- utils::txtProgressBar(min = 0, max = length(starts), style = 3)
-    on.exit(close(bar), add = TRUE)
+  if (isTRUE(progress) && is.null(src) && blocks > 1) {
+    bar <- utils::txtProgressBar(min = 0, max = blocks, style = 3)
   }
-  out <- vector("list", length(starts))
-  read <- n
-  for (i in seq_along(starts)) {
-    to <- min(starts[i] + chunk_size, n)
-    out[[i]] <- gc_segmenter_push(seg, s$x, s$y, s$z, s$temperature,
-                                  starts[i], to, rule, par)
+  i <- 0
+  next_check <- stop_every * 3600 * sf
+  function(n, table) {
+    i <<- i + 1
     if (!is.null(bar)) utils::setTxtProgressBar(bar, i)
-    if (!is.null(halt) && to < n && halt(out[seq_len(i)], to)) {
-      out <- out[seq_len(i)]
-      read <- to
-      attr(out, "stopped") <- TRUE
-      break
+    if (isTRUE(progress) && !is.null(src)) {
+      cat(sprintf("\rblock %d: %.1f hours read", i, n / sf / 3600))
     }
+    if (is.null(stop) || n < next_check) return(FALSE)
+    next_check <<- n + stop_every * 3600 * sf
+    isTRUE(stop(windows_frame(table, s, sf)))
   }
-  attr(out, "samples") <- read
-  out
 }
 
-# The same for a file source (open_source()), one block at a time.
-segment_source <- function(seg, src, rule, par, progress, halt = NULL) {
-  if (is.null(progress)) progress <- interactive()
-  out <- list()
-  n <- 0
-  i <- 1
-  repeat {
-    if (!is.null(src$segment)) {
-      # a native decoder: the block goes from the file to the segmenter in
-      # C++, through a fixed buffer
-      r <- src$segment(seg, rule, par)
-      out[[i]] <- r$windows
-      n <- n + r$samples
-      last <- isTRUE(r$done) || (r$samples == 0 && r$units == 0)
-    } else {
-      blk <- src$read(i)
-      if (is.null(blk)) break
-      temp <- block_has_temp(blk)
-      for (p in block_pieces(blk, temp)) {
-        out[[length(out) + 1]] <- gc_segmenter_push(seg, p$x, p$y, p$z, p$t,
-                                                    p$from, p$to, rule, par)
-        n <- n + (p$to - p$from)
-      }
-      last <- isTRUE(blk$last)
-      rm(blk, p)
-    }
-    if (isTRUE(progress)) {
-      cat(sprintf("\rblock %d: %.1f hours read", i, n / src$sf / 3600))
-    }
-    if (last) break
-    if (!is.null(halt) && halt(out, n)) {
-      attr(out, "stopped") <- TRUE
-      break
-    }
-    if (isTRUE(src$from_file) && is.null(src$segment)) invisible(gc(full = TRUE))
-    i <- i + 1
-  }
-  if (isTRUE(progress)) cat("\n")
-  check_source_read(src, n)
-  attr(out, "samples") <- n
-  out
-}
-
-windows_frame <- function(chunks, s, sf) {
+# The segmenter's window table (gc_pump()'s `windows`) as rest_windows()'s
+# data frame.
+windows_frame <- function(table, s, sf) {
   col <- function(name) {
-    v <- unlist(lapply(chunks, `[[`, name), use.names = FALSE)
+    v <- table[[name]]
     if (is.null(v)) numeric(0) else v
   }
   first <- col("first")

@@ -126,9 +126,12 @@ n_seg <- nrow(rec)
 n <- n_seg
 seg_run <- function(r_arith, L) {
   function() {
-    s <- gravcal:::gc_segmenter_new(L, FALSE, r_arith)
-    gravcal:::gc_segmenter_push(s, rec$x, rec$y, rec$z, rec$temperature, 0, n,
-                                1L, c(0.013, 2))
+    src <- gravcal:::gc_source_columns(rec$x, rec$y, rec$z, rec$temperature)
+    gravcal:::gc_pump(src, "windows",
+                      list(window_samples = L, skip_zero = 0,
+                           r_arithmetic = as.numeric(r_arith), temperature = 1,
+                           rule = 1L, par = c(0.013, 2), block_units = -1,
+                           want_table = 0))
   }
 }
 seg <- list(

@@ -66,35 +66,6 @@ BEGIN_RCPP
     return R_NilValue;
 END_RCPP
 }
-// gc_decoder_segment
-Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule, Rcpp::NumericVector par, bool use_temperature);
-RcppExport SEXP _gravcal_gc_decoder_segment(SEXP ptrSEXP, SEXP segSEXP, SEXP max_unitsSEXP, SEXP ruleSEXP, SEXP parSEXP, SEXP use_temperatureSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    Rcpp::traits::input_parameter< double >::type max_units(max_unitsSEXP);
-    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
-    Rcpp::traits::input_parameter< bool >::type use_temperature(use_temperatureSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_decoder_segment(ptr, seg, max_units, rule, par, use_temperature));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_blocks_decode
-Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule, Rcpp::NumericVector par);
-RcppExport SEXP _gravcal_gc_blocks_decode(SEXP blocksSEXP, SEXP ptrSEXP, SEXP max_unitsSEXP, SEXP ruleSEXP, SEXP parSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type blocks(blocksSEXP);
-    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
-    Rcpp::traits::input_parameter< double >::type max_units(max_unitsSEXP);
-    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_blocks_decode(blocks, ptr, max_units, rule, par));
-    return rcpp_result_gen;
-END_RCPP
-}
 // gc_decoder_drain
 double gc_decoder_drain(SEXP ptr);
 RcppExport SEXP _gravcal_gc_decoder_drain(SEXP ptrSEXP) {
@@ -155,98 +126,6 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_blocks_new
-SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature, double temp_min_sd);
-RcppExport SEXP _gravcal_gc_blocks_new(SEXP segSEXP, SEXP per_hourSEXP, SEXP compatSEXP, SEXP temperatureSEXP, SEXP temp_min_sdSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    Rcpp::traits::input_parameter< double >::type per_hour(per_hourSEXP);
-    Rcpp::traits::input_parameter< bool >::type compat(compatSEXP);
-    Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
-    Rcpp::traits::input_parameter< double >::type temp_min_sd(temp_min_sdSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_blocks_new(seg, per_hour, compat, temperature, temp_min_sd));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_blocks_columns
-Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List& y, const Rcpp::List& z, const Rcpp::List& t, const Rcpp::NumericVector& from, const Rcpp::NumericVector& to, int rule, Rcpp::NumericVector par);
-RcppExport SEXP _gravcal_gc_blocks_columns(SEXP blocksSEXP, SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP ruleSEXP, SEXP parSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type blocks(blocksSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type x(xSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type y(ySEXP);
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::List& >::type t(tSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type from(fromSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type to(toSEXP);
-    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_blocks_columns(blocks, x, y, z, t, from, to, rule, par));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_segmenter_new
-SEXP gc_segmenter_new(double samples_per_window, bool skip_zero, bool r_arithmetic);
-RcppExport SEXP _gravcal_gc_segmenter_new(SEXP samples_per_windowSEXP, SEXP skip_zeroSEXP, SEXP r_arithmeticSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< double >::type samples_per_window(samples_per_windowSEXP);
-    Rcpp::traits::input_parameter< bool >::type skip_zero(skip_zeroSEXP);
-    Rcpp::traits::input_parameter< bool >::type r_arithmetic(r_arithmeticSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_segmenter_new(samples_per_window, skip_zero, r_arithmetic));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_segmenter_lazy_sd
-void gc_segmenter_lazy_sd(SEXP seg, double max_sd);
-RcppExport SEXP _gravcal_gc_segmenter_lazy_sd(SEXP segSEXP, SEXP max_sdSEXP) {
-BEGIN_RCPP
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    Rcpp::traits::input_parameter< double >::type max_sd(max_sdSEXP);
-    gc_segmenter_lazy_sd(seg, max_sd);
-    return R_NilValue;
-END_RCPP
-}
-// gc_segmenter_new_block
-bool gc_segmenter_new_block(SEXP seg);
-RcppExport SEXP _gravcal_gc_segmenter_new_block(SEXP segSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_segmenter_new_block(seg));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_segmenter_push
-Rcpp::List gc_segmenter_push(SEXP seg, const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, double from, double to, int rule, Rcpp::NumericVector par);
-RcppExport SEXP _gravcal_gc_segmenter_push(SEXP segSEXP, SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP fromSEXP, SEXP toSEXP, SEXP ruleSEXP, SEXP parSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temp(tempSEXP);
-    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
-    Rcpp::traits::input_parameter< double >::type to(toSEXP);
-    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type par(parSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_segmenter_push(seg, x, y, z, temp, from, to, rule, par));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_segmenter_state
-Rcpp::NumericVector gc_segmenter_state(SEXP seg);
-RcppExport SEXP _gravcal_gc_segmenter_state(SEXP segSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type seg(segSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_segmenter_state(seg));
-    return rcpp_result_gen;
-END_RCPP
-}
 // gc_select_points
 Rcpp::List gc_select_points(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, int min_per_bin, int max_per_bin, double min_distance, std::string arithmetic);
 RcppExport SEXP _gravcal_gc_select_points(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP min_per_binSEXP, SEXP max_per_binSEXP, SEXP min_distanceSEXP, SEXP arithmeticSEXP) {
@@ -304,6 +183,53 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_source_decoder
+SEXP gc_source_decoder(SEXP file);
+RcppExport SEXP _gravcal_gc_source_decoder(SEXP fileSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type file(fileSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_source_decoder(file));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_source_columns
+SEXP gc_source_columns(SEXP x, SEXP y, SEXP z, SEXP temperature);
+RcppExport SEXP _gravcal_gc_source_columns(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type x(xSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type y(ySEXP);
+    Rcpp::traits::input_parameter< SEXP >::type z(zSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type temperature(temperatureSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_source_columns(x, y, z, temperature));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_source_blocks
+SEXP gc_source_blocks(const Rcpp::List& first, const Rcpp::Function& fetch);
+RcppExport SEXP _gravcal_gc_source_blocks(SEXP firstSEXP, SEXP fetchSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type first(firstSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::Function& >::type fetch(fetchSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_source_blocks(first, fetch));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_pump
+Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts, Rcpp::Nullable<Rcpp::Function> on_block);
+RcppExport SEXP _gravcal_gc_pump(SEXP srcSEXP, SEXP stageSEXP, SEXP optsSEXP, SEXP on_blockSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type src(srcSEXP);
+    Rcpp::traits::input_parameter< const std::string& >::type stage(stageSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type opts(optsSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::Function> >::type on_block(on_blockSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_pump(src, stage, opts, on_block));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
@@ -311,24 +237,19 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_unit_samples", (DL_FUNC) &_gravcal_gc_decoder_unit_samples, 1},
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
-    {"_gravcal_gc_decoder_segment", (DL_FUNC) &_gravcal_gc_decoder_segment, 6},
-    {"_gravcal_gc_blocks_decode", (DL_FUNC) &_gravcal_gc_blocks_decode, 5},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},
     {"_gravcal_gc_use_avx2", (DL_FUNC) &_gravcal_gc_use_avx2, 0},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
-    {"_gravcal_gc_blocks_new", (DL_FUNC) &_gravcal_gc_blocks_new, 5},
-    {"_gravcal_gc_blocks_columns", (DL_FUNC) &_gravcal_gc_blocks_columns, 9},
-    {"_gravcal_gc_segmenter_new", (DL_FUNC) &_gravcal_gc_segmenter_new, 3},
-    {"_gravcal_gc_segmenter_lazy_sd", (DL_FUNC) &_gravcal_gc_segmenter_lazy_sd, 2},
-    {"_gravcal_gc_segmenter_new_block", (DL_FUNC) &_gravcal_gc_segmenter_new_block, 1},
-    {"_gravcal_gc_segmenter_push", (DL_FUNC) &_gravcal_gc_segmenter_push, 9},
-    {"_gravcal_gc_segmenter_state", (DL_FUNC) &_gravcal_gc_segmenter_state, 1},
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 7},
     {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 13},
     {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},
     {"_gravcal_gc_release_memory", (DL_FUNC) &_gravcal_gc_release_memory, 0},
+    {"_gravcal_gc_source_decoder", (DL_FUNC) &_gravcal_gc_source_decoder, 1},
+    {"_gravcal_gc_source_columns", (DL_FUNC) &_gravcal_gc_source_columns, 4},
+    {"_gravcal_gc_source_blocks", (DL_FUNC) &_gravcal_gc_source_blocks, 2},
+    {"_gravcal_gc_pump", (DL_FUNC) &_gravcal_gc_pump, 4},
     {NULL, NULL, 0}
 };
 

@@ -10,15 +10,9 @@
 #include "gravcal/decode.hpp"
 #include "gravcal/simd.hpp"
 #include "decoders.h"
-#include "windows_glue.h"
+#include "sources_glue.h"
 
 namespace {
-
-// What an open file needs kept alive: the byte source, the decoder on it.
-struct OpenFile {
-  std::unique_ptr<gravcal::ByteSource> bytes;
-  std::unique_ptr<gravcal::Decoder> decoder;
-};
 
 gravcal::Options to_options(const Rcpp::List& opts) {
   gravcal::Options o;
@@ -39,11 +33,9 @@ gravcal::Options to_options(const Rcpp::List& opts) {
   return o;
 }
 
-OpenFile* get(SEXP ptr) {
-  Rcpp::XPtr<OpenFile> p(ptr);
-  if (p.get() == nullptr) Rcpp::stop("the file is closed");
-  return p.get();
-}
+using gravcal_glue::OpenFile;
+
+OpenFile* get(SEXP ptr) { return gravcal_glue::open_file(ptr); }
 
 // A fixed buffer of `chunk` samples (x, y, z and, when asked, temperature)
 // that the decoder fills and the core reads, over and over.
@@ -171,86 +163,6 @@ Rcpp::List gc_decoder_report(SEXP ptr) {
 void gc_decoder_close(SEXP ptr) {
   Rcpp::XPtr<OpenFile> p(ptr);
   p.release();
-}
-
-// Streams at most `max_units` format units (negative: to the end) from the
-// decoder into the segmenter through a fixed buffer, without building R
-// vectors of samples. Returns list(windows = the completed windows, samples
-// = samples pushed, units, done).
-// [[Rcpp::export(rng = false)]]
-Rcpp::List gc_decoder_segment(SEXP ptr, SEXP seg, double max_units, int rule,
-                              Rcpp::NumericVector par, bool use_temperature) {
-  OpenFile* f = get(ptr);
-  Rcpp::XPtr<gravcal_glue::SegmenterBox> box(seg);
-  if (box->lazy_max_sd > 0) Rcpp::stop("a lazy segmenter is for GGIR's blocks only");
-  const gravcal_glue::RestRule is_rest(rule, par);
-  ChunkBuffer cb(use_temperature && f->decoder->info().has_temperature);
-  gravcal::SampleBuffer& out = cb.out;
-  gravcal_glue::WindowTable table;
-  std::int64_t left = max_units < 0 ? -1 : static_cast<std::int64_t>(max_units);
-  std::int64_t units = 0;
-  double samples = 0;
-  int rounds = 0;
-  while (!f->decoder->done()) {
-    out.n = 0;
-    const std::int64_t u = f->decoder->read(out, left);
-    units += u;
-    if (left > 0) left -= u;
-    box->seg.push(out.x, out.y, out.z, out.t, out.n,
-                  [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); });
-    samples += static_cast<double>(out.n);
-    if (out.n == 0 && u == 0) break;  // nothing more this call
-    // every unit read and all its samples given (see gc_blocks_decode())
-    if (left == 0 && !out.full()) break;
-    if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
-  }
-  return Rcpp::List::create(Rcpp::Named("windows") = table.to_list(),
-                            Rcpp::Named("samples") = samples,
-                            Rcpp::Named("units") = static_cast<double>(units),
-                            Rcpp::Named("done") = f->decoder->done());
-}
-
-// One of GGIR's blocks, `max_units` format units, from the decoder through
-// GGIR's block rules (`blocks`, see gc_blocks_new()) into their segmenter.
-// The decoder writes straight into the block rules' buffer (no copy).
-// Returns the block's result (gc_blocks_columns()) with `units` and `done`.
-// [[Rcpp::export(rng = false)]]
-Rcpp::List gc_blocks_decode(SEXP blocks, SEXP ptr, double max_units, int rule,
-                            Rcpp::NumericVector par) {
-  OpenFile* f = get(ptr);
-  Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
-  gravcal_glue::check_lazy_rule(*box, rule, par);
-  const gravcal_glue::RestRule is_rest(rule, par);
-  const bool temperature = box->temperature && f->decoder->info().has_temperature;
-  gravcal_glue::WindowTable table;
-  auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
-  box->blocks.begin_block();
-  std::int64_t left = max_units < 0 ? -1 : static_cast<std::int64_t>(max_units);
-  std::int64_t units = 0;
-  int rounds = 0;
-  while (!f->decoder->done()) {
-    const gravcal::BlockSpace s = box->blocks.space(ChunkBuffer::chunk);
-    gravcal::SampleBuffer out;
-    out.x = s.x;
-    out.y = s.y;
-    out.z = s.z;
-    out.t = temperature ? s.t : nullptr;
-    out.capacity = s.capacity;
-    const std::int64_t u = f->decoder->read(out, left);
-    units += u;
-    if (left > 0) left -= u;
-    box->blocks.commit(out.n, out.t != nullptr, sink);
-    if (out.n == 0 && u == 0) break;
-    // the units are all read and their samples all given (out has room
-    // left), or out filled part-way through the last unit: then the next
-    // call, with left == 0, gives the rest of it
-    if (left == 0 && !out.full()) break;
-    if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
-  }
-  Rcpp::List res = gravcal_glue::block_result(table, box->blocks.end_block(sink));
-  res["units"] = static_cast<double>(units);
-  res["done"] = f->decoder->done();
-  return res;
 }
 
 // Decodes the rest of the file into a fixed buffer and drops the samples:

@@ -6,39 +6,11 @@
 #include <string>
 #include <vector>
 
-#include <R_ext/Applic.h>
-
 #include "gravcal/ggir_blocks.hpp"
 #include "gravcal/icp.hpp"
+#include "r_services.h"
 #include "windows_glue.h"
 
-namespace {
-
-// Weighted least squares by R's own LINPACK routine dqrls, with lm.wfit's
-// tolerance and its handling of aliased columns: the numbers GGIR's lm.wfit
-// calls get, to the last bit (see icp.hpp, IcpConfig::r_arithmetic).
-struct RLeastSquares {
-  mutable std::vector<double> qty, qraux, work, b;
-  mutable std::vector<int> jpvt;
-  void operator()(double* X, const double* y, std::size_t n, int p,
-                  double* coef, double* rsd) const {
-    int nn = static_cast<int>(n), pp = p, ny = 1, rank = 0;
-    double tol = 1e-7;
-    qty.assign(n, 0.0);
-    qraux.assign(static_cast<std::size_t>(p), 0.0);
-    work.assign(2 * static_cast<std::size_t>(p), 0.0);
-    b.assign(static_cast<std::size_t>(p), 0.0);
-    jpvt.resize(static_cast<std::size_t>(p));
-    for (int j = 0; j < p; ++j) jpvt[static_cast<std::size_t>(j)] = j + 1;
-    std::vector<double> yy(y, y + n);
-    F77_CALL(dqrls)(X, &nn, &pp, yy.data(), &ny, &tol, b.data(), rsd,
-                    qty.data(), &rank, jpvt.data(), qraux.data(), work.data());
-    for (int j = 0; j < p; ++j) coef[j] = NA_REAL;
-    for (int j = 0; j < rank; ++j) coef[jpvt[static_cast<std::size_t>(j)] - 1] = b[static_cast<std::size_t>(j)];
-  }
-};
-
-}  // namespace
 
 // x, y, z: window means; temp: their temperatures or NULL. rule: "ggir_r"
 // (GGIR's stopping statistic in GGIR's arithmetic with R's least squares,
@@ -79,7 +51,7 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
         for (int k = 0; k < 3; ++k) tr.push_back(q.offset[k]);
         for (int k = 0; k < 3; ++k) tr.push_back(q.tempoffset[k]);
         tr.push_back(q.statistic);
-      }, RLeastSquares());
+      }, gravcal_glue::RLeastSquares());
   Rcpp::NumericMatrix tm(10, static_cast<int>(tr.size() / 10));
   std::copy(tr.begin(), tr.end(), tm.begin());
   return Rcpp::List::create(
@@ -117,59 +89,4 @@ Rcpp::IntegerVector gc_ggir_duplicates(const Rcpp::NumericMatrix& table,
     out[static_cast<R_xlen_t>(i)] = static_cast<int>(cut[i] + 1);
   }
   return out;
-}
-
-// GGIR's block rules in front of segmenter `seg` (see ggir_blocks.hpp);
-// temp_min_sd: the threshold of the temperature's sd.
-// [[Rcpp::export(rng = false)]]
-SEXP gc_blocks_new(SEXP seg, double per_hour, bool compat, bool temperature,
-                   double temp_min_sd) {
-  if (!(per_hour >= 1)) Rcpp::stop("per_hour must be at least 1");
-  return Rcpp::XPtr<gravcal_glue::BlocksBox>(
-      new gravcal_glue::BlocksBox(seg, per_hour, compat, temperature, temp_min_sd),
-      true);
-}
-
-// One block from columns in memory: the pieces [from[k], to[k]) (0-based) of
-// x[[k]], y[[k]], z[[k]] and t[[k]] (NULL without temperature), in order.
-// [[Rcpp::export(rng = false)]]
-Rcpp::List gc_blocks_columns(SEXP blocks, const Rcpp::List& x, const Rcpp::List& y,
-                             const Rcpp::List& z, const Rcpp::List& t,
-                             const Rcpp::NumericVector& from,
-                             const Rcpp::NumericVector& to, int rule,
-                             Rcpp::NumericVector par) {
-  Rcpp::XPtr<gravcal_glue::BlocksBox> box(blocks);
-  gravcal_glue::check_lazy_rule(*box, rule, par);
-  const gravcal_glue::RestRule is_rest(rule, par);
-  const R_xlen_t np = x.size();
-  if (y.size() != np || z.size() != np || t.size() != np || from.size() != np ||
-      to.size() != np)
-    Rcpp::stop("piece lists differ in length");
-  gravcal_glue::WindowTable table;
-  auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
-  box->blocks.begin_block();
-  constexpr std::size_t chunk = 1u << 16;
-  for (R_xlen_t k = 0; k < np; ++k) {
-    Rcpp::NumericVector xv(x[k]), yv(y[k]), zv(z[k]);
-    const R_xlen_t n = xv.size();
-    if (yv.size() != n || zv.size() != n) Rcpp::stop("x, y, z lengths differ");
-    const double* tp = nullptr;
-    Rcpp::NumericVector tv;
-    if (box->temperature && !Rf_isNull(t[k])) {
-      tv = Rcpp::NumericVector(t[k]);
-      if (tv.size() != n) Rcpp::stop("temperature length differs");
-      tp = tv.begin();
-    }
-    if (!(from[k] >= 0 && to[k] <= static_cast<double>(n) && from[k] <= to[k]))
-      Rcpp::stop("piece bounds out of range");
-    std::size_t i = static_cast<std::size_t>(from[k]);
-    const std::size_t end = static_cast<std::size_t>(to[k]);
-    while (i < end) {
-      const std::size_t m = std::min(chunk, end - i);
-      box->blocks.push(xv.begin() + i, yv.begin() + i, zv.begin() + i,
-                       tp ? tp + i : nullptr, m, sink);
-      i += m;
-    }
-  }
-  return gravcal_glue::block_result(table, box->blocks.end_block(sink));
 }

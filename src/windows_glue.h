@@ -6,6 +6,7 @@
 
 #include <Rcpp.h>
 
+#include <cmath>
 #include <vector>
 
 #include "gravcal/gravcal.hpp"
@@ -81,13 +82,15 @@ struct WindowTable {
 // A segmenter together with the window buffer it borrows in R-compatible
 // arithmetic (the core allocates nothing itself).
 struct SegmenterBox {
-  SegmenterBox(double samples_per_window, bool skip_zero)
-      : L(samples_per_window), seg(samples_per_window, skip_zero) {}
-  double L;
+  SegmenterBox(double samples_per_window, bool skip_zero, bool r_arithmetic)
+      : seg(samples_per_window, skip_zero) {
+    if (r_arithmetic) {
+      buffer.assign(3 * (static_cast<std::size_t>(std::ceil(samples_per_window)) + 1), 0.0);
+      if (!seg.use_r_arithmetic(buffer.data(), buffer.size()))
+        Rcpp::stop("could not set up the window buffer");
+    }
+  }
   std::vector<double> buffer;
-  std::vector<double> held;    // Segmenter::lazy_r_sd()'s buffer and state
-  gravcal::LazySd lazy;
-  double lazy_max_sd = 0.0;    // > 0: lazy_r_sd() with this threshold
   gravcal::Segmenter seg;
 };
 
@@ -109,28 +112,6 @@ struct RestRule {
   gravcal::RangeRestRule range;
   gravcal::SdRestRule sd;
 };
-
-// GGIR's block rules in front of a segmenter (ggir_blocks.hpp). Keeps the
-// segmenter's R object alive for as long as it is used.
-struct BlocksBox {
-  BlocksBox(SEXP seg, double per_hour, bool compat, bool temperature,
-            double temp_min_sd)
-      : seg_keep(seg),
-        blocks(Rcpp::XPtr<SegmenterBox>(seg)->seg, per_hour, compat, temperature,
-               temp_min_sd),
-        temperature(temperature) {}
-  Rcpp::RObject seg_keep;
-  gravcal::GgirBlocks blocks;
-  bool temperature;
-};
-
-// A lazy segmenter (Segmenter::lazy_r_sd()) gives R's sds only where the
-// sd rule with its own threshold can see them: refuse any other rule.
-inline void check_lazy_rule(const BlocksBox& box, int rule, const Rcpp::NumericVector& par) {
-  const double m = Rcpp::XPtr<SegmenterBox>(box.seg_keep)->lazy_max_sd;
-  if (m > 0 && !(rule == 1 && par.size() >= 1 && par[0] == m))
-    Rcpp::stop("this segmenter gives R's sds for the sd rule with max_sd = %g only", m);
-}
 
 // A block's result for R: the windows and what the block rules saw.
 inline Rcpp::List block_result(const WindowTable& table, const gravcal::GgirBlockInfo& b) {

@@ -372,28 +372,19 @@ test_that("a block gives every sample of its pages when the buffer fills inside 
   gravcal:::write_geneactiv_bin(ga_sim(700 * 300, 100), f, sf = 100)
   for (compat in 0:1) {
     h <- gravcal:::native_open(f, "geneactiv", list(compat = compat))
-    seg <- gravcal:::gc_segmenter_new(1000, FALSE, compat == 1)
-    got <- list()
-    repeat {
-      r <- gravcal:::gc_decoder_segment(h$ptr, seg, 219, 0L, c(0.05, 7), TRUE)
-      got[[length(got) + 1]] <- c(r$units, r$samples)
-      if (r$done || r$units == 0) break
-    }
+    got <- pump_windows(gravcal:::gc_source_decoder(h$ptr), 1000, compat == 1,
+                        rule = 0L, par = c(0.05, 7), block_units = 219)$blocks
     gravcal:::gc_decoder_close(h$ptr)
-    got <- do.call(rbind, got)
+    got <- matrix(got, ncol = 2, byrow = TRUE)
     expect_identical(got[, 1], c(219, 219, 219, 43))
     expect_identical(got[, 2], got[, 1] * 300)
     # GGIR's blocks: the block rules' rows are the block's pages' samples
     h <- gravcal:::native_open(f, "geneactiv", list(compat = compat))
-    seg <- gravcal:::gc_segmenter_new(1000, FALSE, compat == 1)
-    run <- gravcal:::gc_blocks_new(seg, 360000, compat == 1, TRUE, 0.1)
-    rows <- numeric(0)
-    repeat {
-      r <- gravcal:::gc_blocks_decode(run, h$ptr, 219, 1L, c(0.013, 2))
-      rows <- c(rows, r$rows)
-      if (r$done || r$units == 0) break
-    }
+    res <- gravcal:::gc_pump(gravcal:::gc_source_decoder(h$ptr), "blocks",
+                             list(sf = 100, compat = compat, temperature = 1,
+                                  per_hour = 360000, temp_min_sd = 0.1,
+                                  par = c(0.013, 2), block_units = 219))
     gravcal:::gc_decoder_close(h$ptr)
-    expect_identical(rows, c(219, 219, 219, 43) * 300)
+    expect_identical(vapply(res, `[[`, 0, "rows"), c(219, 219, 219, 43) * 300)
   }
 })

@@ -65,9 +65,7 @@ test_that("R-compatible windows are R's own numbers, bit for bit", {
   z <- round(rnorm(n, 0.9, 0.01), 3)
   tt <- 25 + cumsum(rnorm(n, 0, 0.001))
   L <- 600
-  seg <- gravcal:::gc_segmenter_new(L, FALSE, TRUE)
-  gravcal:::gc_segmenter_new_block(seg)
-  w <- gravcal:::gc_segmenter_push(seg, x, y, z, tt, 0, n, 1L, c(0.013, 2))
+  w <- pump_windows(gravcal:::gc_source_columns(x, y, z, tt), L, TRUE)$windows
   # GGIR's rollMean (cumsum then diff) and rollSD (sd per column)
   rmean <- function(v) diff(cumsum(c(0, v))[seq(1, n + 1, by = L)]) / L
   rsd <- function(v) apply(matrix(v, L), 2, stats::sd)
@@ -77,11 +75,16 @@ test_that("R-compatible windows are R's own numbers, bit for bit", {
   expect_identical(w$sd_y, rsd(y))
   expect_identical(w$mean_norm, rmean(sqrt(x^2 + y^2 + z^2)))
   expect_identical(w$temperature, rmean(tt))
-  # a new block restarts the cumulative sums
-  expect_true(gravcal:::gc_segmenter_new_block(seg))
-  w2 <- gravcal:::gc_segmenter_push(seg, x, y, z, tt, 0, 150, 1L, c(0.013, 2))
-  expect_false(gravcal:::gc_segmenter_new_block(seg))
-  expect_length(w2$mean_x, 0)
+  # a new block of GGIR's (here each third of the samples) restarts the
+  # cumulative sums: each block's means are its own cumsum's differences
+  per <- n / 3
+  b <- pump_blocks(cut_blocks(x, y, z, tt, c(0, per, 2 * per, n)), sf = L / 10,
+                   compat = TRUE, per_hour = per)
+  for (k in 1:3) {
+    r <- (k - 1) * per + seq_len(per)
+    expect_identical(b[[k]]$windows$mean_x,
+                     diff(cumsum(c(0, x[r]))[seq(1, per + 1, by = L)]) / L)
+  }
 })
 
 test_that("fit_icp(): iterations beyond an integer, text temperature", {

@@ -108,13 +108,8 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
     list(used = P[seq_len(use), ], rest = P[-seq_len(use), ])
   }
   for (compat in c(TRUE, FALSE)) {
-    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
-    run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE, 0.01)
-    feed <- function(b) {
-      gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
-                                  list(b$t), 0, nrow(b), 1L, c(0.013, 2))
-    }
-    r1 <- feed(b1)
+    res <- pump_blocks(list(b1, b2), sf, compat, per_hour = H)
+    r1 <- res[[1]]
     keep <- !(b1$x == 0 & b1$y == 0 & b1$z == 0)
     e1 <- ref_block(b1[keep, ], TRUE, compat)
     expect_identical(r1$rows, as.numeric(n1))
@@ -136,7 +131,7 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
       expect_equal(r1$windows$mean_x[1:5], gmean, tolerance = 1e-14)
     }
     # the carry goes in front of the next block
-    r2 <- feed(b2)
+    r2 <- res[[2]]
     e2 <- ref_block(rbind(e1$rest, b2), FALSE, compat)
     expect_identical(r2$used, as.numeric(nrow(e2$used)))
     expect_equal(r2$temp_sd, stats::sd(e2$used$t, na.rm = TRUE), tolerance = 1e-13)
@@ -149,17 +144,10 @@ test_that("GGIR's block rules: zeros, whole hours, carry, temperature", {
   # a block of whole hours: gravcal carries nothing; GGIR's compatible mode
   # puts the previous carry in front once more
   for (compat in c(TRUE, FALSE)) {
-    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
-    run <- gravcal:::gc_blocks_new(seg, H, compat, FALSE, 0.01)
-    feed <- function(b) {
-      gravcal:::gc_blocks_columns(run, list(b$x), list(b$y), list(b$z),
-                                  list(NULL), 0, nrow(b), 1L, c(0.013, 2))
-    }
-    feed(mk(H + 5))
-    r <- feed(mk(2 * H - 5))
-    expect_identical(r$used, 2 * H)
-    r <- feed(mk(H))
-    expect_identical(r$ld, if (compat) H + 5 else H)
+    res <- pump_blocks(list(mk(H + 5), mk(2 * H - 5), mk(H)), sf, compat,
+                       temperature = FALSE, per_hour = H)
+    expect_identical(res[[2]]$used, 2 * H)
+    expect_identical(res[[3]]$ld, if (compat) H + 5 else H)
   }
 })
 
@@ -197,11 +185,9 @@ test_that("the temperature check decides as R's sd() at the threshold", {
   for (k in near) {
     t <- sd_of(k)
     for (compat in c(TRUE, FALSE)) {
-      seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, compat)
-      run <- gravcal:::gc_blocks_new(seg, H, compat, TRUE, thr)
-      r <- gravcal:::gc_blocks_columns(run, list(rep(0.1, H)), list(rep(0.2, H)),
-                                       list(rep(0.97, H)), list(t), 0, H, 1L,
-                                       c(0.013, 2))
+      r <- pump_blocks(list(list(x = rep(0.1, H), y = rep(0.2, H),
+                                 z = rep(0.97, H), t = t)),
+                       sf, compat, temp_min_sd = thr, per_hour = H)[[1]]
       expect_identical(r$used, as.numeric(H))
       if (compat) {
         expect_true(r$temp_sd_exact)
@@ -214,11 +200,9 @@ test_that("the temperature check decides as R's sd() at the threshold", {
   # far from the threshold the fast sd decides; R's decision all the same
   for (spread in c(0, 1e-3, 0.5 * thr, 0.999999 * thr, 1.000001 * thr, 3)) {
     t <- 25 + spread * rep(c(-1, 1), each = 7, length.out = H)
-    seg <- gravcal:::gc_segmenter_new(10 * sf, FALSE, TRUE)
-    run <- gravcal:::gc_blocks_new(seg, H, TRUE, TRUE, thr)
-    r <- gravcal:::gc_blocks_columns(run, list(rep(0.1, H)), list(rep(0.2, H)),
-                                     list(rep(0.97, H)), list(t), 0, H, 1L,
-                                     c(0.013, 2))
+    r <- pump_blocks(list(list(x = rep(0.1, H), y = rep(0.2, H),
+                               z = rep(0.97, H), t = t)),
+                     sf, TRUE, temp_min_sd = thr, per_hour = H)[[1]]
     expect_false(r$temp_sd_exact)
     expect_identical(r$temp_sd < thr, stats::sd(t) < thr)
     expect_equal(r$temp_sd, stats::sd(t), tolerance = 1e-13)

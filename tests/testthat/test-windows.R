@@ -40,13 +40,10 @@ test_that("the segmenter gives identical windows however the signal is split", {
   }
   # also through the core directly with random, uneven chunk boundaries
   s <- gravcal:::as_samples(rec)
-  seg <- gravcal:::gc_segmenter_new(150, TRUE)
   cuts <- sort(unique(c(0, sample(nrow(rec), 40), nrow(rec))))
-  parts <- lapply(seq_len(length(cuts) - 1), function(i) {
-    gravcal:::gc_segmenter_push(seg, s$x, s$y, s$z, s$temperature,
-                                cuts[i], cuts[i + 1], 0L, c(0.12, 7))
-  })
-  got <- gravcal:::windows_frame(parts, s, 30)
+  src <- blocks_source(cut_blocks(s$x, s$y, s$z, s$temperature, cuts))
+  parts <- pump_windows(src, 150, rule = 0L, par = c(0.12, 7), skip_zero = TRUE)
+  got <- gravcal:::windows_frame(parts$windows, s, 30)
   expect_identical(got, whole[names(got)], ignore_attr = TRUE)
 })
 
@@ -153,12 +150,8 @@ test_that("R-compatible windows do not depend on the chunking", {
   t <- 25 + stats::rnorm(n, 0, 0.1)
   x[3333] <- NaN  # this window takes the sample-by-sample path
   one <- function(r, cuts) {
-    s <- gravcal:::gc_segmenter_new(1000, FALSE, r)
-    out <- lapply(seq_len(length(cuts) - 1), function(i) {
-      gravcal:::gc_segmenter_push(s, x, y, z, t, cuts[i], cuts[i + 1], 1L,
-                                  c(0.013, 2))
-    })
-    do.call(rbind, lapply(out, as.data.frame))
+    src <- blocks_source(cut_blocks(x, y, z, t, cuts))
+    as.data.frame(pump_windows(src, 1000, r)$windows)
   }
   for (r in c(TRUE, FALSE)) {
     a <- one(r, c(0, n))

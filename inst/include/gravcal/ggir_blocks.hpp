@@ -84,6 +84,7 @@ struct BlockSpace {
   double* y = nullptr;
   double* z = nullptr;
   double* t = nullptr;
+  double* time = nullptr;  // null: the stage does not take time stamps
   std::size_t capacity = 0;
 };
 
@@ -520,14 +521,15 @@ class GgirBlocks {
   std::vector<Run> runs_;         // the block's temperatures, run-length coded
 };
 
-// GGIR's duplicate filter on its window table (column-major, n_row rows,
-// columns 1 to 6, 0-based, its means and sds): for each pair of consecutive
-// selected rows rows[i], rows[i + 1] (0-based), i < n - 1, how many of the
-// six hold equal values, the count taken as R's sum of logicals (NA when a
-// compared value is NaN, and then equal to nothing). Returns the positions
-// i where the count is `need` (GGIR drops those windows: 3 in compatible
-// mode). The caller guarantees rows[i] < n_row and at least 7 columns.
-inline std::vector<std::size_t> duplicate_cuts(const double* table, std::size_t n_row,
+// GGIR's duplicate filter on its window table: col[1] to col[6] are its
+// means and sds (col[0], the mean norm, is not compared). For each pair of
+// consecutive selected rows rows[i], rows[i + 1] (0-based), i < n - 1, how
+// many of the six hold equal values, the count taken as R's sum of logicals
+// (NA when a compared value is NaN, and then equal to nothing). Returns the
+// positions i where the count is `need` (GGIR drops those windows: 3 in
+// compatible mode). The caller guarantees that every rows[i] is a row of
+// every column.
+inline std::vector<std::size_t> duplicate_cuts(const double* const* col,
                                                const std::size_t* rows, std::size_t n,
                                                int need) {
   std::vector<std::size_t> cut;
@@ -535,13 +537,22 @@ inline std::vector<std::size_t> duplicate_cuts(const double* table, std::size_t 
     int same = 0;
     bool na = false;
     for (std::size_t c = 1; c < 7 && !na; ++c) {
-      const double a = table[c * n_row + rows[i]], b = table[c * n_row + rows[i + 1]];
+      const double a = col[c][rows[i]], b = col[c][rows[i + 1]];
       na = std::isnan(a) || std::isnan(b);
       same += a == b;
     }
     if (!na && same == need) cut.push_back(i);
   }
   return cut;
+}
+
+// The same on a column-major table of n_row rows and at least 7 columns.
+inline std::vector<std::size_t> duplicate_cuts(const double* table, std::size_t n_row,
+                                               const std::size_t* rows, std::size_t n,
+                                               int need) {
+  const double* col[7];
+  for (std::size_t c = 0; c < 7; ++c) col[c] = table + c * n_row;
+  return duplicate_cuts(col, rows, n, need);
 }
 
 }  // namespace gravcal

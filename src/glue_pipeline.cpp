@@ -1,0 +1,303 @@
+// Rcpp glue for the one pump (pipeline.hpp): makes a source, runs one stage
+// over it (the segmenter, GGIR's procedure, or a collector of samples) and
+// converts the result. Nothing here decides anything about the samples.
+#include <Rcpp.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gravcal/ggir_procedure.hpp"
+#include "gravcal/pipeline.hpp"
+#include "r_services.h"
+#include "sources_glue.h"
+#include "windows_glue.h"
+
+using gravcal_glue::SourceBox;
+
+namespace {
+
+SourceBox* source(SEXP ptr) {
+  Rcpp::XPtr<SourceBox> p(ptr);
+  if (p.get() == nullptr || !p->src) Rcpp::stop("the source is closed");
+  return p.get();
+}
+
+double num(const Rcpp::List& o, const char* name) {
+  if (!o.containsElementNamed(name)) Rcpp::stop("option '%s' is missing", name);
+  return Rcpp::as<double>(o[name]);
+}
+
+bool interrupt_tick() {
+  Rcpp::checkUserInterrupt();  // throws on Ctrl-C
+  return false;
+}
+
+// The segmenter over the source, block by block (block_units units; < 0:
+// one block), on_block(samples, windows) after each block but the last
+// (windows: the table so far when want_table, else NULL) returning TRUE to
+// stop.
+Rcpp::List run_windows(gravcal::Source& src, const Rcpp::List& o,
+                       Rcpp::Nullable<Rcpp::Function> on_block) {
+  const double L = num(o, "window_samples");
+  if (!(L >= 1.0 && L < 1e7)) Rcpp::stop("window_samples must be in [1, 1e7)");
+  gravcal_glue::SegmenterBox box(L, num(o, "skip_zero") != 0, num(o, "r_arithmetic") != 0);
+  Rcpp::NumericVector par = o["par"];
+  const gravcal_glue::RestRule is_rest(static_cast<int>(num(o, "rule")), par);
+  gravcal::SegmenterStage stage(box.seg, num(o, "temperature") != 0);
+  gravcal_glue::WindowTable table;
+  auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
+  const double bu = num(o, "block_units");
+  const std::int64_t units = bu < 0 ? -1 : static_cast<std::int64_t>(bu);
+  const bool want_table = num(o, "want_table") != 0;
+  double samples = 0;
+  bool stopped = false;
+  std::vector<double> per_block;  // units and samples of each block
+  for (;;) {
+    const gravcal::PumpResult r = gravcal::pump(src, stage, units, sink, interrupt_tick);
+    samples += static_cast<double>(r.samples);
+    per_block.push_back(static_cast<double>(r.units));
+    per_block.push_back(static_cast<double>(r.samples));
+    if (r.done || (r.samples == 0 && r.units == 0)) break;
+    if (on_block.isNotNull()) {
+      Rcpp::Function f(on_block.get());
+      SEXP tab = want_table ? Rcpp::RObject(table.to_list()) : Rcpp::RObject(R_NilValue);
+      if (Rcpp::as<bool>(f(samples, tab))) {
+        stopped = true;
+        break;
+      }
+    }
+  }
+  const gravcal::Segmenter& s = box.seg;
+  return Rcpp::List::create(
+      Rcpp::Named("windows") = table.to_list(), Rcpp::Named("samples") = samples,
+      Rcpp::Named("stopped") = stopped, Rcpp::Named("blocks") = Rcpp::wrap(per_block),
+      Rcpp::Named("skipped_zero") = static_cast<double>(s.skipped_zero()),
+      Rcpp::Named("pending") = static_cast<double>(s.pending()));
+}
+
+// GGIR's block rules alone over the source, one block of block_units units
+// at a time, with the segmenter behind them: per block, its windows and what
+// the rules saw (for the tests of the rules; the procedure is run_ggir()).
+Rcpp::List run_blocks(gravcal::Source& src, const Rcpp::List& o) {
+  const double sf = num(o, "sf");
+  if (!(10 * sf >= 1 && 10 * sf < 1e7)) Rcpp::stop("sf out of range");
+  const bool compat = num(o, "compat") != 0;
+  gravcal_glue::SegmenterBox box(10 * sf, false, compat);
+  const bool temp = num(o, "temperature") != 0 && src.has_temperature();
+  gravcal::GgirBlocks blocks(box.seg, num(o, "per_hour"), compat, temp, num(o, "temp_min_sd"));
+  gravcal::BlocksStage stage(blocks, temp);
+  Rcpp::NumericVector par = o["par"];
+  const gravcal_glue::RestRule is_rest(1, par);
+  const std::int64_t units = static_cast<std::int64_t>(num(o, "block_units"));
+  Rcpp::List out;
+  for (;;) {
+    gravcal_glue::WindowTable table;
+    auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
+    const gravcal::GgirBlockRead r =
+        gravcal::read_ggir_block(src, blocks, stage, units, sink, interrupt_tick);
+    if (r.pump.units == 0 && r.pump.samples == 0) break;
+    Rcpp::List b = gravcal_glue::block_result(table, r.info);
+    b["units"] = static_cast<double>(r.pump.units);
+    b["done"] = r.pump.done;
+    out.push_back(b);
+    if (r.pump.done) break;
+  }
+  return out;
+}
+
+// Every sample of the source into R vectors.
+Rcpp::List run_samples(gravcal::Source& src, const Rcpp::List& o) {
+  const double chunk = o.containsElementNamed("chunk") ? num(o, "chunk") : 65536.0;
+  if (!(chunk >= 1 && chunk <= 1e8)) Rcpp::stop("chunk must be in [1, 1e8]");
+  gravcal::CollectStage stage(src.has_temperature(), num(o, "time") != 0,
+                              static_cast<std::size_t>(chunk));
+  gravcal::pump(src, stage, -1, [](const gravcal::WindowStats&) {}, interrupt_tick);
+  const char* names[5] = {"x", "y", "z", "temperature", "time"};
+  const bool on[5] = {true, true, true, stage.temperature(), num(o, "time") != 0};
+  Rcpp::List out;
+  for (int c = 0; c < 5; ++c) {
+    if (!on[c]) continue;
+    out[names[c]] = Rcpp::NumericVector(stage.col[c].begin(), stage.col[c].end());
+    std::vector<double>().swap(stage.col[c]);
+  }
+  return out;
+}
+
+// What GGIR's procedure borrows from R.
+class RHost : public gravcal::GgirHost {
+ public:
+  RHost(bool verbose, Rcpp::Nullable<Rcpp::Function> on_block)
+      : verbose_(verbose), on_block_(on_block) {}
+  double round_digits(double x, int digits) override {
+    return R::fround(x, static_cast<double>(digits));
+  }
+  void least_squares(double* X, const double* y, std::size_t n, int p, double* coef,
+                     double* rsd) override {
+    ls_(X, y, n, p, coef, rsd);
+  }
+  void print(const std::string& s) override {
+    if (verbose_) Rprintf("%s", s.c_str());
+  }
+  void warn(const std::string& s) override { warnings.push_back(s); }
+  void block_added(int i) override {
+    if (on_block_.isNotNull()) Rcpp::Function(on_block_.get())(i);
+  }
+  bool interrupted() override { return interrupt_tick(); }
+  std::vector<std::string> warnings;
+
+ private:
+  bool verbose_;
+  Rcpp::Nullable<Rcpp::Function> on_block_;
+  gravcal_glue::RLeastSquares ls_;
+};
+
+const char* qc_name(gravcal::GgirQc q) {
+  switch (q) {
+    case gravcal::GgirQc::done: return "done";
+    case gravcal::GgirQc::done_no_temp: return "done_no_temp";
+    case gravcal::GgirQc::attempted: return "attempted";
+    case gravcal::GgirQc::no_decrease: return "no_decrease";
+    case gravcal::GgirQc::no_sphere: return "no_sphere";
+    case gravcal::GgirQc::no_rest: return "no_rest";
+    case gravcal::GgirQc::no_data: return "no_data";
+    case gravcal::GgirQc::not_finite: return "not_finite";
+    case gravcal::GgirQc::none: break;
+  }
+  return "";
+}
+
+Rcpp::RObject vec3(const double* v, bool present) {
+  if (!present) return R_NilValue;
+  return Rcpp::NumericVector(v, v + 3);
+}
+
+Rcpp::RObject scalar(double v, bool present) {
+  if (!present) return R_NilValue;
+  return Rcpp::NumericVector::create(v);
+}
+
+// GGIR's procedure over the source (ggir_procedure.hpp).
+Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
+                    Rcpp::Nullable<Rcpp::Function> on_block) {
+  gravcal::GgirConfig c;
+  c.compat = num(o, "compat") != 0;
+  c.sf = num(o, "sf");
+  if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
+  c.block_units = num(o, "block_units");
+  c.short_block_rows = num(o, "short_block_rows");
+  c.temperature = num(o, "temperature") != 0;
+  c.lazy = num(o, "lazy") != 0;
+  c.spherecrit = num(o, "spherecrit");
+  c.minloadcrit = num(o, "minloadcrit");
+  c.max_sd = num(o, "max_sd");
+  c.max_abs_mean = num(o, "max_abs_mean");
+  c.min_rest = static_cast<int>(num(o, "min_rest"));
+  c.enough_offset = num(o, "enough_offset");
+  c.min_hours = num(o, "min_hours");
+  c.max_error = num(o, "max_error");
+  c.error_digits = static_cast<int>(num(o, "error_digits"));
+  c.temp_max_first = num(o, "temp_max_first");
+  c.temp_min_sd = num(o, "temp_min_sd");
+  c.temp_missing = num(o, "temp_missing");
+  c.fill = num(o, "fill");
+  c.max_iter = static_cast<int>(num(o, "max_iter"));
+  c.tol = num(o, "tol");
+  c.max_weight = num(o, "max_weight");
+  c.refit_growth = num(o, "refit_growth");
+  RHost host(num(o, "verbose") != 0, on_block);
+  gravcal::GgirProcedure proc(c, host);
+  const gravcal::GgirOutcome r = proc.run(src);
+  Rcpp::RObject table = R_NilValue, rows = R_NilValue;
+  if (r.has_table) {
+    const int n = static_cast<int>(r.table_rows.size());
+    Rcpp::NumericMatrix m(n, r.table_columns);
+    std::copy(r.table.begin(), r.table.end(), m.begin());
+    table = m;
+    rows = Rcpp::IntegerVector(r.table_rows.begin(), r.table_rows.end());
+  }
+  Rcpp::RObject icp = R_NilValue;
+  if (r.has_icp) {
+    icp = Rcpp::List::create(
+        Rcpp::Named("scale") = Rcpp::NumericVector(r.icp.scale, r.icp.scale + 3),
+        Rcpp::Named("offset") = Rcpp::NumericVector(r.icp.offset, r.icp.offset + 3),
+        Rcpp::Named("tempoffset") = Rcpp::NumericVector(r.icp.tempoffset, r.icp.tempoffset + 3),
+        Rcpp::Named("meantemp") = r.icp.meantemp,
+        Rcpp::Named("temp_used") = r.icp.temp_used,
+        Rcpp::Named("iterations") = r.icp.iterations,
+        Rcpp::Named("converged") = r.icp.converged,
+        Rcpp::Named("finite") = r.icp.finite);
+  }
+  Rcpp::List out = Rcpp::List::create(
+      Rcpp::Named("scale") = Rcpp::NumericVector(r.scale, r.scale + 3),
+      Rcpp::Named("offset") = Rcpp::NumericVector(r.offset, r.offset + 3),
+      Rcpp::Named("tempoffset") = vec3(r.tempoffset, r.has_tempoffset),
+      Rcpp::Named("cal.error.start") = scalar(r.error_start, r.has_error_start),
+      Rcpp::Named("cal.error.end") = scalar(r.error_end, r.has_error_end),
+      Rcpp::Named("table") = table, Rcpp::Named("rows") = rows,
+      Rcpp::Named("npoints") = r.has_npoints
+          ? Rcpp::RObject(Rcpp::IntegerVector::create(static_cast<int>(r.npoints)))
+          : Rcpp::RObject(R_NilValue),
+      Rcpp::Named("nhoursused") = r.nhoursused,
+      Rcpp::Named("qc") = std::string(qc_name(r.qc)),
+      Rcpp::Named("use.temp") = r.use_temp,
+      Rcpp::Named("temp.available") = r.temp_available,
+      Rcpp::Named("icp") = icp);
+  out["meantemp"] = r.meantemp;
+  out["blocks"] = r.blocks;
+  out["windows"] = static_cast<double>(r.windows);
+  out["samples"] = static_cast<double>(r.samples);
+  out["warnings"] = Rcpp::wrap(host.warnings);
+  return out;
+}
+
+}  // namespace
+
+// A source over an open device file (gc_decoder_open()'s ptr).
+// [[Rcpp::export(rng = false)]]
+SEXP gc_source_decoder(SEXP file) {
+  gravcal_glue::OpenFile* f = gravcal_glue::open_file(file);
+  std::unique_ptr<SourceBox> b(new SourceBox());
+  b->src.reset(new gravcal::DecoderSource(*f->decoder));
+  b->keep = file;
+  return Rcpp::XPtr<SourceBox>(b.release(), true);
+}
+
+// A source over columns in memory (temperature may be NULL); the vectors
+// are read where they are.
+// [[Rcpp::export(rng = false)]]
+SEXP gc_source_columns(SEXP x, SEXP y, SEXP z, SEXP temperature) {
+  const R_xlen_t n = Rf_xlength(x);
+  std::unique_ptr<SourceBox> b(new SourceBox());
+  b->src.reset(new gravcal::ColumnsSource(
+      gravcal_glue::column(x, n, false, "x"), gravcal_glue::column(y, n, false, "y"),
+      gravcal_glue::column(z, n, false, "z"),
+      gravcal_glue::column(temperature, n, true, "temperature"),
+      static_cast<std::size_t>(n)));
+  b->keep = Rcpp::List::create(x, y, z, temperature);
+  return Rcpp::XPtr<SourceBox>(b.release(), true);
+}
+
+// A source over blocks an R function reads (see RBlockSource).
+// [[Rcpp::export(rng = false)]]
+SEXP gc_source_blocks(const Rcpp::List& first, const Rcpp::Function& fetch) {
+  std::unique_ptr<SourceBox> b(new SourceBox());
+  b->src.reset(new gravcal_glue::RBlockSource(first, fetch));
+  b->keep = Rcpp::List::create(first, fetch);
+  return Rcpp::XPtr<SourceBox>(b.release(), true);
+}
+
+// The one pump: runs `stage` ("windows", "ggir", "blocks" or "samples") over the
+// source with the options `opts`; on_block is the stage's callback (see
+// run_windows() and RHost::block_added()), or NULL.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts,
+                   Rcpp::Nullable<Rcpp::Function> on_block = R_NilValue) {
+  SourceBox* b = source(src);
+  if (stage == "windows") return run_windows(*b->src, opts, on_block);
+  if (stage == "ggir") return run_ggir(*b->src, opts, on_block);
+  if (stage == "samples") return run_samples(*b->src, opts);
+  if (stage == "blocks") return run_blocks(*b->src, opts);
+  Rcpp::stop("stage must be \"windows\", \"ggir\", \"blocks\" or \"samples\"");
+}
