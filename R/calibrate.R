@@ -803,14 +803,13 @@ sphere_error <- function(v) {
   mean(abs(sqrt(rowSums(v^2)) - 1))
 }
 
-# Calibrated n x 3 matrix: a = K (v + offset) + (T - meantemp) tempoffset.
+# Calibrated n x 3 matrix of a fit's model (apply_model()), with the
+# temperature term where the fit has one and `temperature` is given.
 calibrate_points <- function(fit, v, temperature = NULL) {
-  u <- sweep(v, 2, fit$offset, `+`)
-  a <- u %*% t(fit$K)
-  if (any(fit$tempoffset != 0) && !is.null(temperature)) {
-    a <- a + outer(temperature - fit$meantemp, fit$tempoffset)
+  dt <- if (any(fit$tempoffset != 0) && !is.null(temperature)) {
+    temperature - fit$meantemp
   }
-  unname(a)
+  unname(apply_model(v, fit$K, fit$offset, fit$tempoffset, dt))
 }
 
 #' @export
