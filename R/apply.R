@@ -41,35 +41,42 @@ apply_calibration <- function(x, fit) {
   }
   if (segmented(fit)) return(apply_segments(x, s, fit))
   K <- fit$K
-  o <- fit$offset
-  to <- fit$tempoffset
-  if (identical(fit$method, "ggir") && all(K[row(K) != col(K)] == 0)) {
-    # GGIR's model, in GGIR's operation order (g.getmeta): the same bits
-    s3 <- diag(K)
-    ax <- (s$x + o[[1]]) / (1 / s3[1])
-    ay <- (s$y + o[[2]]) / (1 / s3[2])
-    az <- (s$z + o[[3]]) / (1 / s3[3])
-    if (uses_temp) {
-      dt <- s$temperature - fit$meantemp
-      ax <- ax + dt / (1 / to[[1]])
-      ay <- ay + dt / (1 / to[[2]])
-      az <- az + dt / (1 / to[[3]])
+  # GGIR's model in GGIR's operation order (g.getmeta): GGIR's bits
+  ggir <- identical(fit$method, "ggir") && all(K[row(K) != col(K)] == 0)
+  a <- apply_model(s[c("x", "y", "z")], K, fit$offset, fit$tempoffset,
+                   dt = if (uses_temp) s$temperature - fit$meantemp,
+                   arithmetic = if (ggir) "ggir" else "matrix")
+  replace_xyz(x, a[[1]], a[[2]], a[[3]])
+}
+
+# The model, applied here once for every caller: measured v to calibrated
+# a = K (v + offset) + dt tempoffset, dt = T - meantemp (NULL: no
+# temperature term). `v` is an n x 3 matrix (the result is one too) or a
+# list of its three columns (the result is a list too, so that a recording's
+# samples are not bound into a matrix). Two arithmetics, chosen by name:
+#   "matrix": each row of K times (v + offset), summed left to right, then
+#     + dt tempoffset: the bits of `(v + offset) %*% t(K)` with R's
+#     reference BLAS, whatever BLAS R is linked to;
+#   "ggir": GGIR's model (K diagonal, scale = diag(K)) in the operation
+#     order of GGIR's g.getmeta(), (v + offset) / (1 / scale) + dt /
+#     (1 / tempoffset), which differs from "matrix" in the last bit and
+#     gives GGIR's calibrated samples to the bit.
+apply_model <- function(v, K, offset, tempoffset = c(0, 0, 0), dt = NULL,
+                        arithmetic = c("matrix", "ggir")) {
+  arithmetic <- match.arg(arithmetic)
+  col <- if (is.matrix(v)) function(j) v[, j] else function(j) v[[j]]
+  u <- lapply(1:3, function(j) col(j) + offset[[j]])
+  a <- lapply(1:3, function(i) {
+    if (arithmetic == "ggir") {
+      ai <- u[[i]] / (1 / K[i, i])
+      if (!is.null(dt)) ai <- ai + dt / (1 / tempoffset[[i]])
+    } else {
+      ai <- K[i, 1] * u[[1]] + K[i, 2] * u[[2]] + K[i, 3] * u[[3]]
+      if (!is.null(dt)) ai <- ai + dt * tempoffset[[i]]
     }
-  } else {
-    ux <- s$x + o[[1]]
-    uy <- s$y + o[[2]]
-    uz <- s$z + o[[3]]
-    ax <- K[1, 1] * ux + K[1, 2] * uy + K[1, 3] * uz
-    ay <- K[2, 1] * ux + K[2, 2] * uy + K[2, 3] * uz
-    az <- K[3, 1] * ux + K[3, 2] * uy + K[3, 3] * uz
-    if (uses_temp) {
-      dt <- s$temperature - fit$meantemp
-      ax <- ax + dt * to[[1]]
-      ay <- ay + dt * to[[2]]
-      az <- az + dt * to[[3]]
-    }
-  }
-  replace_xyz(x, ax, ay, az)
+    ai
+  })
+  if (is.matrix(v)) do.call(cbind, a) else a
 }
 
 # x with its x, y, z columns replaced, same class and other columns.

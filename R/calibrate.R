@@ -702,11 +702,12 @@ split_dots <- function(dots, table) {
   lapply(table, function(keep) dots[intersect(nms, keep)])
 }
 
-# Plausible coefficient ranges; wider than those seen across devices
-# (scale 0.83-1.13, offset -0.13 to 0.41 g; METHODS.md, van Hees 2014).
-# Wider than what METHODS.md reports across real devices (scale 0.83-1.13,
-# offset -0.13 to 0.41 g, temperature -0.014 to 0.017 g per degree C), so
-# that only coefficients no real sensor needs are refused.
+# Plausible coefficient ranges, far wider than the correction factors van
+# Hees et al. (2014, Table 2; vignette("vanhees2014")) report for the
+# devices of four cohorts (mean gain 0.990-1.005 with SD up to 0.014, mean
+# offset -0.012 to 0.105 g with SD up to 0.037 g, mean temperature offset
+# up to 0.004 g per degree C), so that only coefficients no real sensor
+# needs are refused.
 plausible <- list(scale = c(0.7, 1.3), cross = 0.2, offset = 0.6, temp = 0.05)
 
 # A fit that does not lower the error or whose coefficients are implausible
@@ -803,14 +804,13 @@ sphere_error <- function(v) {
   mean(abs(sqrt(rowSums(v^2)) - 1))
 }
 
-# Calibrated n x 3 matrix: a = K (v + offset) + (T - meantemp) tempoffset.
+# Calibrated n x 3 matrix of a fit's model (apply_model()), with the
+# temperature term where the fit has one and `temperature` is given.
 calibrate_points <- function(fit, v, temperature = NULL) {
-  u <- sweep(v, 2, fit$offset, `+`)
-  a <- u %*% t(fit$K)
-  if (any(fit$tempoffset != 0) && !is.null(temperature)) {
-    a <- a + outer(temperature - fit$meantemp, fit$tempoffset)
+  dt <- if (any(fit$tempoffset != 0) && !is.null(temperature)) {
+    temperature - fit$meantemp
   }
-  unname(a)
+  unname(apply_model(v, fit$K, fit$offset, fit$tempoffset, dt))
 }
 
 #' @export

@@ -52,7 +52,8 @@ check_sf <- function(sf) {
 # optional temperature and time. Returns a list of plain numeric vectors that
 # point at the caller's memory (no copy for double columns).
 # `temperature = "ignore"`: a temperature column that is not numeric is left
-# out with a warning (for the methods that do not use it).
+# out with a warning (for the lightweight method, which uses the temperature
+# when it has one and calibrates without a temperature term otherwise).
 as_samples <- function(x, arg = "x", temperature = c("use", "ignore")) {
   temperature <- temperature[1]
   if (is.matrix(x)) {
@@ -93,8 +94,8 @@ as_samples <- function(x, arg = "x", temperature = c("use", "ignore")) {
   ti <- match("temperature", nm)
   if (temperature == "ignore" && !is.na(ti) && !is.numeric(x[[ti]])) {
     warning("Column `", names(x)[ti], "` of `", arg, "` is not numeric (",
-            class(x[[ti]])[1], "); it is ignored, as this method does not ",
-            "use the temperature.", call. = FALSE)
+            class(x[[ti]])[1], "); it is ignored, and the calibration has ",
+            "no temperature term.", call. = FALSE)
     temp <- NULL
   } else {
     temp <- col("temperature", required = FALSE)

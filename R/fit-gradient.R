@@ -350,8 +350,7 @@ model_label <- function(model) {
 # Residuals of the lightweight objective at parameters p: |a|^2 - 1, or
 # |a| - 1 with use_sqrt, a = K (v + o).
 lm_residuals <- function(v, p, use_sqrt, dT = NULL) {
-  a <- sweep(v, 2, p[7:9], `+`) %*% t(params_to_K(p))
-  if (!is.null(dT)) a <- a + outer(dT, p[10:12])
+  a <- apply_model(v, params_to_K(p), p[7:9], p[10:12], dT)
   na2 <- rowSums(a^2)
   if (use_sqrt) sqrt(na2) - 1 else na2 - 1
 }

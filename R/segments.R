@@ -121,22 +121,21 @@ segment_of <- function(fit, t) {
   pmax(i, 1L)
 }
 
-# Calibrated n x 3 matrix with each row's segment's coefficients.
+# Calibrated n x 3 matrix with each row's segment's coefficients
+# (apply_model(), segment by segment).
 calibrate_points_by_time <- function(fit, v, t, temperature = NULL) {
   seg <- fit$segments
   i <- segment_of(fit, t)
-  col <- function(nm) seg[[nm]][i]
-  ux <- v[, 1] + col("o_x")
-  uy <- v[, 2] + col("o_y")
-  uz <- v[, 3] + col("o_z")
-  a <- cbind(col("k_xx") * ux,
-             col("k_xy") * ux + col("k_yy") * uy,
-             col("k_xz") * ux + col("k_yz") * uy + col("k_zz") * uz)
-  if (!is.null(temperature) && any(seg[c("t_x", "t_y", "t_z")] != 0)) {
-    dt <- temperature - fit$meantemp
-    a <- a + cbind(dt * col("t_x"), dt * col("t_y"), dt * col("t_z"))
+  temp <- !is.null(temperature) && any(seg[c("t_x", "t_y", "t_z")] != 0)
+  a <- matrix(0, nrow(v), 3)
+  for (j in unique(i)) {
+    rows <- which(i == j)
+    p <- unlist(seg[j, c(param_names(), "t_x", "t_y", "t_z")])
+    a[rows, ] <- apply_model(v[rows, , drop = FALSE], params_to_K(p), p[7:9],
+                             p[10:12],
+                             dt = if (temp) temperature[rows] - fit$meantemp)
   }
-  unname(a)
+  a
 }
 
 segmented <- function(fit) {

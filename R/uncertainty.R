@@ -21,15 +21,18 @@ fitted_names <- function(fit) {
   nm
 }
 
-# Jacobian (n x p) and residuals of a fit at its coefficients.
+# Jacobian (n x p) and residuals of a fit at its coefficients: the model's
+# value from apply_model(), its derivatives here.
 residual_jacobian <- function(fit, v, temperature = NULL, use_sqrt = FALSE) {
+  lightweight <- identical(fit$method, "lightweight")
+  temp <- !is.null(temperature) &&
+    (lightweight || "t_x" %in% fitted_names(fit))
+  dt <- if (temp) temperature - fit$meantemp
+  K <- unname(fit$K)
+  a <- apply_model(v, K, fit$offset, fit$tempoffset, dt)
   u <- sweep(v, 2, fit$offset, `+`)
-  if (identical(fit$method, "lightweight")) {
-    K <- unname(fit$K)
-    a <- u %*% t(K)
-    dt <- if (is.null(temperature)) NULL else temperature - fit$meantemp
-    if (!is.null(dt)) a <- a + outer(dt, fit$tempoffset)
-    na <- sqrt(rowSums(a^2))
+  na <- sqrt(rowSums(a^2))
+  if (lightweight) {
     if (use_sqrt) {
       r <- na - 1
       g <- a / na
@@ -42,19 +45,14 @@ residual_jacobian <- function(fit, v, temperature = NULL, use_sqrt = FALSE) {
                g[, 2] * u[, 1], g[, 3] * u[, 1], g[, 3] * u[, 2],
                g %*% K)
     colnames(J) <- param_names()
-    if (!is.null(dt)) {
+    if (temp) {
       J <- cbind(J, t_x = g[, 1] * dt, t_y = g[, 2] * dt, t_z = g[, 3] * dt)
     }
     return(list(J = J, r = r))
   }
-  s <- diag(fit$K)
-  a <- sweep(u, 2, s, `*`)
-  temp <- "t_x" %in% fitted_names(fit) && !is.null(temperature)
-  dt <- if (temp) temperature - fit$meantemp else NULL
-  if (temp) a <- a + outer(dt, fit$tempoffset)
-  na <- sqrt(rowSums(a^2))
+  # GGIR's model (K diagonal): d a_j / d s_j = u_j, d a_j / d o_j = s_j
   g <- a / na
-  J <- cbind(g * u, sweep(g, 2, s, `*`))
+  J <- cbind(g * u, sweep(g, 2, diag(K), `*`))
   if (temp) J <- cbind(J, g * dt)
   colnames(J) <- fitted_names(fit)[seq_len(ncol(J))]
   list(J = J, r = na - 1)

@@ -54,3 +54,43 @@ test_that("invalid fits are refused", {
   fit$offset <- 1:2
   expect_error(apply_calibration(d, fit), "not a valid gravcal_fit")
 })
+
+test_that("a GGIR fit is applied in GGIR's operation order, to the bit", {
+  rec <- simulate_recording(hours = 0.5, sf = 10, seed = 52)
+  s <- c(1.013, 0.987, 1.004)
+  o <- c(-0.021, 0.013, 0.007)
+  to <- c(0.0021, -0.0013, 0.0008)
+  fit <- gravcal:::new_fit(K = diag(s), offset = o, tempoffset = to,
+                           meantemp = 27.3, method = "ggir")
+  cal <- apply_calibration(rec, fit)
+  # GGIR's g.getmeta() calibrates with base R's scale(): (v + o) / (1 / s),
+  # plus (T - meantemp) / (1 / tempoffset)
+  v <- cbind(rec$x, rec$y, rec$z)
+  ggir <- scale(v, center = -o, scale = 1 / s) +
+    scale(cbind(rec$temperature, rec$temperature, rec$temperature),
+          center = rep(27.3, 3), scale = 1 / to)
+  expect_identical(cbind(cal$x, cal$y, cal$z), unname(unclass(ggir)[, 1:3]))
+  # the model's own arithmetic differs in the last bit on some samples,
+  # so the test above tells the two apart
+  lw <- fit
+  lw$method <- "lightweight"
+  own <- apply_calibration(rec, lw)
+  expect_true(any(own$x != cal$x | own$y != cal$y | own$z != cal$z))
+  expect_equal(own$x, cal$x, tolerance = 1e-14)
+})
+
+test_that("the one model function keeps the shape it is given", {
+  K <- matrix(c(1.02, 0.01, -0.02, 0, 0.98, 0.015, 0, 0, 1.01), 3)
+  o <- c(0.01, -0.02, 0.03)
+  v <- matrix(c(1, 0, 0, 0, -1, 0, 0.6, 0, 0.8), ncol = 3, byrow = TRUE)
+  a <- gravcal:::apply_model(v, K, o)
+  expect_true(is.matrix(a))
+  expect_equal(a, (v + rep(o, each = 3)) %*% t(K), tolerance = 1e-15)
+  l <- gravcal:::apply_model(list(v[, 1], v[, 2], v[, 3]), K, o)
+  expect_identical(l, list(a[, 1], a[, 2], a[, 3]))
+  dt <- c(-2, 0, 3)
+  to <- c(0.001, 0, -0.002)
+  expect_identical(gravcal:::apply_model(v, K, o, to, dt),
+                   a + outer(dt, to))
+  expect_error(gravcal:::apply_model(v, K, o, arithmetic = "fma"))
+})

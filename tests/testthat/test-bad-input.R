@@ -257,7 +257,8 @@ test_that("write_ggir_coefs() refuses what GGIR cannot use", {
 
 test_that("GGIR method: implausible coefficients are not applied (gravcal's mode)", {
   # a sensor whose x axis reads 1 / 1.4 of the truth: the fit needs a scale
-  # of 1.4, beyond what real devices show (METHODS.md: 0.83-1.13)
+  # of 1.4, beyond the plausible 0.7-1.3 (real devices: van Hees et al.
+  # 2014, Table 2, mean gains 0.990-1.005 with SD up to 0.014)
   r <- simulate_recording(hours = 30, sf = 10, seed = 61,
                           params = c(1.4, 1, 1, 0, 0, 0, 0, 0, 0))
   f <- calibrate(r, sf = 10, method = "ggir")

@@ -6,7 +6,7 @@ test_that("fit_icp reproduces GGIR's stored fit on data.calibrate (1e-8)", {
   load(f, envir = env)
   C <- env$data.calibrate
   # Reference: GGIR's own g.calibrate output stored with the windows
-  # (wadpac/GGIR data/data.calibrate.RData, v3.3-7; METHODS.md section 3).
+  # (wadpac/GGIR data/data.calibrate.RData, v3.3-7).
   fit <- fit_icp(C$spheredata, ggir_compat = TRUE)
   expect_s3_class(fit, "gravcal_fit")
   expect_equal(fit$status, "ok")
@@ -99,8 +99,8 @@ test_that("fit_icp(): iterations beyond an integer, text temperature", {
   # without the temperature term the column is not used
   expect_identical(coef(fit_icp(wt, use_temp = FALSE)),
                    coef(fit_icp(w, use_temp = FALSE)))
-  # the GGIR method refuses it too; the lightweight method, which does not
-  # use it, says that it leaves it out
+  # the GGIR method refuses it too; the lightweight method, which can
+  # calibrate without a temperature term, says that it leaves it out
   rt <- transform(rec, temperature = as.character(temperature))
   expect_snapshot(error = TRUE, calibrate(rt, sf = 10, method = "ggir"))
   expect_snapshot(fl <- calibrate(rt, sf = 10))

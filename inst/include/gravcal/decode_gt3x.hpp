@@ -413,7 +413,6 @@ class Gt3xDecoder : public Decoder {
 
   bool done() const override { return done_; }
   std::size_t max_samples_per_unit() const override { return gt3x::kMaxRate; }
-  bool old_format() const { return old_; }
 
  private:
   struct ZeroRun {

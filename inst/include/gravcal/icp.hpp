@@ -38,6 +38,7 @@
 #include <limits>
 #include <vector>
 
+#include "model.hpp"
 #include "r_arith.hpp"
 
 // GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
@@ -98,29 +99,23 @@ struct EigenLeastSquares {
   }
 };
 
-// The calibrated value, in GGIR's operation order.
-inline double icp_apply(double v, double o, double s, double t, double to) {
-  return (v + o) / (1.0 / s) + t / (1.0 / to);
-}
-
 // The loops of gravcal's own fit (fit_icp()), element by element, two
 // elements per instruction with SSE2: the same operations on each element
 // as the scalar tail (no fused multiply-add), so the same bits.
 
-// out[i] = icp_apply(v[i], o, s, t ? t[i] : 0, to)
+// out[i] = apply_model_ggir(v[i], o, s, t ? t[i] : 0, to)
 inline void icp_apply_column(const double* v, const double* t, std::size_t n,
                              double o, double s, double to, double* out) {
-  const double is = 1.0 / s, it = 1.0 / to;
   std::size_t i = 0;
 #if defined(GRAVCAL_SSE2)
-  const __m128d ov = _mm_set1_pd(o), sv = _mm_set1_pd(is), tv = _mm_set1_pd(it);
+  const __m128d ov = _mm_set1_pd(o), sv = _mm_set1_pd(1.0 / s), tv = _mm_set1_pd(1.0 / to);
   for (; i + 2 <= n; i += 2) {
     const __m128d tt = t != nullptr ? _mm_loadu_pd(t + i) : _mm_setzero_pd();
     _mm_storeu_pd(out + i, _mm_add_pd(_mm_div_pd(_mm_add_pd(_mm_loadu_pd(v + i), ov), sv),
                                       _mm_div_pd(tt, tv)));
   }
 #endif
-  for (; i < n; ++i) out[i] = (v[i] + o) / is + (t != nullptr ? t[i] : 0.0) / it;
+  for (; i < n; ++i) out[i] = apply_model_ggir(v[i], o, s, t != nullptr ? t[i] : 0.0, to);
 }
 
 // p = c / |c|, |c| = sqrt(c0^2 + c1^2 + c2^2)
@@ -239,8 +234,8 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
   for (int it = 1; it <= cfg.max_iter; ++it) {
     for (int k = 0; k < 3; ++k) {
       for (std::size_t i = 0; i < n; ++i) {
-        cur[k * n + i] = icp_apply(in[k][i], r.offset[k], r.scale[k], t[i],
-                                   r.tempoffset[k]);
+        cur[k * n + i] = apply_model_ggir(in[k][i], r.offset[k], r.scale[k], t[i],
+                                          r.tempoffset[k]);
       }
     }
     // closest points: curr / sqrt(rowSums(curr^2))
@@ -377,9 +372,9 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
   Eigen::VectorXd w_next(N);   // the weights of the next iteration
   const double* tp = use_temp ? t.data() : nullptr;
   for (int it = 1; it <= cfg.max_iter; ++it) {
-    // the calibrated points (icp_apply()), then their closest points on the
-    // sphere; column by column, two points per instruction with SSE2 (the
-    // same operations on each point)
+    // the calibrated points (apply_model_ggir()), then their closest points
+    // on the sphere; column by column, two points per instruction with SSE2
+    // (the same operations on each point)
     for (int k = 0; k < 3; ++k) {
       icp_apply_column(in[k], tp, n, r.offset[k], r.scale[k],
                        use_temp ? r.tempoffset[k] : 0.0, cur.col(k).data());

@@ -5,7 +5,9 @@
 //   a_y = k_xy (v_x + o_x) + k_yy (v_y + o_y)
 //   a_z = k_xz (v_x + o_x) + k_yz (v_y + o_y) + k_zz (v_z + o_z)
 // Parameter order p = (k_xx, k_yy, k_zz, k_xy, k_xz, k_yz, o_x, o_y, o_z),
-// start p0 = (1, 1, 1, 0, 0, 0, 0, 0, 0) (paper Eq. 6).
+// start p0 = (1, 1, 1, 0, 0, 0, 0, 0, 0) (paper Eq. 6). The model is applied
+// here only: apply_model() (this model), apply_model_ggir() (GGIR's, in
+// GGIR's arithmetic).
 //
 // Header-only, standard headers only, no heap: builds for a microcontroller.
 // T is any number type with + - * / (double, float, or gravcal's fixed point).
@@ -40,6 +42,16 @@ inline Vec3<T> apply_model(const T* p, const Vec3<T>& v) {
   return Vec3<T>{p[KXX] * ux,
                  p[KXY] * ux + p[KYY] * uy,
                  p[KXZ] * ux + p[KYZ] * uy + p[KZZ] * uz};
+}
+
+// GGIR's model (van Hees et al. 2014: K diagonal, plus a temperature
+// term), one axis, in the operation order of GGIR's R code:
+//   a = (v + o) / (1 / s) + t / (1 / to),  t = temperature - mean temperature.
+// Not the same bits as s (v + o) + t to: this is the named form wherever
+// GGIR's numbers are promised to the bit (icp.hpp).
+template <typename T>
+inline T apply_model_ggir(T v, T o, T s, T t, T to) {
+  return (v + o) / (T(1) / s) + t / (T(1) / to);
 }
 
 // v = K^-1 a - o: from true to measured, by forward substitution.
