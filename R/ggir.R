@@ -73,20 +73,6 @@ ggir_messages <- c(
                       "coefficient)")
 )
 
-# GGIR's calibration error: mean | |a| - 1 | over the rest windows' means m
-# (n x 3) after calibration, in GGIR's arithmetic ((m + offset) / (1 /
-# scale), to the bit), rounded as GGIR rounds it.
-ggir_error <- function(m, scale, offset, tempoffset = NULL, temp = NULL,
-                       meantemp = 0) {
-  a <- lapply(1:3, function(k) {
-    v <- (m[, k] + offset[k]) / (1 / scale[k])
-    if (!is.null(temp)) v <- v + (temp - meantemp) / (1 / tempoffset[k])
-    v
-  })
-  e <- sqrt(a[[1]]^2 + a[[2]]^2 + a[[3]]^2)
-  round(mean(abs(e - 1)), digits = ggir_constants$error_digits)
-}
-
 ggir_feature_names <- function(temp) {
   c("Euclidean Norm", "meanx", "meany", "meanz", "sdx", "sdy", "sdz",
     if (temp) "temperature")

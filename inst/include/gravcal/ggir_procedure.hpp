@@ -34,6 +34,7 @@
 
 #include "ggir_blocks.hpp"
 #include "icp.hpp"
+#include "model.hpp"
 #include "pipeline.hpp"
 #include "r_arith.hpp"
 #include "segmenter.hpp"
@@ -250,10 +251,13 @@ class GgirProcedure {
                     double meantemp) {
     std::vector<double> d(n);
     for (std::size_t i = 0; i < n; ++i) {
+      // without a temperature the term is +0 (0 / Inf): the same bits as
+      // GGIR's expression without it
+      const double dt = t != nullptr ? t[i] - meantemp : 0.0;
       double a[3];
       for (int k = 0; k < 3; ++k) {
-        a[k] = (m[k][i] + offset[k]) / (1.0 / scale[k]);
-        if (t != nullptr) a[k] = a[k] + (t[i] - meantemp) / (1.0 / tempoffset[k]);
+        a[k] = apply_model_ggir(m[k][i], offset[k], scale[k], dt,
+                                t != nullptr ? tempoffset[k] : 0.0);
       }
       const double e = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
       d[i] = std::fabs(e - 1.0);
