@@ -79,7 +79,14 @@
 #'   otherwise, or when the pooled windows do not calibrate either, the
 #'   rows stay as they were and their `message` says why. Pooled rows have
 #'   `pooled = TRUE`, the pooled fit's coefficients and status, and a
-#'   message naming the recordings pooled.
+#'   message naming the recordings pooled. For the GGIR method, each
+#'   recording's rest windows are those GGIR's procedure kept when it
+#'   calibrated that recording alone (with the settings in `...`: `sf`,
+#'   `chunksize`, `max_sd`, `use_temp`, ...; a recording too short for the
+#'   procedure gives none), and their union goes through the procedure's
+#'   last step: at least 10 windows, every axis beyond `-+spherecrit`, the
+#'   fit, GGIR's errors and QC message (`minloadcrit` against the hours
+#'   pooled), the temperature term when every recording pooled used it.
 #' @return A data frame, one row per recording, in the order of `files`:
 #'   `file` (the recording's identity, see above), `status` (see [calibrate()], or `"failed"`),
 #'   `message` (why, for a recording that failed or was not calibrated;
@@ -545,8 +552,9 @@ fit_hours <- function(fit) {
   if (is.null(fit$hours)) NA_real_ else as.numeric(fit$hours)
 }
 
+# Notes joined with "; " (vectorised: pool_devices() notes several rows).
 join_notes <- function(a, b) {
-  if (is.na(a) || !nzchar(a)) b else paste0(a, "; ", b)
+  ifelse(is.na(a) | !nzchar(a), b, paste0(a, "; ", b))
 }
 
 # ---- writing: atomic files, owned outputs, the lock -----------------------
@@ -911,7 +919,7 @@ pool_devices <- function(paths, ids, tab, fits, method, args, alpha = 0.01) {
                    min(p)))
       next
     }
-    pf <- tryCatch(pooled_fit(paths[idx], method, args),
+    pf <- tryCatch(pooled_fit(paths[idx], fits[idx], method, args),
                    error = function(e) e)
     if (inherits(pf, "error")) {
       note(sprintf("the pooled fit failed: %s", conditionMessage(pf)))
@@ -922,7 +930,9 @@ pool_devices <- function(paths, ids, tab, fits, method, args, alpha = 0.01) {
                           "not calibrate (%s)"), length(idx), s, pf$status))
       next
     }
-    pf$pooled <- list(serial = s, files = ids[idx])
+    # the recordings whose rest windows were pooled
+    from <- if (is.null(pf$pooled$used)) idx else idx[pf$pooled$used]
+    pf$pooled <- list(serial = s, files = ids[from])
     if (is.null(pf$input)) pf$input <- list(source = "pooled")
     pf$input$serial <- s
     for (i in todo) {
@@ -930,8 +940,8 @@ pool_devices <- function(paths, ids, tab, fits, method, args, alpha = 0.01) {
       row$pooled <- TRUE
       row$message <- sprintf(paste0(
         "calibrated with the rest windows of %d recordings of device %s ",
-        "(%s), pooled; alone: %s"), length(idx), s,
-        paste(ids[idx], collapse = ", "), tab$status[i])
+        "(%s), pooled; alone: %s"), length(from), s,
+        paste(ids[from], collapse = ", "), tab$status[i])
       row$hours <- tab$hours[i]
       row$samples <- tab$samples[i]
       tab[i, ] <- row
@@ -958,19 +968,17 @@ pairwise_wald <- function(fits) {
   p
 }
 
-# One fit on the rest windows of several recordings of a device.
-pooled_fit <- function(files, method, args) {
-  if (method == "ggir") {
-    ggir_args <- args[intersect(names(args), c("use_temp", "max_iter", "tol"))]
-    ws <- lapply(files, function(f) rest_windows(f, method = "ggir"))
-    w <- do.call(rbind, ws)
-    return(do.call(fit_icp, c(list(w = w[w$rest, , drop = FALSE]), ggir_args)))
-  }
-  la <- lightweight_args(args)
+# One fit on the rest windows of several recordings of a device: `paths`
+# and `fits`, their calibrations alone.
+pooled_fit <- function(paths, fits, method, args) {
+  if (method == "ggir") return(pooled_ggir(fits, args))
+  la <- lightweight_args(args[names(args) != "sf"])
   rargs <- la$args$rest_windows[intersect(names(la$args$rest_windows),
                                           c("window", "max_range", "axes",
                                             "skip_zero", "reader"))]
-  ws <- lapply(files, function(f) do.call(rest_windows, c(list(x = f), rargs)))
+  ws <- lapply(paths, function(f) {
+    do.call(rest_windows, c(list(x = f, sf = args$sf), rargs))
+  })
   w <- do.call(rbind, ws)
   attr(w, "sf") <- attr(ws[[1]], "sf")
   attr(w, "window") <- attr(ws[[1]], "window")
@@ -986,4 +994,69 @@ pooled_fit <- function(files, method, args) {
   la$choice$budget <- "all"
   lightweight_from_windows(w, la$args, la$choice, la$max_norm_error,
                            la$range_g, call = NULL, file = NULL)
+}
+
+# The GGIR method pooled. Each recording's rest windows are those GGIR's
+# procedure kept when it calibrated that recording alone (its spheredata,
+# in fit$ggir): block rules, duplicate filter, temperature checks and the
+# user's settings (sf, chunksize, max_sd, use_temp, reader, ggir_compat)
+# applied, and nothing decoded twice. minloadcrit stays a rule of each
+# recording's reading, as in GGIR: a recording that could not calibrate
+# alone never reached the error target, so it gives all its rest windows; one
+# that could gives those its own fit used. A recording too short for the
+# procedure (GGIR's spheredata then holds all its windows, not its rest
+# windows) gives none. Then the procedure's last step on the union: at least
+# min_rest windows, every axis beyond -+spherecrit, the method's ICP, GGIR's
+# errors, its QC message (minloadcrit against the hours of the pool) and
+# gravcal's status (ggir_fit()). The temperature term is fitted when every
+# recording pooled used it.
+pooled_ggir <- function(fits, args) {
+  k <- ggir_constants
+  a <- utils::modifyList(
+    list(spherecrit = k$spherecrit, minloadcrit = k$minloadcrit,
+         max_iter = k$max_iter, tol = k$tol, ggir_compat = FALSE),
+    args[intersect(names(args), c("spherecrit", "minloadcrit", "max_iter",
+                                  "tol", "ggir_compat"))])
+  res <- lapply(fits, function(f) f[["ggir"]])
+  has <- vapply(res, function(r) {
+    NROW(r$spheredata) > 0 && !identical(r$QCmessage, ggir_messages[["no_data"]])
+  }, NA)
+  if (!any(has)) abort("no recording of the device has rest windows")
+  res <- res[has]
+  temp <- vapply(res, function(r) isTRUE(r$use.temp), NA)
+  cols <- seq_len(if (all(temp)) 8 else 7)
+  ft <- do.call(rbind, lapply(res, function(r) unname(as.matrix(r$spheredata[, cols]))))
+  m <- ft[, 2:4, drop = FALSE]
+  tt <- if (all(temp)) ft[, 8]
+  hours <- sum(vapply(res, function(r) r$nhoursused, 0))
+  out <- list(scale = c(1, 1, 1), offset = c(0, 0, 0), tempoffset = NULL,
+              cal.error.start = ggir_error(m, c(1, 1, 1), c(0, 0, 0)),
+              cal.error.end = NULL)
+  icp <- NULL
+  covered <- all(apply(m, 2, min) < -a$spherecrit & apply(m, 2, max) > a$spherecrit)
+  qc <- if (nrow(m) < k$min_rest) "no_rest" else if (!covered) "no_sphere"
+  if (is.null(qc)) {
+    icp <- icp_means(m[, 1], m[, 2], m[, 3], tt, all(temp),
+                     if (a$ggir_compat) "ggir_r" else "converge", a$max_iter, a$tol)
+    out[c("scale", "offset", "tempoffset")] <- icp[c("scale", "offset", "tempoffset")]
+    out$cal.error.end <- ggir_error(m, icp$scale, icp$offset, icp$tempoffset, tt,
+                                    if (all(temp)) icp$meantemp else 0)
+    qc <- if (!isTRUE(icp$finite)) "not_finite" else
+      if (out$cal.error.end > out$cal.error.start) "no_decrease" else
+        if (out$cal.error.end < min(out$cal.error.start, k$max_error) &&
+            hours > a$minloadcrit) {
+          if (all(temp) || !any(temp)) "done" else "done_no_temp"
+        } else "attempted"
+  }
+  sd <- as.data.frame(ft)
+  names(sd) <- ggir_feature_names(all(temp))
+  out <- c(out, list(spheredata = sd, npoints = nrow(sd), nhoursused = hours,
+                     QCmessage = ggir_messages[[qc]], use.temp = all(temp),
+                     meantempcal = if (all(temp)) mean(tt), bsc_qc = data.frame()))
+  attr(out, "gravcal") <- list(
+    icp = icp, input = list(source = "pooled"),
+    windows = sum(vapply(fits[has], function(f) as.numeric(f$n_windows), 0)))
+  fit <- ggir_fit(out, a$ggir_compat, call = NULL, a$minloadcrit)
+  fit$pooled <- list(used = has)
+  fit
 }
