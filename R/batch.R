@@ -951,21 +951,13 @@ pool_devices <- function(paths, ids, tab, fits, method, args, alpha = 0.01) {
   list(tab = tab, fits = fits)
 }
 
-# p-values of the Wald tests of every pair of fits' common coefficients.
+# p-values of the Wald tests (wald_test()) of every pair of fits' common
+# coefficients, pairs without any left out.
 pairwise_wald <- function(fits) {
-  p <- numeric(0)
-  if (length(fits) < 2) return(p)
-  for (i in seq_len(length(fits) - 1)) for (j in (i + 1):length(fits)) {
-    a <- fits[[i]]
-    b <- fits[[j]]
-    nm <- intersect(a$model, b$model)
-    if (!length(nm) || is.null(a$vcov) || is.null(b$vcov)) next
-    d <- stats::coef(a)[nm] - stats::coef(b)[nm]
-    V <- a$vcov[nm, nm, drop = FALSE] + b$vcov[nm, nm, drop = FALSE]
-    W <- tryCatch(drop(t(d) %*% solve(V, d)), error = function(e) Inf)
-    p <- c(p, stats::pchisq(W, df = length(nm), lower.tail = FALSE))
-  }
-  p
+  if (length(fits) < 2) return(numeric(0))
+  pairs <- utils::combn(length(fits), 2)
+  p <- apply(pairs, 2, function(ij) wald_test(fits[[ij[1]]], fits[[ij[2]]]))
+  p[!is.na(p)]
 }
 
 # One fit on the rest windows of several recordings of a device: `paths`
