@@ -15,8 +15,8 @@
 #'
 #' **Resuming.** Each finished recording is saved at once under
 #' `outdir/.gravcal/`, with the key it was computed under: the recording's
-#' identity (full path, size, modification time and an MD5 fingerprint of
-#' its first and last megabyte) and every setting that changes the result
+#' full path, size, modification time and an MD5 fingerprint of its first
+#' and last megabyte, and every setting that changes the result
 #' (`method`, the arguments in `...`, gravcal's version). A run started
 #' again with the same `outdir` takes a saved result only when its key is
 #' unchanged (`resume = TRUE`); a recording replaced or changed, or new
@@ -45,6 +45,15 @@
 #' lightweight method removes a `calibration_ggir_coefs.csv` an earlier run
 #' wrote, since it no longer matches the table.
 #'
+#' **Identity.** A recording is known by its path relative to the cohort's
+#' root: the directory given as `files`, or the longest common directory of
+#' the paths given (for recordings all in one folder, their file names;
+#' for `a/p01.bin` and `b/p01.bin`, those). This identity is the table's
+#' `file` column, the names of `attr(, "fits")`, and names the recording in
+#' progress and in messages. GGIR's coefficient file matches rows by file
+#' name alone, so `method = "ggir"` refuses, before any work, two
+#' recordings with the same file name in different folders.
+#'
 #' @param files Paths of recordings (formats as [calibrate()] reads), or
 #'   one directory, whose recordings are all taken.
 #' @param method `"ggir"` (default) or `"lightweight"`; see [calibrate()].
@@ -56,6 +65,10 @@
 #'   (`TRUE`), or calibrate every recording again (`FALSE`).
 #' @param pattern For a directory: the file names to take (a regular
 #'   expression).
+#' @param recursive For a directory: take the recordings in its subfolders
+#'   too (`TRUE`), leaving out gravcal's output folders (`outdir`, and any
+#'   folder holding a `.gravcal` store), or only those in the directory
+#'   itself (`FALSE`, default).
 #' @param pool `"none"` (default) or `"device"`: calibrate the recordings
 #'   that cannot be calibrated alone (status `"sphere_not_covered"`,
 #'   `"bins_incomplete"`, `"too_short"` or `"no_rest"`) with the rest
@@ -66,9 +79,16 @@
 #'   otherwise, or when the pooled windows do not calibrate either, the
 #'   rows stay as they were and their `message` says why. Pooled rows have
 #'   `pooled = TRUE`, the pooled fit's coefficients and status, and a
-#'   message naming the recordings pooled.
+#'   message naming the recordings pooled. For the GGIR method, each
+#'   recording's rest windows are those GGIR's procedure kept when it
+#'   calibrated that recording alone (with the settings in `...`: `sf`,
+#'   `chunksize`, `max_sd`, `use_temp`, ...; a recording too short for the
+#'   procedure gives none), and their union goes through the procedure's
+#'   last step: at least 10 windows, every axis beyond `-+spherecrit`, the
+#'   fit, GGIR's errors and QC message (`minloadcrit` against the hours
+#'   pooled), the temperature term when every recording pooled used it.
 #' @return A data frame, one row per recording, in the order of `files`:
-#'   `file` (the file name), `status` (see [calibrate()], or `"failed"`),
+#'   `file` (the recording's identity, see above), `status` (see [calibrate()], or `"failed"`),
 #'   `message` (why, for a recording that failed or was not calibrated;
 #'   also notes such as a damaged saved result that was recomputed); the
 #'   coefficients named as in GGIR's coefficient file: `scale.x`,
@@ -109,14 +129,19 @@
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
                             pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$",
-                            pool = c("none", "device")) {
+                            pool = c("none", "device"), recursive = FALSE) {
   method <- match_choice(method, "method")
   pool <- match_choice(pool, "pool")
-  files <- cohort_files(files, pattern)
   if (missing(outdir) || !is.character(outdir) || length(outdir) != 1 ||
       is.na(outdir) || !nzchar(outdir)) {
     abort("`outdir` must be a directory path for the results.")
   }
+  check_flag(recursive, "recursive")
+  cohort <- cohort_files(files, pattern, recursive, outdir)
+  paths <- cohort$path
+  ids <- cohort$id
+  # GGIR's coefficient file keys its rows by file name
+  if (method == "ggir") check_ggir_names(paths, ids)
   check_flag(resume, "resume")
   args <- list(...)
   if (length(args) && (is.null(names(args)) || any(!nzchar(names(args))))) {
@@ -134,17 +159,17 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
 
   settings <- list(method = method, args = args,
                    gravcal = as.character(utils::packageVersion("gravcal")))
-  slots <- file.path(store, paste0(slot_names(files, method), ".rds"))
-  saved <- lapply(seq_along(files), function(i) {
-    if (resume) read_saved(slots[i], file_identity(files[i]), settings) else list()
+  slots <- file.path(store, paste0(slot_names(paths, method), ".rds"))
+  saved <- lapply(seq_along(paths), function(i) {
+    if (resume) read_saved(slots[i], file_identity(paths[i]), settings) else list()
   })
   todo <- which(vapply(saved, function(s) is.null(s$result), TRUE))
   # what is redone is not taken from an earlier run if this one fails
   unlink(slots[todo])
-  failures <- run_cohort(todo, cohort_worker(files, slots, method, args, settings),
-                         basename(files))
+  failures <- run_cohort(todo, cohort_worker(paths, ids, slots, method, args,
+                                             settings), ids)
 
-  results <- lapply(seq_along(files), function(i) {
+  results <- lapply(seq_along(paths), function(i) {
     s <- saved[[i]]
     if (i %in% todo) {
       s2 <- read_saved(slots[i], NULL, settings)
@@ -152,20 +177,23 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
       if (is.null(s$result)) {
         why <- failures[[as.character(i)]]
         if (is.null(why)) why <- if (is.null(s2$note)) "no saved result" else s2$note
-        s$result <- list(row = cohort_row(files[i], NULL, paste0(
+        s$result <- list(row = cohort_row(paths[i], ids[i], NULL, paste0(
           "no result: ", sub("[.]$", "", why), "; run again to retry"), "",
           NA_real_, method),
           fit = NULL)
       }
     }
+    # the identity in this run's cohort (a result saved when the cohort's
+    # root was another keeps its key, the full path)
+    s$result$row$file <- ids[i]
     if (!is.null(s$note)) s$result$row$message <- join_notes(s$result$row$message, s$note)
     s$result
   })
   tab <- do.call(rbind, lapply(results, `[[`, "row"))
   rownames(tab) <- NULL
-  fits <- stats::setNames(lapply(results, `[[`, "fit"), basename(files))
+  fits <- stats::setNames(lapply(results, `[[`, "fit"), ids)
   if (pool == "device") {
-    pooled <- pool_devices(files, tab, fits, method, args)
+    pooled <- pool_devices(paths, ids, tab, fits, method, args)
     tab <- pooled$tab
     fits <- pooled$fits
   }
@@ -173,7 +201,9 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   if (method == "ggir") {
     ok <- tab$status %in% c("ok", "high_error") &
       !vapply(fits, is.null, TRUE)
-    coefs <- if (any(ok)) ggir_coef_table(fits[ok]) else empty_ggir_coefs()
+    coefs <- if (any(ok)) {
+      ggir_coef_table(stats::setNames(fits[ok], basename(paths[ok])))
+    } else empty_ggir_coefs()
     write_owned(csv_bytes(coefs), outputs[2], store)
   } else {
     remove_owned(outputs[2], store)
@@ -182,21 +212,32 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   tab
 }
 
-# The recordings: the paths given, or those in one directory; absolute, so
-# that workers with another working directory find them.
-cohort_files <- function(files, pattern) {
+# The recordings of a cohort: list(path, id). `path`: absolute, so that
+# workers with another working directory find them. `id`: the recording's
+# identity, its path relative to the cohort's root (the directory given, or
+# the longest common directory of the paths given), with "/" between
+# folders: the file name when all recordings are in one folder. A directory
+# is listed with its subfolders when `recursive`, leaving out gravcal's
+# output folders (`outdir`, and any folder holding a .gravcal store).
+cohort_files <- function(files, pattern, recursive, outdir) {
   if (!is.character(files) || !length(files) || anyNA(files)) {
     abort("`files` must be file paths or one directory, not ",
           describe(files), ".")
   }
   if (length(files) == 1 && dir.exists(files)) {
-    found <- list.files(files, pattern = pattern, full.names = TRUE,
-                        ignore.case = TRUE)
-    found <- found[!dir.exists(found)]
-    if (!length(found)) {
-      abort("`files`: no recordings in \"", files, "\" (pattern \"", pattern, "\").")
+    root <- normalizePath(files, winslash = "/", mustWork = TRUE)
+    rel <- list.files(root, pattern = pattern, recursive = recursive,
+                      ignore.case = TRUE)
+    path <- file.path(root, rel)
+    keep <- !dir.exists(path)
+    if (recursive) keep <- keep & !under_output(path, root, outdir)
+    rel <- rel[keep]
+    if (!length(rel)) {
+      abort("`files`: no recordings in \"", files, "\" (pattern \"", pattern, "\"",
+            if (recursive) ", subfolders included", ").")
     }
-    return(normalizePath(sort(found), mustWork = TRUE))
+    o <- order(rel)
+    return(list(path = path[keep][o], id = rel[o]))
   }
   absent <- !file.exists(files)
   if (any(absent)) {
@@ -210,11 +251,52 @@ cohort_files <- function(files, pattern) {
           "directories: ", paste0("\"", utils::head(files[folders], 3), "\"",
                                    collapse = ", "), ".")
   }
-  files <- normalizePath(files, mustWork = TRUE)
+  files <- normalizePath(files, winslash = "/", mustWork = TRUE)
   if (anyDuplicated(files)) {
     abort("`files` lists a file twice: \"", files[anyDuplicated(files)], "\".")
   }
-  files
+  list(path = files, id = relative_to_common(files))
+}
+
+# Paths (absolute, "/"-separated) relative to their longest common
+# directory; whole paths where they have none (two drives).
+relative_to_common <- function(paths) {
+  dirs <- strsplit(dirname(paths), "/", fixed = TRUE)
+  k <- 0L
+  while (k < min(lengths(dirs)) &&
+         all(vapply(dirs, `[`, "", k + 1L) == dirs[[1]][k + 1L])) {
+    k <- k + 1L
+  }
+  if (k == 0L) return(paths)
+  substring(paths, nchar(paste(dirs[[1]][seq_len(k)], collapse = "/")) + 2L)
+}
+
+# Which paths lie in gravcal's output folders below `root`: `outdir` and
+# any folder holding a .gravcal store.
+under_output <- function(paths, root, outdir) {
+  dirs <- list.dirs(root, full.names = TRUE, recursive = TRUE)
+  out <- dirs[dir.exists(file.path(dirs, ".gravcal"))]
+  if (dir.exists(outdir)) out <- c(out, normalizePath(outdir, winslash = "/"))
+  out <- setdiff(out, root)
+  inside <- logical(length(paths))
+  for (d in out) inside <- inside | startsWith(paths, paste0(d, "/"))
+  inside
+}
+
+# GGIR's coefficient file (calibration_ggir_coefs.csv; GGIR's
+# backup.cal.coef) matches its rows to recordings by file name: two
+# recordings of one name in different folders are refused before any work.
+check_ggir_names <- function(paths, ids) {
+  name <- basename(paths)
+  d <- anyDuplicated(name)
+  if (d) {
+    both <- ids[name == name[d]]
+    abort("`files`: \"", both[1], "\" and \"", both[2], "\" have the same ",
+          "file name, \"", name[d], "\", and GGIR's coefficient file (",
+          "calibration_ggir_coefs.csv, for GGIR's backup.cal.coef) takes one ",
+          "row per file name. Rename one, calibrate them in separate runs ",
+          "(another `outdir`), or use method = \"lightweight\".")
+  }
 }
 
 # `outdir`, created if needed, as an absolute path.
@@ -233,9 +315,11 @@ cohort_outdir <- function(outdir) {
 # ---- resume: saved results and their keys ---------------------------------
 
 # One saved result per recording and method, named after the file and the
-# MD5 of its path and the method.
-slot_names <- function(files, method) {
-  vapply(files, function(f) {
+# MD5 of its full path and the method: unique however many recordings share
+# a file name, and the same whatever the cohort's root (the identity, the
+# path relative to it, changes when recordings from another folder join).
+slot_names <- function(paths, method) {
+  vapply(paths, function(f) {
     paste0(gsub("[^A-Za-z0-9._-]", "_", basename(f)), "-",
            substr(md5_raw(charToRaw(paste(f, method))), 1, 12))
   }, "", USE.NAMES = FALSE)
@@ -295,18 +379,19 @@ read_saved <- function(slot, identity, settings) {
 }
 
 # The function each worker runs for recording i: calibrate, save at once.
-cohort_worker <- function(files, slots, method, args, settings) {
-  force(files)
+cohort_worker <- function(paths, ids, slots, method, args, settings) {
+  force(paths)
+  force(ids)
   force(slots)
   force(method)
   force(args)
   force(settings)
   function(i, p) {
-    identity <- file_identity(files[i])
-    res <- calibrate_one(files[i], method, args)
+    identity <- file_identity(paths[i])
+    res <- calibrate_one(paths[i], ids[i], method, args)
     res$key <- list(identity = identity, settings = settings)
     write_bytes_atomic(serialize(res, NULL), slots[i])
-    if (!is.null(p)) p(message = basename(files[i]))
+    if (!is.null(p)) p(message = ids[i])
     invisible(NULL)
   }
 }
@@ -386,7 +471,7 @@ restart_workers <- function() {
 
 # One recording: the fit and its row, or a row saying what went wrong. The
 # warnings raised while calibrating it go into its row.
-calibrate_one <- function(file, method, args) {
+calibrate_one <- function(file, id, method, args) {
   t0 <- proc.time()[["elapsed"]]
   cohort_fault("calibrate", file)
   cohort_fault("pause", file)
@@ -403,12 +488,13 @@ calibrate_one <- function(file, method, args) {
       err <<- conditionMessage(e)
       NULL
     })
-  list(row = cohort_row(file, fit, err, unique(warns),
+  list(row = cohort_row(file, id, fit, err, unique(warns),
                         proc.time()[["elapsed"]] - t0, method),
        fit = fit)
 }
 
-cohort_row <- function(file, fit, error, warnings, seconds, method) {
+# `file`: the recording's path; `id`: its identity in the cohort.
+cohort_row <- function(file, id, fit, error, warnings, seconds, method) {
   na <- is.null(fit)
   cf <- if (na) rep(NA_real_, 12) else unname(stats::coef(fit))
   coefs <- stats::setNames(as.list(cf[c(1:3, 7:12)]), c(
@@ -429,7 +515,7 @@ cohort_row <- function(file, fit, error, warnings, seconds, method) {
     as.numeric(NROW(fit$points))
   } else as.numeric(NROW(fit$windows))
   data.frame(
-    file = basename(file),
+    file = id,
     status = if (na) "failed" else fit$status,
     message = if (na) paste(error, collapse = "; ") else fit$message,
     coefs,
@@ -466,8 +552,9 @@ fit_hours <- function(fit) {
   if (is.null(fit$hours)) NA_real_ else as.numeric(fit$hours)
 }
 
+# Notes joined with "; " (vectorised: pool_devices() notes several rows).
 join_notes <- function(a, b) {
-  if (is.na(a) || !nzchar(a)) b else paste0(a, "; ", b)
+  ifelse(is.na(a) | !nzchar(a), b, paste0(a, "; ", b))
 }
 
 # ---- writing: atomic files, owned outputs, the lock -----------------------
@@ -532,7 +619,8 @@ remove_parts <- function(dirs) {
 }
 
 # The files of outdir that gravcal wrote, with their MD5, in
-# .gravcal/written.csv: gravcal overwrites or removes only those.
+# .gravcal/written.csv: gravcal overwrites or removes only those. They are
+# all in outdir, so their file name is their identity there.
 owned_table <- function(store) {
   f <- file.path(store, "written.csv")
   tab <- if (file.exists(f)) {
@@ -810,7 +898,7 @@ poolable_status <- c("sphere_not_covered", "bins_incomplete", "too_short",
                      "no_rest")
 
 # calibrate_files(pool = "device"): see its documentation.
-pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
+pool_devices <- function(paths, ids, tab, fits, method, args, alpha = 0.01) {
   need <- tab$status %in% poolable_status & !is.na(tab$serial)
   for (s in unique(tab$serial[need])) {
     idx <- which(tab$serial == s & !is.na(tab$serial))
@@ -831,7 +919,7 @@ pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
                    min(p)))
       next
     }
-    pf <- tryCatch(pooled_fit(files[idx], method, args),
+    pf <- tryCatch(pooled_fit(paths[idx], fits[idx], method, args),
                    error = function(e) e)
     if (inherits(pf, "error")) {
       note(sprintf("the pooled fit failed: %s", conditionMessage(pf)))
@@ -842,16 +930,18 @@ pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
                           "not calibrate (%s)"), length(idx), s, pf$status))
       next
     }
-    pf$pooled <- list(serial = s, files = basename(files[idx]))
+    # the recordings whose rest windows were pooled
+    from <- if (is.null(pf$pooled$used)) idx else idx[pf$pooled$used]
+    pf$pooled <- list(serial = s, files = ids[from])
     if (is.null(pf$input)) pf$input <- list(source = "pooled")
     pf$input$serial <- s
     for (i in todo) {
-      row <- cohort_row(files[i], pf, NULL, "", tab$seconds[i], method)
+      row <- cohort_row(paths[i], ids[i], pf, NULL, "", tab$seconds[i], method)
       row$pooled <- TRUE
       row$message <- sprintf(paste0(
         "calibrated with the rest windows of %d recordings of device %s ",
-        "(%s), pooled; alone: %s"), length(idx), s,
-        paste(basename(files[idx]), collapse = ", "), tab$status[i])
+        "(%s), pooled; alone: %s"), length(from), s,
+        paste(ids[from], collapse = ", "), tab$status[i])
       row$hours <- tab$hours[i]
       row$samples <- tab$samples[i]
       tab[i, ] <- row
@@ -861,36 +951,26 @@ pool_devices <- function(files, tab, fits, method, args, alpha = 0.01) {
   list(tab = tab, fits = fits)
 }
 
-# p-values of the Wald tests of every pair of fits' common coefficients.
+# p-values of the Wald tests (wald_test()) of every pair of fits' common
+# coefficients, pairs without any left out.
 pairwise_wald <- function(fits) {
-  p <- numeric(0)
-  if (length(fits) < 2) return(p)
-  for (i in seq_len(length(fits) - 1)) for (j in (i + 1):length(fits)) {
-    a <- fits[[i]]
-    b <- fits[[j]]
-    nm <- intersect(a$model, b$model)
-    if (!length(nm) || is.null(a$vcov) || is.null(b$vcov)) next
-    d <- stats::coef(a)[nm] - stats::coef(b)[nm]
-    V <- a$vcov[nm, nm, drop = FALSE] + b$vcov[nm, nm, drop = FALSE]
-    W <- tryCatch(drop(t(d) %*% solve(V, d)), error = function(e) Inf)
-    p <- c(p, stats::pchisq(W, df = length(nm), lower.tail = FALSE))
-  }
-  p
+  if (length(fits) < 2) return(numeric(0))
+  pairs <- utils::combn(length(fits), 2)
+  p <- apply(pairs, 2, function(ij) wald_test(fits[[ij[1]]], fits[[ij[2]]]))
+  p[!is.na(p)]
 }
 
-# One fit on the rest windows of several recordings of a device.
-pooled_fit <- function(files, method, args) {
-  if (method == "ggir") {
-    ggir_args <- args[intersect(names(args), c("use_temp", "max_iter", "tol"))]
-    ws <- lapply(files, function(f) rest_windows(f, method = "ggir"))
-    w <- do.call(rbind, ws)
-    return(do.call(fit_icp, c(list(w = w[w$rest, , drop = FALSE]), ggir_args)))
-  }
-  la <- lightweight_args(args)
+# One fit on the rest windows of several recordings of a device: `paths`
+# and `fits`, their calibrations alone.
+pooled_fit <- function(paths, fits, method, args) {
+  if (method == "ggir") return(pooled_ggir(fits, args))
+  la <- lightweight_args(args[names(args) != "sf"])
   rargs <- la$args$rest_windows[intersect(names(la$args$rest_windows),
                                           c("window", "max_range", "axes",
                                             "skip_zero", "reader"))]
-  ws <- lapply(files, function(f) do.call(rest_windows, c(list(x = f), rargs)))
+  ws <- lapply(paths, function(f) {
+    do.call(rest_windows, c(list(x = f, sf = args$sf), rargs))
+  })
   w <- do.call(rbind, ws)
   attr(w, "sf") <- attr(ws[[1]], "sf")
   attr(w, "window") <- attr(ws[[1]], "window")
@@ -906,4 +986,69 @@ pooled_fit <- function(files, method, args) {
   la$choice$budget <- "all"
   lightweight_from_windows(w, la$args, la$choice, la$max_norm_error,
                            la$range_g, call = NULL, file = NULL)
+}
+
+# The GGIR method pooled. Each recording's rest windows are those GGIR's
+# procedure kept when it calibrated that recording alone (its spheredata,
+# in fit$ggir): block rules, duplicate filter, temperature checks and the
+# user's settings (sf, chunksize, max_sd, use_temp, reader, ggir_compat)
+# applied, and nothing decoded twice. minloadcrit stays a rule of each
+# recording's reading, as in GGIR: a recording that could not calibrate
+# alone never reached the error target, so it gives all its rest windows; one
+# that could gives those its own fit used. A recording too short for the
+# procedure (GGIR's spheredata then holds all its windows, not its rest
+# windows) gives none. Then the procedure's last step on the union: at least
+# min_rest windows, every axis beyond -+spherecrit, the method's ICP, GGIR's
+# errors, its QC message (minloadcrit against the hours of the pool) and
+# gravcal's status (ggir_fit()). The temperature term is fitted when every
+# recording pooled used it.
+pooled_ggir <- function(fits, args) {
+  k <- ggir_constants
+  a <- utils::modifyList(
+    list(spherecrit = k$spherecrit, minloadcrit = k$minloadcrit,
+         max_iter = k$max_iter, tol = k$tol, ggir_compat = FALSE),
+    args[intersect(names(args), c("spherecrit", "minloadcrit", "max_iter",
+                                  "tol", "ggir_compat"))])
+  res <- lapply(fits, function(f) f[["ggir"]])
+  has <- vapply(res, function(r) {
+    NROW(r$spheredata) > 0 && !identical(r$QCmessage, ggir_messages[["no_data"]])
+  }, NA)
+  if (!any(has)) abort("no recording of the device has rest windows")
+  res <- res[has]
+  temp <- vapply(res, function(r) isTRUE(r$use.temp), NA)
+  cols <- seq_len(if (all(temp)) 8 else 7)
+  ft <- do.call(rbind, lapply(res, function(r) unname(as.matrix(r$spheredata[, cols]))))
+  m <- ft[, 2:4, drop = FALSE]
+  tt <- if (all(temp)) ft[, 8]
+  hours <- sum(vapply(res, function(r) r$nhoursused, 0))
+  out <- list(scale = c(1, 1, 1), offset = c(0, 0, 0), tempoffset = NULL,
+              cal.error.start = ggir_error(m, c(1, 1, 1), c(0, 0, 0)),
+              cal.error.end = NULL)
+  icp <- NULL
+  covered <- all(apply(m, 2, min) < -a$spherecrit & apply(m, 2, max) > a$spherecrit)
+  qc <- if (nrow(m) < k$min_rest) "no_rest" else if (!covered) "no_sphere"
+  if (is.null(qc)) {
+    icp <- icp_means(m[, 1], m[, 2], m[, 3], tt, all(temp),
+                     if (a$ggir_compat) "ggir_r" else "converge", a$max_iter, a$tol)
+    out[c("scale", "offset", "tempoffset")] <- icp[c("scale", "offset", "tempoffset")]
+    out$cal.error.end <- ggir_error(m, icp$scale, icp$offset, icp$tempoffset, tt,
+                                    if (all(temp)) icp$meantemp else 0)
+    qc <- if (!isTRUE(icp$finite)) "not_finite" else
+      if (out$cal.error.end > out$cal.error.start) "no_decrease" else
+        if (out$cal.error.end < min(out$cal.error.start, k$max_error) &&
+            hours > a$minloadcrit) {
+          if (all(temp) || !any(temp)) "done" else "done_no_temp"
+        } else "attempted"
+  }
+  sd <- as.data.frame(ft)
+  names(sd) <- ggir_feature_names(all(temp))
+  out <- c(out, list(spheredata = sd, npoints = nrow(sd), nhoursused = hours,
+                     QCmessage = ggir_messages[[qc]], use.temp = all(temp),
+                     meantempcal = if (all(temp)) mean(tt), bsc_qc = data.frame()))
+  attr(out, "gravcal") <- list(
+    icp = icp, input = list(source = "pooled"),
+    windows = sum(vapply(fits[has], function(f) as.numeric(f$n_windows), 0)))
+  fit <- ggir_fit(out, a$ggir_compat, call = NULL, a$minloadcrit)
+  fit$pooled <- list(used = has)
+  fit
 }

@@ -7,8 +7,8 @@
 # coefficients are comparable). Then, repeatedly: a segment that cannot be
 # fitted alone (too few distinct postures for the model) is merged with a
 # neighbour; otherwise the pair of neighbours least different is merged
-# when a Wald test of their difference, d' (V1 + V2)^-1 d against
-# chi-squared with as many degrees of freedom as coefficients, has a
+# when a Wald test of their difference (wald_test(): d' (V1 + V2)^-1 d
+# against chi-squared with as many degrees of freedom as coefficients) has a
 # p-value above `change_alpha` divided by the number of pairs left (a
 # Bonferroni bound over the pairs, so that a recording without drift comes
 # out as one segment in at least 1 - change_alpha of cases when the
@@ -64,13 +64,6 @@ fit_segments <- function(fit, rest, origin, fargs, choice) {
                       fit = fit_one(rows))
     segs[-(i + 1)]
   }
-  wald_p <- function(a, b) {
-    nm <- a$model
-    d <- stats::coef(a)[nm] - stats::coef(b)[nm]
-    V <- a$vcov[nm, nm] + b$vcov[nm, nm]
-    W <- tryCatch(drop(t(d) %*% solve(V, d)), error = function(e) Inf)
-    stats::pchisq(W, df = length(nm), lower.tail = FALSE)
-  }
   repeat {
     if (length(segs) == 1) break
     bad <- which(vapply(segs, function(s) is.null(s$fit), NA))
@@ -80,7 +73,7 @@ fit_segments <- function(fit, rest, origin, fargs, choice) {
       next
     }
     p <- vapply(seq_len(length(segs) - 1), function(i) {
-      wald_p(segs[[i]]$fit, segs[[i + 1]]$fit)
+      wald_test(segs[[i]]$fit, segs[[i + 1]]$fit)
     }, 0)
     i <- which.max(p)
     if (p[i] <= choice$change_alpha / length(p)) break

@@ -206,3 +206,123 @@ test_that("calibrate_cli() calibrates files given on the command line", {
   expect_identical(tab$file, c("p01.csv", "p05_corrupt.csv"))
   expect_true(file.exists(file.path(out, "calibration.csv")))
 })
+
+# ---- the recording's identity: its path relative to the cohort's root ----
+
+# Recordings in subfolders of a new folder: `files` names them relative to
+# it; each a different 8-hour recording at 5 Hz.
+nested_cohort <- function(files) {
+  dir <- tempfile("nested")
+  for (i in seq_along(files)) {
+    f <- file.path(dir, files[i])
+    dir.create(dirname(f), recursive = TRUE, showWarnings = FALSE)
+    saveRDS(simulate_recording(hours = 8, sf = 5, seed = 500 + i), f)
+  }
+  dir
+}
+
+strip_run <- function(tab) {
+  attr(tab, "fits") <- NULL
+  tab$seconds <- NULL
+  tab
+}
+
+test_that("two recordings of one file name in different folders are told apart", {
+  dir <- nested_cohort(c("a/p01.rds", "b/p01.rds"))
+  on.exit(unlink(dir, recursive = TRUE))
+  both <- file.path(dir, c("a/p01.rds", "b/p01.rds"))
+  tab <- calibrate_files(both, method = "lightweight", outdir = file.path(dir, "out"))
+  expect_identical(tab$file, c("a/p01.rds", "b/p01.rds"))
+  expect_identical(names(attr(tab, "fits")), tab$file)
+  # each row is its own recording's calibration
+  for (i in 1:2) {
+    expect_identical(tab$offset.x[i], unname(calibrate(both[i])$offset[1]),
+                     label = tab$file[i])
+  }
+  expect_false(identical(tab$offset.x[1], tab$offset.x[2]))
+  written <- utils::read.csv(file.path(dir, "out", "calibration.csv"))
+  expect_identical(written$file, tab$file)
+  expect_length(list.files(file.path(dir, "out", ".gravcal"), pattern = "rds$"), 2)
+  # GGIR's coefficient file keys by file name: refused before any work,
+  # naming both (paths given, or the folder listed with its subfolders)
+  out <- file.path(dir, "ggir")
+  msg <- "\"a/p01.rds\" and \"b/p01.rds\" have the same file name, \"p01.rds\".*GGIR's coefficient file"
+  expect_error(calibrate_files(both, method = "ggir", outdir = out), msg)
+  expect_error(calibrate_files(dir, method = "ggir", outdir = out, recursive = TRUE), msg)
+  expect_false(dir.exists(out))
+})
+
+test_that("a folder with subfolders: identities relative to it, output folders left out", {
+  dir <- nested_cohort(c("p00.rds", "a/p01.rds", "a/deep/p02.rds", "b/p03.rds"))
+  on.exit(unlink(dir, recursive = TRUE))
+  # an earlier run's output folder inside the cohort
+  calibrate_files(file.path(dir, "p00.rds"), method = "lightweight",
+                  outdir = file.path(dir, "b", "old"))
+  out <- file.path(dir, "out")
+  dir.create(out)
+  writeLines("x,y,z", file.path(out, "stray.csv"))
+  expect_identical(calibrate_files(dir, method = "lightweight", outdir = out)$file,
+                   "p00.rds")
+  tab <- calibrate_files(dir, method = "ggir", outdir = out, recursive = TRUE)
+  ids <- c("a/deep/p02.rds", "a/p01.rds", "b/p03.rds", "p00.rds")
+  expect_identical(tab$file, ids)
+  expect_identical(names(attr(tab, "fits")), ids)
+  expect_true(all(tab$status %in% c("ok", "high_error")))
+  for (i in 1:4) {
+    expect_identical(tab$scale.x[i], unname(diag(calibrate(file.path(dir, ids[i]),
+                                                           method = "ggir")$K)[1]),
+                     label = ids[i])
+  }
+  # GGIR's file names its rows by file name, which GGIR matches
+  coefs <- utils::read.csv(file.path(out, "calibration_ggir_coefs.csv"))
+  expect_identical(coefs$filename, basename(ids))
+  expect_equal(coefs$scale.x, tab$scale.x, tolerance = 1e-13)  # csv: 15 digits
+  # paths given: relative to their longest common directory
+  tp <- calibrate_files(file.path(dir, ids[1:2]), method = "lightweight",
+                        outdir = file.path(dir, "out2"))
+  expect_identical(tp$file, c("deep/p02.rds", "p01.rds"))
+  expect_error(calibrate_files(dir, outdir = out, recursive = NA),
+               "`recursive` must be TRUE or FALSE")
+})
+
+test_that("an interrupted run of recordings in subfolders resumes", {
+  skip_on_os("windows")  # fork
+  dir <- nested_cohort(c("a/p01.rds", "b/p01.rds", "c/p02.rds"))
+  on.exit(unlink(dir, recursive = TRUE))
+  run <- function(out, files = dir) {
+    calibrate_files(files, method = "lightweight", outdir = out, recursive = TRUE)
+  }
+  clean <- strip_run(run(file.path(dir, "clean")))
+  out <- file.path(dir, "out")
+  store <- file.path(out, ".gravcal")
+  # killed while the last recording (held 3 s) is being calibrated
+  old <- Sys.getenv("GRAVCAL_FAULT", unset = NA)
+  Sys.setenv(GRAVCAL_FAULT = "pause:c/p02")
+  job <- parallel::mcparallel(run(out), silent = TRUE)
+  if (is.na(old)) Sys.unsetenv("GRAVCAL_FAULT") else Sys.setenv(GRAVCAL_FAULT = old)
+  t0 <- Sys.time()
+  while (length(list.files(store, pattern = "rds$")) < 2 &&
+         difftime(Sys.time(), t0, units = "secs") < 60) Sys.sleep(0.05)
+  tools::pskill(job$pid, tools::SIGKILL)
+  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
+  saved <- list.files(store, pattern = "rds$", full.names = TRUE)
+  expect_length(saved, 2)
+  # both recordings named p01.rds have their own saved result
+  expect_identical(sort(sub("-.*$", "", basename(saved))), c("p01.rds", "p01.rds"))
+  stamp <- file.mtime(saved)
+  expect_message(tab <- run(out), "took over the lock")
+  expect_identical(strip_run(tab), clean)
+  expect_identical(file.mtime(saved), stamp)
+  # another root (a recording from elsewhere joins): the saved results are
+  # taken, under their new identities
+  extra <- tempfile("extra")
+  dir.create(extra)
+  on.exit(unlink(extra, recursive = TRUE), add = TRUE)
+  saveRDS(simulate_recording(hours = 8, sf = 5, seed = 599), file.path(extra, "q.rds"))
+  wider <- run(out, c(file.path(dir, c("a/p01.rds", "b/p01.rds")),
+                      file.path(extra, "q.rds")))
+  expect_identical(wider$file, c(file.path(basename(dir), c("a/p01.rds", "b/p01.rds")),
+                                 file.path(basename(extra), "q.rds")))
+  expect_identical(file.mtime(saved), stamp)
+  expect_identical(strip_run(wider)[1:2, -1], clean[1:2, -1])
+})

@@ -104,3 +104,85 @@ test_that("a device whose recordings disagree is not pooled", {
   expect_false(any(res$pooled))
   expect_match(res$message[3], "not pooled: the recordings of device 42 that calibrate alone disagree")
 })
+
+# The GGIR procedure on each recording alone, with calibrate_files()'s
+# settings, then fit_icp() (the method's ICP, gravcal's convergence rule) on
+# the union of the rest windows it kept (spheredata): what pooling must give.
+manual_ggir_pool <- function(files, sf = NULL, chunksize = 1, spherecrit = 0.3,
+                             minloadcrit = 168, max_sd = 0.013) {
+  sd <- lapply(files, function(f) {
+    src <- gravcal:::open_source(f, sf = sf, chunksize = chunksize, compat = FALSE)
+    suppressWarnings(gravcal:::ggir_run(src, compat = FALSE, spherecrit = spherecrit,
+                                        minloadcrit = minloadcrit,
+                                        sdcriter = max_sd)$spheredata)
+  })
+  fit_icp(do.call(rbind, sd))
+}
+
+faces <- list(c(1, 0, 0), c(-1, 0, 0), c(0, 1, 0), c(0, -1, 0), c(0, 0, 1),
+              c(0, 0, -1))
+
+test_that("GGIR pooling takes each recording's rest windows from GGIR's procedure, with the user's settings", {
+  p <- c(1.03, 0.97, 1.02, 0.02, -0.015, 0.01, 0.04, -0.03, 0.02)
+  dir <- tempfile("poolggir")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  # six recordings of one device, each resting near one face; temperature
+  # varies, so that the temperature term is fitted
+  files <- file.path(dir, sprintf("f%d.cwa", seq_along(faces)))
+  for (k in seq_along(faces)) {
+    v <- device_rest(p, 360, faces[[k]], seed = 30 + k)
+    gravcal:::write_cwa(v, files[k], sf = 25, packed = FALSE, device_id = 77,
+                        temperature = 20 + k + 4 * sin(seq_len(nrow(v)) / 5e4))
+  }
+  set <- list(spherecrit = 0.25, minloadcrit = 3, max_sd = 0.015, chunksize = 0.5)
+  res <- do.call(calibrate_files, c(list(files, method = "ggir", pool = "device",
+                                         outdir = file.path(dir, "out")), set))
+  expect_true(all(res$pooled))
+  expect_true(all(grepl("alone: sphere_not_covered", res$message)))
+  fp <- attr(res, "fits")[["f1.cwa"]]
+  expect_identical(fp$status, "ok")
+  expect_true(fp$use_temp)
+  ref <- do.call(manual_ggir_pool, c(list(files), set))
+  expect_identical(coef(fp), coef(ref))
+  expect_identical(fp$meantemp, ref$meantemp)
+  expect_identical(nrow(fp$points), nrow(ref$points))
+  expect_identical(res$offset.x, rep(unname(ref$offset[1]), 6))
+  # the pooled windows must cover the sphere at the user's spherecrit:
+  # without the face at -z, z reaches about -0.35 g only
+  five <- calibrate_files(files[1:5], method = "ggir", pool = "device",
+                          outdir = file.path(dir, "five"), spherecrit = 0.5)
+  expect_false(any(five$pooled))
+  expect_true(all(five$status == "sphere_not_covered"))
+  expect_true(all(grepl(paste0("not pooled: pooled, the 5 recordings of device 77 ",
+                               "still do not calibrate \\(sphere_not_covered\\)"),
+                        five$message)))
+})
+
+test_that("GGIR pooling reads each recording at the sampling rate given", {
+  p <- c(1.03, 0.97, 1.02, 0.02, -0.015, 0.01, 0, 0, 0)
+  dir <- tempfile("poolsf")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  # ActiGraph csv exports of one device (one serial number) whose headers
+  # say 50 Hz; the samples are at 25 Hz, as `sf` says
+  files <- file.path(dir, sprintf("g%d.csv", seq_along(faces)))
+  for (k in seq_along(faces)) {
+    gravcal:::write_actigraph_csv(device_rest(p, 180, faces[[k]], seed = 60 + k),
+                                  files[k], sf = 50)
+  }
+  res <- calibrate_files(dir, method = "ggir", pool = "device", sf = 25,
+                         outdir = file.path(dir, "out"))
+  expect_true(all(res$pooled))
+  fp <- attr(res, "fits")[[1]]
+  ref <- manual_ggir_pool(files, sf = 25)
+  expect_identical(coef(fp), coef(ref))
+  # at the header's rate each recording is 1.5 hours, too short for GGIR's
+  # procedure, which then keeps no rest windows: nothing to pool
+  head_rate <- calibrate_files(dir, method = "ggir", pool = "device",
+                               outdir = file.path(dir, "header"))
+  expect_true(all(head_rate$status == "too_short"))
+  expect_false(any(head_rate$pooled))
+  expect_true(all(grepl("not pooled: the pooled fit failed: no recording of the device has rest windows",
+                        head_rate$message)))
+})

@@ -84,3 +84,35 @@ test_that("segments that cannot be fitted alone join a neighbour; bad arguments"
   expect_error(calibrate(rec, sf = 5, segments = "day", change_alpha = 2),
                "`change_alpha` must be")
 })
+
+test_that("wald_test() is d' (Va + Vb)^-1 d against chi-squared", {
+  # two fits of x and y offset, 10 and 20 mg apart; standard errors 10 mg
+  # in x and 20 mg in y each, b's two correlated (covariance 5e-5)
+  fit <- function(o, V) {
+    f <- gravcal:::new_fit(offset = o, method = "ggir")
+    f$model <- c("o_x", "o_y")
+    f$vcov <- matrix(V, 2, 2, dimnames = list(f$model, f$model))
+    f
+  }
+  a <- fit(c(0.01, 0.02, 0), c(1e-4, 0, 0, 4e-4))
+  b <- fit(c(0, 0, 0), c(1e-4, 5e-5, 5e-5, 4e-4))
+  # by hand: d = (0.01, 0.02), V = [2e-4 5e-5; 5e-5 8e-4], det V = 1.575e-7,
+  # V^-1 = [8e-4 -5e-5; -5e-5 2e-4] / det V, so
+  # W = (8e-4 * 1e-4 - 2 * 5e-5 * 2e-4 + 2e-4 * 4e-4) / 1.575e-7 = 8 / 9,
+  # and with 2 degrees of freedom P(chi2 > W) = exp(-W / 2)
+  expect_equal(gravcal:::wald_test(a, b), exp(-4 / 9), tolerance = 1e-12)
+  # uncorrelated, equal errors in x alone: W = 0.01^2 / 2e-4 = 0.5, one
+  # degree of freedom
+  expect_equal(gravcal:::wald_test(a, b, nm = "o_x"),
+               pchisq(0.5, df = 1, lower.tail = FALSE), tolerance = 1e-12)
+  expect_identical(gravcal:::wald_test(a, a), 1)
+  # nothing to compare: NA; a covariance that cannot be inverted: 0
+  b0 <- b
+  b0$vcov <- NULL
+  expect_identical(gravcal:::wald_test(a, b0), NA_real_)
+  sing <- fit(c(0, 0, 0), c(-1e-4, 0, 0, -4e-4))
+  expect_identical(gravcal:::wald_test(a, sing), 0)
+  # pairwise over a device's fits: every pair, in order
+  expect_equal(gravcal:::pairwise_wald(list(a, b, a)),
+               c(gravcal:::wald_test(a, b), 1, gravcal:::wald_test(b, a)))
+})
