@@ -73,3 +73,7 @@ gc_pump <- function(src, stage, opts, on_block = NULL) {
     .Call(`_gravcal_gc_pump`, src, stage, opts, on_block)
 }
 
+gc_ggir_fit_table <- function(table, temp_available, hours, opts) {
+    .Call(`_gravcal_gc_ggir_fit_table`, table, temp_available, hours, opts)
+}
+

@@ -1018,36 +1018,15 @@ pooled_ggir <- function(fits, args) {
   temp <- vapply(res, function(r) isTRUE(r$use.temp), NA)
   cols <- seq_len(if (all(temp)) 8 else 7)
   ft <- do.call(rbind, lapply(res, function(r) unname(as.matrix(r$spheredata[, cols]))))
-  m <- ft[, 2:4, drop = FALSE]
-  tt <- if (all(temp)) ft[, 8]
   hours <- sum(vapply(res, function(r) r$nhoursused, 0))
-  out <- list(scale = c(1, 1, 1), offset = c(0, 0, 0), tempoffset = NULL,
-              cal.error.start = ggir_error(m, c(1, 1, 1), c(0, 0, 0)),
-              cal.error.end = NULL)
-  icp <- NULL
-  covered <- all(apply(m, 2, min) < -a$spherecrit & apply(m, 2, max) > a$spherecrit)
-  qc <- if (nrow(m) < k$min_rest) "no_rest" else if (!covered) "no_sphere"
-  if (is.null(qc)) {
-    icp <- icp_means(m[, 1], m[, 2], m[, 3], tt, all(temp),
-                     if (a$ggir_compat) "ggir_r" else "converge", a$max_iter, a$tol)
-    out[c("scale", "offset", "tempoffset")] <- icp[c("scale", "offset", "tempoffset")]
-    out$cal.error.end <- ggir_error(m, icp$scale, icp$offset, icp$tempoffset, tt,
-                                    if (all(temp)) icp$meantemp else 0)
-    qc <- if (!isTRUE(icp$finite)) "not_finite" else
-      if (out$cal.error.end > out$cal.error.start) "no_decrease" else
-        if (out$cal.error.end < min(out$cal.error.start, k$max_error) &&
-            hours > a$minloadcrit) {
-          if (all(temp) || !any(temp)) "done" else "done_no_temp"
-        } else "attempted"
-  }
-  sd <- as.data.frame(ft)
-  names(sd) <- ggir_feature_names(all(temp))
-  out <- c(out, list(spheredata = sd, npoints = nrow(sd), nhoursused = hours,
-                     QCmessage = ggir_messages[[qc]], use.temp = all(temp),
-                     meantempcal = if (all(temp)) mean(tt), bsc_qc = data.frame()))
-  attr(out, "gravcal") <- list(
-    icp = icp, input = list(source = "pooled"),
-    windows = sum(vapply(fits[has], function(f) as.numeric(f$n_windows), 0)))
+  # the procedure's last stages (sphere check, fit, errors, QC) on the
+  # pooled rest windows
+  sf <- fits[has][[1]]$input$sf %||% 1
+  opts <- ggir_options(a$ggir_compat, sf, a$spherecrit, a$minloadcrit,
+                       ggir_constants$max_sd, a$max_iter, a$tol, FALSE)
+  r <- gc_ggir_fit_table(ft, any(temp), hours, opts)
+  r$windows <- sum(vapply(fits[has], function(f) as.numeric(f$n_windows), 0))
+  out <- ggir_result(r, data.frame(), list(source = "pooled"))
   fit <- ggir_fit(out, a$ggir_compat, call = NULL, a$minloadcrit)
   fit$pooled <- list(used = has)
   fit

@@ -95,20 +95,10 @@ ggir_run <- function(src, compat = TRUE,
           if (isTRUE(!is.na(src$filename))) paste0(", from \"", src$filename, "\""),
           ").")
   }
-  k <- ggir_constants
-  opts <- list(compat = compat, sf = sf, block_units = src$units,
-               short_block_rows = src$short_rows %||% 0,
-               temperature = isTRUE(src$temperature),
-               lazy = lazy, spherecrit = spherecrit, minloadcrit = minloadcrit,
-               max_sd = sdcriter, max_abs_mean = k$max_abs_mean,
-               min_rest = k$min_rest, enough_offset = k$enough_offset,
-               min_hours = k$min_hours, max_error = k$max_error,
-               error_digits = k$error_digits, temp_max_first = k$temp_max_first,
-               temp_min_sd = k$temp_min_sd, temp_missing = k$temp_missing,
-               fill = k$fill, max_iter = max_iter, tol = tol,
-               max_weight = k$max_weight, refit_growth = k$refit_growth,
-               verbose = verbose)
-  opts <- lapply(opts, as.numeric)
+  opts <- ggir_options(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter,
+                       tol, verbose, block_units = src$units,
+                       short_block_rows = src$short_rows %||% 0,
+                       temperature = isTRUE(src$temperature), lazy = lazy)
   # memory in use after each block (GGIR records R's heap from a full gc(),
   # which costs about as much as decoding the block)
   bsc <- list()
@@ -119,8 +109,35 @@ ggir_run <- function(src, compat = TRUE,
     NULL
   }
   r <- gc_pump(src$pump(), "ggir", opts, record)
-  for (w in r$warnings) warning(w, call. = FALSE)
   check_source_read(src, r$samples)
+  ggir_result(r, if (length(bsc)) do.call(rbind, bsc) else data.frame(),
+              source_input(src, r$samples), verbose, printsummary)
+}
+
+# The procedure's settings for the core (GgirConfig in ggir_procedure.hpp):
+# the user's, then GGIR's constants.
+ggir_options <- function(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter,
+                         tol, verbose, block_units = 0, short_block_rows = 0,
+                         temperature = TRUE, lazy = TRUE) {
+  k <- ggir_constants
+  opts <- list(compat = compat, sf = sf, block_units = block_units,
+               short_block_rows = short_block_rows, temperature = temperature,
+               lazy = lazy, spherecrit = spherecrit, minloadcrit = minloadcrit,
+               max_sd = sdcriter, max_abs_mean = k$max_abs_mean,
+               min_rest = k$min_rest, enough_offset = k$enough_offset,
+               min_hours = k$min_hours, max_error = k$max_error,
+               error_digits = k$error_digits, temp_max_first = k$temp_max_first,
+               temp_min_sd = k$temp_min_sd, temp_missing = k$temp_missing,
+               fill = k$fill, max_iter = max_iter, tol = tol,
+               max_weight = k$max_weight, refit_growth = k$refit_growth,
+               verbose = verbose)
+  lapply(opts, as.numeric)
+}
+
+# GGIR's list from the core's outcome `r` (gc_pump(stage = "ggir") or
+# gc_ggir_fit_table()), with what calibrate() needs in attribute "gravcal".
+ggir_result <- function(r, bsc_qc, input, verbose = FALSE, printsummary = FALSE) {
+  for (w in r$warnings) warning(w, call. = FALSE)
   QC <- if (nzchar(r$qc)) ggir_messages[[r$qc]]
   spheredata <- NULL
   ft <- r$table
@@ -136,15 +153,13 @@ ggir_run <- function(src, compat = TRUE,
               cal.error.start = r$cal.error.start, cal.error.end = r$cal.error.end,
               spheredata = spheredata, npoints = r$npoints,
               nhoursused = r$nhoursused, QCmessage = QC, use.temp = use.temp,
-              meantempcal = meantempcal,
-              bsc_qc = if (length(bsc)) do.call(rbind, bsc) else data.frame())
+              meantempcal = meantempcal, bsc_qc = bsc_qc)
   if (printsummary && verbose) ggir_print_summary(out)
   if (verbose) cat("\n")
   icp <- r$icp
   if (!is.null(icp)) icp$meantemp <- r$meantemp
   attr(out, "gravcal") <- list(icp = icp, meantemp = r$meantemp,
-                               blocks = r$blocks,
-                               input = source_input(src, r$samples),
+                               blocks = r$blocks, input = input,
                                temp.available = r$temp.available,
                                windows = r$windows)
   out

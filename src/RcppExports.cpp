@@ -230,6 +230,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_ggir_fit_table
+Rcpp::List gc_ggir_fit_table(const Rcpp::NumericMatrix& table, bool temp_available, double hours, const Rcpp::List& opts);
+RcppExport SEXP _gravcal_gc_ggir_fit_table(SEXP tableSEXP, SEXP temp_availableSEXP, SEXP hoursSEXP, SEXP optsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type table(tableSEXP);
+    Rcpp::traits::input_parameter< bool >::type temp_available(temp_availableSEXP);
+    Rcpp::traits::input_parameter< double >::type hours(hoursSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type opts(optsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_fit_table(table, temp_available, hours, opts));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
@@ -250,6 +263,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_source_columns", (DL_FUNC) &_gravcal_gc_source_columns, 4},
     {"_gravcal_gc_source_blocks", (DL_FUNC) &_gravcal_gc_source_blocks, 2},
     {"_gravcal_gc_pump", (DL_FUNC) &_gravcal_gc_pump, 4},
+    {"_gravcal_gc_ggir_fit_table", (DL_FUNC) &_gravcal_gc_ggir_fit_table, 4},
     {NULL, NULL, 0}
 };
 

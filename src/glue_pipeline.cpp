@@ -178,9 +178,8 @@ Rcpp::RObject scalar(double v, bool present) {
   return Rcpp::NumericVector::create(v);
 }
 
-// GGIR's procedure over the source (ggir_procedure.hpp).
-Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
-                    Rcpp::Nullable<Rcpp::Function> on_block) {
+// GGIR's procedure's settings from R (ggir_run()'s list).
+gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
   gravcal::GgirConfig c;
   c.compat = num(o, "compat") != 0;
   c.sf = num(o, "sf");
@@ -206,9 +205,11 @@ Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
   c.tol = num(o, "tol");
   c.max_weight = num(o, "max_weight");
   c.refit_growth = num(o, "refit_growth");
-  RHost host(num(o, "verbose") != 0, on_block);
-  gravcal::GgirProcedure proc(c, host);
-  const gravcal::GgirOutcome r = proc.run(src);
+  return c;
+}
+
+// The procedure's outcome for R (ggir_run() shapes GGIR's list from it).
+Rcpp::List outcome_list(const gravcal::GgirOutcome& r, const RHost& host) {
   Rcpp::RObject table = R_NilValue, rows = R_NilValue;
   if (r.has_table) {
     const int n = static_cast<int>(r.table_rows.size());
@@ -249,7 +250,16 @@ Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
   out["windows"] = static_cast<double>(r.windows);
   out["samples"] = static_cast<double>(r.samples);
   out["warnings"] = Rcpp::wrap(host.warnings);
+  out["stopped"] = r.stopped;
   return out;
+}
+
+// GGIR's procedure over the source (ggir_procedure.hpp).
+Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
+                    Rcpp::Nullable<Rcpp::Function> on_block) {
+  RHost host(num(o, "verbose") != 0, on_block);
+  gravcal::GgirProcedure proc(ggir_config(o), host);
+  return outcome_list(proc.run(src), host);
 }
 
 }  // namespace
@@ -300,4 +310,18 @@ Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts,
   if (stage == "samples") return run_samples(*b->src, opts);
   if (stage == "blocks") return run_blocks(*b->src, opts);
   Rcpp::stop("stage must be \"windows\", \"ggir\", \"blocks\" or \"samples\"");
+}
+
+// GGIR's procedure's last stages on points already chosen (pooled rest
+// windows): `table` has 7 columns (8 with a temperature to use), `hours`
+// were read, temp_available: some of the recordings had a temperature.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_ggir_fit_table(const Rcpp::NumericMatrix& table, bool temp_available,
+                             double hours, const Rcpp::List& opts) {
+  if (table.ncol() != 7 && table.ncol() != 8) Rcpp::stop("the table needs 7 or 8 columns");
+  RHost host(num(opts, "verbose") != 0, R_NilValue);
+  gravcal::GgirProcedure proc(ggir_config(opts), host);
+  return outcome_list(proc.fit_table(table.begin(), static_cast<std::size_t>(table.nrow()),
+                                     table.ncol() == 8, temp_available, hours),
+                      host);
 }

@@ -147,6 +147,34 @@ class GgirProcedure {
     return o;
   }
 
+  // The procedure's last stages ([4] end to [7]) on points already chosen
+  // (several recordings' rest windows, pooled): `table` column-major with n
+  // rows and 7 columns (8 with a temperature column, to be used), `hours`
+  // read; temp_available: some of the recordings had a temperature.
+  GgirOutcome fit_table(const double* table, std::size_t n, bool temperature,
+                        bool temp_available, double hours) {
+    GgirOutcome o;
+    o.temp_available = temp_available;
+    o.use_temp = temperature;
+    o.nhoursused = hours;
+    o.table_columns = temperature ? 8 : 7;
+    o.table.assign(table, table + static_cast<std::size_t>(o.table_columns) * n);
+    o.table_rows.resize(n);
+    for (std::size_t i = 0; i < n; ++i) o.table_rows[i] = i + 1;
+    o.has_table = true;
+    try {
+      if (n < static_cast<std::size_t>(cfg_.min_rest)) {
+        o.qc = GgirQc::no_rest;
+      } else {
+        fit_points(o, true);
+      }
+      finish(o);
+    } catch (const Interrupted&) {
+      o.stopped = true;
+    }
+    return o;
+  }
+
  private:
   void blocks(Source& src, GgirOutcome& o) {
     const double per_hour = 3600.0 * cfg_.sf;
@@ -270,7 +298,6 @@ class GgirProcedure {
   bool fit(GgirOutcome& o, bool last) {
     pending_ = false;
     next_fit_ = static_cast<double>(n_feat()) * cfg_.refit_growth;
-    bool spherepopulated = false;
     const std::size_t N = col_[0].size();
     std::vector<std::size_t> idx;
     idx.reserve(N);
@@ -293,41 +320,48 @@ class GgirProcedure {
     const double n = static_cast<double>(idx.size());
     const bool enough = cfg_.compat ? n > (cfg_.minloadcrit - cfg_.enough_offset)
                                     : n * 10 >= cfg_.min_hours * 3600;
-    if (enough) {
-      o.nhoursused = (n * 10) / 3600;
-      // the first window is left out, then the windows at rest
-      std::vector<std::size_t> keep;
-      for (std::size_t j = 1; j < idx.size(); ++j) {
-        if (rest_[idx[j]]) keep.push_back(idx[j]);
-      }
-      if (keep.size() < static_cast<std::size_t>(cfg_.min_rest)) {
-        o.qc = GgirQc::no_rest;
-      } else {
-        take_table(o, keep);
-        o.has_npoints = true;
-        o.npoints = static_cast<double>(keep.size());
-        const double* m[3] = {&o.table[1 * keep.size()], &o.table[2 * keep.size()],
-                              &o.table[3 * keep.size()]};
-        const double one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
-        o.error_start = ggir_error(m, keep.size(), one, zero, nullptr, nullptr, 0);
-        o.has_error_start = true;
-        int tel = 0;
-        for (int a = 0; a < 3; ++a) {
-          double lo = m[a][0], hi = m[a][0];
-          for (std::size_t i = 1; i < keep.size(); ++i) {
-            lo = std::min(lo, m[a][i]);
-            hi = std::max(hi, m[a][i]);
-          }
-          if (lo < -cfg_.spherecrit && hi > cfg_.spherecrit) ++tel;
-        }
-        spherepopulated = tel == 3;
-        if (!spherepopulated) o.qc = GgirQc::no_sphere;
-      }
-    } else {
+    if (!enough) {
       o.qc = GgirQc::no_data;
       take_table(o, idx);
+      return false;
     }
-    if (!spherepopulated) return false;
+    o.nhoursused = (n * 10) / 3600;
+    // the first window is left out, then the windows at rest
+    std::vector<std::size_t> keep;
+    for (std::size_t j = 1; j < idx.size(); ++j) {
+      if (rest_[idx[j]]) keep.push_back(idx[j]);
+    }
+    if (keep.size() < static_cast<std::size_t>(cfg_.min_rest)) {
+      o.qc = GgirQc::no_rest;
+      return false;
+    }
+    take_table(o, keep);
+    return fit_points(o, last);
+  }
+
+  // [4] (end) - [6] on the points in o.table: the error before, the sphere
+  // check, the fit, the error after; true when the reading may stop
+  bool fit_points(GgirOutcome& o, bool last) {
+    const std::size_t n = o.table_rows.size();
+    o.has_npoints = true;
+    o.npoints = static_cast<double>(n);
+    const double* m[3] = {&o.table[1 * n], &o.table[2 * n], &o.table[3 * n]};
+    const double one[3] = {1, 1, 1}, zero[3] = {0, 0, 0};
+    o.error_start = ggir_error(m, n, one, zero, nullptr, nullptr, 0);
+    o.has_error_start = true;
+    int tel = 0;
+    for (int a = 0; a < 3; ++a) {
+      double lo = m[a][0], hi = m[a][0];
+      for (std::size_t i = 1; i < n; ++i) {
+        lo = std::min(lo, m[a][i]);
+        hi = std::max(hi, m[a][i]);
+      }
+      if (lo < -cfg_.spherecrit && hi > cfg_.spherecrit) ++tel;
+    }
+    if (tel < 3) {
+      o.qc = GgirQc::no_sphere;
+      return false;
+    }
     // [5] compatible mode fits as GGIR does; gravcal's own mode decides
     // whether to read on with GGIR's cheap early stop, and fits to
     // convergence only for a result it keeps
