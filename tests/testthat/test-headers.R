@@ -1,0 +1,53 @@
+# The header tiers (ARCHITECTURE.md): what gravcal.hpp includes, and all
+# that those include in turn, is the microcontroller core; it may include
+# only C++ standard headers and other headers of that tier (no R, no Eigen,
+# no decoders, no GGIR emulation). tests/cpp builds it for a Cortex-M4.
+std_headers <- c(
+  "algorithm", "array", "cassert", "cfloat", "climits", "cmath", "cstddef",
+  "cstdint", "cstdio", "cstdlib", "cstring", "limits", "type_traits",
+  "utility", "emmintrin.h", "immintrin.h")
+
+includes_of <- function(path) {
+  l <- readLines(path, warn = FALSE)
+  l <- grep("^\\s*#\\s*include", l, value = TRUE)
+  list(system = sub('^\\s*#\\s*include\\s*<([^>]+)>.*', "\\1",
+                    grep("<", l, value = TRUE, fixed = TRUE)),
+       local = sub('^\\s*#\\s*include\\s*"([^"]+)".*', "\\1",
+                   grep('"', l, value = TRUE, fixed = TRUE)))
+}
+
+core_tier <- function(dir) {
+  seen <- character(0)
+  todo <- "gravcal.hpp"
+  while (length(todo)) {
+    h <- todo[1]
+    todo <- todo[-1]
+    if (h %in% seen) next
+    seen <- c(seen, h)
+    todo <- c(todo, includes_of(file.path(dir, h))$local)
+  }
+  seen
+}
+
+test_that("the microcontroller core includes only standard headers", {
+  dir <- system.file("include", "gravcal", package = "gravcal")
+  skip_if(!nzchar(dir), "the package's headers are not installed")
+  tier <- core_tier(dir)
+  # the core itself, and none of the tiers above it
+  expect_true(all(c("model.hpp", "segmenter.hpp", "bins.hpp", "gradient.hpp",
+                    "fixed_point.hpp") %in% tier))
+  expect_false(any(c("icp.hpp", "pipeline.hpp", "ggir_procedure.hpp",
+                     "ggir_blocks.hpp", "decode.hpp") %in% tier))
+  for (h in tier) {
+    inc <- includes_of(file.path(dir, h))
+    expect_identical(setdiff(inc$system, std_headers), character(0),
+                     label = paste(h, "includes"))
+    expect_identical(setdiff(inc$local, tier), character(0),
+                     label = paste(h, "includes"))
+  }
+  # the check can fail: a header that includes R's is caught
+  f <- tempfile(fileext = ".hpp")
+  writeLines(c('#include <Rcpp.h>', '#include "icp.hpp"'), f)
+  inc <- includes_of(f)
+  expect_identical(setdiff(inc$system, std_headers), "Rcpp.h")
+})
