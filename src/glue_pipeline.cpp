@@ -182,29 +182,25 @@ Rcpp::RObject scalar(double v, bool present) {
 gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
   gravcal::GgirConfig c;
   c.compat = num(o, "compat") != 0;
-  c.sf = num(o, "sf");
-  if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
-  c.block_units = num(o, "block_units");
-  c.short_block_rows = num(o, "short_block_rows");
   c.temperature = num(o, "temperature") != 0;
   c.lazy = num(o, "lazy") != 0;
-  c.spherecrit = num(o, "spherecrit");
-  c.minloadcrit = num(o, "minloadcrit");
-  c.max_sd = num(o, "max_sd");
-  c.max_abs_mean = num(o, "max_abs_mean");
   c.min_rest = static_cast<int>(num(o, "min_rest"));
-  c.enough_offset = num(o, "enough_offset");
-  c.min_hours = num(o, "min_hours");
-  c.max_error = num(o, "max_error");
   c.error_digits = static_cast<int>(num(o, "error_digits"));
-  c.temp_max_first = num(o, "temp_max_first");
-  c.temp_min_sd = num(o, "temp_min_sd");
-  c.temp_missing = num(o, "temp_missing");
-  c.fill = num(o, "fill");
   c.max_iter = static_cast<int>(num(o, "max_iter"));
-  c.tol = num(o, "tol");
-  c.max_weight = num(o, "max_weight");
-  c.refit_growth = num(o, "refit_growth");
+  const struct {
+    const char* name;
+    double* field;
+  } numbers[] = {
+      {"sf", &c.sf}, {"block_units", &c.block_units},
+      {"short_block_rows", &c.short_block_rows}, {"spherecrit", &c.spherecrit},
+      {"minloadcrit", &c.minloadcrit}, {"max_sd", &c.max_sd},
+      {"max_abs_mean", &c.max_abs_mean}, {"enough_offset", &c.enough_offset},
+      {"min_hours", &c.min_hours}, {"max_error", &c.max_error},
+      {"temp_max_first", &c.temp_max_first}, {"temp_min_sd", &c.temp_min_sd},
+      {"temp_missing", &c.temp_missing}, {"fill", &c.fill}, {"tol", &c.tol},
+      {"max_weight", &c.max_weight}, {"refit_growth", &c.refit_growth}};
+  for (const auto& f : numbers) *f.field = num(o, f.name);
+  if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
   return c;
 }
 

@@ -138,14 +138,32 @@ class ColumnsSource : public Source {
   std::size_t pos_ = 0;
 };
 
-// The segmenter as a stage: lent samples go straight in; written ones
-// through a fixed buffer of `chunk` samples.
-class SegmenterStage {
+// What the stages below share: lent samples go straight to the target
+// (the segmenter, or GGIR's block rules), with their temperature when the
+// stage takes it.
+template <class Target>
+class ForwardStage {
+ public:
+  ForwardStage(Target& to, bool temperature) : to_(to), temp_(temperature) {}
+  bool temperature() const { return temp_; }
+  template <class Sink>
+  void push(const double* x, const double* y, const double* z, const double* t,
+            std::size_t n, Sink&& sink) {
+    to_.push(x, y, z, temp_ ? t : nullptr, n, sink);
+  }
+
+ protected:
+  Target& to_;
+  bool temp_;
+};
+
+// The segmenter as a stage: written samples go through a fixed buffer of
+// `chunk` samples.
+class SegmenterStage : public ForwardStage<Segmenter> {
  public:
   static constexpr std::size_t chunk = 1u << 16;
   SegmenterStage(Segmenter& seg, bool temperature)
-      : seg_(seg), temp_(temperature), buf_((temperature ? 4u : 3u) * chunk) {}
-  bool temperature() const { return temp_; }
+      : ForwardStage(seg, temperature), buf_((temperature ? 4u : 3u) * chunk) {}
   BlockSpace space(std::size_t want) {
     BlockSpace s;
     s.x = buf_.data();
@@ -158,39 +176,23 @@ class SegmenterStage {
   template <class Sink>
   void commit(std::size_t n, bool has_t, Sink&& sink) {
     const BlockSpace s = space(chunk);
-    seg_.push(s.x, s.y, s.z, has_t ? s.t : nullptr, n, sink);
-  }
-  template <class Sink>
-  void push(const double* x, const double* y, const double* z, const double* t,
-            std::size_t n, Sink&& sink) {
-    seg_.push(x, y, z, temp_ ? t : nullptr, n, sink);
+    to_.push(s.x, s.y, s.z, has_t ? s.t : nullptr, n, sink);
   }
 
  private:
-  Segmenter& seg_;
-  bool temp_;
   std::vector<double> buf_;
 };
 
-// GGIR's block rules as a stage (they feed their segmenter themselves).
-class BlocksStage {
+// GGIR's block rules as a stage: they lend their own buffer for written
+// samples and feed their segmenter themselves.
+class BlocksStage : public ForwardStage<GgirBlocks> {
  public:
-  BlocksStage(GgirBlocks& blocks, bool temperature) : b_(blocks), temp_(temperature) {}
-  bool temperature() const { return temp_; }
-  BlockSpace space(std::size_t want) { return b_.space(want); }
+  BlocksStage(GgirBlocks& blocks, bool temperature) : ForwardStage(blocks, temperature) {}
+  BlockSpace space(std::size_t want) { return to_.space(want); }
   template <class Sink>
   void commit(std::size_t n, bool has_t, Sink&& sink) {
-    b_.commit(n, has_t, sink);
+    to_.commit(n, has_t, sink);
   }
-  template <class Sink>
-  void push(const double* x, const double* y, const double* z, const double* t,
-            std::size_t n, Sink&& sink) {
-    b_.push(x, y, z, temp_ ? t : nullptr, n, sink);
-  }
-
- private:
-  GgirBlocks& b_;
-  bool temp_;
 };
 
 // A collector of samples (a whole recording read into memory), with the
