@@ -3,7 +3,7 @@
 # table equal to a clean run's. Faults are real where the machine allows
 # (processes killed with SIGKILL, a full tmpfs when we may mount one) and
 # injected through gravcal's test hook GRAVCAL_FAULT otherwise (see
-# cohort_fault() in R/batch.R): "write:REGEX" writes only half of a file,
+# cohort_fault() in R/cohort.R): "write:REGEX" writes only half of a file,
 # "calibrate:REGEX" kills the process that starts a recording, "pause:REGEX"
 # makes a recording take 3 s.
 

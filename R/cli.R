@@ -1,0 +1,140 @@
+# The command line: calibrate_cli().
+
+#' Command-line entry for batch scripts
+#'
+#' Runs [calibrate_files()] from the command line, for batch jobs on a
+#' workstation or a cluster:
+#'
+#' `Rscript -e 'gravcal::calibrate_cli()' -- --method ggir --out results/ data/*.cwa`
+#'
+#' Options: `--method ggir|lightweight` (default ggir), `--out DIR`
+#' (required), `--workers N` (parallel R sessions through
+#' `future::plan(multisession)`; default: the plan already set, else one),
+#' `--sf HZ` (for files that do not give their sampling rate), `--pattern
+#' REGEX` (the recordings taken from a directory), `--no-resume` (redo
+#' recordings already done), `--help`. The other arguments are the
+#' recordings (or one directory).
+#'
+#' It prints a summary line, `gravcal: N recording(s): a calibrated, b not
+#' calibrated, c failed; results in DIR/calibration.csv`. With `quit =
+#' TRUE` (the default outside an interactive session) the R process then
+#' ends with exit status 0 when no recording failed, 1 when any recording
+#' failed (status `"failed"`: unreadable, or its worker died), and 2 when
+#' the run could not start (bad arguments, `outdir` locked by another run,
+#' a file that could not be written); the message says why. A recording
+#' that was read but could not be calibrated (for example `"no_rest"`) is
+#' not a failure. A batch job can therefore be resubmitted until it exits
+#' with 0: it resumes.
+#'
+#' @param args The command-line arguments (by default those after `--`).
+#' @param quit End the R process with the exit status above (`TRUE`), or
+#'   return (`FALSE`, for use from R). `--help` always returns.
+#' @return The table of [calibrate_files()], invisibly (when `quit =
+#'   FALSE`); `NULL` after `--help`.
+#' @export
+#' @examples
+#' calibrate_cli("--help")
+calibrate_cli <- function(args = commandArgs(trailingOnly = TRUE),
+                          quit = !interactive()) {
+  check_flag(quit, "quit")
+  args <- as.character(args)
+  if (length(args) && args[1] == "--") args <- args[-1]
+  if (!length(args) || any(args %in% c("--help", "-h"))) {
+    writeLines(cli_help())
+    return(invisible(NULL))
+  }
+  if (!quit) return(invisible(cli_run(args)))
+  tab <- tryCatch(cli_run(args), error = function(e) {
+    message("gravcal: error: ", conditionMessage(e))
+    base::quit(save = "no", status = 2)
+  })
+  base::quit(save = "no", status = if (any(tab$status == "failed")) 1 else 0)
+}
+
+cli_help <- function() {
+  c(
+    "Usage: Rscript -e 'gravcal::calibrate_cli()' -- [options] FILE... | DIR",
+    "Calibrate accelerometer recordings against gravity (gravcal).",
+    "",
+    "  --method M       ggir (default) or lightweight",
+    "  --out DIR        directory for calibration.csv and the per-recording results",
+    "  --workers N      parallel R sessions (future's multisession plan)",
+    "  --sf HZ          sampling rate, for files that do not give it",
+    "  --pattern REGEX  for a directory: the file names to take",
+    "  --no-resume      redo recordings already done in DIR",
+    "  --help           this text",
+    "",
+    "Exit status: 0 no recording failed, 1 some recording failed,",
+    "2 the run could not start (bad arguments, DIR locked by another run).")
+}
+
+cli_run <- function(args) {
+  opt <- cli_parse(args)
+  extra <- list()
+  if (!is.null(opt$sf)) {
+    sf <- suppressWarnings(as.numeric(opt$sf))
+    if (!isTRUE(is.finite(sf) && sf > 0)) {
+      abort("`--sf` must be a positive number (Hz), not \"", opt$sf, "\".")
+    }
+    extra$sf <- sf
+  }
+  if (!is.null(opt$pattern)) extra$pattern <- opt$pattern
+  if (!is.null(opt$workers)) {
+    w <- suppressWarnings(as.numeric(opt$workers))
+    if (!isTRUE(is.finite(w) && w >= 1 && w == round(w))) {
+      abort("`--workers` must be a positive whole number, not \"",
+            opt$workers, "\".")
+    }
+    if (!requireNamespace("future", quietly = TRUE)) {
+      abort("`--workers` needs the future package: install.packages(\"future\").")
+    }
+    old <- future::plan(future::multisession, workers = w)
+    on.exit(future::plan(old), add = TRUE)
+  }
+  tab <- do.call(calibrate_files, c(list(files = opt$files, method = opt$method,
+                                         outdir = opt$out, resume = opt$resume),
+                                    extra))
+  done <- tab$status %in% c("ok", "high_error")
+  failed <- tab$status == "failed"
+  message(sprintf(paste0("gravcal: %d recording(s): %d calibrated, %d not ",
+                         "calibrated, %d failed; results in %s"),
+                  nrow(tab), sum(done), sum(!done & !failed), sum(failed),
+                  file.path(normalizePath(opt$out), "calibration.csv")))
+  tab
+}
+
+cli_parse <- function(args) {
+  opt <- list(method = "ggir", resume = TRUE)
+  files <- character(0)
+  given <- character(0)
+  takes <- c("--method", "--out", "--workers", "--sf", "--pattern")
+  i <- 1
+  while (i <= length(args)) {
+    a <- args[i]
+    if (a %in% takes) {
+      if (i == length(args) || startsWith(args[i + 1], "--")) {
+        abort("`", a, "` needs a value; see --help.")
+      }
+      name <- sub("^--", "", a)
+      if (name %in% given) abort("`", a, "` is given twice.")
+      given <- c(given, name)
+      opt[[name]] <- args[i + 1]
+      i <- i + 2
+    } else if (a == "--no-resume") {
+      opt$resume <- FALSE
+      i <- i + 1
+    } else if (startsWith(a, "-") && a != "-") {
+      abort("Unknown option `", a, "`; see --help.")
+    } else {
+      files <- c(files, a)
+      i <- i + 1
+    }
+  }
+  if (is.null(opt$out)) abort("`--out DIR` is required; see --help.")
+  if (!length(files)) abort("No recordings given; see --help.")
+  if (!opt$method %in% c("ggir", "lightweight")) {
+    abort("`--method` must be ggir or lightweight, not \"", opt$method, "\".")
+  }
+  opt$files <- files
+  opt
+}

@@ -1,0 +1,183 @@
+# The lightweight method (Farago, Maczak & Gingl 2024) from rest windows to
+# a fit: its arguments, the guards on its windows, the fit.
+
+# The lightweight method's arguments from calibrate()'s `...`, routed and
+# checked: list(args (by destination), choice, max_norm_error, range_g).
+lightweight_args <- function(dots) {
+  args <- split_dots(dots, list(
+    rest_windows = c("window", "max_range", "axes", "skip_zero",
+                     "chunk_size", "progress", "reader"),
+    guards = c("max_norm_error", "range_g"),
+    choice = c("selection", "cell", "max_se", "model", "use_temp",
+               "segments", "change_alpha", "budget", "target_se",
+               "check_hours"),
+    select_points = c("per_bin", "min_per_bin", "min_distance"),
+    fit_gradient = c("arithmetic", "max_iter", "rates", "h", "objective",
+                     "use_sqrt", "tol", "trace", "difference", "algorithm",
+                     "se")))
+  choice <- check_choice_args(args$choice, args$select_points)
+  gargs <- args$guards
+  max_norm_error <- if (is.null(gargs$max_norm_error)) 0.3 else
+    gargs$max_norm_error
+  if (!identical(max_norm_error, Inf)) {
+    check_number(max_norm_error, "max_norm_error", min = 0,
+                 min_inclusive = FALSE)
+  }
+  range_g <- gargs$range_g
+  if (!is.null(range_g)) {
+    check_number(range_g, "range_g", min = 0, min_inclusive = FALSE)
+  }
+  list(args = args, choice = choice, max_norm_error = max_norm_error,
+       range_g = range_g)
+}
+
+# The lightweight method from its windows (rest_windows()'s table, with its
+# attributes): the guards, the points, the fit and the held-out errors.
+# `file`: the file's name for the fit (NULL for samples in memory); `timed`:
+# whether the windows' start comes from a `time` column.
+lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
+                                     call, file = NULL, timed = FALSE) {
+  if (is.null(range_g)) range_g <- attr(w, "input")$range_g
+  rest <- w[w$rest, , drop = FALSE]
+  why <- guard_windows(rest, max_norm_error, range_g)
+  excluded <- table(factor(why[!is.na(why)], levels = c("norm", "clipped")))
+  excluded <- stats::setNames(as.integer(excluded), names(excluded))
+  excluded_windows <- rest[!is.na(why), , drop = FALSE]
+  excluded_windows$why <- why[!is.na(why)]
+  rest <- rest[is.na(why), , drop = FALSE]
+  rownames(rest) <- NULL
+  attr(rest, "n_windows") <- nrow(w)
+  guards <- list(max_norm_error = max_norm_error,
+                 range_g = if (is.null(range_g)) NA_real_ else range_g)
+  hours <- attr(w, "samples") / attr(w, "sf") / 3600
+  budget <- list(budget = choice$budget, target_se = choice$target_se,
+                 check_hours = choice$check_hours,
+                 stopped = isTRUE(attr(w, "stopped")), hours_read = hours,
+                 hours_total = attr(w, "samples_total") / attr(w, "sf") / 3600)
+  fail <- function(status, message, points = rest[0, , drop = FALSE]) {
+    f <- new_fit(points = points, method = "lightweight", status = status,
+                 message = message, call = call)
+    f$hours <- hours
+    f$budget <- budget
+    f$input <- attr(w, "input")
+    f$file <- file
+    f <- add_guards(f, excluded, excluded_windows, guards)
+    finish_fit(f, rest)
+  }
+  if (nrow(w) == 0) {
+    return(fail("too_short", sprintf(paste0(
+      "recording too short: %d samples, fewer than one %g s window at %g Hz"),
+      attr(w, "samples"), attr(w, "window"), attr(w, "sf"))))
+  }
+  if (nrow(rest) == 0 && sum(excluded) > 0) {
+    return(fail("no_rest", sprintf(paste0(
+      "no rest: %d windows met the rest criterion but all were left out ",
+      "(%s); are the samples in g?"), sum(excluded), format_excluded(
+        excluded, guards))))
+  }
+  if (nrow(rest) == 0) {
+    return(fail("no_rest", sprintf(paste0(
+      "no rest: none of the %d windows met the rest criterion; are the ",
+      "samples in g and is sf right?"), nrow(w))))
+  }
+  if (choice$selection == "cells") {
+    pts <- select_points(rest, selection = "cells", cell = choice$cell)
+    fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+    if (fit$status == "sphere_not_covered") return(fit)
+    fit$call <- call
+    fit$selection <- choice
+    fit <- guard_fit(fit)
+    if (!is.null(choice$segments) && fit$status == "ok") {
+      fit <- fit_segments(fit, rest, origin = w$start[1], args$fit_gradient,
+                          choice)
+      fit$segment_settings$time <- if (timed) "time" else "seconds"
+      fit$segment_settings$sf <- attr(w, "sf")
+    }
+    fit$hours <- hours
+    fit$budget <- budget
+    fit$input <- attr(w, "input")
+    fit$file <- file
+    fit <- add_guards(fit, excluded, excluded_windows, guards)
+    return(finish_fit(fit, rest))
+  }
+  # the paper's procedure: the bins that a 0.3 g novelty threshold cannot
+  # fill are filled with smaller thresholds, keeping the points already
+  # chosen (unless the user set the thresholds)
+  sargs <- args$select_points
+  if (is.null(sargs$min_distance)) sargs$min_distance <- c(0.3, 0.1, 0.03)
+  pts <- do.call(select_points, c(list(w = rest), sargs))
+  if (!isTRUE(attr(pts, "complete"))) {
+    return(fail("bins_incomplete", paste0(
+      "not enough rest points on all sides of the sphere: ",
+      nrow(rest), " rest windows, bins short of points: ",
+      missing_bins(pts)), points = pts))
+  }
+  fargs <- utils::modifyList(list(max_iter = 5000, tol = 1e-10),
+                             args$fit_gradient)
+  if (choice$model != "auto") fargs$model <- choice$model
+  fit <- do.call(fit_gradient, c(list(pts = pts), fargs))
+  fit$call <- call
+  fit$selection <- choice
+  fit <- guard_fit(fit)
+  fit$hours <- hours
+  fit$input <- attr(w, "input")
+  fit$file <- file
+  fit <- add_guards(fit, excluded, excluded_windows, guards)
+  finish_fit(fit, rest)
+}
+
+# The rest windows that are never calibration points, and why: "clipped"
+# when on some axis the largest |sample| the window can hold, |mean| +
+# (max - min), reaches 98 % of the sensor's full scale `range_g` (skipped
+# when the range is unknown); else "norm" when the mean vector's norm is
+# farther than `max_norm_error` g from 1 g. NA for the windows kept.
+guard_windows <- function(rest, max_norm_error, range_g) {
+  why <- rep(NA_character_, nrow(rest))
+  if (nrow(rest) == 0) return(why)
+  m <- cbind(rest$mean_x, rest$mean_y, rest$mean_z)
+  norm <- sqrt(rowSums(m^2))
+  why[abs(norm - 1) > max_norm_error] <- "norm"
+  if (length(range_g) == 1 && is.finite(range_g) && range_g > 0) {
+    r <- cbind(rest$range_x, rest$range_y, rest$range_z)
+    if (is.null(r) || ncol(r) < 3) r <- matrix(0, nrow(m), 3)
+    r[!is.finite(r)] <- 0
+    reach <- rowSums(abs(m) + r >= clip_fraction * range_g) > 0
+    why[reach] <- "clipped"
+  }
+  why
+}
+
+# A window reaches the sensor's range when a sample may lie within 2 % of
+# full scale: the last counts of an ADC and a decoder's rounding.
+clip_fraction <- 0.98
+
+add_guards <- function(fit, excluded, excluded_windows, guards) {
+  fit$excluded <- excluded
+  fit$excluded_windows <- excluded_windows
+  fit$guards <- guards
+  fit
+}
+
+format_excluded <- function(excluded, guards) {
+  paste0(excluded[["norm"]], " with | |v| - 1 | > ",
+         format(guards$max_norm_error), " g, ", excluded[["clipped"]],
+         " clipped", if (is.finite(guards$range_g))
+           paste0(" (range +-", format(guards$range_g), " g)") else
+             " (sensor range unknown, not checked)")
+}
+
+# Route `...` to the functions that take each argument; unknown names fail.
+split_dots <- function(dots, table) {
+  nms <- names(dots)
+  if (length(dots) && (is.null(nms) || any(nms == ""))) {
+    abort("All arguments in `...` must be named.")
+  }
+  known <- unlist(table, use.names = FALSE)
+  bad <- setdiff(nms, known)
+  if (length(bad)) {
+    abort("Unknown argument", if (length(bad) > 1) "s", " in `...`: ",
+          paste0("`", bad, "`", collapse = ", "), ". Known: ",
+          paste(known, collapse = ", "), ".")
+  }
+  lapply(table, function(keep) dots[intersect(nms, keep)])
+}
