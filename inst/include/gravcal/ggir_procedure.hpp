@@ -191,7 +191,7 @@ class GgirProcedure {
                                                [&] { return host_.interrupted(); });
       const PumpResult& p = rd.pump;
       const GgirBlockInfo& b = rd.info;
-      if (p.stopped) throw Interrupted();
+      if (p.stopped || host_.interrupted()) throw Interrupted();
       bool present = b.rows > 0;
       bool last = !present || p.done ||
                   (cfg_.short_block_rows > 0 && static_cast<double>(b.rows) < cfg_.short_block_rows);
