@@ -522,6 +522,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   }
   pr <- ggir_params(params_rawdata, dots)
   check_flag(verbose, "verbose")
+  check_fp_build("`g.calibrate()`")
   sf <- dots$sf
   if (is.null(sf) && length(inspectfileobject) && !is.null(inspectfileobject$sf)) {
     sf <- inspectfileobject$sf
@@ -599,6 +600,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
                integer = TRUE)
   check_number(a$tol, "tol", min = 0)
   check_flag(a$verbose, "verbose")
+  if (compat) check_fp_build("`calibrate(method = \"ggir\", ggir_compat = TRUE)`")
   if (is.null(sf) && !is.character(x) && is.null(attr(x, "sf")) &&
       !("time" %in% tolower(colnames(x)))) {
     abort("`sf` (sampling frequency in Hz) is missing.")
