@@ -1,7 +1,8 @@
 # gravcal: the README's commands.
 #   make demo   set up, install, calibrate the bundled example recording
 #   make test   set up, R CMD build + R CMD check --as-cran (all tests),
-#               then the standalone C++ core tests
+#               then the standalone C++ core tests and the build with a
+#               user's aggressive compiler flags (flags-check)
 #   make site   the pkgdown documentation site (_build/site), checked in
 #               headless Chromium
 R ?= R
@@ -22,7 +23,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup install demo test check core sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-slurm setup install demo test check core flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 setup:
 	bash tools/setup.sh
@@ -34,7 +35,7 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check core sanitize valgrind fuzz-short test-slurm site
+test: check core flags-check sanitize valgrind fuzz-short test-slurm site
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
@@ -43,6 +44,32 @@ test: check core sanitize valgrind fuzz-short test-slurm site
 core: install
 	$(MAKE) -C tests/cpp test arm cost
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r check-m4
+
+# gravcal built as a user with aggressive flags in ~/.R/Makevars builds it
+# (R_MAKEVARS_USER; a C++17 package is compiled with CXX17FLAGS, not
+# CXXFLAGS, so both are set). g++ with -O3 -march=native (and GCC's default
+# -ffp-contract=fast, said explicitly): the pin in gravcal/fp_contract.hpp
+# wins, so no fused multiply-add outside Eigen's own kernels
+# (tools/fma-count.sh), g.calibrate() identical to GGIR's on real files
+# (tools/flags-check.R) and the core's digests those of the default build.
+# clang++ with -ffp-contract=fast, which beats the pin: the load-time probe
+# sees it and the GGIR-compatible entries refuse. About 5 minutes.
+FLAGS_NATIVE := -O3 -march=native -ffp-contract=fast
+FLAGS_CLANG := -O1 -march=native -ffp-contract=fast
+flags-check: setup
+	mkdir -p $(BUILD)/lib-native $(BUILD)/lib-clang-fast
+	printf 'CXX17FLAGS = $(FLAGS_NATIVE)\nCXXFLAGS = $(FLAGS_NATIVE)\n' > $(BUILD)/native.mk
+	printf 'CXX17 = clang++\nCXX17FLAGS = $(FLAGS_CLANG)\nCXXFLAGS = $(FLAGS_CLANG)\n' > $(BUILD)/clang-fast.mk
+	R_MAKEVARS_USER=$(abspath $(BUILD)/native.mk) $(R) CMD INSTALL --preclean --no-multiarch \
+	  -l $(BUILD)/lib-native . > $(BUILD)/native-install.log 2>&1 || (tail -40 $(BUILD)/native-install.log; exit 1)
+	sh tools/fma-count.sh $(BUILD)/lib-native/gravcal/libs/gravcal.so
+	R_LIBS="$(abspath $(BUILD)/lib-native)$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) \
+	  $(RSCRIPT) tools/flags-check.R bits
+	$(MAKE) -C tests/cpp digest-flags DIGEST_FLAGS="$(FLAGS_NATIVE)"
+	R_MAKEVARS_USER=$(abspath $(BUILD)/clang-fast.mk) $(R) CMD INSTALL --preclean --no-multiarch \
+	  -l $(BUILD)/lib-clang-fast . > $(BUILD)/clang-install.log 2>&1 || (tail -40 $(BUILD)/clang-install.log; exit 1)
+	R_LIBS="$(abspath $(BUILD)/lib-clang-fast)$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/flags-check.R refuse
+	rm -f src/*.o src/*.so
 
 # the whole test suite against the package built with AddressSanitizer and
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not

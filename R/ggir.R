@@ -284,6 +284,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   }
   pr <- ggir_params(params_rawdata, dots)
   check_flag(verbose, "verbose")
+  check_fp_build("`g.calibrate()`")
   sf <- dots$sf
   if (is.null(sf) && length(inspectfileobject) && !is.null(inspectfileobject$sf)) {
     sf <- inspectfileobject$sf
@@ -309,58 +310,29 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   invisible(out)
 }
 
-# GGIR's parameters with defaults; legacy arguments in `dots` win.
+# g.calibrate()'s parameters (ggir-params.R) from GGIR's params_rawdata and
+# the legacy arguments in `dots`, which win; other arguments GGIR takes are
+# accepted, anything else warned about.
 ggir_params <- function(params_rawdata, dots) {
-  p <- list(chunksize = 1, spherecrit = ggir_constants$spherecrit,
-            minloadcrit = ggir_constants$minloadcrit,
-            printsummary = FALSE, rmc.noise = NULL, rmc.sf = NULL,
-            reader = "native")
-  if (length(params_rawdata)) {
-    if (!is.list(params_rawdata)) {
-      abort("`params_rawdata` must be a list (as from GGIR::load_params()), ",
-            "not ", describe(params_rawdata), ".")
-    }
-    for (nm in intersect(names(p), names(params_rawdata))) p[nm] <- list(params_rawdata[[nm]])
+  if (length(params_rawdata) && !is.list(params_rawdata)) {
+    abort("`params_rawdata` must be a list (as from GGIR::load_params()), ",
+          "not ", describe(params_rawdata), ".")
   }
-  for (nm in intersect(names(p), names(dots))) p[nm] <- list(dots[[nm]])
-  known <- c(names(p), "sf", "desiredtz", "configtz", "do.cal", "use.temp",
-             "windowsizes", "outputdir", "studyname", "overwrite")
+  known <- c(ggir_param_names("ggir"), "sf", "desiredtz", "configtz", "do.cal",
+             "use.temp", "windowsizes", "outputdir", "studyname", "overwrite")
   extra <- setdiff(names(dots), known)
   if (length(extra)) {
     warning("g.calibrate(): ignored argument", if (length(extra) > 1) "s",
             " ", paste0("`", extra, "`", collapse = ", "), call. = FALSE)
   }
-  check_number(p$chunksize, "chunksize", min = 0, max = 1, min_inclusive = FALSE)
-  check_number(p$spherecrit, "spherecrit", min = 0)
-  check_number(p$minloadcrit, "minloadcrit", min = 0)
-  check_flag(p$printsummary, "printsummary")
-  if (!is.null(p$rmc.noise)) {
-    check_number(p$rmc.noise, "rmc.noise", min = 0, min_inclusive = FALSE)
-  }
-  p
+  ggir_param_values("ggir", list(params_rawdata, dots))
 }
 
 # calibrate(method = "ggir"): the procedure, then a gravcal_fit.
 calibrate_ggir <- function(x, sf, compat, dots, call) {
-  args <- split_dots(dots, list(ggir = c(
-    "use_temp", "spherecrit", "minloadcrit", "chunksize", "max_sd",
-    "max_iter", "tol", "verbose", "reader")))$ggir
-  k <- ggir_constants
-  a <- utils::modifyList(list(use_temp = TRUE, spherecrit = k$spherecrit,
-                              minloadcrit = k$minloadcrit, chunksize = 1,
-                              max_sd = k$max_sd, max_iter = k$max_iter,
-                              tol = k$tol, verbose = FALSE,
-                              reader = "native"),
-                         args)
-  check_flag(a$use_temp, "use_temp")
-  check_number(a$spherecrit, "spherecrit", min = 0)
-  check_number(a$minloadcrit, "minloadcrit", min = 0)
-  check_number(a$chunksize, "chunksize", min = 0, max = 1, min_inclusive = FALSE)
-  check_number(a$max_sd, "max_sd", min = 0, min_inclusive = FALSE)
-  check_number(a$max_iter, "max_iter", min = 1, max = .Machine$integer.max,
-               integer = TRUE)
-  check_number(a$tol, "tol", min = 0)
-  check_flag(a$verbose, "verbose")
+  args <- split_dots(dots, list(ggir = ggir_param_names("own")))$ggir
+  a <- ggir_param_values("own", list(args))
+  if (compat) check_fp_build("`calibrate(method = \"ggir\", ggir_compat = TRUE)`")
   if (is.null(sf) && !is.character(x) && is.null(attr(x, "sf")) &&
       !("time" %in% tolower(colnames(x)))) {
     abort("`sf` (sampling frequency in Hz) is missing.")

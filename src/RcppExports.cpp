@@ -11,6 +11,18 @@ Rcpp::Rostream<true>&  Rcpp::Rcout = Rcpp::Rcpp_cout_get();
 Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
+// gc_fp_probe
+Rcpp::List gc_fp_probe(double a, double b, double c);
+RcppExport SEXP _gravcal_gc_fp_probe(SEXP aSEXP, SEXP bSEXP, SEXP cSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< double >::type a(aSEXP);
+    Rcpp::traits::input_parameter< double >::type b(bSEXP);
+    Rcpp::traits::input_parameter< double >::type c(cSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fp_probe(a, b, c));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_decoder_open
 Rcpp::List gc_decoder_open(const std::string& path, const std::string& format, const Rcpp::List& options);
 RcppExport SEXP _gravcal_gc_decoder_open(SEXP pathSEXP, SEXP formatSEXP, SEXP optionsSEXP) {
@@ -245,6 +257,7 @@ END_RCPP
 }
 
 static const R_CallMethodDef CallEntries[] = {
+    {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},
     {"_gravcal_gc_decoder_unit_samples", (DL_FUNC) &_gravcal_gc_decoder_unit_samples, 1},

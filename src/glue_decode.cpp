@@ -1,6 +1,8 @@
 // Rcpp glue for the device-file decoders (decode*.hpp): opens a file with
 // the format's decoder, hands blocks of samples to R, and reports what was
 // skipped. Converts and calls, nothing more.
+#include "gravcal/fp_contract.hpp"  // first: see there
+
 #include <Rcpp.h>
 
 #include <memory>

@@ -1,4 +1,6 @@
 // Rcpp glue for the GGIR fit (icp.hpp). Converts and checks shapes only.
+#include "gravcal/fp_contract.hpp"  // first: see there
+
 #include <RcppEigen.h>
 
 #include <algorithm>

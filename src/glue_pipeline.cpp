@@ -1,6 +1,8 @@
 // Rcpp glue for the one pump (pipeline.hpp): makes a source, runs one stage
 // over it (the segmenter, GGIR's procedure, or a collector of samples) and
 // converts the result. Nothing here decides anything about the samples.
+#include "gravcal/fp_contract.hpp"  // first: see there
+
 #include <Rcpp.h>
 
 #include <cstdint>

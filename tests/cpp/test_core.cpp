@@ -4,6 +4,10 @@
 // rules and recovery of known parameters by the gradient fit, in double and
 // float, and by the ICP fit (icp.hpp, with Eigen); and that the R-compatible
 // window arithmetic is also chunk invariant.
+// First, as in the package: no contraction anywhere in this translation
+// unit (the test data's generators included), whatever the flags.
+#include "gravcal/fp_contract.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <cstdio>

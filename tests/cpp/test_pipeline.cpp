@@ -2,6 +2,8 @@
 // without R: the same windows whether a source lends its samples or writes
 // them where the stage asks, in blocks of any size; the procedure recovers
 // a known miscalibration, and stops when its host says so.
+#include "gravcal/fp_contract.hpp"  // first: see there
+
 #include <cmath>
 #include <cstdio>
 #include <random>

@@ -22,6 +22,8 @@
 #ifndef GRAVCAL_DECODE_HPP
 #define GRAVCAL_DECODE_HPP
 
+#include "fp_contract.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -14,6 +14,8 @@
 #ifndef GRAVCAL_MODEL_HPP
 #define GRAVCAL_MODEL_HPP
 
+#include "fp_contract.hpp"
+
 namespace gravcal {
 
 enum Param { KXX = 0, KYY = 1, KZZ = 2, KXY = 3, KXZ = 4, KYZ = 5,

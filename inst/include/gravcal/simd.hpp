@@ -17,6 +17,8 @@
 #ifndef GRAVCAL_SIMD_HPP
 #define GRAVCAL_SIMD_HPP
 
+#include "fp_contract.hpp"
+
 #include <cstdlib>
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && defined(__SSE2__) && \
