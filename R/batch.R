@@ -55,7 +55,8 @@
 #' @param resume Take the results saved in `outdir` whose key matches
 #'   (`TRUE`), or calibrate every recording again (`FALSE`).
 #' @param pattern For a directory: the file names to take (a regular
-#'   expression).
+#'   expression; the default takes every extension [read_recording()]
+#'   reads).
 #' @param pool `"none"` (default) or `"device"`: calibrate the recordings
 #'   that cannot be calibrated alone (status `"sphere_not_covered"`,
 #'   `"bins_incomplete"`, `"too_short"` or `"no_rest"`) with the rest
@@ -108,7 +109,7 @@
 #' unlink(dir, recursive = TRUE)
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
-                            pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$",
+                            pattern = format_file_pattern(),
                             pool = c("none", "device")) {
   method <- match_choice(method, "method")
   pool <- match_choice(pool, "pool")
