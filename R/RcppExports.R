@@ -13,10 +13,6 @@ gc_decoder_read <- function(ptr, max_units, capacity, want_temperature, want_tim
     .Call(`_gravcal_gc_decoder_read`, ptr, max_units, capacity, want_temperature, want_time)
 }
 
-gc_decoder_unit_samples <- function(ptr) {
-    .Call(`_gravcal_gc_decoder_unit_samples`, ptr)
-}
-
 gc_decoder_report <- function(ptr) {
     .Call(`_gravcal_gc_decoder_report`, ptr)
 }

@@ -64,7 +64,8 @@
 #' @param resume Take the results saved in `outdir` whose key matches
 #'   (`TRUE`), or calibrate every recording again (`FALSE`).
 #' @param pattern For a directory: the file names to take (a regular
-#'   expression).
+#'   expression; the default takes every extension [read_recording()]
+#'   reads).
 #' @param recursive For a directory: take the recordings in its subfolders
 #'   too (`TRUE`), leaving out gravcal's output folders (`outdir`, and any
 #'   folder holding a `.gravcal` store), or only those in the directory
@@ -128,7 +129,7 @@
 #' unlink(dir, recursive = TRUE)
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
-                            pattern = "\\.(csv|csv\\.gz|rds|gt3x|cwa|bin)$",
+                            pattern = format_file_pattern(),
                             pool = c("none", "device"), recursive = FALSE) {
   method <- match_choice(method, "method")
   pool <- match_choice(pool, "pool")

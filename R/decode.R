@@ -10,11 +10,7 @@ native_open <- function(file, format, options = list(), arg = "file") {
   r
 }
 
-native_format_name <- function(format) {
-  switch(format, cwa = "an Axivity .cwa file", geneactiv = "a GENEActiv .bin file",
-         gt3x = "an ActiGraph .gt3x file", actigraph_csv = "an ActiGraph csv export",
-         csv = "a csv file of samples", format)
-}
+native_format_name <- function(format) format_entry(format)$label %||% format
 
 # The next block of at most `max_units` format units (NULL: no limit) and
 # `capacity` samples, as list(cols = list(x, y, z, temperature, time), from

@@ -67,16 +67,11 @@ check_file <- function(file, arg) {
 read_file <- function(file, sf, reader, arg) {
   format <- file_format(file, arg)
   data <- NULL
-  if (reader == "native" && format %in% names(native_block_units)) {
+  if (reader == "native" && format_has_decoder(format)) {
     data <- read_native(file, format, sf, arg)
   }
   if (is.null(data)) {
-    data <- switch(format,
-      rds = read_rds(file, arg),
-      actigraph_csv = read_blocks(file, sf, reader),
-      csv = read_plain_csv(file, arg),
-      gt3x = read_gt3x_file(file),
-      cwa = , geneactiv = read_blocks(file, sf, reader))
+    data <- format_entry(format)$read(file, sf, reader, arg)
   }
   if (!is.data.frame(data)) {
     abort("`", arg, "` does not hold a data frame of samples: \"", file,
@@ -305,19 +300,11 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   reader <- match_choice(reader, "reader", c("native", "reference"))
   format <- file_format(datafile, arg)
   src <- NULL
-  if (reader == "native" && format %in% names(native_block_units)) {
+  if (reader == "native" && format_has_decoder(format)) {
     src <- source_native(datafile, format, sf, chunksize, compat, arg)
   }
   if (is.null(src)) {
-    src <- switch(format,
-      actigraph_csv = , csv = source_csv(datafile, sf, chunksize),
-      rds = {
-        rec <- read_file(datafile, sf, "native", arg)
-        source_frame(rec$data, rec$sf, chunksize, arg)
-      },
-      gt3x = source_gt3x(datafile, chunksize),
-      cwa = source_cwa(datafile, chunksize),
-      geneactiv = source_geneactiv(datafile, chunksize))
+    src <- format_entry(format)$source(datafile, sf, chunksize, arg)
   }
   src$filename <- basename(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
@@ -419,32 +406,25 @@ format_input <- function(input) {
 }
 
 unit_name <- function(format, n) {
-  u <- switch(format, cwa = "block", geneactiv = "page", gt3x = "record",
-              actigraph_csv = , csv = "line", "unit")
+  u <- format_entry(format)$unit %||% "unit"
   if (n == 1) u else paste0(u, "s")
 }
 
-# The format of a recording from its name (and, for csv, its first line).
+# The format of a recording from its name (and, for csv, its first line):
+# the first format in the registry (formats.R) with the file's extension
+# whose detector, if it has one, says yes.
 file_format <- function(file, arg = "file") {
-  ext <- tolower(sub(".*?\\.((csv\\.gz)|[^.]+)$", "\\1", basename(file)))
-  switch(ext,
-    csv = , "csv.gz" = if (is_actigraph_csv(file)) "actigraph_csv" else "csv",
-    rds = "rds", gt3x = "gt3x", cwa = "cwa", bin = "geneactiv",
-    abort("`", arg, "` has an unsupported extension \".", ext, "\"; gravcal ",
-          "reads .csv (ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, ",
-          ".cwa and GENEActiv .bin."))
+  exts <- format_extensions()
+  two <- gsub(".", "\\.", exts[grepl(".", exts, fixed = TRUE)], fixed = TRUE)
+  ext <- tolower(sub(paste0(".*?\\.(", paste0("(", two, ")|", collapse = ""),
+                            "[^.]+)$"), "\\1", basename(file)))
+  for (nm in names(recording_formats)) {
+    f <- recording_formats[[nm]]
+    if (ext %in% names(f$ext) && (is.null(f$detect) || f$detect(file))) return(nm)
+  }
+  abort("`", arg, "` has an unsupported extension \".", ext, "\"; ",
+        format_readable())
 }
-
-# Format units in one of GGIR's blocks (g.calibrate's blocksize, chunksize =
-# 1 is about 12 hours), per format: cwa 512-byte blocks, GENEActiv pages,
-# gt3x seconds, csv lines.
-native_block_units <- list(
-  cwa = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
-  geneactiv = function(sf, chunksize) round((14512 * (sf / 50)) * (chunksize * 0.5)),
-  gt3x = function(sf, chunksize) (12 * 3600) * chunksize,
-  actigraph_csv = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
-  csv = function(sf, chunksize) ggir_rows_per_block(sf, chunksize)
-)
 
 # A file read by gravcal's own decoder (decode_*.hpp). NULL when this build
 # has no decoder for the format. Blocks are GGIR's (in the format's units);
@@ -467,7 +447,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
   check_sf(sf)
-  B <- native_block_units[[format]](sf, chunksize)
+  B <- format_block_units(format, sf, chunksize)
   # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
   # pages hold for the last one; after its resampling of a rate that rounds
   # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first

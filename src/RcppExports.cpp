@@ -49,16 +49,6 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_decoder_unit_samples
-double gc_decoder_unit_samples(SEXP ptr);
-RcppExport SEXP _gravcal_gc_decoder_unit_samples(SEXP ptrSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_decoder_unit_samples(ptr));
-    return rcpp_result_gen;
-END_RCPP
-}
 // gc_decoder_report
 Rcpp::List gc_decoder_report(SEXP ptr);
 RcppExport SEXP _gravcal_gc_decoder_report(SEXP ptrSEXP) {
@@ -260,7 +250,6 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},
-    {"_gravcal_gc_decoder_unit_samples", (DL_FUNC) &_gravcal_gc_decoder_unit_samples, 1},
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},

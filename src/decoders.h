@@ -1,6 +1,7 @@
 // The formats gravcal decodes natively, and what each needs from outside the
-// header-only core (a zip entry's inflated bytes, for .gt3x). Each format
-// adds its branch to the two functions below.
+// header-only core (gzip for csv, a zip entry's inflated bytes for .gt3x):
+// one table, decoder_kinds(), whose names are the decoder names of R's
+// format registry (R/formats.R). A new format adds its row there.
 #ifndef GRAVCAL_GLUE_DECODERS_H
 #define GRAVCAL_GLUE_DECODERS_H
 
@@ -18,6 +19,59 @@
 
 namespace gravcal_glue {
 
+using DecoderPtr = std::unique_ptr<gravcal::Decoder>;
+
+// One native decoder: its name, whether its bytes may come gzip-compressed,
+// and how to make it on a file's bytes (`name` tells the csv decoder which
+// layout to expect).
+struct DecoderKind {
+  const char* name;
+  bool gzip;
+  DecoderPtr (*make)(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                     const std::string& name);
+};
+
+inline DecoderPtr make_cwa(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                           const std::string&) {
+  return DecoderPtr(new gravcal::CwaDecoder(bytes, opts));
+}
+
+inline DecoderPtr make_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                           const std::string& name) {
+  return DecoderPtr(new gravcal::CsvDecoder(bytes, opts, name));
+}
+
+inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                                 const std::string&) {
+  std::unique_ptr<gravcal::GeneactivDecoder> d(new gravcal::GeneactivDecoder(bytes, opts));
+  // GGIR resamples a rate that is not whole onto whole Hz (compat = 1;
+  // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
+  if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d)));
+}
+
+// .gt3x: the decoder reads the zip's entries itself, zlib inflating
+inline DecoderPtr make_gt3x(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                            const std::string&) {
+  static gravcal_glue::ZlibInflater inflater;
+  return DecoderPtr(new gravcal::Gt3xDecoder(bytes, opts, &inflater));
+}
+
+// The table's row for `format`, or null when there is none.
+inline const DecoderKind* find_decoder(const std::string& format) {
+  static const DecoderKind kinds[] = {
+      {"actigraph_csv", true, make_csv},
+      {"csv", true, make_csv},
+      {"gt3x", false, make_gt3x},
+      {"cwa", false, make_cwa},
+      {"geneactiv", false, make_geneactiv},
+  };
+  for (const DecoderKind& k : kinds) {
+    if (format == k.name) return &k;
+  }
+  return nullptr;
+}
+
 // The bytes the decoder of `format` reads from `path` (the file itself, or
 // for a container format the entry inside it). Null, with `why`, on failure.
 inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
@@ -25,7 +79,8 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
                                                        const gravcal::Options& opts,
                                                        std::string& why) {
   (void)opts;
-  if ((format == "csv" || format == "actigraph_csv") && is_gzip(path.c_str())) {
+  const DecoderKind* kind = find_decoder(format);
+  if (kind != nullptr && kind->gzip && is_gzip(path.c_str())) {
     std::unique_ptr<GzSource> g(new GzSource(path.c_str()));
     if (!g->is_open()) {
       why = "cannot open the file";
@@ -42,28 +97,11 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
 }
 
 // The decoder for `format` on `bytes`, or null when there is none.
-inline std::unique_ptr<gravcal::Decoder> make_decoder(const std::string& format,
-                                                      gravcal::ByteSource& bytes,
-                                                      const gravcal::Options& opts) {
-  if (format == "cwa") {
-    return std::unique_ptr<gravcal::Decoder>(new gravcal::CwaDecoder(bytes, opts));
-  }
-  if (format == "csv" || format == "actigraph_csv") {
-    return std::unique_ptr<gravcal::Decoder>(new gravcal::CsvDecoder(bytes, opts, format));
-  }
-  if (format == "geneactiv") {
-    std::unique_ptr<gravcal::GeneactivDecoder> d(new gravcal::GeneactivDecoder(bytes, opts));
-    // GGIR resamples a rate that is not whole onto whole Hz (compat = 1;
-    // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
-    if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
-    return std::unique_ptr<gravcal::Decoder>(new gravcal::GgirResampler(std::move(d)));
-  }
-  // .gt3x: the decoder reads the zip's entries itself, zlib inflating
-  if (format == "gt3x") {
-    static gravcal_glue::ZlibInflater inflater;
-    return std::unique_ptr<gravcal::Decoder>(new gravcal::Gt3xDecoder(bytes, opts, &inflater));
-  }
-  return nullptr;
+inline DecoderPtr make_decoder(const std::string& format, gravcal::ByteSource& bytes,
+                               const gravcal::Options& opts) {
+  const DecoderKind* kind = find_decoder(format);
+  if (kind == nullptr) return nullptr;
+  return kind->make(bytes, opts, format);
 }
 
 }  // namespace gravcal_glue

@@ -130,12 +130,6 @@ Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity,
       Rcpp::Named("done") = f->decoder->done());
 }
 
-// Upper bound of samples per unit (format constant).
-// [[Rcpp::export(rng = false)]]
-double gc_decoder_unit_samples(SEXP ptr) {
-  return static_cast<double>(get(ptr)->decoder->max_samples_per_unit());
-}
-
 // What was read and skipped so far.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_decoder_report(SEXP ptr) {

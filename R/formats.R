@@ -1,0 +1,107 @@
+# The recording formats gravcal reads, once. Everything that depends on a
+# file's format asks here: file_format() (which format a file is),
+# calibrate_files() (which files in a folder are recordings), the messages
+# (what a format, its unit and the readable files are called), the native
+# reader (which decoder, and GGIR's block in the decoder's units) and the
+# reference readers.
+#
+# For each format, under its name (the `format` of sources, fits and
+# tables), in the order messages list them:
+# * ext: its file name extensions (lower case), each with the words the
+#   list of readable files gives it (NA where a format before it, sharing
+#   the extension, already does);
+# * detect: for formats that share an extension, whether a file is this one
+#   (a file is the first format of its extension whose detector says yes or
+#   that has none);
+# * label: the format in messages ("as an Axivity .cwa file");
+# * unit: what its native decoder reads and skips by (".. blocks skipped");
+# * block_units: the size of one of GGIR's blocks in those units, from the
+#   sampling rate and chunksize (g.calibrate's blocksize; chunksize = 1 is
+#   about 12 hours; NULL: not read natively);
+# * decoder: the name of its native decoder (src/decoders.h), or NULL;
+# * read(file, sf, reader, arg): the whole file by the reference reader (or
+#   the native one where the reference reads blocks: read_blocks());
+# * source(file, sf, chunksize, arg): the file block by block, without a
+#   native decoder (see open_source()).
+recording_formats <- list(
+  actigraph_csv = list(
+    ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
+    detect = function(file) is_actigraph_csv(file),
+    label = "an ActiGraph csv export", unit = "line",
+    block_units = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
+    decoder = "actigraph_csv",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = NULL,
+    label = "a csv file of samples", unit = "line",
+    block_units = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
+    decoder = "csv",
+    read = function(file, sf, reader, arg) read_plain_csv(file, arg),
+    source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  rds = list(
+    ext = c(rds = ".rds"), detect = NULL,
+    label = "an .rds file", unit = "unit", block_units = NULL, decoder = NULL,
+    read = function(file, sf, reader, arg) read_rds(file, arg),
+    source = function(file, sf, chunksize, arg) {
+      rec <- read_file(file, sf, "native", arg)
+      source_frame(rec$data, rec$sf, chunksize, arg)
+    }),
+  gt3x = list(
+    ext = c(gt3x = ".gt3x"), detect = NULL,
+    label = "an ActiGraph .gt3x file", unit = "record",
+    block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
+    decoder = "gt3x",
+    read = function(file, sf, reader, arg) read_gt3x_file(file),
+    source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
+  cwa = list(
+    ext = c(cwa = ".cwa"), detect = NULL,
+    label = "an Axivity .cwa file", unit = "block",
+    # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
+    block_units = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
+    decoder = "cwa",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
+  geneactiv = list(
+    ext = c(bin = "GENEActiv .bin"), detect = NULL,
+    label = "a GENEActiv .bin file", unit = "page",
+    block_units = function(sf, chunksize) round((14512 * (sf / 50)) * (chunksize * 0.5)),
+    decoder = "geneactiv",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize))
+)
+
+# The registry's entry for `format`; NULL for a format it does not hold
+# (samples in memory: "data.frame").
+format_entry <- function(format) {
+  if (format %in% names(recording_formats)) recording_formats[[format]]
+}
+
+# Every extension, once, in the registry's order.
+format_extensions <- function() {
+  unique(unlist(lapply(recording_formats, function(f) names(f$ext)),
+                use.names = FALSE))
+}
+
+# A regular expression for the file names of recordings (calibrate_files()).
+format_file_pattern <- function() {
+  paste0("\\.(", paste(gsub(".", "\\.", format_extensions(), fixed = TRUE),
+                       collapse = "|"), ")$")
+}
+
+# "gravcal reads .csv (...), .csv.gz, ... and GENEActiv .bin.", for messages.
+format_readable <- function() {
+  says <- unlist(lapply(recording_formats, `[[`, "ext"), use.names = FALSE)
+  says <- says[!is.na(says)]
+  n <- length(says)
+  paste0("gravcal reads ", paste(says[-n], collapse = ", "), " and ", says[n], ".")
+}
+
+# Whether the format has a native decoder (whether this build runs it is the
+# decoder's to say: gc_decoder_open() answers `unsupported`).
+format_has_decoder <- function(format) !is.null(format_entry(format)$decoder)
+
+# The size of GGIR's block for `format` in its decoder's units.
+format_block_units <- function(format, sf, chunksize) {
+  format_entry(format)$block_units(sf, chunksize)
+}
