@@ -1,0 +1,302 @@
+# Sources. A source is a list with `format`, `sf`, `filename`, `temperature`
+# (does it carry a temperature column), `units` (the source's units in one
+# of GGIR's blocks), `short_rows` (GENEActiv in compatible mode: a block
+# with fewer rows is the last) and `pump()`, which makes the core's source
+# for the one pump (gc_pump(), pipeline.hpp): an open decoder, the columns
+# of a data frame, or the blocks that GGIR's own readers give (`read(i)`:
+# block i, 1, 2, ... in order, as list(data = data frame with x, y, z and
+# maybe temperature, last = logical), or NULL at the end; one block a unit).
+# Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
+# file where GGIR does: `chunksize` scales them (1 = about 12 hours).
+
+# Samples per block for formats GGIR reads by rows (csv, and data frames).
+ggir_rows_per_block <- function(sf, chunksize) {
+  round((14512 * (sf / 50)) * (chunksize * 0.5)) * 300
+}
+
+open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
+                        reader = "native", compat = TRUE) {
+  if (is.data.frame(datafile) || is.matrix(datafile)) {
+    return(source_frame(datafile, sf, chunksize, arg))
+  }
+  if (!is.character(datafile) || length(datafile) != 1 || is.na(datafile)) {
+    abort("`", arg, "` must be a file path or a data frame of raw samples, ",
+          "not ", describe(datafile), ".")
+  }
+  check_file(datafile, arg)
+  reader <- match_choice(reader, "reader", c("native", "reference"))
+  format <- file_format(datafile, arg)
+  src <- NULL
+  if (reader == "native" && format_has_decoder(format)) {
+    src <- source_native(datafile, format, sf, chunksize, compat, arg)
+  }
+  if (is.null(src)) {
+    src <- format_entry(format)$source(datafile, sf, chunksize, arg)
+  }
+  src$filename <- basename(datafile)
+  if (is.null(src$pump)) src <- reference_source(src)
+  src
+}
+
+# A source whose blocks GGIR's own readers give (`read(i)`): one block a
+# unit. The previous block is garbage once the next is asked for: it is
+# collected before the next is read, so that memory stays at about one
+# block.
+reference_source <- function(src) {
+  read <- src$read
+  columns <- function(blk) {
+    if (is.null(blk)) return(NULL)
+    d <- blk$data
+    col <- function(v) {
+      if (!is.numeric(v)) abort("The recording has a non-numeric acceleration or temperature column.")
+      as.double(v)
+    }
+    list(x = col(d$x), y = col(d$y), z = col(d$z),
+         temperature = if ("temperature" %in% names(d)) col(d$temperature),
+         last = isTRUE(blk$last))
+  }
+  src$units <- 1
+  src$pump <- function() {
+    i <- 1
+    first <- columns(read(1))
+    if (is.null(first)) {
+      first <- list(x = numeric(0), y = numeric(0), z = numeric(0),
+                    temperature = NULL, last = TRUE)
+    }
+    gc_source_blocks(first, function() {
+      first <<- NULL
+      invisible(gc(full = TRUE))
+      i <<- i + 1
+      columns(read(i))
+    })
+  }
+  src
+}
+
+# What a fit was computed from: the source, the samples read and, from a
+# native decoder, its report of what it skipped (see decode.hpp's Report).
+source_input <- function(src, samples) {
+  if (is.null(src) || identical(src$format, "data.frame")) {
+    return(list(source = "memory", samples = samples))
+  }
+  rep <- if (is.null(src$report)) NULL else src$report()
+  list(source = src$filename, format = src$format,
+       reader = if (is.null(src$native)) "reference" else "native",
+       serial = if (is.null(src$info$serial)) NA_character_ else src$info$serial,
+       range_g = if (is.numeric(src$info$range_g) &&
+                     length(src$info$range_g) == 1) src$info$range_g else
+                       NA_real_,
+       samples = samples, report = rep)
+}
+
+# A file whose reader found no sample at all, having skipped what it read,
+# cannot be read: an error naming it and the first problem.
+check_source_read <- function(src, samples) {
+  if (samples > 0 || is.null(src$report)) return(invisible())
+  r <- src$report()
+  if (r$skipped > 0 || isTRUE(r$read_error)) {
+    abort("Cannot read \"", src$filename, "\": no ", unit_name(src$format, 2),
+          " of it hold samples (", format(r$skipped), " skipped",
+          if (length(r$notes)) paste0("; first: ", r$notes[1]), ").")
+  }
+}
+
+# The decoder's reason a file could not be opened, in the package's words
+# where it is the missing sampling rate.
+native_open_error <- function(file, format, why, arg) {
+  if (grepl("sampling rate is unknown", why, fixed = TRUE)) {
+    abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
+  }
+  abort("Cannot read `", arg, "` \"", file, "\" as ", native_format_name(format),
+        ": ", why, ".")
+}
+
+# A file read by gravcal's own decoder (decode_*.hpp). NULL when this build
+# has no decoder for the format. Blocks are GGIR's (in the format's units);
+# each block comes as one or more parts (list(cols, from, to)), which hold
+# the samples of GGIR's block together, however many samples that is.
+# `segment()` streams units straight into a segmenter, without R vectors.
+source_native <- function(file, format, sf, chunksize, compat, arg) {
+  opts <- list(compat = as.numeric(isTRUE(compat)))
+  if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
+  # it back as zeros where it was, as a whole read does
+  if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1
+  h <- gc_decoder_open(path.expand(file), format, opts)
+  if (is.null(h$ptr)) {
+    if (isTRUE(h$unsupported)) return(NULL)
+    native_open_error(file, format, h$error, arg)
+  }
+  if (is.null(sf) || format %in% c("cwa", "geneactiv", "gt3x")) sf <- h$info$sf
+  if (!isTRUE(is.finite(sf) && sf > 0)) {
+    abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
+  }
+  check_sf(sf)
+  B <- format_block_units(format, sf, chunksize)
+  # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
+  # pages hold for the last one; after its resampling of a rate that rounds
+  # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
+  short <- if (format == "geneactiv" && isTRUE(compat)) B * 300 else 0
+  list(format = format, sf = sf, temperature = isTRUE(h$info$temperature),
+       info = h$info, native = h, units = B, short_rows = short,
+       report = function() native_report(h),
+       pump = function() gc_source_decoder(h$ptr))
+}
+
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
+source_frame <- function(x, sf, chunksize, arg) {
+  s <- as_samples(x, arg)
+  if (is.null(sf)) sf <- attr(x, "sf")
+  if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
+  if (is.null(sf)) abort("The sampling frequency of `", arg, "` is unknown: give `sf`.")
+  check_sf(sf)
+  list(format = "data.frame", sf = sf, filename = NA_character_,
+       temperature = !is.null(s$temperature), n = s$n, time = s$time,
+       units = ggir_rows_per_block(sf, chunksize), short_rows = 0,
+       pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
+}
+
+# ActiGraph csv export (10 header lines, optional column-name line, then
+# [timestamp,] x, y, z) or a plain csv with a header line naming x, y, z.
+source_csv <- function(file, sf, chunksize) {
+  head <- suppressWarnings(readLines(file, n = 12, warn = FALSE))
+  if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
+  actigraph <- is_actigraph_csv(file)
+  if (!actigraph) {
+    rec <- read_file(file, sf, "native", "datafile")
+    src <- source_frame(rec$data, rec$sf, chunksize, "datafile")
+    src$format <- "csv"
+    return(src)
+  }
+  hz <- regmatches(head[1], regexpr("[0-9.]+ *Hz", head[1]))
+  if (is.null(sf)) {
+    if (!length(hz)) abort("No sampling frequency (\"at N Hz\") in the header of \"", file, "\": give `sf`.")
+    sf <- as.numeric(sub(" *Hz", "", hz))
+  }
+  check_sf(sf)
+  skip0 <- 10L
+  if (length(head) >= 11) {
+    first <- strsplit(head[11], ",")[[1]][1]
+    if (is.na(suppressWarnings(as.numeric(first)))) skip0 <- 11L
+  }
+  B <- ggir_rows_per_block(sf, chunksize)
+  # with a time stamp column first, x, y, z are columns 2 to 4; the time
+  # stamps are not read at all (as strings they would take more memory than
+  # the samples)
+  data_line <- head[skip0 + 1]
+  fields <- if (is.na(data_line)) 3L else length(strsplit(data_line, ",")[[1]])
+  cols <- if (fields > 3) 2:4 else 1:3
+  read_rows <- function(skip, nrows) {
+    d <- tryCatch({
+      if (requireNamespace("data.table", quietly = TRUE)) {
+        data.table::fread(file, skip = skip, nrows = nrows, header = FALSE,
+                          select = cols, showProgress = FALSE,
+                          data.table = FALSE)
+      } else {
+        cc <- rep("NULL", fields)
+        cc[cols] <- NA
+        utils::read.csv(file, skip = skip, nrows = nrows, header = FALSE,
+                        colClasses = cc)
+      }
+    }, error = function(e) NULL)
+    if (is.null(d) || !nrow(d) || ncol(d) < 3) return(NULL)
+    names(d) <- c("x", "y", "z")
+    for (v in c("x", "y", "z")) {
+      if (!is.numeric(d[[v]])) abort("Corrupt file \"", file, "\": column ", v, " is not numeric.")
+    }
+    d
+  }
+  list(format = "actigraph_csv", sf = sf, temperature = FALSE,
+       read = function(i) {
+         d <- read_rows(skip0 + (i - 1) * B, B)
+         if (is.null(d)) return(NULL)
+         list(data = d, last = nrow(d) < B)
+       })
+}
+
+need_ggirread <- function(what) {
+  if (!requireNamespace("GGIRread", quietly = TRUE)) {
+    abort("Reading ", what, " files needs the GGIRread package: install.packages(\"GGIRread\").")
+  }
+}
+
+source_cwa <- function(file, chunksize) {
+  need_ggirread("Axivity .cwa")
+  first <- tryCatch(GGIRread::readAxivity(file, start = 0, end = 1, progressBar = FALSE),
+                    error = function(e) NULL)
+  if (is.null(first) || is.null(first$header$frequency)) {
+    abort("Corrupt or unreadable .cwa file \"", file, "\".")
+  }
+  sf <- first$header$frequency
+  B <- round(12 * 3600 * sf / 80 * chunksize)
+  list(format = "cwa", sf = sf, temperature = TRUE,
+       read = function(i) {
+         start <- B * (i - 1)
+         P <- tryCatch(GGIRread::readAxivity(file, start = start, end = start + B,
+                                             progressBar = FALSE, frequency_tol = 0.1),
+                       error = function(e) NULL)
+         if (is.null(P) || is.null(P$data) || !nrow(P$data)) return(NULL)
+         # GGIRread calls the temperature "temp" (GGIR renames it too)
+         names(P$data)[names(P$data) == "temp"] <- "temperature"
+         d <- P$data[, intersect(c("x", "y", "z", "temperature"), names(P$data))]
+         list(data = d, last = FALSE)
+       })
+}
+
+source_geneactiv <- function(file, chunksize) {
+  need_ggirread("GENEActiv .bin")
+  first <- tryCatch(GGIRread::readGENEActiv(file, start = 1, end = 2),
+                    error = function(e) NULL)
+  if (is.null(first) || is.null(first$header$SampleRate)) {
+    abort("Corrupt or unreadable GENEActiv .bin file \"", file, "\".")
+  }
+  sf <- round(first$header$SampleRate)
+  B <- round((14512 * (sf / 50)) * (chunksize * 0.5))
+  list(format = "geneactiv", sf = sf, temperature = TRUE,
+       read = function(i) {
+         start <- B * (i - 1) + 1
+         P <- tryCatch(GGIRread::readGENEActiv(file, start = start, end = start + B - 1),
+                       error = function(e) NULL)
+         if (is.null(P) || is.null(P$data.out) || !nrow(P$data.out)) return(NULL)
+         d <- P$data.out[, intersect(c("x", "y", "z", "temperature"), names(P$data.out))]
+         list(data = d, last = nrow(d) < B * 300)
+       })
+}
+
+source_gt3x <- function(file, chunksize) {
+  if (!requireNamespace("read.gt3x", quietly = TRUE)) {
+    abort("Reading .gt3x files needs the read.gt3x package: install.packages(\"read.gt3x\").")
+  }
+  hdr <- tryCatch(read.gt3x::parse_gt3x_info(file),
+                  error = function(e) abort("Corrupt .gt3x file \"", file, "\": ", conditionMessage(e)))
+  sf <- as.numeric(hdr[["Sample Rate"]])
+  # read.gt3x counts batches in seconds of stored data: idle-sleep periods,
+  # which the device does not store, are skipped, and batches come without
+  # the zeros that a whole read (imputeZeroes = TRUE) puts there. Put them
+  # back from the time stamps, so that a streamed file has the same samples
+  # at the same positions as the file read whole.
+  B <- (12 * 3600) * chunksize
+  t0 <- NULL
+  next_i <- 0
+  list(format = "gt3x", sf = sf, temperature = FALSE,
+       read = function(i) {
+         from <- B * (i - 1) + 1
+         d <- tryCatch(read.gt3x::read.gt3x(file, batch_begin = from,
+                                            batch_end = from + B - 1,
+                                            asDataFrame = TRUE, verbose = FALSE),
+                       error = function(e) NULL)
+         if (is.null(d) || !nrow(d)) return(NULL)
+         t <- as.numeric(d$time)
+         if (is.null(t0)) t0 <<- t[1]
+         pos <- round((t - t0) * sf) - next_i
+         keep <- pos >= 0 & !duplicated(pos)
+         n <- max(pos[keep]) + 1
+         out <- data.frame(x = numeric(n), y = numeric(n), z = numeric(n))
+         out$x[pos[keep] + 1] <- as.numeric(d$X[keep])
+         out$y[pos[keep] + 1] <- as.numeric(d$Y[keep])
+         out$z[pos[keep] + 1] <- as.numeric(d$Z[keep])
+         next_i <<- next_i + n
+         list(data = out, last = FALSE)
+       })
+}
