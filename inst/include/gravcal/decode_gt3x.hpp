@@ -194,6 +194,18 @@ inline void keep_entry(ZipEntries& z, const std::string& name, const ZipEntry& e
   else if (name == "activity.bin" && !z.activity.found) z.activity = e;
 }
 
+// A zip header's flags, method and sizes, which stand in the same order in
+// a central directory header and a local one, from `p` (the flags' offset).
+inline ZipEntry zip_entry_at(const unsigned char* p) {
+  ZipEntry e;
+  e.found = true;
+  e.flags = le16(p);
+  e.method = le16(p + 2);
+  e.comp_size = le32(p + 12);
+  e.size = le32(p + 16);
+  return e;
+}
+
 // The end-of-central-directory record: searched in the last 64 KiB + 22.
 inline bool find_end_record(ByteSource& src, std::int64_t& cd_offset, int& n_entries) {
   const std::int64_t size = src.size();
@@ -224,12 +236,7 @@ inline bool read_central_directory(ByteSource& src, ZipEntries& z) {
     const std::size_t keep = std::min(nlen, kMaxName);
     if (read_full(src, reinterpret_cast<unsigned char*>(name), keep) != keep) return false;
     off += static_cast<std::int64_t>(kCentralLen + nlen + skip);
-    ZipEntry e;
-    e.found = true;
-    e.flags = le16(h + 8);
-    e.method = le16(h + 10);
-    e.comp_size = le32(h + 20);
-    e.size = le32(h + 24);
+    ZipEntry e = zip_entry_at(h + 8);
     e.local_offset = le32(h + 42);
     keep_entry(z, std::string(name, keep), e);
     if (!src.seek(off)) return false;
@@ -247,12 +254,7 @@ inline bool read_local_headers(ByteSource& src, ZipEntries& z) {
     const std::size_t nlen = le16(h + 26), elen = le16(h + 28);
     const std::size_t keep = std::min(nlen, kMaxName);
     if (read_full(src, reinterpret_cast<unsigned char*>(name), keep) != keep) break;
-    ZipEntry e;
-    e.found = true;
-    e.flags = le16(h + 6);
-    e.method = le16(h + 8);
-    e.comp_size = le32(h + 18);
-    e.size = le32(h + 22);
+    ZipEntry e = zip_entry_at(h + 6);
     e.local_offset = off;
     const bool sizes_later = (e.flags & 0x08) != 0 && e.comp_size == 0;  // data descriptor
     if (sizes_later) e.comp_size = -1;

@@ -73,6 +73,15 @@ struct IcpResult {
   double statistic = 0.0;  // last value of GGIR's res
 };
 
+// Whether an iteration's statistic and coefficients are all finite.
+inline bool icp_finite(const IcpResult& r, double res) {
+  bool finite = std::isfinite(res);
+  for (int k = 0; k < 3; ++k) {
+    finite = finite && std::isfinite(r.offset[k]) && std::isfinite(r.scale[k]) &&
+             std::isfinite(r.tempoffset[k]);
+  }
+  return finite;
+}
 
 // Weighted least squares by Householder QR. X: n x p, column-major, rows
 // already multiplied by sqrt(weight); y likewise. Writes the p coefficients
@@ -300,11 +309,7 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
     r.iterations = it;
     r.statistic = res;
     obs(it, static_cast<const IcpResult&>(r));
-    finite = std::isfinite(res);
-    for (int k = 0; k < 3; ++k) {
-      finite = finite && std::isfinite(r.offset[k]) && std::isfinite(r.scale[k]) &&
-               std::isfinite(r.tempoffset[k]);
-    }
+    finite = icp_finite(r, res);
     if (!finite) {
       r.finite = false;
       break;
@@ -425,11 +430,7 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
     r.iterations = it;
     r.statistic = res;
     obs(it, static_cast<const IcpResult&>(r));
-    bool finite = std::isfinite(res);
-    for (int k = 0; k < 3; ++k) {
-      finite = finite && std::isfinite(r.offset[k]) && std::isfinite(r.scale[k]) &&
-               std::isfinite(r.tempoffset[k]);
-    }
+    const bool finite = icp_finite(r, res);
     if (!finite) {
       r.finite = false;
       break;
