@@ -28,14 +28,14 @@ recording_formats <- list(
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
     detect = function(file) is_actigraph_csv(file),
     label = "an ActiGraph csv export", unit = "line",
-    block_units = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
   csv = list(
     ext = c(csv = NA, csv.gz = NA), detect = NULL,
     label = "a csv file of samples", unit = "line",
-    block_units = function(sf, chunksize) ggir_rows_per_block(sf, chunksize),
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
     decoder = "csv",
     read = function(file, sf, reader, arg) read_plain_csv(file, arg),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
@@ -65,7 +65,7 @@ recording_formats <- list(
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = NULL,
     label = "a GENEActiv .bin file", unit = "page",
-    block_units = function(sf, chunksize) round((14512 * (sf / 50)) * (chunksize * 0.5)),
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize))
@@ -102,6 +102,13 @@ format_readable <- function() {
 format_has_decoder <- function(format) !is.null(format_entry(format)$decoder)
 
 # The size of GGIR's block for `format` in its decoder's units.
+# GGIR's block of GENEActiv pages (300 samples each; g.calibrate's
+# blocksize, chunksize = 1 about 12 hours): the block, in rows, of every
+# format GGIR reads by rows too.
+ggir_pages <- function(sf, chunksize) {
+  round((14512 * (sf / 50)) * (chunksize * 0.5))
+}
+
 format_block_units <- function(format, sf, chunksize) {
   format_entry(format)$block_units(sf, chunksize)
 }

@@ -9,10 +9,6 @@
 # Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
 # file where GGIR does: `chunksize` scales them (1 = about 12 hours).
 
-# Samples per block for formats GGIR reads by rows (csv, and data frames).
-ggir_rows_per_block <- function(sf, chunksize) {
-  round((14512 * (sf / 50)) * (chunksize * 0.5)) * 300
-}
 
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
                         reader = "native", compat = TRUE) {
@@ -153,7 +149,7 @@ source_frame <- function(x, sf, chunksize, arg) {
   check_sf(sf)
   list(format = "data.frame", sf = sf, filename = NA_character_,
        temperature = !is.null(s$temperature), n = s$n, time = s$time,
-       units = ggir_rows_per_block(sf, chunksize), short_rows = 0,
+       units = format_block_units("csv", sf, chunksize), short_rows = 0,
        pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
 }
 
@@ -180,7 +176,7 @@ source_csv <- function(file, sf, chunksize) {
     first <- strsplit(head[11], ",")[[1]][1]
     if (is.na(suppressWarnings(as.numeric(first)))) skip0 <- 11L
   }
-  B <- ggir_rows_per_block(sf, chunksize)
+  B <- format_block_units("actigraph_csv", sf, chunksize)
   # with a time stamp column first, x, y, z are columns 2 to 4; the time
   # stamps are not read at all (as strings they would take more memory than
   # the samples)
@@ -229,7 +225,7 @@ source_cwa <- function(file, chunksize) {
     abort("Corrupt or unreadable .cwa file \"", file, "\".")
   }
   sf <- first$header$frequency
-  B <- round(12 * 3600 * sf / 80 * chunksize)
+  B <- format_block_units("cwa", sf, chunksize)
   list(format = "cwa", sf = sf, temperature = TRUE,
        read = function(i) {
          start <- B * (i - 1)
@@ -252,7 +248,7 @@ source_geneactiv <- function(file, chunksize) {
     abort("Corrupt or unreadable GENEActiv .bin file \"", file, "\".")
   }
   sf <- round(first$header$SampleRate)
-  B <- round((14512 * (sf / 50)) * (chunksize * 0.5))
+  B <- format_block_units("geneactiv", sf, chunksize)
   list(format = "geneactiv", sf = sf, temperature = TRUE,
        read = function(i) {
          start <- B * (i - 1) + 1
@@ -276,7 +272,7 @@ source_gt3x <- function(file, chunksize) {
   # the zeros that a whole read (imputeZeroes = TRUE) puts there. Put them
   # back from the time stamps, so that a streamed file has the same samples
   # at the same positions as the file read whole.
-  B <- (12 * 3600) * chunksize
+  B <- format_block_units("gt3x", sf, chunksize)
   t0 <- NULL
   next_i <- 0
   list(format = "gt3x", sf = sf, temperature = FALSE,
