@@ -48,13 +48,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "kernels.hpp"
 #include "r_arith.hpp"
-#include "simd.hpp"
-// GRAVCAL_NO_SIMD: the portable loop only (the results are the same bits)
-#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
-#define GRAVCAL_SSE2 1
-#include <emmintrin.h>
-#endif
 
 #if defined(__GNUC__)
 #define GRAVCAL_NOINLINE __attribute__((noinline))
@@ -79,54 +74,13 @@ struct WindowStats {
   double temperature;  // mean of finite temperatures, NaN if none
 };
 
-#if defined(GRAVCAL_AVX2)
-// run_end()'s scan from j, eight values at a time.
-GRAVCAL_TARGET_AVX2 inline std::size_t run_scan_avx2(const double* v, std::size_t j,
-                                                     std::size_t n, std::uint64_t bits) {
-  const __m256i b = _mm256_set1_epi64x(static_cast<long long>(bits));
-  for (; j + 8 <= n; j += 8) {
-    const __m256i a0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(v + j));
-    const __m256i a1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(v + j + 4));
-    const __m256i eq = _mm256_and_si256(_mm256_cmpeq_epi64(a0, b), _mm256_cmpeq_epi64(a1, b));
-    if (_mm256_movemask_epi8(eq) != -1) break;
-  }
-  return j;
-}
-#endif
-
-// The end of the run of values with the same bits as v[i], from i on (eight
-// at a time with AVX2, four with SSE2).
-inline std::size_t run_end(const double* v, std::size_t i, std::size_t n) {
-  std::uint64_t bits;
-  std::memcpy(&bits, v + i, sizeof bits);
-  std::size_t j = i + 1;
-#if defined(GRAVCAL_AVX2)
-  if (use_avx2()) {
-    j = run_scan_avx2(v, j, n, bits);
-    while (j < n && std::memcmp(v + j, &bits, sizeof bits) == 0) ++j;
-    return j;
-  }
-#endif
-#if defined(GRAVCAL_SSE2)
-  const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
-  for (; j + 4 <= n; j += 4) {
-    const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j));
-    const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j + 2));
-    const __m128i eq = _mm_and_si128(_mm_cmpeq_epi32(a0, b), _mm_cmpeq_epi32(a1, b));
-    if (_mm_movemask_epi8(eq) != 0xffff) break;
-  }
-#endif
-  while (j < n && std::memcmp(v + j, &bits, sizeof bits) == 0) ++j;
-  return j;
-}
-
 // for (k < n) s += v[k], in long double, to the bit, by runs of equal values
 // (add_repeated(), r_arith.hpp): a temperature repeats over a page or a
 // block of the file. b: the grid of s, kept between calls.
 inline void add_in_order(long double& s, const double* v, std::size_t n, Binade& b) {
   std::size_t i = 0;
   while (i < n) {
-    const std::size_t j = run_end(v, i, n);
+    const std::size_t j = kernels::active().run_end(v, i, n);
     add_repeated(s, v[i], static_cast<std::uint64_t>(j - i), b);
     i = j;
   }
@@ -318,11 +272,12 @@ class Segmenter {
   bool whole_window(const double* x, const double* y, const double* z,
                     const double* t, std::size_t m, Sink& sink) {
     const double h0 = x[0], h1 = y[0], h2 = z[0];
-    StreamScan a;
-    RScan r;
+    kernels::StreamSums a;
+    kernels::RScanOut r;
+    bool has_w = false;  // r.w holds the window's sums (for r_sd3())
     bool fast = false;
     if (rbuf_ == nullptr) {
-      scan_stream(x, y, z, t, m, a);
+      kernels::active().stream_window(x, y, z, t, m, a);
       double all = lanes(a.nrm);
       for (int k = 0; k < 3; ++k) all += lanes(a.s[k]) + lanes(a.q[k]);
       if ((skip_zero_ && a.zero) || !std::isfinite(all) ||
@@ -330,13 +285,18 @@ class Segmenter {
         return false;
       }
     } else {
-      for (int k = 0; k < 5; ++k) r.c[k] = csum_[k];
-      scan_r(x, y, z, m, r);
+      // R's running sums, with the window's own sums where r_var_means3()
+      // cannot decide R's means (the first pass of R's sd, nearly free
+      // there); min, max, the zero test and the lanes for fast_sd()
+      long double c[5];
+      for (int k = 0; k < 5; ++k) c[k] = csum_[k];
+      has_w = !kernels::r_var_means_available();
+      kernels::active().r_scan(x, y, z, m, c, has_w, r);
       // the running sums stay finite through windows of finite samples
       // (add() leaves out non-finite ones), so a non-finite sum here means
       // this window holds a non-finite value
       if ((skip_zero_ && r.zero) ||
-          !std::isfinite(static_cast<double>(r.c[0] + r.c[1] + r.c[2] + r.c[3]))) {
+          !std::isfinite(static_cast<double>(c[0] + c[1] + c[2] + c[3]))) {
         return false;
       }
       const double* cols[3] = {x, y, z};
@@ -349,14 +309,14 @@ class Segmenter {
       // non-finite temperature still sends the window to the
       // sample-by-sample path
       if (!fast && m > 1) {
-        r_sd3(cols, m, r.has_w ? r.w : nullptr, t, &r.c[4], wsd_);
+        r_sd3(cols, m, has_w ? r.w : nullptr, t, &c[4], wsd_);
       } else if (t != nullptr) {
         Binade b;
-        add_in_order(r.c[4], t, m, b);
+        add_in_order(c[4], t, m, b);
       }
-      if (t != nullptr && !std::isfinite(static_cast<double>(r.c[4]))) return false;
-      for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
-      a = StreamScan();  // sums replaced by close_r()
+      if (t != nullptr && !std::isfinite(static_cast<double>(c[4]))) return false;
+      for (int k = 0; k < 5; ++k) csum_[k] = c[k];
+      a = kernels::StreamSums();  // sums replaced by close_r()
       for (int k = 0; k < 3; ++k) {
         a.lo[k] = r.lo[k];
         a.hi[k] = r.hi[k];
@@ -399,524 +359,10 @@ class Segmenter {
         h.w[k] = r.w[k];
       }
       h.m = m;
-      h.has_w = r.has_w;
+      h.has_w = has_w;
     }
     deliver(h, sink);
     return true;
-  }
-
-  // The one-pass loops of whole_window(), kept out of line so that their
-  // code does not depend on the caller's.
-  struct StreamScan {
-    double s[3][4] = {}, q[3][4] = {}, lo[3] = {}, hi[3] = {}, nrm[4] = {},
-           st[4] = {};
-    bool zero = false;
-  };
-  struct RScan {
-    long double c[5], w[3];
-    double lo[3], hi[3], ls[3][4];
-    bool has_w;  // w holds the window's sums (scan_r() without r_var_means3())
-    bool zero;
-  };
-
-  // Streaming sums about the first sample, in lanes by position (add()'s
-  // arithmetic): with SSE2, lanes 0 and 1 in one register and 2 and 3 in
-  // another; otherwise one lane at a time. Either way every lane adds its
-  // own samples in order, so the results are the same bits.
-  GRAVCAL_NOINLINE static void scan_stream(const double* x, const double* y,
-                                           const double* z, const double* t,
-                                           std::size_t m, StreamScan& o) {
-    const double h[3] = {x[0], y[0], z[0]};
-    const double* col[3] = {x, y, z};
-    std::size_t k = 0;
-    double lo[3] = {h[0], h[1], h[2]}, hi[3] = {h[0], h[1], h[2]};
-    bool zero = false;
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) {
-      k = scan_stream_avx2(x, y, z, t, m, h, o, lo, hi, zero);
-    } else
-#endif
-#if defined(GRAVCAL_SSE2)
-    {
-      // named registers, not arrays, so that all of them stay in registers;
-      // suffix a: lanes 0 and 1 (samples k, k + 1), b: lanes 2 and 3
-      const __m128d zr = _mm_setzero_pd();
-      const __m128d h0 = _mm_set1_pd(h[0]), h1 = _mm_set1_pd(h[1]),
-                    h2 = _mm_set1_pd(h[2]);
-      __m128d s0a = zr, s0b = zr, s1a = zr, s1b = zr, s2a = zr, s2b = zr;
-      __m128d q0a = zr, q0b = zr, q1a = zr, q1b = zr, q2a = zr, q2b = zr;
-      __m128d na = zr, nb = zr, ta = zr, tb = zr, zacc = zr;
-      __m128d lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
-      for (; k + 4 <= m; k += 4) {
-        const __m128d xa = _mm_loadu_pd(x + k), xb = _mm_loadu_pd(x + k + 2);
-        const __m128d ya = _mm_loadu_pd(y + k), yb = _mm_loadu_pd(y + k + 2);
-        const __m128d za = _mm_loadu_pd(z + k), zb = _mm_loadu_pd(z + k + 2);
-        __m128d d = _mm_sub_pd(xa, h0);
-        s0a = _mm_add_pd(s0a, d);
-        q0a = _mm_add_pd(q0a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(xb, h0);
-        s0b = _mm_add_pd(s0b, d);
-        q0b = _mm_add_pd(q0b, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(ya, h1);
-        s1a = _mm_add_pd(s1a, d);
-        q1a = _mm_add_pd(q1a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(yb, h1);
-        s1b = _mm_add_pd(s1b, d);
-        q1b = _mm_add_pd(q1b, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(za, h2);
-        s2a = _mm_add_pd(s2a, d);
-        q2a = _mm_add_pd(q2a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(zb, h2);
-        s2b = _mm_add_pd(s2b, d);
-        q2b = _mm_add_pd(q2b, _mm_mul_pd(d, d));
-        lo0 = _mm_min_pd(lo0, _mm_min_pd(xa, xb));
-        hi0 = _mm_max_pd(hi0, _mm_max_pd(xa, xb));
-        lo1 = _mm_min_pd(lo1, _mm_min_pd(ya, yb));
-        hi1 = _mm_max_pd(hi1, _mm_max_pd(ya, yb));
-        lo2 = _mm_min_pd(lo2, _mm_min_pd(za, zb));
-        hi2 = _mm_max_pd(hi2, _mm_max_pd(za, zb));
-        na = _mm_add_pd(na, _mm_sqrt_pd(_mm_add_pd(
-                                _mm_add_pd(_mm_mul_pd(xa, xa), _mm_mul_pd(ya, ya)),
-                                _mm_mul_pd(za, za))));
-        nb = _mm_add_pd(nb, _mm_sqrt_pd(_mm_add_pd(
-                                _mm_add_pd(_mm_mul_pd(xb, xb), _mm_mul_pd(yb, yb)),
-                                _mm_mul_pd(zb, zb))));
-        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(xa, zr),
-                                                     _mm_cmpeq_pd(ya, zr)),
-                                          _mm_cmpeq_pd(za, zr)));
-        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(xb, zr),
-                                                     _mm_cmpeq_pd(yb, zr)),
-                                          _mm_cmpeq_pd(zb, zr)));
-        if (t != nullptr) {
-          ta = _mm_add_pd(ta, _mm_loadu_pd(t + k));
-          tb = _mm_add_pd(tb, _mm_loadu_pd(t + k + 2));
-        }
-      }
-      _mm_storeu_pd(o.s[0], s0a);
-      _mm_storeu_pd(o.s[0] + 2, s0b);
-      _mm_storeu_pd(o.s[1], s1a);
-      _mm_storeu_pd(o.s[1] + 2, s1b);
-      _mm_storeu_pd(o.s[2], s2a);
-      _mm_storeu_pd(o.s[2] + 2, s2b);
-      _mm_storeu_pd(o.q[0], q0a);
-      _mm_storeu_pd(o.q[0] + 2, q0b);
-      _mm_storeu_pd(o.q[1], q1a);
-      _mm_storeu_pd(o.q[1] + 2, q1b);
-      _mm_storeu_pd(o.q[2], q2a);
-      _mm_storeu_pd(o.q[2] + 2, q2b);
-      _mm_storeu_pd(o.nrm, na);
-      _mm_storeu_pd(o.nrm + 2, nb);
-      _mm_storeu_pd(o.st, ta);
-      _mm_storeu_pd(o.st + 2, tb);
-      const __m128d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
-      for (int c = 0; c < 3; ++c) {
-        double e[2];
-        _mm_storeu_pd(e, lov[c]);
-        lo[c] = e[0] < e[1] ? e[0] : e[1];
-        _mm_storeu_pd(e, hiv[c]);
-        hi[c] = e[0] > e[1] ? e[0] : e[1];
-      }
-      zero = _mm_movemask_pd(zacc) != 0;
-    }
-#endif
-    for (; k < m; ++k) {
-      const int l = static_cast<int>(k & 3);
-      const double xi = x[k], yi = y[k], zi = z[k];
-      zero = zero || (xi == 0.0 && yi == 0.0 && zi == 0.0);
-      for (int a = 0; a < 3; ++a) {
-        const double v = col[a][k];
-        const double d = v - h[a];
-        o.s[a][l] += d;
-        o.q[a][l] += d * d;
-        lo[a] = v < lo[a] ? v : lo[a];
-        hi[a] = v > hi[a] ? v : hi[a];
-      }
-      o.nrm[l] += std::sqrt(xi * xi + yi * yi + zi * zi);
-      if (t != nullptr) o.st[l] += t[k];
-    }
-    for (int a = 0; a < 3; ++a) {
-      o.lo[a] = lo[a];
-      o.hi[a] = hi[a];
-    }
-    zero_signs(col, m, o.lo, o.hi);
-    o.zero = zero;
-  }
-
-#if defined(GRAVCAL_AVX2)
-  // scan_stream()'s loop with the four lanes in one AVX2 register each:
-  // the same operations on the same lanes (no fused multiply-add), so the
-  // same bits. Returns the samples done (a multiple of 4).
-  GRAVCAL_TARGET_AVX2 static std::size_t scan_stream_avx2(
-      const double* x, const double* y, const double* z, const double* t, std::size_t m,
-      const double* h, StreamScan& o, double* lo, double* hi, bool& zero) {
-    const __m256d zr = _mm256_setzero_pd();
-    const __m256d h0 = _mm256_set1_pd(h[0]), h1 = _mm256_set1_pd(h[1]),
-                  h2 = _mm256_set1_pd(h[2]);
-    __m256d s0 = zr, s1 = zr, s2 = zr, q0 = zr, q1 = zr, q2 = zr, n = zr, st = zr, zacc = zr;
-    __m256d lo0 = h0, lo1 = h1, lo2 = h2, hi0 = h0, hi1 = h1, hi2 = h2;
-    std::size_t k = 0;
-    for (; k + 4 <= m; k += 4) {
-      const __m256d xa = _mm256_loadu_pd(x + k), ya = _mm256_loadu_pd(y + k),
-                    za = _mm256_loadu_pd(z + k);
-      __m256d d = _mm256_sub_pd(xa, h0);
-      s0 = _mm256_add_pd(s0, d);
-      q0 = _mm256_add_pd(q0, _mm256_mul_pd(d, d));
-      d = _mm256_sub_pd(ya, h1);
-      s1 = _mm256_add_pd(s1, d);
-      q1 = _mm256_add_pd(q1, _mm256_mul_pd(d, d));
-      d = _mm256_sub_pd(za, h2);
-      s2 = _mm256_add_pd(s2, d);
-      q2 = _mm256_add_pd(q2, _mm256_mul_pd(d, d));
-      lo0 = _mm256_min_pd(lo0, xa);
-      hi0 = _mm256_max_pd(hi0, xa);
-      lo1 = _mm256_min_pd(lo1, ya);
-      hi1 = _mm256_max_pd(hi1, ya);
-      lo2 = _mm256_min_pd(lo2, za);
-      hi2 = _mm256_max_pd(hi2, za);
-      n = _mm256_add_pd(n, _mm256_sqrt_pd(_mm256_add_pd(
-                               _mm256_add_pd(_mm256_mul_pd(xa, xa), _mm256_mul_pd(ya, ya)),
-                               _mm256_mul_pd(za, za))));
-      zacc = _mm256_or_pd(
-          zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(xa, zr, _CMP_EQ_OQ),
-                                            _mm256_cmp_pd(ya, zr, _CMP_EQ_OQ)),
-                              _mm256_cmp_pd(za, zr, _CMP_EQ_OQ)));
-      if (t != nullptr) st = _mm256_add_pd(st, _mm256_loadu_pd(t + k));
-    }
-    _mm256_storeu_pd(o.s[0], s0);
-    _mm256_storeu_pd(o.s[1], s1);
-    _mm256_storeu_pd(o.s[2], s2);
-    _mm256_storeu_pd(o.q[0], q0);
-    _mm256_storeu_pd(o.q[1], q1);
-    _mm256_storeu_pd(o.q[2], q2);
-    _mm256_storeu_pd(o.nrm, n);
-    _mm256_storeu_pd(o.st, st);
-    const __m256d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
-    for (int c = 0; c < 3; ++c) {
-      double e[4];
-      _mm256_storeu_pd(e, lov[c]);
-      for (int l = 0; l < 4; ++l) lo[c] = e[l] < lo[c] ? e[l] : lo[c];
-      _mm256_storeu_pd(e, hiv[c]);
-      for (int l = 0; l < 4; ++l) hi[c] = e[l] > hi[c] ? e[l] : hi[c];
-    }
-    zero = _mm256_movemask_pd(zacc) != 0;
-    return k;
-  }
-
-  // min_max()'s loop, four samples at a time, with lane_sums()'s sums (the
-  // same lanes in the same order). Sums: also scan_r()'s cumulative sums
-  // (sum: x, y, z and the norm, long double, in sample order), the four
-  // norms of a step by one square root instruction: the cumulative sums are
-  // bound by the latency of their additions, which leaves room for the rest
-  // of the loop, so the pass costs about what the sums alone did.
-  template <bool Sums>
-  GRAVCAL_TARGET_AVX2 static std::size_t min_max_avx2(const double* x, const double* y,
-                                                      const double* z, std::size_t m,
-                                                      double* lo, double* hi, bool& zero,
-                                                      double (*ls)[4],
-                                                      long double* sum = nullptr) {
-    const __m256d zr = _mm256_setzero_pd();
-    __m256d lo0 = _mm256_set1_pd(lo[0]), lo1 = _mm256_set1_pd(lo[1]), lo2 = _mm256_set1_pd(lo[2]);
-    __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
-    __m256d s0 = _mm256_loadu_pd(ls[0]), s1 = _mm256_loadu_pd(ls[1]), s2 = _mm256_loadu_pd(ls[2]);
-    long double c0 = 0.0L, c1 = 0.0L, c2 = 0.0L, c3 = 0.0L;
-    if (Sums) {
-      c0 = sum[0];
-      c1 = sum[1];
-      c2 = sum[2];
-      c3 = sum[3];
-    }
-    alignas(32) double nrm[4];
-    std::size_t k = 0;
-    for (; k + 4 <= m; k += 4) {
-      const __m256d a = _mm256_loadu_pd(x + k), b = _mm256_loadu_pd(y + k),
-                    c = _mm256_loadu_pd(z + k);
-      if (Sums) {
-        // scan_r()'s norm: x^2 + y^2, then + z^2, then the square root
-        const __m256d sq = _mm256_add_pd(_mm256_mul_pd(a, a), _mm256_mul_pd(b, b));
-        _mm256_store_pd(nrm, _mm256_sqrt_pd(_mm256_add_pd(sq, _mm256_mul_pd(c, c))));
-        for (int j = 0; j < 4; ++j) {
-          c0 += x[k + j];
-          c1 += y[k + j];
-          c2 += z[k + j];
-          c3 += nrm[j];
-        }
-      }
-      s0 = _mm256_add_pd(s0, a);
-      s1 = _mm256_add_pd(s1, b);
-      s2 = _mm256_add_pd(s2, c);
-      lo0 = _mm256_min_pd(a, lo0);
-      lo1 = _mm256_min_pd(b, lo1);
-      lo2 = _mm256_min_pd(c, lo2);
-      hi0 = _mm256_max_pd(a, hi0);
-      hi1 = _mm256_max_pd(b, hi1);
-      hi2 = _mm256_max_pd(c, hi2);
-      zacc = _mm256_or_pd(
-          zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a, zr, _CMP_EQ_OQ),
-                                            _mm256_cmp_pd(b, zr, _CMP_EQ_OQ)),
-                              _mm256_cmp_pd(c, zr, _CMP_EQ_OQ)));
-    }
-    if (Sums) {
-      sum[0] = c0;
-      sum[1] = c1;
-      sum[2] = c2;
-      sum[3] = c3;
-    }
-    const __m256d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
-    for (int a = 0; a < 3; ++a) {
-      double e[4];
-      _mm256_storeu_pd(e, lov[a]);
-      for (int l = 0; l < 4; ++l) lo[a] = e[l] < lo[a] ? e[l] : lo[a];
-      _mm256_storeu_pd(e, hiv[a]);
-      for (int l = 0; l < 4; ++l) hi[a] = e[l] > hi[a] ? e[l] : hi[a];
-    }
-    zero = _mm256_movemask_pd(zacc) != 0;
-    _mm256_storeu_pd(ls[0], s0);
-    _mm256_storeu_pd(ls[1], s1);
-    _mm256_storeu_pd(ls[2], s2);
-    return k;
-  }
-
-  // fast_sd()'s loop: the squared deviations of the four lanes by position
-  // in one register per axis (the SSE2 loop's two), the same bits.
-  GRAVCAL_TARGET_AVX2 static std::size_t sq_dev_avx2(const double* const* v, std::size_t n,
-                                                     const double* mu, double (*q)[4]) {
-    const __m256d m0 = _mm256_set1_pd(mu[0]), m1 = _mm256_set1_pd(mu[1]),
-                  m2 = _mm256_set1_pd(mu[2]);
-    const __m256d zr = _mm256_setzero_pd();
-    __m256d q0 = zr, q1 = zr, q2 = zr;
-    const double* x = v[0];
-    const double* y = v[1];
-    const double* z = v[2];
-    std::size_t k = 0;
-    for (; k + 4 <= n; k += 4) {
-      __m256d d = _mm256_sub_pd(_mm256_loadu_pd(x + k), m0);
-      q0 = _mm256_add_pd(q0, _mm256_mul_pd(d, d));
-      d = _mm256_sub_pd(_mm256_loadu_pd(y + k), m1);
-      q1 = _mm256_add_pd(q1, _mm256_mul_pd(d, d));
-      d = _mm256_sub_pd(_mm256_loadu_pd(z + k), m2);
-      q2 = _mm256_add_pd(q2, _mm256_mul_pd(d, d));
-    }
-    _mm256_storeu_pd(q[0], q0);
-    _mm256_storeu_pd(q[1], q1);
-    _mm256_storeu_pd(q[2], q2);
-    return k;
-  }
-#endif
-
-  // A zero minimum (maximum) as add()'s sequential rule leaves it: the
-  // first zero of the column, with its sign (lanes may have kept the other
-  // one). Any other value is the same in any order.
-  static void zero_signs(const double* const* col, std::size_t m, double* lo, double* hi) {
-    for (int a = 0; a < 3; ++a) {
-      if (lo[a] == 0.0 || hi[a] == 0.0) {
-        std::size_t j = 0;
-        while (j < m && col[a][j] != 0.0) ++j;
-        if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
-        if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
-      }
-    }
-  }
-
-  // R's cumsum(), one column at a time, continuing o.c, and the norm as
-  // add() forms it. Scalar accumulators, so that they stay in x87
-  // registers; min, max and the zero test in a second loop (the
-  // temperature's sum: r_sd3() or add_in_order()). Where r_var_means3()
-  // cannot decide R's means, the window's own long double sums (the first
-  // pass of R's sd) ride along, nearly free in this loop.
-  GRAVCAL_NOINLINE static void scan_r(const double* x, const double* y,
-                                      const double* z, std::size_t m, RScan& o) {
-    o.has_w = !r_var_means_available();
-#if defined(GRAVCAL_AVX2)
-    if (!o.has_w && use_avx2()) {
-      min_max(x, y, z, m, o, o.c);  // the sums ride in min_max()'s loop
-      return;
-    }
-#endif
-    long double c0 = o.c[0], c1 = o.c[1], c2 = o.c[2], c3 = o.c[3];
-    if (o.has_w) {
-      long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
-      for (std::size_t k = 0; k < m; ++k) {
-        const double xi = x[k], yi = y[k], zi = z[k];
-        c0 += xi;
-        c1 += yi;
-        c2 += zi;
-        w0 += xi;
-        w1 += yi;
-        w2 += zi;
-        const double sq = xi * xi + yi * yi;
-        c3 += std::sqrt(sq + zi * zi);
-      }
-      o.w[0] = w0;
-      o.w[1] = w1;
-      o.w[2] = w2;
-    } else {
-      for (std::size_t k = 0; k < m; ++k) {
-        const double xi = x[k], yi = y[k], zi = z[k];
-        c0 += xi;
-        c1 += yi;
-        c2 += zi;
-        const double sq = xi * xi + yi * yi;
-        c3 += std::sqrt(sq + zi * zi);
-      }
-    }
-    o.c[0] = c0;
-    o.c[1] = c1;
-    o.c[2] = c2;
-    o.c[3] = c3;
-    min_max(x, y, z, m, o);
-  }
-
-  // min, max and whether some sample is all zeros. min and max are those of
-  // the sequential rule (v < lo ? v : lo from the first sample, as add()):
-  // the same value in any order, except that a zero minimum (maximum) is
-  // the first zero met, with its sign, which a second look finds. Also the
-  // columns' sums by lanes for fast_sd() (lane_sums()). sum: where AVX2 runs,
-  // scan_r()'s four cumulative sums go on in the same loop (else null).
-  static void min_max(const double* x, const double* y, const double* z,
-                      std::size_t m, RScan& o, long double* sum = nullptr) {
-    const double* col[3] = {x, y, z};
-    double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
-    bool zero = false;
-    std::size_t k = 0;
-    for (int a = 0; a < 3; ++a) {
-      for (int l = 0; l < 4; ++l) o.ls[a][l] = 0.0;
-    }
-    (void)sum;  // only given where AVX2 runs
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) {
-      if (sum != nullptr) {
-        k = min_max_avx2<true>(x, y, z, m, lo, hi, zero, o.ls, sum);
-        long double c0 = sum[0], c1 = sum[1], c2 = sum[2], c3 = sum[3];
-        for (std::size_t j = k; j < m; ++j) {
-          const double xi = x[j], yi = y[j], zi = z[j];
-          c0 += xi;
-          c1 += yi;
-          c2 += zi;
-          const double sq = xi * xi + yi * yi;
-          c3 += std::sqrt(sq + zi * zi);
-        }
-        sum[0] = c0;
-        sum[1] = c1;
-        sum[2] = c2;
-        sum[3] = c3;
-      } else {
-        k = min_max_avx2<false>(x, y, z, m, lo, hi, zero, o.ls);
-      }
-      for (std::size_t j = k; j < m; ++j) {
-        for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
-      }
-    } else
-#endif
-#if defined(GRAVCAL_SSE2)
-    {
-      const __m128d zr = _mm_setzero_pd();
-      __m128d lo0 = _mm_set1_pd(lo[0]), lo1 = _mm_set1_pd(lo[1]), lo2 = _mm_set1_pd(lo[2]);
-      __m128d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
-      // lane_sums()'s sums: lanes 0 and 1 in one register, 2 and 3 in another
-      __m128d s0a = zr, s0b = zr, s1a = zr, s1b = zr, s2a = zr, s2b = zr;
-      bool odd = false;  // whether lanes 2 and 3 come next
-      for (; k + 2 <= m; k += 2) {
-        const __m128d a = _mm_loadu_pd(x + k), b = _mm_loadu_pd(y + k),
-                      c = _mm_loadu_pd(z + k);
-        if (odd) {
-          s0b = _mm_add_pd(s0b, a);
-          s1b = _mm_add_pd(s1b, b);
-          s2b = _mm_add_pd(s2b, c);
-        } else {
-          s0a = _mm_add_pd(s0a, a);
-          s1a = _mm_add_pd(s1a, b);
-          s2a = _mm_add_pd(s2a, c);
-        }
-        odd = !odd;
-        lo0 = _mm_min_pd(a, lo0);
-        lo1 = _mm_min_pd(b, lo1);
-        lo2 = _mm_min_pd(c, lo2);
-        hi0 = _mm_max_pd(a, hi0);
-        hi1 = _mm_max_pd(b, hi1);
-        hi2 = _mm_max_pd(c, hi2);
-        zacc = _mm_or_pd(zacc, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(a, zr),
-                                                     _mm_cmpeq_pd(b, zr)),
-                                          _mm_cmpeq_pd(c, zr)));
-      }
-      const __m128d lov[3] = {lo0, lo1, lo2}, hiv[3] = {hi0, hi1, hi2};
-      for (int a = 0; a < 3; ++a) {
-        double e[2];
-        _mm_storeu_pd(e, lov[a]);
-        lo[a] = e[0] < e[1] ? e[0] : e[1];
-        _mm_storeu_pd(e, hiv[a]);
-        hi[a] = e[0] > e[1] ? e[0] : e[1];
-      }
-      zero = _mm_movemask_pd(zacc) != 0;
-      _mm_storeu_pd(o.ls[0], s0a);
-      _mm_storeu_pd(o.ls[0] + 2, s0b);
-      _mm_storeu_pd(o.ls[1], s1a);
-      _mm_storeu_pd(o.ls[1] + 2, s1b);
-      _mm_storeu_pd(o.ls[2], s2a);
-      _mm_storeu_pd(o.ls[2] + 2, s2b);
-      for (std::size_t j = k; j < m; ++j) {
-        for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
-      }
-    }
-#else
-    lane_sums(col, m, o.ls);
-#endif
-    for (; k < m; ++k) {
-      zero = zero || (x[k] == 0.0 && y[k] == 0.0 && z[k] == 0.0);
-      for (int a = 0; a < 3; ++a) {
-        const double v = col[a][k];
-        lo[a] = v < lo[a] ? v : lo[a];
-        hi[a] = v > hi[a] ? v : hi[a];
-      }
-    }
-    zero_signs(col, m, lo, hi);
-    for (int a = 0; a < 3; ++a) {
-      o.lo[a] = lo[a];
-      o.hi[a] = hi[a];
-    }
-    o.zero = zero;
-  }
-
-  // The sums of three columns in four lanes by position k & 3 (added to
-  // s); the AVX2 loop adds the same lanes in the same order.
-#if defined(GRAVCAL_AVX2)
-  GRAVCAL_TARGET_AVX2 static std::size_t lane_sums_avx2(const double* const* v, std::size_t n,
-                                                        double (*s)[4]) {
-    __m256d s0 = _mm256_loadu_pd(s[0]), s1 = _mm256_loadu_pd(s[1]), s2 = _mm256_loadu_pd(s[2]);
-    std::size_t k = 0;
-    for (; k + 4 <= n; k += 4) {
-      s0 = _mm256_add_pd(s0, _mm256_loadu_pd(v[0] + k));
-      s1 = _mm256_add_pd(s1, _mm256_loadu_pd(v[1] + k));
-      s2 = _mm256_add_pd(s2, _mm256_loadu_pd(v[2] + k));
-    }
-    _mm256_storeu_pd(s[0], s0);
-    _mm256_storeu_pd(s[1], s1);
-    _mm256_storeu_pd(s[2], s2);
-    return k;
-  }
-#endif
-  static void lane_sums(const double* const* v, std::size_t n, double (*s)[4]) {
-    std::size_t k = 0;
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) k = lane_sums_avx2(v, n, s);
-#endif
-    // each lane in a local of its own (sums kept in the array would wait
-    // on their own stores), four samples a step, in the same order
-    for (int a = 0; a < 3; ++a) {
-      const double* x = v[a];
-      double l0 = s[a][0], l1 = s[a][1], l2 = s[a][2], l3 = s[a][3];
-      std::size_t j = k;
-      for (; j + 4 <= n; j += 4) {
-        l0 += x[j];
-        l1 += x[j + 1];
-        l2 += x[j + 2];
-        l3 += x[j + 3];
-      }
-      s[a][0] = l0;
-      s[a][1] = l1;
-      s[a][2] = l2;
-      s[a][3] = l3;
-      for (; j < n; ++j) s[a][j & 3] += x[j];
-    }
   }
 
   // The sds of n (>= 2) samples in double, for lazy_r_sd(): about the mean
@@ -947,49 +393,8 @@ class Segmenter {
     const long double ln = static_cast<long double>(n);
     const double dn = static_cast<double>(n);
     const double mu[3] = {lanes(ls[0]) / dn, lanes(ls[1]) / dn, lanes(ls[2]) / dn};
-    double q[3][4] = {};
-    std::size_t k = 0;
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) {
-      k = sq_dev_avx2(v, n, mu, q);
-    } else
-#endif
-#if defined(GRAVCAL_SSE2)
-    {
-      const __m128d m0 = _mm_set1_pd(mu[0]), m1 = _mm_set1_pd(mu[1]), m2 = _mm_set1_pd(mu[2]);
-      const __m128d zr = _mm_setzero_pd();
-      __m128d q0a = zr, q0b = zr, q1a = zr, q1b = zr, q2a = zr, q2b = zr;
-      const double* x = v[0];
-      const double* y = v[1];
-      const double* z = v[2];
-      for (; k + 4 <= n; k += 4) {
-        __m128d d = _mm_sub_pd(_mm_loadu_pd(x + k), m0);
-        q0a = _mm_add_pd(q0a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(_mm_loadu_pd(x + k + 2), m0);
-        q0b = _mm_add_pd(q0b, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(_mm_loadu_pd(y + k), m1);
-        q1a = _mm_add_pd(q1a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(_mm_loadu_pd(y + k + 2), m1);
-        q1b = _mm_add_pd(q1b, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(_mm_loadu_pd(z + k), m2);
-        q2a = _mm_add_pd(q2a, _mm_mul_pd(d, d));
-        d = _mm_sub_pd(_mm_loadu_pd(z + k + 2), m2);
-        q2b = _mm_add_pd(q2b, _mm_mul_pd(d, d));
-      }
-      _mm_storeu_pd(q[0], q0a);
-      _mm_storeu_pd(q[0] + 2, q0b);
-      _mm_storeu_pd(q[1], q1a);
-      _mm_storeu_pd(q[1] + 2, q1b);
-      _mm_storeu_pd(q[2], q2a);
-      _mm_storeu_pd(q[2] + 2, q2b);
-    }
-#endif
-    for (; k < n; ++k) {
-      for (int a = 0; a < 3; ++a) {
-        const double d = v[a][k] - mu[a];
-        q[a][k & 3] += d * d;
-      }
-    }
+    double q[3][4];
+    kernels::active().sq_dev(v, n, mu, q);
     const long double u = std::ldexp(1.0L, -53);
     const long double eps = 4.0L * (ln + 16.0L) * u;
     const long double t2 = static_cast<long double>(lz_->max_sd) * lz_->max_sd;
@@ -1209,7 +614,7 @@ class Segmenter {
         // the same choice as whole_window() makes, on the same values
         const std::size_t nv = static_cast<std::size_t>(n_valid_);
         double ls[3][4] = {};
-        lane_sums(v, nv, ls);
+        kernels::active().lane_sums(v, nv, ls);
         h.fast = fast_sd(v, nv, min_, max_, ls, h);
         if (h.fast) {
           for (int a = 0; a < 3; ++a) {
@@ -1247,7 +652,7 @@ class Segmenter {
     const double* b = v[1];
     const double* c = v[2];
     double mean[3];
-    if (r_var_means3(v, n, mean)) {
+    if (kernels::active().r_var_means3(v, n, mean)) {
       if (t != nullptr && tsum != nullptr) {
         Binade bt;
         add_in_order(*tsum, t, n, bt);
