@@ -33,7 +33,9 @@ Rcpp::NumericVector num(const double* v, std::size_t n) {
 Rcpp::NumericVector lanes12(const double (*s)[4]) { return num(&s[0][0], 12); }
 
 const double* col(const Rcpp::List& a, const char* name) {
-  return REAL(static_cast<SEXP>(a[name]));
+  SEXP v = a[name];
+  if (TYPEOF(v) != REALSXP) Rcpp::stop("`%s` must be a numeric vector", name);
+  return REAL(v);
 }
 
 std::size_t len(const Rcpp::List& a, const char* name) {
@@ -96,21 +98,6 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
           Rcpp::_["w"] = want_w ? Rcpp::RObject(ld_bytes(o.w, 3)) : Rcpp::RObject(),
           Rcpp::_["lo"] = num(o.lo, 3), Rcpp::_["hi"] = num(o.hi, 3),
           Rcpp::_["ls"] = lanes12(o.ls), Rcpp::_["zero"] = o.zero);
-    });
-  }
-  if (name == "lane_sums") {
-    return each_variant(k::lane_sums_variants, [&](k::LaneSumsFn f) {
-      double s[3][4] = {};
-      f(v, m, s);
-      return Rcpp::List::create(Rcpp::_["s"] = lanes12(s));
-    });
-  }
-  if (name == "sq_dev") {
-    const Rcpp::NumericVector mu = a["mu"];
-    return each_variant(k::sq_dev_variants, [&](k::SqDevFn f) {
-      double q[3][4];
-      f(v, m, mu.begin(), q);
-      return Rcpp::List::create(Rcpp::_["q"] = lanes12(q));
     });
   }
   if (name == "r_var_means3") {
@@ -180,12 +167,7 @@ Rcpp::List decode_kernel(const std::string& name, const Rcpp::List& a) {
     const std::size_t room = static_cast<std::size_t>(stop - pos);
     return each_variant(k::cwa_interp_variants, [&](k::CwaInterpFn f) {
       std::vector<double> ox(room), oy(room), oz(room), ot(room), otime(room);
-      k::InterpOut o;
-      o.x = ox.data();
-      o.y = oy.data();
-      o.z = oz.data();
-      o.t = ot.data();
-      o.time = otime.data();
+      const k::InterpOut o{ox.data(), oy.data(), oz.data(), ot.data(), otime.data()};
       int source = source0;
       double last[3] = {-1, -2, -3}, at = -4;
       const std::int64_t w = f(sp, pos, stop, source, o, last, at);
@@ -213,69 +195,6 @@ Rcpp::List decode_kernel(const std::string& name, const Rcpp::List& a) {
   Rcpp::stop("unknown kernel '%s'", name);
 }
 
-Rcpp::List icp_kernel(const std::string& name, const Rcpp::List& a) {
-  const double* c0 = col(a, "a");
-  const double* c1 = col(a, "b");
-  const double* c2 = col(a, "c");
-  const std::size_t n = len(a, "a");
-  if (len(a, "b") != n || len(a, "c") != n) Rcpp::stop("`a`, `b` and `c` must have one length");
-  const Rcpp::NumericVector p = a["p"];  // scalar parameters
-  if (p.size() < 3) Rcpp::stop("`p` must hold 3 numbers");
-  const bool with_t = Rcpp::as<bool>(a["with_t"]);
-  std::vector<double> o0(n), o1(n), o2(n);
-  auto out3 = [&]() {
-    return Rcpp::List::create(Rcpp::_["o0"] = o0, Rcpp::_["o1"] = o1, Rcpp::_["o2"] = o2);
-  };
-  if (name == "icp_apply") {
-    return each_variant(k::icp_apply_variants, [&](k::IcpApplyFn f) {
-      f(c0, with_t ? c1 : nullptr, n, p[0], p[1], p[2], o0.data());
-      return out3();
-    });
-  }
-  if (name == "icp_project") {
-    return each_variant(k::icp_project_variants, [&](k::IcpProjectFn f) {
-      f(c0, c1, c2, n, o0.data(), o1.data(), o2.data());
-      return out3();
-    });
-  }
-  if (name == "icp_sqrt") {
-    return each_variant(k::icp_sqrt_variants, [&](k::IcpSqrtFn f) {
-      f(c0, n, o0.data());
-      return out3();
-    });
-  }
-  if (name == "icp_times") {
-    return each_variant(k::icp_times_variants, [&](k::IcpTimesFn f) {
-      f(c0, c1, n, o0.data());
-      return out3();
-    });
-  }
-  if (name == "icp_fitted") {
-    return each_variant(k::icp_fitted_variants, [&](k::IcpFittedFn f) {
-      o0.assign(c0, c0 + n);
-      f(p[0], p[1], p[2], with_t ? c1 : nullptr, n, o0.data());
-      return out3();
-    });
-  }
-  if (name == "icp_weights") {
-    // c = (a, b, c), the points p = (a, b, c) shifted by the parameters
-    std::vector<double> q0(n), q1(n), q2(n), w(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      q0[i] = c0[i] * p[0];
-      q1[i] = c1[i] * p[1];
-      q2[i] = c2[i] * p[2];
-      w[i] = c1[i];
-    }
-    const double max_weight = p.size() > 3 ? p[3] : 100.0;
-    return each_variant(k::icp_weights_variants, [&](k::IcpWeightsFn f) {
-      f(c0, c1, c2, q0.data(), q1.data(), q2.data(), n, max_weight, w.data(), o0.data(),
-        o1.data());
-      return out3();
-    });
-  }
-  Rcpp::stop("unknown kernel '%s'", name);
-}
-
 }  // namespace
 
 // Every compiled variant of kernel `name` on the inputs in `args` (what
@@ -284,7 +203,6 @@ Rcpp::List icp_kernel(const std::string& name, const Rcpp::List& a) {
 // has it), each the kernel's outputs.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_kernel_check(const std::string& name, const Rcpp::List& args) {
-  if (name.compare(0, 4, "icp_") == 0) return icp_kernel(name, args);
   if (name == "word_sum" || name == "scale_packed" || name == "span_times" ||
       name == "cwa_interp" || name == "hex_counts") {
     return decode_kernel(name, args);

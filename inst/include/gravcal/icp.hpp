@@ -38,7 +38,6 @@
 #include <limits>
 #include <vector>
 
-#include "kernels.hpp"
 #include "r_arith.hpp"
 
 namespace gravcal {
@@ -96,6 +95,52 @@ struct EigenLeastSquares {
 // The calibrated value, in GGIR's operation order.
 inline double icp_apply(double v, double o, double s, double t, double to) {
   return (v + o) / (1.0 / s) + t / (1.0 / to);
+}
+
+// The loops of gravcal's own fit (fit_icp()), element by element. (SSE2
+// versions saved less than 5 % of a week's calibrate(method = "ggir"):
+// bench/results/ab-kernels.md.)
+
+// out[i] = icp_apply(v[i], o, s, t ? t[i] : 0, to)
+inline void icp_apply_column(const double* v, const double* t, std::size_t n, double o, double s,
+                             double to, double* out) {
+  const double is = 1.0 / s, it = 1.0 / to;
+  for (std::size_t i = 0; i < n; ++i) out[i] = (v[i] + o) / is + (t != nullptr ? t[i] : 0.0) / it;
+}
+
+// p = c / |c|, |c| = sqrt(c0^2 + c1^2 + c2^2)
+inline void icp_project(const double* c0, const double* c1, const double* c2, std::size_t n,
+                        double* p0, double* p1, double* p2) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = std::sqrt(c0[i] * c0[i] + c1[i] * c1[i] + c2[i] * c2[i]);
+    p0[i] = c0[i] / r;
+    p1[i] = c1[i] / r;
+    p2[i] = c2[i] / r;
+  }
+}
+
+// c = b0 + b1 c (+ b2 t when t is not null)
+inline void icp_fitted(double b0, double b1, double b2, const double* t, std::size_t n,
+                       double* c) {
+  for (std::size_t i = 0; i < n; ++i) {
+    double f = b0 + b1 * c[i];
+    if (t != nullptr) f += b2 * t[i];
+    c[i] = f;
+  }
+}
+
+// d2 = |c - p|^2; wd2 = w d2 (GGIR's statistic); next = min(1 / sqrt(d2),
+// max_weight)
+inline void icp_weights(const double* c0, const double* c1, const double* c2, const double* p0,
+                        const double* p1, const double* p2, std::size_t n, double max_weight,
+                        const double* w, double* next, double* wd2) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = c0[i] - p0[i], b = c1[i] - p1[i], c = c2[i] - p2[i];
+    const double d2 = a * a + b * b + c * c;
+    wd2[i] = w[i] * d2;
+    const double wi = 1.0 / std::sqrt(d2);
+    next[i] = wi < max_weight ? wi : max_weight;
+  }
 }
 
 // GGIR's loop with R's arithmetic (IcpConfig::r_arithmetic). As GGIR: the
@@ -265,31 +310,30 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
   const double* tp = use_temp ? t.data() : nullptr;
   for (int it = 1; it <= cfg.max_iter; ++it) {
     // the calibrated points (icp_apply()), then their closest points on the
-    // sphere; column by column (the loops: kernels/icp.hpp)
-    const kernels::Table& kt = kernels::active();
+    // sphere; column by column
     for (int k = 0; k < 3; ++k) {
-      kt.icp_apply(in[k], tp, n, r.offset[k], r.scale[k],
+      icp_apply_column(in[k], tp, n, r.offset[k], r.scale[k],
                        use_temp ? r.tempoffset[k] : 0.0, cur.col(k).data());
     }
-    kt.icp_project(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(), n,
+    icp_project(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(), n,
                 cp.col(0).data(), cp.col(1).data(), cp.col(2).data());
     if (!cp.allFinite()) {
       r.finite = false;
       break;
     }
-    kt.icp_sqrt(w.data(), n, sw.data());
+    sw = w.cwiseSqrt();
     double d_off[3], d_scale[3], d_temp[3] = {0.0, 0.0, 0.0};
     for (int k = 0; k < 3; ++k) {
       X.col(0) = sw;
-      kt.icp_times(sw.data(), cur.col(k).data(), n, X.col(1).data());
-      if (use_temp) kt.icp_times(sw.data(), tp, n, X.col(2).data());
-      kt.icp_times(sw.data(), cp.col(k).data(), n, b.data());
+      X.col(1) = sw.cwiseProduct(cur.col(k));
+      if (use_temp) X.col(2) = sw.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(tp, N));
+      b = sw.cwiseProduct(cp.col(k));
       qr.compute(X);
       const Eigen::VectorXd beta = qr.solve(b);
       d_off[k] = beta(0);
       d_scale[k] = beta(1);
       if (use_temp) d_temp[k] = beta(2);
-      kt.icp_fitted(beta(0), beta(1), use_temp ? beta(2) : 0.0, tp, n, cur.col(k).data());
+      icp_fitted(beta(0), beta(1), use_temp ? beta(2) : 0.0, tp, n, cur.col(k).data());
     }
     double change = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -304,7 +348,7 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
       r.tempoffset[k] = t_new;
     }
     // GGIR's statistic, with the weights of this iteration; then new weights.
-    kt.icp_weights(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(),
+    icp_weights(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(),
                 cp.col(0).data(), cp.col(1).data(), cp.col(2).data(), n,
                 cfg.max_weight, w.data(), w_next.data(), wd2.data());
     long double num = 0.0L, wsum = 0.0L;

@@ -1,12 +1,14 @@
 // gravcal: the kernel table, the one place where the instruction set is
 // chosen.
 //
-// The loops that have vector code (kernels/*.hpp: window statistics, the
-// device decoders, gravcal's ICP) are called through one table of function
+// The loops that have vector code (kernels/*.hpp: window statistics and
+// the device decoders) are called through one table of function
 // pointers, filled once, when first used: each kernel its best variant for
 // this processor (AVX2 where it has it, else SSE2 where compiled, else the
 // scalar reference). No kernel tests the processor itself. Every variant
-// gives its reference's bits, so the choice changes only the time.
+// gives its reference's bits, so the choice changes only the time; and a
+// variant stays only where it saves a measured share of a week's
+// calibration (5 % for floating-point ones: bench/results/ab-kernels.md).
 //
 // Environment, read when the table is filled:
 // - GRAVCAL_NO_AVX2 set to anything but "" or "0": no AVX2 variant.
@@ -25,7 +27,6 @@
 
 #include "simd.hpp"
 #include "kernels/decode.hpp"
-#include "kernels/icp.hpp"
 #include "kernels/r_mean.hpp"
 #include "kernels/window.hpp"
 
@@ -42,9 +43,7 @@ struct Table {
   // window statistics (kernels/window.hpp, kernels/r_mean.hpp)
   RunEndFn run_end = nullptr;
   StreamWindowFn stream_window = nullptr;
-  LaneSumsFn lane_sums = nullptr;
   RScanFn r_scan = nullptr;
-  SqDevFn sq_dev = nullptr;
   RVarMeans3Fn r_var_means3 = nullptr;
   FirstZeroFn first_zero = nullptr;
   // device decoders (kernels/decode.hpp)
@@ -53,13 +52,6 @@ struct Table {
   SpanTimesFn span_times = nullptr;
   CwaInterpFn cwa_interp = nullptr;
   HexCountsFn hex_counts = nullptr;
-  // gravcal's ICP (kernels/icp.hpp)
-  IcpApplyFn icp_apply = nullptr;
-  IcpProjectFn icp_project = nullptr;
-  IcpSqrtFn icp_sqrt = nullptr;
-  IcpTimesFn icp_times = nullptr;
-  IcpFittedFn icp_fitted = nullptr;
-  IcpWeightsFn icp_weights = nullptr;
 };
 
 // visit(slot, variants, name) for every kernel of table t.
@@ -67,9 +59,7 @@ template <class T, class Visit>
 constexpr void each_kernel(T& t, Visit&& visit) {
   visit(t.run_end, run_end_variants, "run_end");
   visit(t.stream_window, stream_window_variants, "stream_window");
-  visit(t.lane_sums, lane_sums_variants, "lane_sums");
   visit(t.r_scan, r_scan_variants, "r_scan");
-  visit(t.sq_dev, sq_dev_variants, "sq_dev");
   visit(t.r_var_means3, r_var_means3_variants, "r_var_means3");
   visit(t.first_zero, first_zero_variants, "first_zero");
   visit(t.word_sum, word_sum_variants, "word_sum");
@@ -77,12 +67,6 @@ constexpr void each_kernel(T& t, Visit&& visit) {
   visit(t.span_times, span_times_variants, "span_times");
   visit(t.cwa_interp, cwa_interp_variants, "cwa_interp");
   visit(t.hex_counts, hex_counts_variants, "hex_counts");
-  visit(t.icp_apply, icp_apply_variants, "icp_apply");
-  visit(t.icp_project, icp_project_variants, "icp_project");
-  visit(t.icp_sqrt, icp_sqrt_variants, "icp_sqrt");
-  visit(t.icp_times, icp_times_variants, "icp_times");
-  visit(t.icp_fitted, icp_fitted_variants, "icp_fitted");
-  visit(t.icp_weights, icp_weights_variants, "icp_weights");
 }
 
 // A table with every slot pick(variants, name).

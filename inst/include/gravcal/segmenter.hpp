@@ -20,8 +20,9 @@
 //   rest windows, with no storage beyond a few sums; what a microcontroller
 //   runs. Each sum is kept in four lanes by the sample's position in the
 //   window (position mod 4) and the lanes are added as (0 + 1) + (2 + 3) when
-//   the window closes, so that whole windows can be summed two samples per
-//   instruction (SSE2) with the same result as sample by sample.
+//   the window closes, so that whole windows can be summed several samples
+//   per instruction (kernels/window.hpp) with the same result as sample by
+//   sample.
 // - R-compatible (use_r_arithmetic()): the numbers GGIR gets in R, to the
 //   last bit, so that GGIR's exact-equality rules (its duplicate-window
 //   filter) and thresholds decide the same way. Means are differences of a
@@ -30,7 +31,8 @@
 //   new_block() where GGIR restarts its cumsum (each block it reads); the sd
 //   is R's var(): a two-pass mean with a correction pass, then the sum of
 //   squared deviations, all in long double (the two-pass mean decided
-//   without its passes where a bound allows: r_var_means3(), r_arith.hpp).
+//   without its passes where a bound allows: r_var_means3(),
+//   kernels/r_mean.hpp).
 //   The caller lends the buffer that
 //   holds the open window's samples, so the core still allocates nothing.
 //   GGIR's procedure only compares the sds with its rest threshold and
@@ -367,9 +369,8 @@ class Segmenter {
 
   // The sds of n (>= 2) samples in double, for lazy_r_sd(): about the mean
   // in double (ls: the values summed in four lanes by position,
-  // lane_sums(); lanes() of them, over n), the squared deviations summed in four lanes by position
-  // (two SSE2 registers per axis; the portable loop adds the same lanes),
-  // so the same samples give the same bits on every path. Error bounds as
+  // kernels::lane_sums() or the kernel r_scan; lanes() of them, over n),
+  // the squared deviations summed in four lanes by position (sq_dev()). Error bounds as
   // r_sd_below()'s (r_arith.hpp), with u = 2^-53 and M = max |x|: this
   // sd^2 is (s2 + n / (n - 1) dF^2) (1 + f), |dF| <= (n / 4 + 4) u M (each
   // lane a recursive sum of at most n / 4 + 1 values, two levels joining
@@ -394,7 +395,7 @@ class Segmenter {
     const double dn = static_cast<double>(n);
     const double mu[3] = {lanes(ls[0]) / dn, lanes(ls[1]) / dn, lanes(ls[2]) / dn};
     double q[3][4];
-    kernels::active().sq_dev(v, n, mu, q);
+    sq_dev(v, n, mu, q);
     const long double u = std::ldexp(1.0L, -53);
     const long double eps = 4.0L * (ln + 16.0L) * u;
     const long double t2 = static_cast<long double>(lz_->max_sd) * lz_->max_sd;
@@ -409,6 +410,32 @@ class Segmenter {
       if (h.lo2[a] > t2 * (1.0L + 1e-12L)) above = true;
     }
     return above;
+  }
+
+  // The squared deviations (v[a][k] - mu[a])^2 of three columns of n
+  // values, summed in four lanes by position into q, each lane in a local of
+  // its own, four values a step. (Vector versions saved less than 5 % of a
+  // week's calibration: bench/results/ab-kernels.md.)
+  static void sq_dev(const double* const* v, std::size_t n, const double* mu, double (*q)[4]) {
+    for (int a = 0; a < 3; ++a) {
+      const double* x = v[a];
+      const double m = mu[a];
+      double l0 = 0.0, l1 = 0.0, l2 = 0.0, l3 = 0.0;
+      std::size_t k = 0;
+      for (; k + 4 <= n; k += 4) {
+        const double d0 = x[k] - m, d1 = x[k + 1] - m, d2 = x[k + 2] - m, d3 = x[k + 3] - m;
+        l0 += d0 * d0;
+        l1 += d1 * d1;
+        l2 += d2 * d2;
+        l3 += d3 * d3;
+      }
+      double l[4] = {l0, l1, l2, l3};
+      for (; k < n; ++k) {
+        const double d = x[k] - m;
+        l[k & 3] += d * d;
+      }
+      for (int j = 0; j < 4; ++j) q[a][j] = l[j];
+    }
   }
 
   // R's sds for a window kept in double.
@@ -614,7 +641,7 @@ class Segmenter {
         // the same choice as whole_window() makes, on the same values
         const std::size_t nv = static_cast<std::size_t>(n_valid_);
         double ls[3][4] = {};
-        kernels::active().lane_sums(v, nv, ls);
+        kernels::lane_sums(v, nv, ls);
         h.fast = fast_sd(v, nv, min_, max_, ls, h);
         if (h.fast) {
           for (int a = 0; a < 3; ++a) {

@@ -41,22 +41,6 @@ inline std::size_t run_end_scalar(const double* v, std::size_t i, std::size_t n)
   return run_tail(v, i + 1, n, bits);
 }
 
-#if defined(GRAVCAL_SSE2)
-inline std::size_t run_end_sse2(const double* v, std::size_t i, std::size_t n) {
-  std::uint64_t bits;
-  std::memcpy(&bits, v + i, sizeof bits);
-  std::size_t j = i + 1;
-  const __m128i b = _mm_set1_epi64x(static_cast<long long>(bits));
-  for (; j + 4 <= n; j += 4) {
-    const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j));
-    const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(v + j + 2));
-    const __m128i eq = _mm_and_si128(_mm_cmpeq_epi32(a0, b), _mm_cmpeq_epi32(a1, b));
-    if (_mm_movemask_epi8(eq) != 0xffff) break;
-  }
-  return run_tail(v, j, n, bits);
-}
-#endif
-
 #if defined(GRAVCAL_AVX2)
 GRAVCAL_TARGET_AVX2 inline std::size_t run_end_avx2(const double* v, std::size_t i,
                                                     std::size_t n) {
@@ -75,11 +59,13 @@ GRAVCAL_TARGET_AVX2 inline std::size_t run_end_avx2(const double* v, std::size_t
 #endif
 
 using RunEndFn = std::size_t (*)(const double*, std::size_t, std::size_t);
-constexpr Variants<RunEndFn> run_end_variants = {run_end_scalar, GRAVCAL_IF_SSE2(run_end_sse2),
+constexpr Variants<RunEndFn> run_end_variants = {run_end_scalar, nullptr,
                                                  GRAVCAL_IF_AVX2(run_end_avx2)};
 
 // ---------------------------------------------------------------------------
 // Shared by the window kernels.
+
+inline bool is_zero3(double x, double y, double z) { return x == 0.0 && y == 0.0 && z == 0.0; }
 
 // A zero minimum (maximum) as the sequential rule (v < lo ? v : lo from the
 // first sample) leaves it: the first zero of the column, with its sign
@@ -96,17 +82,33 @@ inline void zero_signs(const double* const* col, std::size_t m, double* lo, doub
   }
 }
 
-// min, max and the all-zeros test of samples [k, m), continuing lo, hi, zero.
+// min, max and the all-zeros test of samples [k, m), continuing lo, hi,
+// zero (in locals: through the pointers every step would be a store and a
+// load).
 inline void min_max_tail(const double* const* col, std::size_t k, std::size_t m, double* lo,
                          double* hi, bool& zero) {
+  const double* x = col[0];
+  const double* y = col[1];
+  const double* z = col[2];
+  double lo0 = lo[0], lo1 = lo[1], lo2 = lo[2], hi0 = hi[0], hi1 = hi[1], hi2 = hi[2];
+  bool zr = zero;
   for (; k < m; ++k) {
-    zero = zero || (col[0][k] == 0.0 && col[1][k] == 0.0 && col[2][k] == 0.0);
-    for (int a = 0; a < 3; ++a) {
-      const double v = col[a][k];
-      lo[a] = v < lo[a] ? v : lo[a];
-      hi[a] = v > hi[a] ? v : hi[a];
-    }
+    const double a = x[k], b = y[k], c = z[k];
+    zr = zr | ((a == 0.0) & (b == 0.0) & (c == 0.0));
+    lo0 = a < lo0 ? a : lo0;
+    lo1 = b < lo1 ? b : lo1;
+    lo2 = c < lo2 ? c : lo2;
+    hi0 = a > hi0 ? a : hi0;
+    hi1 = b > hi1 ? b : hi1;
+    hi2 = c > hi2 ? c : hi2;
   }
+  lo[0] = lo0;
+  lo[1] = lo1;
+  lo[2] = lo2;
+  hi[0] = hi0;
+  hi[1] = hi1;
+  hi[2] = hi2;
+  zero = zr;
 }
 
 // ---------------------------------------------------------------------------
@@ -147,14 +149,82 @@ inline void stream_tail(const double* const* col, const double* t, std::size_t k
   o.zero = zero;
 }
 
+// An axis at a time, then the norms, the temperatures and the zero test,
+// each lane in a local of its own (sums kept in the arrays would wait on
+// their own stores), four samples a step, in the same order as sample by
+// sample.
 inline void stream_window_scalar(const double* x, const double* y, const double* z,
                                  const double* t, std::size_t m, StreamSums& o) {
   const double* col[3] = {x, y, z};
-  const double h[3] = {x[0], y[0], z[0]};
-  double lo[3] = {h[0], h[1], h[2]}, hi[3] = {h[0], h[1], h[2]};
-  bool zero = false;
+  const std::size_t m4 = m & ~std::size_t(3);
   o = StreamSums();
-  stream_tail(col, t, 0, m, h, o, lo, hi, zero);
+  for (int a = 0; a < 3; ++a) {
+    const double* v = col[a];
+    const double h = v[0];
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, q0 = 0.0, q1 = 0.0, q2 = 0.0, q3 = 0.0;
+    double lo0 = h, lo1 = h, lo2 = h, lo3 = h, hi0 = h, hi1 = h, hi2 = h, hi3 = h;
+    for (std::size_t k = 0; k < m4; k += 4) {
+      const double v0 = v[k], v1 = v[k + 1], v2 = v[k + 2], v3 = v[k + 3];
+      const double d0 = v0 - h, d1 = v1 - h, d2 = v2 - h, d3 = v3 - h;
+      s0 += d0;
+      q0 += d0 * d0;
+      s1 += d1;
+      q1 += d1 * d1;
+      s2 += d2;
+      q2 += d2 * d2;
+      s3 += d3;
+      q3 += d3 * d3;
+      // min and max by lanes too: the same values in any order, but a
+      // zero's sign (zero_signs() in stream_tail())
+      lo0 = v0 < lo0 ? v0 : lo0;
+      lo1 = v1 < lo1 ? v1 : lo1;
+      lo2 = v2 < lo2 ? v2 : lo2;
+      lo3 = v3 < lo3 ? v3 : lo3;
+      hi0 = v0 > hi0 ? v0 : hi0;
+      hi1 = v1 > hi1 ? v1 : hi1;
+      hi2 = v2 > hi2 ? v2 : hi2;
+      hi3 = v3 > hi3 ? v3 : hi3;
+    }
+    const double s4[4] = {s0, s1, s2, s3}, q4[4] = {q0, q1, q2, q3};
+    const double lo4[4] = {lo0, lo1, lo2, lo3}, hi4[4] = {hi0, hi1, hi2, hi3};
+    o.lo[a] = h;
+    o.hi[a] = h;
+    for (int l = 0; l < 4; ++l) {
+      o.s[a][l] = s4[l];
+      o.q[a][l] = q4[l];
+      o.lo[a] = lo4[l] < o.lo[a] ? lo4[l] : o.lo[a];
+      o.hi[a] = hi4[l] > o.hi[a] ? hi4[l] : o.hi[a];
+    }
+  }
+  double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0;
+  for (std::size_t k = 0; k < m4; k += 4) {
+    n0 += std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
+    n1 += std::sqrt(x[k + 1] * x[k + 1] + y[k + 1] * y[k + 1] + z[k + 1] * z[k + 1]);
+    n2 += std::sqrt(x[k + 2] * x[k + 2] + y[k + 2] * y[k + 2] + z[k + 2] * z[k + 2]);
+    n3 += std::sqrt(x[k + 3] * x[k + 3] + y[k + 3] * y[k + 3] + z[k + 3] * z[k + 3]);
+  }
+  o.nrm[0] = n0;
+  o.nrm[1] = n1;
+  o.nrm[2] = n2;
+  o.nrm[3] = n3;
+  if (t != nullptr) {
+    double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
+    for (std::size_t k = 0; k < m4; k += 4) {
+      t0 += t[k];
+      t1 += t[k + 1];
+      t2 += t[k + 2];
+      t3 += t[k + 3];
+    }
+    o.st[0] = t0;
+    o.st[1] = t1;
+    o.st[2] = t2;
+    o.st[3] = t3;
+  }
+  bool zero = false;
+  for (std::size_t k = 0; k < m4 && !zero; ++k) zero = is_zero3(x[k], y[k], z[k]);
+  const double h[3] = {x[0], y[0], z[0]};
+  double lo[3] = {o.lo[0], o.lo[1], o.lo[2]}, hi[3] = {o.hi[0], o.hi[1], o.hi[2]};
+  stream_tail(col, t, m4, m, h, o, lo, hi, zero);
 }
 
 #if defined(GRAVCAL_SSE2)
@@ -311,15 +381,17 @@ constexpr Variants<StreamWindowFn> stream_window_variants = {
 
 // ---------------------------------------------------------------------------
 // lane_sums(v, n, s): the sums of three columns of n values in four lanes
-// by position, added to s.
+// by position, added to s (r_scan's reference, and the segmenter's for a
+// window taken sample by sample; an AVX2 version saved nothing measurable:
+// bench/results/ab-kernels.md).
 
-// each lane in a local of its own (sums kept in the array would wait on
-// their own stores), four samples a step, in the same order
-inline void lane_sums_from(const double* const* v, std::size_t k, std::size_t n, double (*s)[4]) {
+// Each lane in a local of its own (sums kept in the array would wait on
+// their own stores), four samples a step, in the same order.
+inline void lane_sums(const double* const* v, std::size_t n, double (*s)[4]) {
   for (int a = 0; a < 3; ++a) {
     const double* x = v[a];
     double l0 = s[a][0], l1 = s[a][1], l2 = s[a][2], l3 = s[a][3];
-    std::size_t j = k;
+    std::size_t j = 0;
     for (; j + 4 <= n; j += 4) {
       l0 += x[j];
       l1 += x[j + 1];
@@ -334,30 +406,6 @@ inline void lane_sums_from(const double* const* v, std::size_t k, std::size_t n,
   }
 }
 
-inline void lane_sums_scalar(const double* const* v, std::size_t n, double (*s)[4]) {
-  lane_sums_from(v, 0, n, s);
-}
-
-#if defined(GRAVCAL_AVX2)
-GRAVCAL_TARGET_AVX2 inline void lane_sums_avx2(const double* const* v, std::size_t n,
-                                               double (*s)[4]) {
-  __m256d s0 = _mm256_loadu_pd(s[0]), s1 = _mm256_loadu_pd(s[1]), s2 = _mm256_loadu_pd(s[2]);
-  std::size_t k = 0;
-  for (; k + 4 <= n; k += 4) {
-    s0 = _mm256_add_pd(s0, _mm256_loadu_pd(v[0] + k));
-    s1 = _mm256_add_pd(s1, _mm256_loadu_pd(v[1] + k));
-    s2 = _mm256_add_pd(s2, _mm256_loadu_pd(v[2] + k));
-  }
-  _mm256_storeu_pd(s[0], s0);
-  _mm256_storeu_pd(s[1], s1);
-  _mm256_storeu_pd(s[2], s2);
-  lane_sums_from(v, k, n, s);
-}
-#endif
-
-using LaneSumsFn = void (*)(const double* const*, std::size_t, double (*)[4]);
-constexpr Variants<LaneSumsFn> lane_sums_variants = {lane_sums_scalar, nullptr,
-                                                     GRAVCAL_IF_AVX2(lane_sums_avx2)};
 
 // ---------------------------------------------------------------------------
 // r_scan(x, y, z, m, c, want_w, o): a whole window of m >= 1 samples for
@@ -426,7 +474,7 @@ inline void r_scan_scalar(const double* x, const double* y, const double* z, std
   const double* col[3] = {x, y, z};
   o = RScanOut();
   r_cumsums(x, y, z, 0, m, c, want_w, o);
-  lane_sums_scalar(col, m, o.ls);
+  lane_sums(col, m, o.ls);
   double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
   bool zero = false;
   min_max_tail(col, 0, m, lo, hi, zero);
@@ -592,95 +640,8 @@ constexpr Variants<RScanFn> r_scan_variants = {r_scan_scalar, GRAVCAL_IF_SSE2(r_
                                                GRAVCAL_IF_AVX2(r_scan_avx2)};
 
 // ---------------------------------------------------------------------------
-// sq_dev(v, n, mu, q): the squared deviations (v[a][k] - mu[a])^2 of three
-// columns of n values, summed in four lanes by position into q (set).
-
-inline void sq_dev_tail(const double* const* v, std::size_t k, std::size_t n, const double* mu,
-                        double (*q)[4]) {
-  for (; k < n; ++k) {
-    for (int a = 0; a < 3; ++a) {
-      const double d = v[a][k] - mu[a];
-      q[a][k & 3] += d * d;
-    }
-  }
-}
-
-inline void sq_dev_scalar(const double* const* v, std::size_t n, const double* mu,
-                          double (*q)[4]) {
-  for (int a = 0; a < 3; ++a) {
-    for (int l = 0; l < 4; ++l) q[a][l] = 0.0;
-  }
-  sq_dev_tail(v, 0, n, mu, q);
-}
-
-#if defined(GRAVCAL_SSE2)
-inline void sq_dev_sse2(const double* const* v, std::size_t n, const double* mu,
-                        double (*q)[4]) {
-  const __m128d m0 = _mm_set1_pd(mu[0]), m1 = _mm_set1_pd(mu[1]), m2 = _mm_set1_pd(mu[2]);
-  const __m128d zr = _mm_setzero_pd();
-  __m128d q0a = zr, q0b = zr, q1a = zr, q1b = zr, q2a = zr, q2b = zr;
-  const double* x = v[0];
-  const double* y = v[1];
-  const double* z = v[2];
-  std::size_t k = 0;
-  for (; k + 4 <= n; k += 4) {
-    __m128d d = _mm_sub_pd(_mm_loadu_pd(x + k), m0);
-    q0a = _mm_add_pd(q0a, _mm_mul_pd(d, d));
-    d = _mm_sub_pd(_mm_loadu_pd(x + k + 2), m0);
-    q0b = _mm_add_pd(q0b, _mm_mul_pd(d, d));
-    d = _mm_sub_pd(_mm_loadu_pd(y + k), m1);
-    q1a = _mm_add_pd(q1a, _mm_mul_pd(d, d));
-    d = _mm_sub_pd(_mm_loadu_pd(y + k + 2), m1);
-    q1b = _mm_add_pd(q1b, _mm_mul_pd(d, d));
-    d = _mm_sub_pd(_mm_loadu_pd(z + k), m2);
-    q2a = _mm_add_pd(q2a, _mm_mul_pd(d, d));
-    d = _mm_sub_pd(_mm_loadu_pd(z + k + 2), m2);
-    q2b = _mm_add_pd(q2b, _mm_mul_pd(d, d));
-  }
-  _mm_storeu_pd(q[0], q0a);
-  _mm_storeu_pd(q[0] + 2, q0b);
-  _mm_storeu_pd(q[1], q1a);
-  _mm_storeu_pd(q[1] + 2, q1b);
-  _mm_storeu_pd(q[2], q2a);
-  _mm_storeu_pd(q[2] + 2, q2b);
-  sq_dev_tail(v, k, n, mu, q);
-}
-#endif
-
-#if defined(GRAVCAL_AVX2)
-GRAVCAL_TARGET_AVX2 inline void sq_dev_avx2(const double* const* v, std::size_t n,
-                                            const double* mu, double (*q)[4]) {
-  const __m256d m0 = _mm256_set1_pd(mu[0]), m1 = _mm256_set1_pd(mu[1]), m2 = _mm256_set1_pd(mu[2]);
-  const __m256d zr = _mm256_setzero_pd();
-  __m256d q0 = zr, q1 = zr, q2 = zr;
-  const double* x = v[0];
-  const double* y = v[1];
-  const double* z = v[2];
-  std::size_t k = 0;
-  for (; k + 4 <= n; k += 4) {
-    __m256d d = _mm256_sub_pd(_mm256_loadu_pd(x + k), m0);
-    q0 = _mm256_add_pd(q0, _mm256_mul_pd(d, d));
-    d = _mm256_sub_pd(_mm256_loadu_pd(y + k), m1);
-    q1 = _mm256_add_pd(q1, _mm256_mul_pd(d, d));
-    d = _mm256_sub_pd(_mm256_loadu_pd(z + k), m2);
-    q2 = _mm256_add_pd(q2, _mm256_mul_pd(d, d));
-  }
-  _mm256_storeu_pd(q[0], q0);
-  _mm256_storeu_pd(q[1], q1);
-  _mm256_storeu_pd(q[2], q2);
-  sq_dev_tail(v, k, n, mu, q);
-}
-#endif
-
-using SqDevFn = void (*)(const double* const*, std::size_t, const double*, double (*)[4]);
-constexpr Variants<SqDevFn> sq_dev_variants = {sq_dev_scalar, GRAVCAL_IF_SSE2(sq_dev_sse2),
-                                               GRAVCAL_IF_AVX2(sq_dev_avx2)};
-
-// ---------------------------------------------------------------------------
 // first_zero(x, y, z, n): where the first sample with x = y = z = 0 (an
 // idle-sleep sample) is among n; n if none.
-
-inline bool is_zero3(double x, double y, double z) { return x == 0.0 && y == 0.0 && z == 0.0; }
 
 inline std::size_t first_zero_scalar(const double* x, const double* y, const double* z,
                                      std::size_t n) {
