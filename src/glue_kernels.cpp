@@ -75,7 +75,7 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
     const double* t = Rf_isNull(a["t"]) ? nullptr : col(a, "t");
     if (t != nullptr && len(a, "t") != m) Rcpp::stop("`t` must have the length of `x`");
     return each_variant(k::stream_window_variants, [&](k::StreamWindowFn f) {
-      k::StreamSums o;
+      gravcal::StreamSums o;
       f(x, y, z, t, m, o);
       return Rcpp::List::create(
           Rcpp::_["s"] = lanes12(o.s), Rcpp::_["q"] = lanes12(o.q), Rcpp::_["lo"] = num(o.lo, 3),

@@ -2,7 +2,7 @@
 //
 // r_var_means3(v, n, mean): the three means R's var() subtracts from three
 // columns of n values, or false when they cannot be decided here and R's
-// passes must run (r_sd3(), segmenter.hpp). The scalar reference decides
+// passes must run (r_sd3(), stats_r.hpp). The scalar reference decides
 // none (R's passes are the reference); the AVX2 variant decides most
 // windows at rest, and where it does, its means are R's to the bit.
 //

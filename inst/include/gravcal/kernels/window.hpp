@@ -1,5 +1,5 @@
-// gravcal kernels: the loops over a window's samples (segmenter.hpp) and
-// over a block's (ggir_blocks.hpp).
+// gravcal kernels: the loops over a window's samples (stats_streaming.hpp,
+// stats_r.hpp) and over a block's (ggir_blocks.hpp).
 //
 // Each kernel is a scalar reference (name_scalar) and, beside it, the
 // vector code that stands in for it (name_sse2, name_avx2), with the same
@@ -22,6 +22,8 @@
 #include <cstring>
 
 #include "../simd.hpp"
+#include "../stats_streaming.hpp"
+#include "../window_cutter.hpp"
 
 namespace gravcal {
 namespace kernels {
@@ -65,23 +67,6 @@ constexpr Variants<RunEndFn> run_end_variants = {run_end_scalar, nullptr,
 // ---------------------------------------------------------------------------
 // Shared by the window kernels.
 
-inline bool is_zero3(double x, double y, double z) { return x == 0.0 && y == 0.0 && z == 0.0; }
-
-// A zero minimum (maximum) as the sequential rule (v < lo ? v : lo from the
-// first sample) leaves it: the first zero of the column, with its sign
-// (lanes may have kept the other one). Any other value is the same in any
-// order.
-inline void zero_signs(const double* const* col, std::size_t m, double* lo, double* hi) {
-  for (int a = 0; a < 3; ++a) {
-    if (lo[a] == 0.0 || hi[a] == 0.0) {
-      std::size_t j = 0;
-      while (j < m && col[a][j] != 0.0) ++j;
-      if (j < m && lo[a] == 0.0) lo[a] = col[a][j];
-      if (j < m && hi[a] == 0.0) hi[a] = col[a][j];
-    }
-  }
-}
-
 // min, max and the all-zeros test of samples [k, m), continuing lo, hi,
 // zero (in locals: through the pointers every step would be a store and a
 // load).
@@ -113,119 +98,13 @@ inline void min_max_tail(const double* const* col, std::size_t k, std::size_t m,
 
 // ---------------------------------------------------------------------------
 // stream_window(x, y, z, t, m, o): a whole window of m >= 1 samples in one
-// pass, the streaming arithmetic (Segmenter's default): per axis the sums
-// of d and d^2, d = v - v[0] (the shifted data algorithm), in lanes; the
-// norms' and the temperatures' sums in lanes (t may be null); min, max and
-// whether some sample is all zeros. With a non-finite sample the sums are
-// not finite (the caller's test) and min and max are not defined.
-
-struct StreamSums {
-  double s[3][4] = {}, q[3][4] = {}, lo[3] = {}, hi[3] = {}, nrm[4] = {}, st[4] = {};
-  bool zero = false;
-};
-
-inline void stream_tail(const double* const* col, const double* t, std::size_t k, std::size_t m,
-                        const double* h, StreamSums& o, double* lo, double* hi, bool& zero) {
-  for (; k < m; ++k) {
-    const int l = static_cast<int>(k & 3);
-    const double xi = col[0][k], yi = col[1][k], zi = col[2][k];
-    zero = zero || (xi == 0.0 && yi == 0.0 && zi == 0.0);
-    for (int a = 0; a < 3; ++a) {
-      const double v = col[a][k];
-      const double d = v - h[a];
-      o.s[a][l] += d;
-      o.q[a][l] += d * d;
-      lo[a] = v < lo[a] ? v : lo[a];
-      hi[a] = v > hi[a] ? v : hi[a];
-    }
-    o.nrm[l] += std::sqrt(xi * xi + yi * yi + zi * zi);
-    if (t != nullptr) o.st[l] += t[k];
-  }
-  for (int a = 0; a < 3; ++a) {
-    o.lo[a] = lo[a];
-    o.hi[a] = hi[a];
-  }
-  zero_signs(col, m, o.lo, o.hi);
-  o.zero = zero;
-}
-
-// An axis at a time, then the norms, the temperatures and the zero test,
-// each lane in a local of its own (sums kept in the arrays would wait on
-// their own stores), four samples a step, in the same order as sample by
-// sample.
-inline void stream_window_scalar(const double* x, const double* y, const double* z,
-                                 const double* t, std::size_t m, StreamSums& o) {
-  const double* col[3] = {x, y, z};
-  const std::size_t m4 = m & ~std::size_t(3);
-  o = StreamSums();
-  for (int a = 0; a < 3; ++a) {
-    const double* v = col[a];
-    const double h = v[0];
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, q0 = 0.0, q1 = 0.0, q2 = 0.0, q3 = 0.0;
-    double lo0 = h, lo1 = h, lo2 = h, lo3 = h, hi0 = h, hi1 = h, hi2 = h, hi3 = h;
-    for (std::size_t k = 0; k < m4; k += 4) {
-      const double v0 = v[k], v1 = v[k + 1], v2 = v[k + 2], v3 = v[k + 3];
-      const double d0 = v0 - h, d1 = v1 - h, d2 = v2 - h, d3 = v3 - h;
-      s0 += d0;
-      q0 += d0 * d0;
-      s1 += d1;
-      q1 += d1 * d1;
-      s2 += d2;
-      q2 += d2 * d2;
-      s3 += d3;
-      q3 += d3 * d3;
-      // min and max by lanes too: the same values in any order, but a
-      // zero's sign (zero_signs() in stream_tail())
-      lo0 = v0 < lo0 ? v0 : lo0;
-      lo1 = v1 < lo1 ? v1 : lo1;
-      lo2 = v2 < lo2 ? v2 : lo2;
-      lo3 = v3 < lo3 ? v3 : lo3;
-      hi0 = v0 > hi0 ? v0 : hi0;
-      hi1 = v1 > hi1 ? v1 : hi1;
-      hi2 = v2 > hi2 ? v2 : hi2;
-      hi3 = v3 > hi3 ? v3 : hi3;
-    }
-    const double s4[4] = {s0, s1, s2, s3}, q4[4] = {q0, q1, q2, q3};
-    const double lo4[4] = {lo0, lo1, lo2, lo3}, hi4[4] = {hi0, hi1, hi2, hi3};
-    o.lo[a] = h;
-    o.hi[a] = h;
-    for (int l = 0; l < 4; ++l) {
-      o.s[a][l] = s4[l];
-      o.q[a][l] = q4[l];
-      o.lo[a] = lo4[l] < o.lo[a] ? lo4[l] : o.lo[a];
-      o.hi[a] = hi4[l] > o.hi[a] ? hi4[l] : o.hi[a];
-    }
-  }
-  double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0;
-  for (std::size_t k = 0; k < m4; k += 4) {
-    n0 += std::sqrt(x[k] * x[k] + y[k] * y[k] + z[k] * z[k]);
-    n1 += std::sqrt(x[k + 1] * x[k + 1] + y[k + 1] * y[k + 1] + z[k + 1] * z[k + 1]);
-    n2 += std::sqrt(x[k + 2] * x[k + 2] + y[k + 2] * y[k + 2] + z[k + 2] * z[k + 2]);
-    n3 += std::sqrt(x[k + 3] * x[k + 3] + y[k + 3] * y[k + 3] + z[k + 3] * z[k + 3]);
-  }
-  o.nrm[0] = n0;
-  o.nrm[1] = n1;
-  o.nrm[2] = n2;
-  o.nrm[3] = n3;
-  if (t != nullptr) {
-    double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
-    for (std::size_t k = 0; k < m4; k += 4) {
-      t0 += t[k];
-      t1 += t[k + 1];
-      t2 += t[k + 2];
-      t3 += t[k + 3];
-    }
-    o.st[0] = t0;
-    o.st[1] = t1;
-    o.st[2] = t2;
-    o.st[3] = t3;
-  }
-  bool zero = false;
-  for (std::size_t k = 0; k < m4 && !zero; ++k) zero = is_zero3(x[k], y[k], z[k]);
-  const double h[3] = {x[0], y[0], z[0]};
-  double lo[3] = {o.lo[0], o.lo[1], o.lo[2]}, hi[3] = {o.hi[0], o.hi[1], o.hi[2]};
-  stream_tail(col, t, m4, m, h, o, lo, hi, zero);
-}
+// pass, the streaming arithmetic: per axis the sums of d and d^2, d = v -
+// v[0] (the shifted data algorithm), in lanes; the norms' and the
+// temperatures' sums in lanes (t may be null); min, max and whether some
+// sample is all zeros. With a non-finite sample the sums are not finite
+// (the caller's test) and min and max are not defined. The scalar
+// reference is stream_window() of the microcontroller tier
+// (stats_streaming.hpp).
 
 #if defined(GRAVCAL_SSE2)
 // lanes 0 and 1 (samples k, k + 1) in one register (suffix a), 2 and 3 in
@@ -377,7 +256,7 @@ GRAVCAL_TARGET_AVX2 inline void stream_window_avx2(const double* x, const double
 using StreamWindowFn = void (*)(const double*, const double*, const double*, const double*,
                                 std::size_t, StreamSums&);
 constexpr Variants<StreamWindowFn> stream_window_variants = {
-    stream_window_scalar, GRAVCAL_IF_SSE2(stream_window_sse2), GRAVCAL_IF_AVX2(stream_window_avx2)};
+    stream_window, GRAVCAL_IF_SSE2(stream_window_sse2), GRAVCAL_IF_AVX2(stream_window_avx2)};
 
 // ---------------------------------------------------------------------------
 // lane_sums(v, n, s): the sums of three columns of n values in four lanes
@@ -646,7 +525,7 @@ constexpr Variants<RScanFn> r_scan_variants = {r_scan_scalar, GRAVCAL_IF_SSE2(r_
 inline std::size_t first_zero_scalar(const double* x, const double* y, const double* z,
                                      std::size_t n) {
   std::size_t i = 0;
-  while (i < n && !is_zero3(x[i], y[i], z[i])) ++i;
+  while (i < n && !all_zero(x[i], y[i], z[i])) ++i;
   return i;
 }
 
@@ -664,7 +543,7 @@ inline std::size_t first_zero_sse2(const double* x, const double* y, const doubl
     }
     if (_mm_movemask_pd(any) != 0) break;
   }
-  while (i < n && !is_zero3(x[i], y[i], z[i])) ++i;
+  while (i < n && !all_zero(x[i], y[i], z[i])) ++i;
   return i;
 }
 #endif
@@ -710,7 +589,7 @@ GRAVCAL_TARGET_AVX2 inline std::size_t zero_scan_avx2(const double* x, const dou
 GRAVCAL_TARGET_AVX2 inline std::size_t first_zero_avx2(const double* x, const double* y,
                                                        const double* z, std::size_t n) {
   std::size_t i = zero_scan_avx2(x, y, z, n);
-  while (i < n && !is_zero3(x[i], y[i], z[i])) ++i;
+  while (i < n && !all_zero(x[i], y[i], z[i])) ++i;
   return i;
 }
 #endif
