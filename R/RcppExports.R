@@ -25,20 +25,28 @@ gc_decoder_drain <- function(ptr) {
     .Call(`_gravcal_gc_decoder_drain`, ptr)
 }
 
-gc_set_avx2 <- function(on) {
-    .Call(`_gravcal_gc_set_avx2`, on)
-}
-
-gc_use_avx2 <- function() {
-    .Call(`_gravcal_gc_use_avx2`)
-}
-
 gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace) {
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }
 
 gc_ggir_duplicates <- function(table, rows, need) {
     .Call(`_gravcal_gc_ggir_duplicates`, table, rows, need)
+}
+
+gc_kernel_check <- function(name, args) {
+    .Call(`_gravcal_gc_kernel_check`, name, args)
+}
+
+gc_kernels <- function() {
+    .Call(`_gravcal_gc_kernels`)
+}
+
+gc_set_avx2 <- function(on) {
+    .Call(`_gravcal_gc_set_avx2`, on)
+}
+
+gc_use_avx2 <- function() {
+    .Call(`_gravcal_gc_use_avx2`)
 }
 
 gc_select_points <- function(x, y, z, min_per_bin, max_per_bin, min_distance, arithmetic = "double") {

@@ -11,8 +11,9 @@
 #' (required), `--workers N` (parallel R sessions through
 #' `future::plan(multisession)`; default: the plan already set, else one),
 #' `--sf HZ` (for files that do not give their sampling rate), `--pattern
-#' REGEX` (the recordings taken from a directory), `--no-resume` (redo
-#' recordings already done), `--help`. The other arguments are the
+#' REGEX` (the recordings taken from a directory), `--recursive` (a
+#' directory's subfolders too; recordings are then named by their path
+#' relative to it), `--no-resume` (redo recordings already done), `--help`. The other arguments are the
 #' recordings (or one directory).
 #'
 #' It prints a summary line, `gravcal: N recording(s): a calibrated, b not
@@ -61,6 +62,7 @@ cli_help <- function() {
     "  --workers N      parallel R sessions (future's multisession plan)",
     "  --sf HZ          sampling rate, for files that do not give it",
     "  --pattern REGEX  for a directory: the file names to take",
+    "  --recursive      for a directory: its subfolders too",
     "  --no-resume      redo recordings already done in DIR",
     "  --help           this text",
     "",
@@ -91,6 +93,7 @@ cli_run <- function(args) {
     old <- future::plan(future::multisession, workers = w)
     on.exit(future::plan(old), add = TRUE)
   }
+  if (opt$recursive) extra$recursive <- TRUE
   tab <- do.call(calibrate_files, c(list(files = opt$files, method = opt$method,
                                          outdir = opt$out, resume = opt$resume),
                                     extra))
@@ -104,7 +107,7 @@ cli_run <- function(args) {
 }
 
 cli_parse <- function(args) {
-  opt <- list(method = "ggir", resume = TRUE)
+  opt <- list(method = "ggir", resume = TRUE, recursive = FALSE)
   files <- character(0)
   given <- character(0)
   takes <- c("--method", "--out", "--workers", "--sf", "--pattern")
@@ -122,6 +125,9 @@ cli_parse <- function(args) {
       i <- i + 2
     } else if (a == "--no-resume") {
       opt$resume <- FALSE
+      i <- i + 1
+    } else if (a == "--recursive") {
+      opt$recursive <- TRUE
       i <- i + 1
     } else if (startsWith(a, "-") && a != "-") {
       abort("Unknown option `", a, "`; see --help.")

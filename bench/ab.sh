@@ -5,7 +5,10 @@
 #
 #   bash bench/ab.sh <lib A> <lib B> <runs> <contender> <file>...
 #
-# <lib A>, <lib B>: R libraries holding the two builds (R CMD INSTALL -l).
+# <lib A>, <lib B>: R libraries holding the two builds (R CMD INSTALL -l);
+# they may be the same library, with AB_ENV_A / AB_ENV_B set to what each
+# side's process gets in its environment (for one build with a kernel
+# forced to its scalar reference: AB_ENV_B="GRAVCAL_KERNELS=r_scan=scalar").
 # Prints, per file, the median CPU seconds of each and B's time over A's,
 # and whether the two gave the same coefficients (exact hexadecimal).
 set -euo pipefail
@@ -16,8 +19,8 @@ printf "| file | A (s) | B (s) | B / A | same coefficients |\n|---|---|---|---|-
 for f in "$@"; do
   ta=(); tb=(); ca=""; cb=""
   for ((i = 0; i < runs; i++)); do
-    la=$(R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
-    lb=$(R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
+    la=$(env ${AB_ENV_A:-} R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
+    lb=$(env ${AB_ENV_B:-} R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
     ta+=("$(cut -f 8 <<< "$la")"); tb+=("$(cut -f 8 <<< "$lb")")
     ca=$(cut -f 6 <<< "$la"); cb=$(cut -f 6 <<< "$lb")
   done

@@ -78,25 +78,6 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_set_avx2
-bool gc_set_avx2(bool on);
-RcppExport SEXP _gravcal_gc_set_avx2(SEXP onSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< bool >::type on(onSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_set_avx2(on));
-    return rcpp_result_gen;
-END_RCPP
-}
-// gc_use_avx2
-bool gc_use_avx2();
-RcppExport SEXP _gravcal_gc_use_avx2() {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    rcpp_result_gen = Rcpp::wrap(gc_use_avx2());
-    return rcpp_result_gen;
-END_RCPP
-}
 // gc_fit_icp
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
 RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
@@ -125,6 +106,45 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type rows(rowsSEXP);
     Rcpp::traits::input_parameter< int >::type need(needSEXP);
     rcpp_result_gen = Rcpp::wrap(gc_ggir_duplicates(table, rows, need));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_kernel_check
+Rcpp::List gc_kernel_check(const std::string& name, const Rcpp::List& args);
+RcppExport SEXP _gravcal_gc_kernel_check(SEXP nameSEXP, SEXP argsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const std::string& >::type name(nameSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type args(argsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_kernel_check(name, args));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_kernels
+Rcpp::CharacterVector gc_kernels();
+RcppExport SEXP _gravcal_gc_kernels() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(gc_kernels());
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_set_avx2
+bool gc_set_avx2(bool on);
+RcppExport SEXP _gravcal_gc_set_avx2(SEXP onSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< bool >::type on(onSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_set_avx2(on));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_use_avx2
+bool gc_use_avx2();
+RcppExport SEXP _gravcal_gc_use_avx2() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(gc_use_avx2());
     return rcpp_result_gen;
 END_RCPP
 }
@@ -253,10 +273,12 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
-    {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},
-    {"_gravcal_gc_use_avx2", (DL_FUNC) &_gravcal_gc_use_avx2, 0},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
+    {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},
+    {"_gravcal_gc_kernels", (DL_FUNC) &_gravcal_gc_kernels, 0},
+    {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},
+    {"_gravcal_gc_use_avx2", (DL_FUNC) &_gravcal_gc_use_avx2, 0},
     {"_gravcal_gc_select_points", (DL_FUNC) &_gravcal_gc_select_points, 7},
     {"_gravcal_gc_fit_gradient", (DL_FUNC) &_gravcal_gc_fit_gradient, 13},
     {"_gravcal_gc_read_once", (DL_FUNC) &_gravcal_gc_read_once, 1},

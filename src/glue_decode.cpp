@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "gravcal/decode.hpp"
-#include "gravcal/simd.hpp"
 #include "decoders.h"
 #include "sources_glue.h"
 
@@ -179,18 +178,4 @@ double gc_decoder_drain(SEXP ptr) {
     if ((++rounds & 31) == 0) Rcpp::checkUserInterrupt();
   }
   return samples;
-}
-
-// Turns the core's AVX2 paths off (false) or back on where the processor has
-// them (true), for the tests that compare them with the baseline paths;
-// returns whether they now run.
-// [[Rcpp::export(rng = false)]]
-bool gc_set_avx2(bool on) {
-  return gravcal::set_avx2(on);
-}
-
-// Whether the core's AVX2 paths run in this process.
-// [[Rcpp::export(rng = false)]]
-bool gc_use_avx2() {
-  return gravcal::use_avx2();
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gravcal/gravcal.hpp"
+#include "gravcal/segmenter.hpp"
 #include "gravcal/ggir_blocks.hpp"
 
 namespace gravcal_glue {

@@ -8,9 +8,16 @@
 // 16-bit fixed point with the analytic gradient (what a device without
 // 32-bit multiplies would run), and applied to later samples. Everything is
 // static: no malloc, no new (the Makefile checks the linked image for them).
+// Only the microcontroller tier of the core: the window cutter with the
+// streaming statistics, the bins, the gradient fit, fixed point.
 #include <cstdint>
 
-#include "gravcal/gravcal.hpp"
+#include "gravcal/bins.hpp"
+#include "gravcal/fixed_point.hpp"
+#include "gravcal/gradient.hpp"
+#include "gravcal/model.hpp"
+#include "gravcal/stats_streaming.hpp"
+#include "gravcal/window_cutter.hpp"
 
 namespace {
 
@@ -21,7 +28,7 @@ constexpr double kMaxRange = 0.12;   // g
 using Num = gravcal::fixed32;
 using Num16 = gravcal::fixed16;
 
-gravcal::Segmenter segmenter(kRate * kWindowSeconds, true);
+gravcal::StreamSegmenter segmenter(kRate * kWindowSeconds, true);
 gravcal::BinSelector<Num, 18> bins{gravcal::BinConfig{}};
 Num params[gravcal::NPARAM];
 Num16 params16[gravcal::NPARAM];

@@ -22,6 +22,7 @@
 #include "gravcal/decode_geneactiv.hpp"
 #include "gravcal/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
+#include "gravcal/segmenter.hpp"
 #include "gravcal/icp.hpp"
 
 static int failures = 0;
@@ -332,7 +333,7 @@ static void test_r_var_mean() {
     }
     double m = 0;
     ++tried;
-    const bool ok = gravcal::r_var_mean_avx2(x.data(), n, &m);
+    const bool ok = gravcal::kernels::r_var_mean_avx2(x.data(), n, &m);
     if (kind <= 1 && sd <= 0x1p-7 && n >= 100) {
       ++ordinary;
       ordinary_decided += ok;
@@ -354,10 +355,10 @@ static void test_r_var_mean() {
   double m = 0;
   const double bad[4] = {1.0, NAN, 1.0, 1.0}, inf[4] = {1.0, INFINITY, 1.0, 1.0};
   const double one[1] = {1.0}, zero[4] = {0.0, 0.0, 0.0, 0.0};
-  CHECK(!gravcal::r_var_mean_avx2(bad, 4, &m));
-  CHECK(!gravcal::r_var_mean_avx2(inf, 4, &m));
-  CHECK(!gravcal::r_var_mean_avx2(one, 1, &m));
-  CHECK(!gravcal::r_var_mean_avx2(zero, 4, &m));
+  CHECK(!gravcal::kernels::r_var_mean_avx2(bad, 4, &m));
+  CHECK(!gravcal::kernels::r_var_mean_avx2(inf, 4, &m));
+  CHECK(!gravcal::kernels::r_var_mean_avx2(one, 1, &m));
+  CHECK(!gravcal::kernels::r_var_mean_avx2(zero, 4, &m));
 #endif
 }
 
@@ -699,7 +700,7 @@ static void test_hex16() {
       unsigned char s[16], v[16];
       for (int k = 0; k < 16; ++k) s[k] = static_cast<unsigned char>("0123456789abcDEF"[k]);
       s[pos] = static_cast<unsigned char>(c);
-      const int bad = gravcal::geneactiv::hex16(s, v);
+      const int bad = gravcal::kernels::hex16(s, v);
       for (int k = 0; k < 16; ++k) {
         const bool digit = h[s[k]] < 16;
         ok = ok && (((bad >> k) & 1) == !digit) && (!digit || v[k] == h[s[k]]);

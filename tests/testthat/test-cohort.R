@@ -285,6 +285,22 @@ test_that("a folder with subfolders: identities relative to it, output folders l
                "`recursive` must be TRUE or FALSE")
 })
 
+test_that("calibrate_cli() --recursive takes a folder's subfolders", {
+  dir <- nested_cohort(c("p00.rds", "a/p01.rds", "a/deep/p02.rds"))
+  on.exit(unlink(dir, recursive = TRUE))
+  cli <- function(...) {
+    suppressMessages(calibrate_cli(c("--method", "lightweight", ...), quit = FALSE))
+  }
+  expect_identical(cli("--out", file.path(dir, "o1"), dir)$file, "p00.rds")
+  tab <- cli("--recursive", "--out", file.path(dir, "o2"), dir)
+  expect_identical(tab$file, c("a/deep/p02.rds", "a/p01.rds", "p00.rds"))
+  direct <- calibrate_files(dir, method = "lightweight", outdir = file.path(dir, "o3"),
+                            recursive = TRUE)
+  expect_identical(strip_run(tab), strip_run(direct))
+  help <- utils::capture.output(calibrate_cli("--help", quit = FALSE))
+  expect_true(any(grepl("--recursive", help, fixed = TRUE)))
+})
+
 test_that("an interrupted run of recordings in subfolders resumes", {
   skip_on_os("windows")  # fork
   dir <- nested_cohort(c("a/p01.rds", "b/p01.rds", "c/p02.rds"))

@@ -132,3 +132,242 @@ test_that("windows and fits are the same bits with and without AVX2", {
   expect_identical(coef(r$avx2$gg), coef(r$baseline$gg))
   expect_gt(nrow(r$avx2$g$spheredata), 100)
 })
+
+# ---------------------------------------------------------------------------
+# Each vector kernel (inst/include/gravcal/kernels/) against its scalar
+# reference: gc_kernel_check() runs every variant compiled in (and, for AVX2,
+# runnable here) on the same input, and each must give the reference's bits
+# (identical() with num.eq = FALSE: -0 is not 0; every NaN that is not NA is
+# one value), on random input and on adversarial input: NaN, +-0, +-Inf,
+# denormals, huge and tiny values, exact midpoints between doubles, and every
+# length from 0 (or 1) to 33, so that every loop's tail is met.
+
+kernel_variants <- function(name, args) {
+  out <- gc_kernel_check(name, args)
+  if (length(out) < 2) skip(paste0("no vector variant of ", name, " runs here"))
+  out
+}
+
+# The cases where a variant's outputs (after `view`) differ from the scalar
+# reference's, as labels; character(0) when none does.
+kernel_diffs <- function(name, cases, view = function(o, a) o) {
+  bad <- character(0)
+  for (i in seq_along(cases)) {
+    out <- kernel_variants(name, cases[[i]])
+    ref <- view(out$scalar, cases[[i]])
+    for (v in setdiff(names(out), "scalar")) {
+      if (!identical(view(out[[v]], cases[[i]]), ref, num.eq = FALSE)) {
+        bad <- c(bad, paste0(v, " case ", i, " (", names(cases)[i], ")"))
+      }
+    }
+  }
+  bad
+}
+
+# Values that stress a kernel's arithmetic and comparisons.
+tricky <- c(NaN, 0, -0, Inf, -Inf, 4.9e-324, -4.9e-324, 2.2250738585072014e-308,
+            1e-310, -1e-310, .Machine$double.xmax, -.Machine$double.xmax, 1e300, -1e300,
+            1e-300, 1, 1 + 2^-52, 1 - 2^-53, 2^-53, 2^53, 2^53 + 2, 0.5, 1.5, -1.5, 3)
+
+# n values: ordinary samples (about a gravity component), or drawn from
+# `tricky` and ordinary ones; finite = TRUE leaves out NaN and +-Inf.
+kernel_values <- function(n, kind, finite = FALSE) {
+  pool <- if (finite) tricky[is.finite(tricky)] else tricky
+  v <- switch(kind,
+    ordinary = 0.6 + 0.01 * stats::rnorm(n),
+    tricky = ifelse(stats::runif(n) < 0.5, sample(pool, n, replace = TRUE),
+                    0.6 + 0.01 * stats::rnorm(n)),
+    # the mean of d and the next double is a midpoint; zeros of both signs
+    midpoint = sample(c(1, 1 + 2^-52, 0, -0), n, replace = TRUE),
+    wide = stats::rnorm(n) * 10^sample(-300:300, n, replace = TRUE))
+  as.double(v)
+}
+
+# Three columns of every length 0 (or `from`) to 33, of every kind.
+column_cases <- function(from = 0, finite = FALSE, kinds = c("ordinary", "tricky", "midpoint", "wide")) {
+  cases <- list()
+  for (kind in kinds) {
+    for (n in from:33) {
+      cases[[paste(kind, n)]] <- list(x = kernel_values(n, kind, finite),
+                                      y = kernel_values(n, kind, finite),
+                                      z = kernel_values(n, kind, finite))
+    }
+  }
+  cases
+}
+
+test_that("run_end: every variant finds the run's end of the reference", {
+  set.seed(1)
+  cases <- list()
+  for (n in 1:33) {
+    for (rep in 1:4) {
+      v <- sample(c(0, -0, NaN, 1, 1 + 2^-52), 1)
+      x <- rep(v, n)
+      if (rep > 1) x[sample(n, rep - 1, replace = TRUE)] <- sample(tricky, rep - 1)
+      cases[[paste(n, rep)]] <- list(v = x, i = sample(n, 1) - 1)
+    }
+  }
+  expect_identical(kernel_diffs("run_end", cases), character(0))
+})
+
+test_that("stream_window: the streaming sums, min, max and zero test of the reference", {
+  set.seed(2)
+  finite <- column_cases(from = 1, finite = TRUE)
+  with_t <- lapply(finite, function(a) c(a, list(t = 20 + stats::rnorm(length(a$x)))))
+  without_t <- lapply(finite, function(a) c(a, list(t = NULL)))
+  expect_identical(kernel_diffs("stream_window", c(with_t, without_t)), character(0))
+  # with a non-finite sample only the sums' finiteness is promised (the
+  # segmenter then takes the window sample by sample)
+  any_nonfinite <- lapply(column_cases(from = 1, kinds = "tricky"),
+                          function(a) c(a, list(t = NULL)))
+  sums_finite <- function(o, a) all(is.finite(c(o$s, o$q, o$nrm)))
+  expect_identical(kernel_diffs("stream_window", any_nonfinite, sums_finite), character(0))
+})
+
+test_that("r_scan: R's running sums, min, max, zero test and lanes of the reference", {
+  set.seed(3)
+  cases <- list()
+  for (want_w in c(TRUE, FALSE)) {
+    cs <- column_cases(from = 1, finite = TRUE)
+    names(cs) <- paste(names(cs), want_w)
+    cases <- c(cases, lapply(cs, function(a) {
+      c(a, list(c = c(stats::rnorm(3) * 1e4, 1e5 * stats::runif(1)), want_w = want_w))
+    }))
+  }
+  expect_identical(kernel_diffs("r_scan", cases), character(0))
+  # the long double sums themselves, on a week-like window of 500 samples
+  big <- list(x = 0.6 + 0.01 * stats::rnorm(500), y = -0.2 + 0.01 * stats::rnorm(500),
+              z = 0.7 + 0.01 * stats::rnorm(500), c = c(1234.5, -321.25, 777, 9999),
+              want_w = FALSE)
+  expect_identical(kernel_diffs("r_scan", list(big = big)), character(0))
+  nonfinite <- lapply(column_cases(from = 1, kinds = "tricky"),
+                      function(a) c(a, list(c = c(0, 0, 0, 0), want_w = FALSE)))
+  sums_finite <- function(o, a) all(is.finite(o$c_double))
+  expect_identical(kernel_diffs("r_scan", nonfinite, sums_finite), character(0))
+})
+
+test_that("r_var_means3: the means it decides are R's (mean())", {
+  set.seed(5)
+  cases <- column_cases()
+  # windows of a sensor at rest, where it must decide most
+  for (i in 1:50) {
+    n <- sample(50:600, 1)
+    cases[[paste("rest", i)]] <- list(x = 0.6 + 0.003 * stats::rnorm(n),
+                                      y = -0.1 + 0.003 * stats::rnorm(n),
+                                      z = 0.8 + 0.003 * stats::rnorm(n))
+  }
+  # where R's own rounding matters (as tests/cpp/test_core.cpp's
+  # test_r_var_mean()): the exact mean half-way between two doubles or next
+  # to one, values crossing zero, a wide spread about a small mean
+  after <- function(d) d + 2^(floor(log2(abs(d))) - 52)
+  for (i in 1:300) {
+    n <- sample(2:1500, 1)
+    centre <- (0.5 + stats::runif(1)) * 2^sample(-8:3, 1)
+    col <- function() {
+      switch(i %% 4 + 1,
+        rep(c(centre, after(centre)), length.out = n),
+        { v <- rep(c(centre, after(centre)), length.out = n); k <- sample(n, 1); v[k] <- after(v[k]); v },
+        2^-sample(3:30, 1) * stats::rnorm(n),
+        centre + 300 * centre * stats::rnorm(n))
+    }
+    cases[[paste("rounding", i)]] <- list(x = col(), y = col(), z = col())
+  }
+  decided <- 0
+  wrong <- character(0)
+  for (i in seq_along(cases)) {
+    a <- cases[[i]]
+    out <- kernel_variants("r_var_means3", a)
+    expect_false(out$scalar$decided)  # the reference leaves every mean to R's passes
+    for (v in setdiff(names(out), "scalar")) {
+      if (!out[[v]]$decided) next
+      decided <- decided + 1
+      r <- c(mean(a$x), mean(a$y), mean(a$z))
+      if (!identical(out[[v]]$mean, r, num.eq = FALSE)) wrong <- c(wrong, names(cases)[i])
+    }
+  }
+  expect_identical(wrong, character(0))
+  expect_gt(decided, 40)
+})
+
+test_that("first_zero: the first idle-sleep sample of the reference", {
+  set.seed(6)
+  cases <- column_cases()
+  for (n in 0:40) {  # zeros of both signs on some axes, all zeros somewhere
+    zeros <- function() as.double(sample(c(0, -0, 1), n, replace = TRUE))
+    cases[[paste("zeros", n)]] <- list(x = zeros(), y = zeros(),
+                                       z = as.double(ifelse(stats::runif(n) < 0.9, 1, -0)))
+  }
+  expect_identical(kernel_diffs("first_zero", cases), character(0))
+})
+
+test_that(".cwa kernels: checksum, packed samples, sample times and resampling", {
+  set.seed(7)
+  sums <- lapply(0:16, function(k) list(bytes = as.raw(sample(0:255, 32 * k, replace = TRUE))))
+  sums$ones <- list(bytes = as.raw(rep(255, 512)))
+  expect_identical(kernel_diffs("word_sum", sums), character(0))
+  packed <- list()
+  for (n in 0:33) {
+    for (scale in c(2^-8, 2^-15, 1, 2^-1074, 2^1019)) {
+      b <- as.raw(sample(0:255, 4 * n, replace = TRUE))
+      if (n > 0) b[4 * seq_len(n) - sample(0:3, n, replace = TRUE)] <- as.raw(sample(c(0, 255, 0x80, 0x7f, 0xc0), n, replace = TRUE))
+      packed[[paste(n, scale)]] <- list(bytes = b, scale = scale)
+    }
+  }
+  expect_identical(kernel_diffs("scale_packed", packed), character(0))
+  times <- list()
+  for (len in 1:33) {
+    times[[paste(len)]] <- list(len = len, start = 1.7e9 + stats::runif(1),
+                                spacing = 0.01 * stats::runif(1))
+    times[[paste(len, "tricky")]] <- list(len = len, start = sample(tricky, 1),
+                                          spacing = sample(tricky, 1))
+  }
+  expect_identical(kernel_diffs("span_times", times), character(0))
+  interp <- list()
+  for (len in 1:33) {
+    for (kind in c("regular", "jitter", "tricky")) {
+      tm <- 1.7e9 + cumsum(c(0, rep(0.01, len)))
+      if (kind == "jitter") tm <- tm + c(0, stats::runif(len, -0.004, 0.004))
+      if (kind == "tricky" && len > 1) tm[sample(len + 1, 2)] <- sample(c(NaN, tm[1], -Inf, 2e9), 2)
+      vals <- function() if (kind == "tricky") kernel_values(len + 1, "tricky") else kernel_values(len + 1, "ordinary")
+      step <- 0.01 * (1 + sample(c(0, 0, 1e-9, -0.05, 0.3), 1))
+      pos <- sample(0:3, 1)
+      interp[[paste(len, kind)]] <- list(
+        time = tm, x = vals(), y = vals(), z = vals(), start = tm[1] - 0.001 - pos * step,
+        step = step, end = tm[1] + sample(c(1e9, 0.01 * len / 2), 1), temp = 25.5, pos = pos,
+        stop = pos + sample(0:40, 1), source = sample(len, 1))
+    }
+  }
+  expect_identical(kernel_diffs("cwa_interp", interp), character(0))
+})
+
+test_that("GENEActiv kernel: the hex digits' counts and checks of the reference", {
+  set.seed(8)
+  digits <- charToRaw("0123456789ABCDEFabcdef")
+  others <- as.raw(c(0:47, 58:64, 71:96, 103:255))
+  cases <- list()
+  for (k in 0:33) {
+    for (kind in c("valid", "one bad", "many bad")) {
+      b <- sample(digits, 12 * k, replace = TRUE)
+      nbad <- switch(kind, valid = 0, "one bad" = 1, "many bad" = k)
+      if (k > 0 && nbad > 0) b[sample(12 * k, nbad)] <- sample(others, nbad, replace = TRUE)
+      cases[[paste(k, kind)]] <- list(bytes = b)
+    }
+  }
+  expect_identical(kernel_diffs("hex_counts", cases), character(0))
+  # the checks are met: a bad digit anywhere in a sample's 12 is found
+  expect_true(gc_kernel_check("hex_counts", cases[["5 one bad"]])$scalar$bad)
+})
+
+test_that("the kernel table holds one variant per kernel, chosen once", {
+  k <- gc_kernels()
+  expect_true(all(k %in% c("scalar", "sse2", "avx2")))
+  expect_setequal(names(k), c("run_end", "stream_window", "r_scan", "r_var_means3",
+                              "first_zero", "word_sum", "scale_packed", "span_times",
+                              "cwa_interp", "hex_counts"))
+  # GRAVCAL_KERNELS forces a kernel to its scalar reference in a new process
+  skip_if_no_avx2()
+  out <- system2(file.path(R.home("bin"), "Rscript"),
+                 c("-e", shQuote("k <- gravcal:::gc_kernels(); cat(k[['r_scan']], k[['run_end']])")),
+                 stdout = TRUE, stderr = FALSE, env = "GRAVCAL_KERNELS=r_scan=scalar")
+  expect_identical(utils::tail(out, 1), "scalar avx2")
+})

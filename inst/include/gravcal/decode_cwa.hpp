@@ -67,13 +67,7 @@
 #include <string>
 
 #include "gravcal/decode.hpp"
-#include "gravcal/simd.hpp"
-
-// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
-#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
-#define GRAVCAL_SSE2 1
-#include <emmintrin.h>
-#endif
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 
@@ -141,26 +135,8 @@ inline double rate_frequency(int rate) {
   return 3200.0 / static_cast<double>(1u << (15 - (rate & 15)));
 }
 
-// The sum of a block's 256 little-endian 16-bit words, modulo 2^16 (eight
-// lanes of 16 bits with SSE2: the sum wraps the same way).
-inline unsigned word_sum(const unsigned char* b) {
-#if defined(GRAVCAL_SSE2) && (defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
-  __m128i a = _mm_setzero_si128(), c = a;
-  for (std::size_t i = 0; i < block_bytes; i += 32) {
-    a = _mm_add_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i)));
-    c = _mm_add_epi16(c, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i + 16)));
-  }
-  alignas(16) std::uint16_t w[8];
-  _mm_store_si128(reinterpret_cast<__m128i*>(w), _mm_add_epi16(a, c));
-  unsigned sum = 0;
-  for (int l = 0; l < 8; ++l) sum += w[l];
-  return sum & 0xffffu;
-#else
-  unsigned sum = 0;
-  for (std::size_t i = 0; i < block_bytes; i += 2) sum += le16(b + i);
-  return sum & 0xffffu;
-#endif
-}
+// The sum of a block's 256 little-endian 16-bit words, modulo 2^16.
+inline unsigned word_sum(const unsigned char* b) { return kernels::active().word_sum(b, block_bytes); }
 
 // Checks a block and reads its header fields (GGIRread's order: checksum
 // first, unless the rate byte is 0, then the "AX" tag and length).
@@ -219,79 +195,15 @@ inline double block_start(double T, const Header& h, const Params& p) {
   return T + frac / 65536.0 + (-shift / f);
 }
 
-inline int signed10(std::uint32_t v) {
-  return static_cast<int>((v & 0x3ffu) ^ 0x200u) - 0x200;
-}
+using kernels::signed10;
 
-// Samples [from, from + n) of the block, in g,
-// into three columns: packed ones four at a time with SSE2 (the same
-// integer and the same product per value, so the same doubles).
-#if defined(GRAVCAL_AVX2)
-// scale_columns()'s packed samples eight at a time: signed10(v) << e, an
-// exact integer, times packed_scale is signed10(v) times 2^e packed_scale
-// (both products exact scalings of the same value), so the same doubles.
-// Returns the samples done (a multiple of 8).
-GRAVCAL_TARGET_AVX2 inline int scale_packed_avx2(const unsigned char* d, double packed_scale,
-                                                 int n, double* x, double* y, double* z) {
-  const __m256i m10 = _mm256_set1_epi32(0x3ff), sign = _mm256_set1_epi32(0x200);
-  const __m256d ps = _mm256_set1_pd(packed_scale);
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d + 4 * i));
-    const __m256i e = _mm256_srli_epi32(w, 30);
-    // the three axes written out (an array of the column pointers ends up
-    // on the stack)
-#define GRAVCAL_CWA_AXIS(U, OUT)                                                            \
-  {                                                                                       \
-    const __m256i v = _mm256_sllv_epi32(                                                  \
-        _mm256_sub_epi32(_mm256_xor_si256(_mm256_and_si256(U, m10), sign), sign), e);     \
-    _mm256_storeu_pd(OUT, _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(v)), ps)); \
-    _mm256_storeu_pd(OUT + 4,                                                             \
-                     _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(v, 1)), ps)); \
-  }
-    GRAVCAL_CWA_AXIS(w, x + i)
-    GRAVCAL_CWA_AXIS(_mm256_srli_epi32(w, 10), y + i)
-    GRAVCAL_CWA_AXIS(_mm256_srli_epi32(w, 20), z + i)
-#undef GRAVCAL_CWA_AXIS
-  }
-  return i;
-}
-#endif
-
+// Samples [from, from + n) of the block, in g, into three columns.
 inline void scale_columns(const unsigned char* b, const Header& h, const Params& p,
                           double packed_scale, int from, int n, double* x, double* y,
                           double* z) {
   const unsigned char* d = b + data_offset;
   if (h.packed) {
-    const double f[4] = {packed_scale, 2 * packed_scale, 4 * packed_scale, 8 * packed_scale};
-    int i = 0;
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) i = scale_packed_avx2(d + 4 * from, packed_scale, n, x, y, z);
-#endif
-#if defined(GRAVCAL_SSE2)
-    const __m128i m10 = _mm_set1_epi32(0x3ff), sign = _mm_set1_epi32(0x200);
-    for (; i + 4 <= n; i += 4) {
-      const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + 4 * (from + i)));
-      alignas(16) std::int32_t e[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(e), _mm_srli_epi32(w, 30));
-      const __m128d m01 = _mm_set_pd(f[e[1]], f[e[0]]), m23 = _mm_set_pd(f[e[3]], f[e[2]]);
-      double* col[3] = {x + i, y + i, z + i};
-      for (int a = 0; a < 3; ++a) {
-        // signed10(v >> 10 a), four at a time
-        const __m128i u = a == 0 ? w : _mm_srli_epi32(w, 10 * a);
-        const __m128i v = _mm_sub_epi32(_mm_xor_si128(_mm_and_si128(u, m10), sign), sign);
-        _mm_storeu_pd(col[a], _mm_mul_pd(_mm_cvtepi32_pd(v), m01));
-        _mm_storeu_pd(col[a] + 2, _mm_mul_pd(_mm_cvtepi32_pd(_mm_shuffle_epi32(v, 0xee)), m23));
-      }
-    }
-#endif
-    for (; i < n; ++i) {
-      const std::uint32_t v = le32(d + 4 * (from + i));
-      const double m = f[v >> 30];
-      x[i] = signed10(v) * m;
-      y[i] = signed10(v >> 10) * m;
-      z[i] = signed10(v >> 20) * m;
-    }
+    kernels::active().scale_packed(d + 4 * from, packed_scale, n, x, y, z);
     return;
   }
   const int acc = p.axes == 6 ? 3 : 0;
@@ -356,13 +268,6 @@ class CwaDecoder : public Decoder {
   void begin_span(double next_time, bool alone, bool final_block, bool seq_break);
   bool emit_span(SampleBuffer& out);
   double grid(std::int64_t k) const;
-#if defined(GRAVCAL_AVX2)
-  std::int64_t emit_avx2(std::int64_t pos, std::int64_t end_pos, int& source, int len,
-                         double lim, double temp, const double (*xyz)[cwa::max_samples + 1],
-                         double* ox, double* oy, double* oz, double* ot, double* otime,
-                         double* a, double& at) const;
-  static void span_times_avx2(double* dst, int len, double start, double spacing);
-#endif
 
   ByteSource& src_;
   bool compat_;
@@ -848,17 +753,7 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   const int len = prev_len_;
   const double spacing = alone ? 1.0 / p.frequency : (next_time - prev_start_) / len;
   raw_t_[1] = prev_start_;
-  int from = 1;
-#if defined(GRAVCAL_AVX2)
-  if (use_avx2()) {
-    span_times_avx2(raw_t_, len, prev_start_, spacing);
-    from = len;
-  }
-#endif
-  for (int i = from; i < len; ++i) {
-    volatile double elapsed = i * spacing;  // rounded before the addition, as R's seq()
-    raw_t_[i + 1] = prev_start_ + elapsed;
-  }
+  kernels::active().span_times(raw_t_, len, prev_start_, spacing);  // as R's seq()
   raw_t_[len + 1] = next_time;
   if (first_iter_) {
     for (int a = 0; a < 3; ++a) anchor_[a] = ianchor_[a] = p.xyz[a][1];
@@ -906,209 +801,60 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   span_open_ = true;
 }
 
-#if defined(GRAVCAL_AVX2)
-// begin_span()'s sample times raw_t_[i + 1] = start + i * spacing, i = 1 ..
-// len - 1, four at a time: the product rounded, then the sum (no fused
-// multiply-add), as the scalar loop.
-GRAVCAL_TARGET_AVX2 inline void CwaDecoder::span_times_avx2(double* dst, int len, double start,
-                                                            double spacing) {
-  const __m256d st = _mm256_set1_pd(start), sp = _mm256_set1_pd(spacing);
-  const __m256d step = _mm256_setr_pd(0, 1, 2, 3);
-  int i = 1;
-  for (; i + 4 <= len; i += 4) {
-    const __m256d iv = _mm256_add_pd(_mm256_set1_pd(static_cast<double>(i)), step);
-    _mm256_storeu_pd(dst + i + 1, _mm256_add_pd(st, _mm256_mul_pd(iv, sp)));
-  }
-  for (; i < len; ++i) {
-    const __m128d e = _mm_mul_sd(_mm_set_sd(static_cast<double>(i)), _mm_set_sd(spacing));
-    _mm_store_sd(dst + i + 1, _mm_add_sd(_mm_set_sd(start), e));
-  }
-}
-
-// Grid points pos, pos + 1, ... (before end_pos) of a span that is not
-// imputed, four at a time while they lie in consecutive intervals (the usual
-// case: grid and samples at the same rate): their times as grid(), the
-// intervals as emit_span()'s search, the weights and values with
-// emit_span()'s operations, four lanes at a time. Stops, with nothing of
-// the four written, at four of which any is otherwise (past the span's end,
-// in the same or a skipped interval), so that emit_span() takes the next
-// one alone. Returns how many it wrote (a multiple of 4); source, a (the
-// last values) and at (the last time) follow.
-GRAVCAL_TARGET_AVX2 inline std::int64_t CwaDecoder::emit_avx2(
-    std::int64_t pos, std::int64_t end_pos, int& source, int len, double lim, double temp,
-    const double (*xyz)[cwa::max_samples + 1], double* ox, double* oy, double* oz, double* ot,
-    double* otime, double* a, double& at) const {
-  const __m256d start = _mm256_set1_pd(start_ts_), step = _mm256_set1_pd(step_),
-                end = _mm256_set1_pd(end_ts_), limit = _mm256_set1_pd(lim),
-                lanes = _mm256_setr_pd(0, 1, 2, 3), tv = _mm256_set1_pd(temp);
-  const std::int64_t pos0 = pos;
-  int s = source;
-  const double* X = xyz[0];
-  const double* Y = xyz[1];
-  const double* Z = xyz[2];
-  __m256d lx = _mm256_setzero_pd(), ly = lx, lz = lx, t = lx;
-  for (; pos + 4 <= end_pos; pos += 4) {
-    const __m256d pv = _mm256_add_pd(_mm256_set1_pd(static_cast<double>(pos)), lanes);
-    __m256d u = _mm256_add_pd(start, _mm256_mul_pd(pv, step));
-    u = _mm256_min_pd(u, end);  // u < end ? u : end
-    if (_mm256_movemask_pd(_mm256_cmp_pd(u, limit, _CMP_LE_OQ)) != 0xf) break;
-    // point j in (raw_t_[k + j - 1], raw_t_[k + j]]. Usually the search
-    // from s moves exactly one on (k = s + 1): raw_t_[s] < u0 <=
-    // raw_t_[s + 1], which is lane 0 of the checks below, so the guess is
-    // taken when all eight hold; otherwise the search runs as emit_span()'s
-    int k = s + 1;
-    __m256d T1, T0;
-    bool fits = k + 3 <= len;
-    if (fits) {
-      T1 = _mm256_loadu_pd(raw_t_ + k);
-      T0 = _mm256_loadu_pd(raw_t_ + k - 1);
-      fits = _mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) == 0 &&
-             _mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) == 0xf;
-    }
-    if (!fits) {
-      const double u0 = _mm256_cvtsd_f64(u);
-      k = s;
-      while (k < len && raw_t_[k] < u0) ++k;
-      if (k + 3 > len) break;
-      // and then each of the next three moves exactly one on
-      T1 = _mm256_loadu_pd(raw_t_ + k);
-      T0 = _mm256_loadu_pd(raw_t_ + k - 1);
-      if (_mm256_movemask_pd(_mm256_cmp_pd(T1, u, _CMP_LT_OQ)) != 0) break;
-      if ((_mm256_movemask_pd(_mm256_cmp_pd(T0, u, _CMP_LT_OQ)) & 0xe) != 0xe) break;
-    }
-    const __m256d w = _mm256_div_pd(_mm256_sub_pd(u, T0), _mm256_sub_pd(T1, T0));
-    const std::int64_t o = pos - pos0;
-    __m256d L = _mm256_loadu_pd(X + k - 1), R = _mm256_loadu_pd(X + k);
-    lx = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
-    _mm256_storeu_pd(ox + o, lx);
-    L = _mm256_loadu_pd(Y + k - 1);
-    R = _mm256_loadu_pd(Y + k);
-    ly = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
-    _mm256_storeu_pd(oy + o, ly);
-    L = _mm256_loadu_pd(Z + k - 1);
-    R = _mm256_loadu_pd(Z + k);
-    lz = _mm256_add_pd(_mm256_mul_pd(w, _mm256_sub_pd(R, L)), L);
-    _mm256_storeu_pd(oz + o, lz);
-    if (ot != nullptr) _mm256_storeu_pd(ot + o, tv);
-    if (otime != nullptr) _mm256_storeu_pd(otime + o, u);
-    s = k + 3;
-    t = u;
-  }
-  if (pos > pos0) {
-    double e[4];
-    _mm256_storeu_pd(e, lx);
-    a[0] = e[3];
-    _mm256_storeu_pd(e, ly);
-    a[1] = e[3];
-    _mm256_storeu_pd(e, lz);
-    a[2] = e[3];
-    _mm256_storeu_pd(e, t);
-    at = e[3];
-    source = s;
-  }
-  return pos - pos0;
-}
-#endif
-
 // Writes the open span's grid points into out; false when out filled first.
-// The loop keeps its state in locals (the output columns could alias the
-// members, so the compiler would store and reload them every sample) and
-// writes it back once; the arithmetic is grid() and out.put()'s.
+// A span that is not imputed: GGIRread's interpolation (the kernel
+// cwa_interp); an imputed one: the imputed values.
 inline bool CwaDecoder::emit_span(SampleBuffer& out) {
   cwa::Block& p = blk_[span_blk_];
   const int len = span_len_;
   const double lim = raw_t_[len];
-  const double temp = p.h.temperature;
-  const double start = start_ts_, step = step_, end = end_ts_;
-  const double il[3] = {ianchor_[0], ianchor_[1], ianchor_[2]};
   const bool impute = impute_;
-  const std::int64_t last = last_;
-  std::int64_t pos = pos_;
-  int source = source_;
-  // the last output sample, in scalars (an array here ends up on the stack)
-  double a0 = anchor_[0], a1 = anchor_[1], a2 = anchor_[2];
-  double at = anchor_t_;
-  std::size_t n = out.n;
-  const std::size_t cap = out.capacity;
-  double* const ox = out.x;
-  double* const oy = out.y;
-  double* const oz = out.z;
-  double* const ot = out.t;
-  double* const otime = out.time;
-  const std::int64_t pos0 = pos;
-  bool full = false;
   // an interval's left end is the sample before, or for the first the
   // value the span starts from
-  for (int c = 0; c < 3; ++c) p.xyz[c][0] = il[c];
-  const double* X = p.xyz[0];
-  const double* Y = p.xyz[1];
-  const double* Z = p.xyz[2];
-#if defined(GRAVCAL_AVX2)
-  const bool vec = !impute && use_avx2();
-#endif
-  while (pos <= last) {
-#if defined(GRAVCAL_AVX2)
-    if (vec) {
-      // as many as fit in out and lie in the span's grid
-      const std::int64_t room = static_cast<std::int64_t>(cap - n);
-      const std::int64_t stop = std::min(last + 1, pos + room);
-      if (stop - pos >= 4) {
-        double av[3];
-        const std::int64_t k =
-            emit_avx2(pos, stop, source, len, lim, temp, p.xyz, ox + n, oy + n, oz + n,
-                      ot != nullptr ? ot + n : nullptr, otime != nullptr ? otime + n : nullptr,
-                      av, at);
-        if (k > 0) {
-          a0 = av[0];
-          a1 = av[1];
-          a2 = av[2];
-          n += static_cast<std::size_t>(k);
-          pos += k;
-        }
-      }
+  for (int c = 0; c < 3; ++c) p.xyz[c][0] = ianchor_[c];
+  // the span's grid points, as many as fit in out
+  const std::int64_t room = static_cast<std::int64_t>(out.capacity - out.n);
+  const std::int64_t stop = std::min(last_ + 1, pos_ + room);
+  kernels::InterpOut o;
+  o.x = out.x + out.n;
+  o.y = out.y + out.n;
+  o.z = out.z + out.n;
+  o.t = out.t != nullptr ? out.t + out.n : nullptr;
+  o.time = out.time != nullptr ? out.time + out.n : nullptr;
+  std::int64_t given = 0;
+  if (impute) {
+    for (; pos_ + given < stop; ++given) {
+      const double t = grid(pos_ + given);
+      if (!(t < lim)) break;
+      o.x[given] = anchor_[0] = imputed_[0];
+      o.y[given] = anchor_[1] = imputed_[1];
+      o.z[given] = anchor_[2] = imputed_[2];
+      if (o.t != nullptr) o.t[given] = p.h.temperature;
+      if (o.time != nullptr) o.time[given] = t;
+      anchor_t_ = t;
     }
-    if (pos > last) break;
-#endif
-    volatile double e = static_cast<double>(pos) * step;  // as grid(): no fused multiply-add
-    double t = start + e;
-    t = t < end ? t : end;
-    if (impute ? !(t < lim) : !(t <= lim)) break;
-    if (n >= cap) {
-      full = true;
-      break;
-    }
-    if (impute) {
-      a0 = imputed_[0];
-      a1 = imputed_[1];
-      a2 = imputed_[2];
-    } else {
-      while (source < len && raw_t_[source] < t) ++source;
-      const double w = (t - raw_t_[source - 1]) / (raw_t_[source] - raw_t_[source - 1]);
-      a0 = w * (X[source] - X[source - 1]) + X[source - 1];
-      a1 = w * (Y[source] - Y[source - 1]) + Y[source - 1];
-      a2 = w * (Z[source] - Z[source - 1]) + Z[source - 1];
-    }
-    ox[n] = a0;
-    oy[n] = a1;
-    oz[n] = a2;
-    if (ot != nullptr) ot[n] = temp;
-    if (otime != nullptr) otime[n] = t;
-    ++n;
-    at = t;
-    ++pos;
+  } else {
+    kernels::InterpSpan sp;
+    sp.time = raw_t_;
+    for (int c = 0; c < 3; ++c) sp.v[c] = p.xyz[c];
+    sp.len = len;
+    sp.lim = lim;
+    sp.start = start_ts_;
+    sp.step = step_;
+    sp.end = end_ts_;
+    sp.temp = p.h.temperature;
+    given = kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
   }
-  const std::int64_t given = pos - pos0;
-  out.n = n;
-  pos_ = pos;
-  source_ = source;
-  anchor_[0] = a0;
-  anchor_[1] = a1;
-  anchor_[2] = a2;
-  anchor_t_ = at;
+  pos_ += given;
+  out.n += static_cast<std::size_t>(given);
   report_.samples += given;
-  if (impute_) report_.count("imputed_samples", given);
-  if (full) return false;
-  if (impute_) {  // go on from the imputed output, not the raw samples
+  if (impute) report_.count("imputed_samples", given);
+  // out is full when the next grid point still lies in the span
+  if (pos_ <= last_ && out.n >= out.capacity) {
+    const double t = grid(pos_);
+    if (impute ? t < lim : t <= lim) return false;
+  }
+  if (impute) {  // go on from the imputed output, not the raw samples
     ianchor_t_ = anchor_t_;
     for (int c = 0; c < 3; ++c) ianchor_[c] = anchor_[c];
   } else {

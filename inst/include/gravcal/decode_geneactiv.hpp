@@ -74,13 +74,7 @@
 #include <string>
 
 #include "decode.hpp"
-#include "simd.hpp"
-
-// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
-#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
-#define GRAVCAL_SSE2 1
-#include <emmintrin.h>
-#endif
+#include "kernels.hpp"
 
 namespace gravcal {
 
@@ -113,91 +107,7 @@ constexpr const char* kPageKeys[kPageHeaderLines] = {
 enum PageKey { kSerial = 0, kSequence = 1, kTime = 2, kTemperature = 4, kFrequency = 7 };
 
 // Hex digit values; 0x10 marks a byte that is not a hex digit.
-struct HexTable {
-  unsigned char v[256];
-  HexTable() {
-    for (int i = 0; i < 256; ++i) v[i] = 0x10;
-    for (int i = 0; i < 10; ++i) v['0' + i] = static_cast<unsigned char>(i);
-    for (int i = 0; i < 6; ++i) {
-      v['A' + i] = static_cast<unsigned char>(10 + i);
-      v['a' + i] = static_cast<unsigned char>(10 + i);
-    }
-  }
-};
-inline const HexTable& hex_table() {
-  static const HexTable t;
-  return t;
-}
-
-#if defined(GRAVCAL_SSE2)
-// hex_table() for 16 bytes at once: their values into v (any value for a
-// byte that is not a hex digit) and a mask, bit k set when byte k is not a
-// hex digit. Signed byte comparisons: bytes from 0x80 on are below '0'.
-inline int hex16(const unsigned char* s, unsigned char* v) {
-  const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s));
-  const __m128i dg = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('0' - 1)),
-                                   _mm_cmpgt_epi8(_mm_set1_epi8('9' + 1), c));
-  const __m128i up = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('A' - 1)),
-                                   _mm_cmpgt_epi8(_mm_set1_epi8('F' + 1), c));
-  const __m128i lo = _mm_and_si128(_mm_cmpgt_epi8(c, _mm_set1_epi8('a' - 1)),
-                                   _mm_cmpgt_epi8(_mm_set1_epi8('f' + 1), c));
-  // '0'-'9': c - '0'; 'A'-'F': c - '0' - 7; 'a'-'f': c - '0' - 39
-  const __m128i val = _mm_sub_epi8(
-      _mm_sub_epi8(_mm_sub_epi8(c, _mm_set1_epi8('0')), _mm_and_si128(up, _mm_set1_epi8(7))),
-      _mm_and_si128(lo, _mm_set1_epi8(39)));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(v), val);
-  return _mm_movemask_epi8(_mm_or_si128(_mm_or_si128(dg, up), lo)) ^ 0xffff;
-}
-#endif
-
-#if defined(GRAVCAL_AVX2)
-// The counts x, y, z of k samples (k even) from their hex digits at s, two
-// samples at a time (one in each 128-bit lane): each lane holds a sample's
-// 12 digits and the next sample's first 4, which are not used (so s must
-// have 12 k + 4 readable bytes). The digits' values as hex16()'s; then a
-// sample's counts are (d0 << 8) | (16 d1 + d2), (d3 << 8) | (16 d4 + d5)
-// and (d6 << 8) | (16 d7 + d8): the pairs by one multiply-add of bytes, the
-// high digits by a shuffle into the high bytes. Each sample's three counts
-// are stored as 8 bytes at raw[i], so raw must have room for k + 1 samples
-// (the last 2 bytes land on raw[k][0]). Returns nonzero when some digit of
-// the k samples' 12 is not a hex digit.
-GRAVCAL_TARGET_AVX2 inline unsigned hex_xyz_avx2(const unsigned char* s, std::size_t k,
-                                                 std::uint16_t (*raw)[3]) {
-  const __m256i below0 = _mm256_set1_epi8('0' - 1), above9 = _mm256_set1_epi8('9' + 1);
-  const __m256i belowA = _mm256_set1_epi8('A' - 1), aboveF = _mm256_set1_epi8('F' + 1);
-  const __m256i belowa = _mm256_set1_epi8('a' - 1), abovef = _mm256_set1_epi8('f' + 1);
-  const __m256i zero = _mm256_set1_epi8('0'), seven = _mm256_set1_epi8(7),
-                thirty9 = _mm256_set1_epi8(39);
-  // bytes (d1, d2), (d4, d5), (d7, d8) into 16-bit lanes 0-2, times (16, 1)
-  const __m256i pairs = _mm256_setr_epi8(1, 2, 4, 5, 7, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                         1, 2, 4, 5, 7, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-  // d0, d3, d6 into the high bytes of lanes 0-2
-  const __m256i highs = _mm256_setr_epi8(-1, 0, -1, 3, -1, 6, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                         -1, 0, -1, 3, -1, 6, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-  const __m256i weights = _mm256_set1_epi16(0x0110);  // bytes 16, 1
-  unsigned bad = 0;
-  for (std::size_t j = 0; j < k; j += 2, s += 2 * kDigitsPerSample) {
-    const __m256i c = _mm256_inserti128_si256(
-        _mm256_castsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(s))),
-        _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + kDigitsPerSample)), 1);
-    const __m256i dg = _mm256_and_si256(_mm256_cmpgt_epi8(c, below0), _mm256_cmpgt_epi8(above9, c));
-    const __m256i up = _mm256_and_si256(_mm256_cmpgt_epi8(c, belowA), _mm256_cmpgt_epi8(aboveF, c));
-    const __m256i lo = _mm256_and_si256(_mm256_cmpgt_epi8(c, belowa), _mm256_cmpgt_epi8(abovef, c));
-    const __m256i val = _mm256_sub_epi8(
-        _mm256_sub_epi8(_mm256_sub_epi8(c, zero), _mm256_and_si256(up, seven)),
-        _mm256_and_si256(lo, thirty9));
-    const unsigned ok = static_cast<unsigned>(
-        _mm256_movemask_epi8(_mm256_or_si256(_mm256_or_si256(dg, up), lo)));
-    bad |= ~ok & 0x0fff0fffu;  // each lane's own 12 digits
-    const __m256i r = _mm256_or_si256(
-        _mm256_maddubs_epi16(_mm256_shuffle_epi8(val, pairs), weights),
-        _mm256_shuffle_epi8(val, highs));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(raw[j]), _mm256_castsi256_si128(r));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(raw[j + 1]), _mm256_extracti128_si256(r, 1));
-  }
-  return bad;
-}
-#endif
+using kernels::hex_table;
 
 
 // A Page Time "YYYY-MM-DD HH:MM:SS:mmm" (":mmm" optional).
@@ -675,63 +585,8 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   const unsigned char* s = reinterpret_cast<const unsigned char*>(p);
   if (complete ? n != kDigitsPerPage : n > kDigitsPerPage) return false;
   const std::size_t whole = n / kDigitsPerSample;
-  unsigned bad = 0;
-  std::size_t i = 0;
-#if defined(GRAVCAL_AVX2)
-  if (use_avx2()) {
-    // the samples whose 16-digit loads stay inside the n digits and whose
-    // 8-byte stores stay inside raw, an even number of them
-    std::size_t k = whole;
-    if (k > 0 && k * kDigitsPerSample + 4 > n) --k;
-    if (k > kSamplesPerPage - 1) k = kSamplesPerPage - 1;
-    k &= ~std::size_t(1);
-    if (hex_xyz_avx2(s, k, next_->raw) != 0) bad |= 0x10u;
-    i = k;
-    s += k * kDigitsPerSample;
-  }
-#endif
-#if defined(GRAVCAL_SSE2)
-  // four samples (48 digits) at a time: the digits' values and whether each
-  // is a hex digit sixteen at a time (hex16()); then digit pairs p_j =
-  // d_2j d_2j+1 in 16-bit lanes, so that a sample's counts (digits 0-2,
-  // 3-5, 6-8 of its 12, pairs p_0..p_5 from its first) are x = p_0 p_1
-  // >> 4, y = (p_1 & 15) p_2 and z = p_3 p_4 >> 4: lanes 0 and 3 of q_j =
-  // p_j << 4 | p_j+1 >> 4 and lane 1 of r_j = (p_j & 15) << 8 | p_j+1
-  alignas(16) unsigned char v[48];
-  for (; i + 4 <= whole; i += 4, s += 4 * kDigitsPerSample) {
-    if ((hex16(s, v) | hex16(s + 16, v + 16) | hex16(s + 32, v + 32)) != 0) bad |= 0x10u;
-    const __m128i lo8 = _mm_set1_epi16(0xff), lo4 = _mm_set1_epi16(0xf);
-    __m128i pr[4];  // p_0..p_23, and zeros after
-    for (int k = 0; k < 3; ++k) {
-      const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(v + 16 * k));
-      pr[k] = _mm_or_si128(_mm_slli_epi16(_mm_and_si128(w, lo8), 4), _mm_srli_epi16(w, 8));
-    }
-    pr[3] = _mm_setzero_si128();
-    alignas(16) std::uint16_t q[24], r[24];
-    for (int k = 0; k < 3; ++k) {
-      // p_j+1 in lane j: this vector one lane on, the next one's first last
-      const __m128i nx = _mm_or_si128(_mm_srli_si128(pr[k], 2), _mm_slli_si128(pr[k + 1], 14));
-      _mm_store_si128(reinterpret_cast<__m128i*>(q + 8 * k),
-                      _mm_or_si128(_mm_slli_epi16(pr[k], 4), _mm_srli_epi16(nx, 4)));
-      _mm_store_si128(reinterpret_cast<__m128i*>(r + 8 * k),
-                      _mm_or_si128(_mm_slli_epi16(_mm_and_si128(pr[k], lo4), 8), nx));
-    }
-    for (int j = 0; j < 4; ++j) {
-      std::uint16_t* o = next_->raw[i + static_cast<std::size_t>(j)];
-      o[0] = q[6 * j];
-      o[1] = r[6 * j + 1];
-      o[2] = q[6 * j + 3];
-    }
-  }
-#endif
-  for (; i < whole; ++i, s += kDigitsPerSample) {
-    for (int a = 0; a < 3; ++a) {
-      const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
-      bad |= d0 | d1 | d2;
-      next_->raw[i][a] = static_cast<std::uint16_t>((d0 << 8) | (d1 << 4) | d2);
-    }
-    bad |= h[s[9]] | h[s[10]] | h[s[11]];
-  }
+  unsigned bad = kernels::active().hex_counts(s, whole, n, next_->raw, kSamplesPerPage);
+  s += whole * kDigitsPerSample;
   std::size_t count = whole;
   const std::size_t rest = n - whole * kDigitsPerSample;
   if (rest >= (compat_ ? kDigitsXyzCompat : kDigitsPerSample)) {

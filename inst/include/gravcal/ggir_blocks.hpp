@@ -261,79 +261,11 @@ class GgirBlocks {
     return x == 0.0 && y == 0.0 && z == 0.0;
   }
 
-#if defined(GRAVCAL_AVX2)
-  // Whether one of the eight samples at i is all zeros.
-  GRAVCAL_TARGET_AVX2 static bool zero_in8_avx2(const double* x, const double* y,
-                                                const double* z, std::size_t i) {
-    const __m256d zr = _mm256_setzero_pd();
-    const __m256d a = _mm256_and_pd(
-        _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
-                      _mm256_cmp_pd(_mm256_loadu_pd(y + i), zr, _CMP_EQ_OQ)),
-        _mm256_cmp_pd(_mm256_loadu_pd(z + i), zr, _CMP_EQ_OQ));
-    const __m256d b = _mm256_and_pd(
-        _mm256_and_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ),
-                      _mm256_cmp_pd(_mm256_loadu_pd(y + i + 4), zr, _CMP_EQ_OQ)),
-        _mm256_cmp_pd(_mm256_loadu_pd(z + i + 4), zr, _CMP_EQ_OQ));
-    return _mm256_movemask_pd(_mm256_or_pd(a, b)) != 0;
-  }
-
-  // first_zero()'s scan, four samples per instruction: where to go on from
-  // (a multiple of 8 before the first idle-sleep sample, or less than 8
-  // from the end). Sixteen samples' x first: only where some x is 0 can a
-  // sample be all zeros, and then their eights are checked whole.
-  GRAVCAL_TARGET_AVX2 static std::size_t zero_scan_avx2(const double* x, const double* y,
-                                                        const double* z, std::size_t n) {
-    std::size_t i = 0;
-    const __m256d zr = _mm256_setzero_pd();
-    for (; i + 16 <= n; i += 16) {
-      const __m256d a = _mm256_or_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i), zr, _CMP_EQ_OQ),
-                                     _mm256_cmp_pd(_mm256_loadu_pd(x + i + 4), zr, _CMP_EQ_OQ));
-      const __m256d b = _mm256_or_pd(_mm256_cmp_pd(_mm256_loadu_pd(x + i + 8), zr, _CMP_EQ_OQ),
-                                     _mm256_cmp_pd(_mm256_loadu_pd(x + i + 12), zr, _CMP_EQ_OQ));
-      if (_mm256_movemask_pd(_mm256_or_pd(a, b)) == 0) continue;
-      if (zero_in8_avx2(x, y, z, i)) return i;
-      if (zero_in8_avx2(x, y, z, i + 8)) return i + 8;
-    }
-    for (; i + 8 <= n; i += 8) {
-      if (zero_in8_avx2(x, y, z, i)) break;
-    }
-    return i;
-  }
-#endif
-
-  // Where the first idle-sleep sample among n is (n if none): four samples
-  // per instruction with AVX2, two with SSE2.
-  static std::size_t first_zero(const double* x, const double* y, const double* z,
-                                std::size_t n) {
-    std::size_t i = 0;
-#if defined(GRAVCAL_AVX2)
-    if (use_avx2()) {
-      i = zero_scan_avx2(x, y, z, n);
-      while (i < n && !is_zero(x[i], y[i], z[i])) ++i;
-      return i;
-    }
-#endif
-#if defined(GRAVCAL_SSE2)
-    const __m128d zr = _mm_setzero_pd();
-    for (; i + 8 <= n; i += 8) {
-      __m128d any = zr;
-      for (std::size_t k = i; k < i + 8; k += 2) {
-        any = _mm_or_pd(any, _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(_mm_loadu_pd(x + k), zr),
-                                                   _mm_cmpeq_pd(_mm_loadu_pd(y + k), zr)),
-                                        _mm_cmpeq_pd(_mm_loadu_pd(z + k), zr)));
-      }
-      if (_mm_movemask_pd(any) != 0) break;
-    }
-#endif
-    while (i < n && !is_zero(x[i], y[i], z[i])) ++i;
-    return i;
-  }
-
   // Removes the idle-sleep samples among n in place; returns how many are
   // left.
   static std::size_t drop_zeros(double* x, double* y, double* z, double* t,
                                 std::size_t n) {
-    std::size_t i = first_zero(x, y, z, n);
+    std::size_t i = kernels::active().first_zero(x, y, z, n);
     if (i == n) return n;
     std::size_t m = i;
     for (; i < n; ++i) {
@@ -423,7 +355,7 @@ class GgirBlocks {
       if (runs_.empty() || runs_.back().bits != bits) {
         runs_.push_back(Run{bits, t[i], 0});
       }
-      const std::size_t j = run_end(t, i, m);
+      const std::size_t j = kernels::active().run_end(t, i, m);
       runs_.back().count += static_cast<std::int64_t>(j - i);
       i = j;
     }

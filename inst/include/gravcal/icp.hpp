@@ -41,12 +41,6 @@
 #include "model.hpp"
 #include "r_arith.hpp"
 
-// GRAVCAL_NO_SIMD: the portable loops only (the results are the same bits)
-#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
-#define GRAVCAL_SSE2 1
-#include <emmintrin.h>
-#endif
-
 namespace gravcal {
 
 enum class StopRule { ggir, parameters };
@@ -108,41 +102,20 @@ struct EigenLeastSquares {
   }
 };
 
-// The loops of gravcal's own fit (fit_icp()), element by element, two
-// elements per instruction with SSE2: the same operations on each element
-// as the scalar tail (no fused multiply-add), so the same bits.
+// The loops of gravcal's own fit (fit_icp()), element by element. (SSE2
+// versions saved less than 5 % of a week's calibrate(method = "ggir"):
+// bench/results/ab-kernels.md.)
 
 // out[i] = apply_model_ggir(v[i], o, s, t ? t[i] : 0, to)
-inline void icp_apply_column(const double* v, const double* t, std::size_t n,
-                             double o, double s, double to, double* out) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  const __m128d ov = _mm_set1_pd(o), sv = _mm_set1_pd(1.0 / s), tv = _mm_set1_pd(1.0 / to);
-  for (; i + 2 <= n; i += 2) {
-    const __m128d tt = t != nullptr ? _mm_loadu_pd(t + i) : _mm_setzero_pd();
-    _mm_storeu_pd(out + i, _mm_add_pd(_mm_div_pd(_mm_add_pd(_mm_loadu_pd(v + i), ov), sv),
-                                      _mm_div_pd(tt, tv)));
-  }
-#endif
-  for (; i < n; ++i) out[i] = apply_model_ggir(v[i], o, s, t != nullptr ? t[i] : 0.0, to);
+inline void icp_apply_column(const double* v, const double* t, std::size_t n, double o, double s,
+                             double to, double* out) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = apply_model_ggir(v[i], o, s, t != nullptr ? t[i] : 0.0, to);
 }
 
 // p = c / |c|, |c| = sqrt(c0^2 + c1^2 + c2^2)
-inline void icp_project(const double* c0, const double* c1, const double* c2,
-                        std::size_t n, double* p0, double* p1, double* p2) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  for (; i + 2 <= n; i += 2) {
-    const __m128d a = _mm_loadu_pd(c0 + i), b = _mm_loadu_pd(c1 + i),
-                  c = _mm_loadu_pd(c2 + i);
-    const __m128d r = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(a, a), _mm_mul_pd(b, b)),
-                                             _mm_mul_pd(c, c)));
-    _mm_storeu_pd(p0 + i, _mm_div_pd(a, r));
-    _mm_storeu_pd(p1 + i, _mm_div_pd(b, r));
-    _mm_storeu_pd(p2 + i, _mm_div_pd(c, r));
-  }
-#endif
-  for (; i < n; ++i) {
+inline void icp_project(const double* c0, const double* c1, const double* c2, std::size_t n,
+                        double* p0, double* p1, double* p2) {
+  for (std::size_t i = 0; i < n; ++i) {
     const double r = std::sqrt(c0[i] * c0[i] + c1[i] * c1[i] + c2[i] * c2[i]);
     p0[i] = c0[i] / r;
     p1[i] = c1[i] / r;
@@ -150,37 +123,10 @@ inline void icp_project(const double* c0, const double* c1, const double* c2,
   }
 }
 
-inline void icp_sqrt(const double* w, std::size_t n, double* out) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  for (; i + 2 <= n; i += 2) _mm_storeu_pd(out + i, _mm_sqrt_pd(_mm_loadu_pd(w + i)));
-#endif
-  for (; i < n; ++i) out[i] = std::sqrt(w[i]);
-}
-
-inline void icp_times(const double* a, const double* b, std::size_t n, double* out) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  for (; i + 2 <= n; i += 2) {
-    _mm_storeu_pd(out + i, _mm_mul_pd(_mm_loadu_pd(a + i), _mm_loadu_pd(b + i)));
-  }
-#endif
-  for (; i < n; ++i) out[i] = a[i] * b[i];
-}
-
 // c = b0 + b1 c (+ b2 t when t is not null)
 inline void icp_fitted(double b0, double b1, double b2, const double* t, std::size_t n,
                        double* c) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  const __m128d v0 = _mm_set1_pd(b0), v1 = _mm_set1_pd(b1), v2 = _mm_set1_pd(b2);
-  for (; i + 2 <= n; i += 2) {
-    __m128d f = _mm_add_pd(v0, _mm_mul_pd(v1, _mm_loadu_pd(c + i)));
-    if (t != nullptr) f = _mm_add_pd(f, _mm_mul_pd(v2, _mm_loadu_pd(t + i)));
-    _mm_storeu_pd(c + i, f);
-  }
-#endif
-  for (; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     double f = b0 + b1 * c[i];
     if (t != nullptr) f += b2 * t[i];
     c[i] = f;
@@ -189,24 +135,10 @@ inline void icp_fitted(double b0, double b1, double b2, const double* t, std::si
 
 // d2 = |c - p|^2; wd2 = w d2 (GGIR's statistic); next = min(1 / sqrt(d2),
 // max_weight)
-inline void icp_weights(const double* c0, const double* c1, const double* c2,
-                        const double* p0, const double* p1, const double* p2,
-                        std::size_t n, double max_weight, const double* w,
-                        double* next, double* wd2) {
-  std::size_t i = 0;
-#if defined(GRAVCAL_SSE2)
-  const __m128d one = _mm_set1_pd(1.0), mw = _mm_set1_pd(max_weight);
-  for (; i + 2 <= n; i += 2) {
-    const __m128d a = _mm_sub_pd(_mm_loadu_pd(c0 + i), _mm_loadu_pd(p0 + i));
-    const __m128d b = _mm_sub_pd(_mm_loadu_pd(c1 + i), _mm_loadu_pd(p1 + i));
-    const __m128d c = _mm_sub_pd(_mm_loadu_pd(c2 + i), _mm_loadu_pd(p2 + i));
-    const __m128d d2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(a, a), _mm_mul_pd(b, b)),
-                                  _mm_mul_pd(c, c));
-    _mm_storeu_pd(wd2 + i, _mm_mul_pd(_mm_loadu_pd(w + i), d2));
-    _mm_storeu_pd(next + i, _mm_min_pd(_mm_div_pd(one, _mm_sqrt_pd(d2)), mw));
-  }
-#endif
-  for (; i < n; ++i) {
+inline void icp_weights(const double* c0, const double* c1, const double* c2, const double* p0,
+                        const double* p1, const double* p2, std::size_t n, double max_weight,
+                        const double* w, double* next, double* wd2) {
+  for (std::size_t i = 0; i < n; ++i) {
     const double a = c0[i] - p0[i], b = c1[i] - p1[i], c = c2[i] - p2[i];
     const double d2 = a * a + b * b + c * c;
     wd2[i] = w[i] * d2;
@@ -378,8 +310,7 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
   const double* tp = use_temp ? t.data() : nullptr;
   for (int it = 1; it <= cfg.max_iter; ++it) {
     // the calibrated points (apply_model_ggir()), then their closest points
-    // on the sphere; column by column, two points per instruction with SSE2
-    // (the same operations on each point)
+    // on the sphere; column by column
     for (int k = 0; k < 3; ++k) {
       icp_apply_column(in[k], tp, n, r.offset[k], r.scale[k],
                        use_temp ? r.tempoffset[k] : 0.0, cur.col(k).data());
@@ -390,13 +321,13 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
       r.finite = false;
       break;
     }
-    icp_sqrt(w.data(), n, sw.data());
+    sw = w.cwiseSqrt();
     double d_off[3], d_scale[3], d_temp[3] = {0.0, 0.0, 0.0};
     for (int k = 0; k < 3; ++k) {
       X.col(0) = sw;
-      icp_times(sw.data(), cur.col(k).data(), n, X.col(1).data());
-      if (use_temp) icp_times(sw.data(), tp, n, X.col(2).data());
-      icp_times(sw.data(), cp.col(k).data(), n, b.data());
+      X.col(1) = sw.cwiseProduct(cur.col(k));
+      if (use_temp) X.col(2) = sw.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(tp, N));
+      b = sw.cwiseProduct(cp.col(k));
       qr.compute(X);
       const Eigen::VectorXd beta = qr.solve(b);
       d_off[k] = beta(0);

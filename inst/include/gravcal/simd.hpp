@@ -1,19 +1,18 @@
-// gravcal: optional AVX2 code paths, chosen when the program runs.
+// gravcal: which vector instructions the kernels may be compiled with.
 //
-// The package is built for the baseline of its platform (SSE2 on x86-64),
-// so code for newer instructions is compiled function by function
-// (GRAVCAL_TARGET_AVX2) and called only where use_avx2() says the processor
-// has them. Every such path gives the same bits as the baseline one it
-// stands in for (integer work, or the same floating-point operations in the
-// same order, never fused), and the tests compare the two
-// (set_avx2(false) forces the baseline).
+// The only place that says so. GRAVCAL_SSE2: the platform's baseline has
+// SSE2 (x86-64), so SSE2 kernels are compiled in and may run anywhere.
+// GRAVCAL_AVX2: AVX2 kernels are compiled function by function
+// (GRAVCAL_TARGET_AVX2), to be run only where the processor has AVX2; the
+// choice is made once, in the kernel table (kernels.hpp), never inside a
+// kernel.
 //
-// GRAVCAL_NO_SIMD or GRAVCAL_NO_AVX2 defined when compiling: no AVX2 code
-// at all. Only with GCC or clang on x86. The environment variable
-// GRAVCAL_NO_AVX2 set to anything but "" or "0" when the process first asks
-// turns the AVX2 paths off (to compare, or to rule them out).
+// GRAVCAL_NO_SIMD defined when compiling: no vector kernel at all (the
+// scalar references only; the results are the same bits). GRAVCAL_NO_AVX2:
+// no AVX2 kernel. AVX2 needs GCC or clang on x86.
 //
-// Header-only, standard headers only.
+// Header-only, standard headers only (and the compiler's intrinsics
+// headers on x86).
 #ifndef GRAVCAL_SIMD_HPP
 #define GRAVCAL_SIMD_HPP
 
@@ -21,21 +20,22 @@
 
 #include <cstdlib>
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && defined(__SSE2__) && \
-    !defined(GRAVCAL_NO_SIMD) && !defined(GRAVCAL_NO_AVX2)
+#if defined(__SSE2__) && !defined(GRAVCAL_NO_SIMD)
+#define GRAVCAL_SSE2 1
+#include <emmintrin.h>
+#endif
+
+#if defined(GRAVCAL_SSE2) && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && \
+    !defined(GRAVCAL_NO_AVX2)
 #define GRAVCAL_AVX2 1
 #define GRAVCAL_TARGET_AVX2 __attribute__((target("avx2")))
 #include <immintrin.h>
 #endif
 
 namespace gravcal {
-
 namespace simd_detail {
-// -1: not yet asked; 0: baseline; 1: AVX2
-inline int& avx2_state() {
-  static int s = -1;
-  return s;
-}
+
+// Whether the processor has AVX2 (false where no AVX2 kernel is compiled).
 inline bool cpu_has_avx2() {
 #if defined(GRAVCAL_AVX2)
   __builtin_cpu_init();
@@ -44,27 +44,40 @@ inline bool cpu_has_avx2() {
   return false;
 #endif
 }
-inline bool env_says_no() {
-  const char* e = std::getenv("GRAVCAL_NO_AVX2");
-  return e != nullptr && e[0] != '\0' && !(e[0] == '0' && e[1] == '\0');
-}
+
 }  // namespace simd_detail
 
-// Whether the AVX2 paths run: the processor has AVX2, GRAVCAL_NO_AVX2 was
-// not set and set_avx2(false) was not called.
-inline bool use_avx2() {
-  int& s = simd_detail::avx2_state();
-  if (s < 0) s = simd_detail::cpu_has_avx2() && !simd_detail::env_says_no() ? 1 : 0;
-  return s == 1;
-}
+namespace kernels {
 
-// Turns the AVX2 paths off (false) or back on where the processor has AVX2
-// (true); returns whether they now run. For tests and benchmarks.
-inline bool set_avx2(bool on) {
-  simd_detail::avx2_state() = on && simd_detail::cpu_has_avx2() ? 1 : 0;
-  return use_avx2();
-}
+// The instruction sets a kernel can be had in.
+enum Level : int { scalar = 0, sse2 = 1, avx2 = 2 };
 
+// One kernel's variants, all with the same signature and the same results
+// to the bit: the scalar reference and the vector code standing in for it
+// (null where there is none, or it is not compiled).
+template <class F>
+struct Variants {
+  F scalar;
+  F sse2;
+  F avx2;
+  constexpr F at(int level) const {
+    return level == Level::avx2 ? avx2 : level == Level::sse2 ? sse2 : scalar;
+  }
+};
+
+}  // namespace kernels
 }  // namespace gravcal
+
+// A variant's name where it is compiled, else null (for Variants).
+#if defined(GRAVCAL_SSE2)
+#define GRAVCAL_IF_SSE2(f) f
+#else
+#define GRAVCAL_IF_SSE2(f) nullptr
+#endif
+#if defined(GRAVCAL_AVX2)
+#define GRAVCAL_IF_AVX2(f) f
+#else
+#define GRAVCAL_IF_AVX2(f) nullptr
+#endif
 
 #endif  // GRAVCAL_SIMD_HPP
