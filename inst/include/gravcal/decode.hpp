@@ -230,6 +230,15 @@ struct SampleBuffer {
   }
 };
 
+// GGIR's nearest-neighbour resampling (interpolationType = 2, as
+// GGIRread::resample computes it): the weight u of a grid point between two
+// samples becomes 0 up to u = 0.5 and 1 beyond (0 outside [0, 1]); the value
+// is then computed as the linear one, w * (right - left) + left.
+inline double ggir_nearest_weight(double u) {
+  if (u < 0 || u > 1) u = 0;
+  return std::ceil(u - 0.5);
+}
+
 // Named options for a decoder (numbers and strings), set by the caller: for
 // example "compat" = 1 for the reference reader's behaviour, or a csv's
 // column layout. A decoder reads the ones it knows, with its own defaults.
