@@ -96,7 +96,7 @@ ggir_param_table <- function() {
       row("configtz", NA, NULL, tz_check, list = "general",
           effect = "as desiredtz, which it replaces when given"),
       # checked where the source is opened (open_source())
-      row("reader", "reader", "native")
+      row("reader", "reader", "native", list = NA_character_)
     ),
     no_effect("rawdata", list(
       do.cal = TRUE, backup.cal.coef = "retrieve", dynrange = NULL,

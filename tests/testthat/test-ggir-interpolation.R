@@ -60,14 +60,18 @@ nat_cwa <- function(f, B, opts) {
 }
 
 # A 30-hour .cwa at 25 Hz from the simulator: rest on several faces, with
-# movement, temperature and a clock that runs 3 % fast for a stretch (so
-# frequency_tol decides whether readAxivity imputes there).
-synth_cwa <- function(hours = 30, sf = 25, seed = 61, start = 1.7e9) {
+# movement and temperature; `drift`: from hour 3 to hour 20 the block times
+# advance 5 % slower than the samples (readAxivity observes a rate 5 % off
+# the nominal one: imputed when frequency_tol is below 0.05).
+synth_cwa <- function(hours = 30, sf = 25, seed = 61, start = 1.7e9, drift = FALSE) {
   rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
                             tempoffset = c(0.002, -0.001, 0.0015))
+  dt <- rep(1 / sf, nrow(rec))
+  if (drift) dt[(3 * 3600 * sf):(20 * 3600 * sf)] <- 1 / (sf * 1.05)
   f <- tempfile(fileext = ".cwa")
   gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = sf,
-                      start = start, temperature = rec$temperature, range = 8)
+                      start = start, temperature = rec$temperature, range = 8,
+                      time = start + cumsum(dt) - dt[1])
   f
 }
 
@@ -117,4 +121,77 @@ test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
     }
   }
   expect_identical(n, 6)
+})
+
+test_that("g.calibrate() is GGIR's with frequency_tol 0.1 and 0.02 (.cwa, a clock off by 5 %)", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  f <- synth_cwa(seed = 62, drift = TRUE)
+  on.exit(unlink(f))
+  res <- list()
+  for (tol in c(0.1, 0.02)) {
+    b <- with_tz("UTC", run_both(f, list(frequency_tol = tol)))
+    expect_same_as_ggir(b)
+    res[[length(res) + 1]] <- b$ggir
+  }
+  # the tolerance changes GGIR's result here (imputed hours are not rest
+  # windows of the device's own samples)
+  expect_gt(res[[1]]$npoints, 50)
+  expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
+})
+
+test_that("desiredtz: a zone with a fixed offset over the recording gives GGIR's result", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # GGIR's desiredtz = "" is the session's zone: Europe/Amsterdam (UTC + 1
+  # in November, no change within these 30 hours) moves every block time by
+  # an hour, which leaves the result to the bit
+  f <- synth_cwa(seed = 63)
+  on.exit(unlink(f))
+  for (it in 1:2) {
+    b <- with_tz("Europe/Amsterdam", run_both(f, list(interpolationType = it)))
+    expect_same_as_ggir(b)
+  }
+})
+
+test_that("interpolationType 2: GENEActiv at a rate that is not whole, GGIR's to the bit", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  rec <- simulate_recording(hours = 30, sf = 12.5, seed = 64,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(rec, f, sf = 12.5)
+  res <- list()
+  for (it in 1:2) {
+    b <- run_both(f, list(interpolationType = it))
+    expect_same_as_ggir(b)
+    res[[it]] <- b$ggir
+  }
+  expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
+})
+
+test_that("desiredtz: across a change of UTC offset GGIR's result moves, and gravcal refuses", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # 30 hours across the end of daylight saving in Europe/Amsterdam
+  # (2023-10-29 01:00 UTC): readAxivity's block times go back an hour there
+  f <- synth_cwa(seed = 65, start = as.numeric(as.POSIXct("2023-10-28 12:00:00", tz = "UTC")))
+  on.exit(unlink(f))
+  quiet_ggir <- function() {
+    pr <- GGIR::load_params()$params_rawdata
+    I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr))
+    suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
+                                       verbose = FALSE))
+  }
+  utc <- with_tz("UTC", quiet_ggir())
+  ams <- with_tz("Europe/Amsterdam", quiet_ggir())
+  expect_false(identical(utc$spheredata, ams$spheredata))
+  # gravcal gives GGIR's UTC result, and refuses the other
+  G <- with_tz("UTC", suppressWarnings(g.calibrate(f, verbose = FALSE)))
+  expect_identical(G$scale, utc$scale)
+  expect_identical(unname(as.matrix(G$spheredata)), unname(as.matrix(utc$spheredata)))
+  expect_error(with_tz("Europe/Amsterdam", g.calibrate(f, verbose = FALSE)),
+               "`desiredtz` = \"\" (the session's time zone): the recording spans a change of UTC offset",
+               fixed = TRUE)
 })
