@@ -157,9 +157,11 @@ ggir_param_values <- function(door, given = list()) {
   out
 }
 
-# The parameters GGIR's g.calibrate() takes in its lists and `...`, by name
-# (every row with a GGIR name, whatever its status).
+# The parameters g.calibrate() takes silently in `...`, by name: every row
+# with a GGIR name but the ad hoc csv ones not yet read ("rmc (h7)"), which
+# are warned about there as before.
 ggir_param_known <- function() {
-  nms <- vapply(ggir_param_table(), function(p) as.character(p$ggir), "")
-  nms[!is.na(nms)]
+  rows <- Filter(function(p) !is.na(p$ggir) && p$status != "rmc (h7)",
+                 ggir_param_table())
+  vapply(rows, `[[`, "", "ggir")
 }

@@ -115,7 +115,7 @@ test_that("a reading parameter gravcal cannot honour is an error naming it", {
   # GGIR's parameters with no effect on the result are taken silently
   expect_silent(g.calibrate(rec, sf = 10, verbose = FALSE, do.cal = FALSE,
                             imputeTimegaps = FALSE, dataFormat = "raw",
-                            rmc.dec = ","))
+                            nonwear_range_threshold = 100))
 })
 
 test_that("desiredtz / configtz: refused for a .cwa that spans a change of UTC offset", {
