@@ -175,14 +175,15 @@ ggir_params <- function(params_rawdata, params_general, dots) {
 # 2004 to 2038 share one floating-point exponent); a change of offset
 # (daylight saving) during the recording moves the blocks after it, which
 # gravcal does not reproduce: an error naming the parameter. The span looked
-# at is the first block's time to the last block's, a day either side.
+# at is the first block's time to the last block's (calendar times read as
+# UTC), 15 hours either side (more than any zone's offset).
 ggir_check_tz <- function(src, datafile, desiredtz, configtz) {
   if (!identical(src$format, "cwa") || !is.character(datafile)) return(invisible())
   tz <- if (length(configtz)) configtz else desiredtz
   arg <- if (length(configtz)) "configtz" else "desiredtz"
   span <- cwa_time_span(datafile)
   if (is.null(span)) return(invisible())
-  at <- seq(span[1] - 86400, span[2] + 86400, by = 1800)
+  at <- seq(span[1] - 15 * 3600, span[2] + 15 * 3600, by = 1800)
   off <- as.POSIXlt(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), tz = tz)$gmtoff
   if (length(unique(off)) > 1 || anyNA(off)) {
     abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",

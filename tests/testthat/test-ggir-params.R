@@ -136,6 +136,13 @@ test_that("desiredtz / configtz: refused for a .cwa that spans a change of UTC o
   expect_error(g.calibrate(f, verbose = FALSE, desiredtz = "UTC",
                            configtz = "Europe/London"),
                "`configtz` = \"Europe/London\"", fixed = TRUE)
+  # the same two hours a day and a half before the change are taken
+  g <- tempfile(fileext = ".cwa")
+  on.exit(unlink(g), add = TRUE)
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), g, sf = 25,
+                      start = start - 36 * 3600)
+  C <- suppressWarnings(g.calibrate(g, verbose = FALSE, desiredtz = "Europe/Amsterdam"))
+  expect_type(C$QCmessage, "character")
   for (tz in c("UTC", "Etc/GMT-1", "Asia/Tokyo")) {
     C <- suppressWarnings(g.calibrate(f, verbose = FALSE, desiredtz = tz))
     expect_type(C$QCmessage, "character")
