@@ -102,7 +102,8 @@ test_that("frequency_tol: the decoder imputes where readAxivity does", {
 
 test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
   skip_if_not_installed("GGIR")
-  files <- c(cwa_testfile("ax3_testfile.cwa"), cwa_testfile("ax6_testfile.cwa"))
+  files <- c(cwa_testfile("ax3_testfile.cwa"), cwa_testfile("ax6_testfile.cwa"),
+             cwa_testfile("ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa"))
   long <- synth_cwa()
   on.exit(unlink(long))
   n <- 0
@@ -120,7 +121,7 @@ test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
       expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
     }
   }
-  expect_identical(n, 6)
+  expect_identical(n, 8)
 })
 
 test_that("g.calibrate() is GGIR's with frequency_tol 0.1 and 0.02 (.cwa, a clock off by 5 %)", {
