@@ -183,9 +183,12 @@ ggir_check_tz <- function(src, datafile, desiredtz, configtz) {
   arg <- if (length(configtz)) "configtz" else "desiredtz"
   span <- cwa_time_span(datafile)
   if (is.null(span)) return(invisible())
+  # calendar times every half hour, converted as readAxivity converts them
+  # (as.POSIXct() of the text in the zone): by how much each moves
   at <- seq(span[1] - 15 * 3600, span[2] + 15 * 3600, by = 1800)
-  off <- as.POSIXlt(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), tz = tz)$gmtoff
-  if (length(unique(off)) > 1 || anyNA(off)) {
+  txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+  off <- at - as.numeric(as.POSIXct(txt, tz = tz))
+  if (anyNA(off) || length(unique(off)) > 1) {
     abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",
           ": the recording spans a change of UTC offset in that zone (daylight ",
           "saving), which moves GGIR's .cwa block times; gravcal's decoder reads ",
