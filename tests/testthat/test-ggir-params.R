@@ -112,6 +112,9 @@ test_that("a reading parameter gravcal cannot honour is an error naming it", {
                             params_general = list(interpolationType = 3,
                                                   windowsizes = c(5, 900, 3600)),
                             params_cleaning = list(includedaycrit = 10)))
+  # calibrate(method = "ggir") takes no GGIR reading parameter: named
+  expect_error(calibrate(f, method = "ggir", interpolationType = 2),
+               "Unknown argument in `...`: `interpolationType`", fixed = TRUE)
   # GGIR's parameters with no effect on the result are taken silently
   expect_silent(g.calibrate(rec, sf = 10, verbose = FALSE, do.cal = FALSE,
                             imputeTimegaps = FALSE, dataFormat = "raw",
