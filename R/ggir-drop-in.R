@@ -51,20 +51,39 @@
 #' samples where GGIR's readers stop. `reader = "reference"` in `...` reads
 #' through GGIR's readers themselves (GGIRread, read.gt3x, data.table).
 #'
+#' @section GGIR's parameters:
+#' Every parameter of GGIR 3.3-9's `params_rawdata` and `params_general`
+#' that can change what `GGIR::g.calibrate()` returns, and what this
+#' function does with it (the package's one table of them is
+#' `R/ggir-params.R`). The others (`do.cal`, `backup.cal.coef`, `dynrange`,
+#' `minimumFileSizeMB`, `nonwear_range_threshold`, `imputeTimegaps`, the
+#' rest of `params_general` and all of `params_cleaning`) do not change
+#' it, and are taken and left alone.
+#'
+#' | parameter | changes GGIR's result for | here |
+#' |---|---|---|
+#' | `chunksize`, `spherecrit`, `minloadcrit` | every format | honoured |
+#' | `printsummary` | (prints only) | honoured |
+#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole | honoured (an error with `reader = "reference"` unless 1) |
+#' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
+#' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
+#' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
+#' | other `rmc.*` | ad hoc csv | as the ad hoc csv reader takes them |
+#'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
-#'   lists (as from `GGIR::load_params()`); gravcal uses `chunksize`,
-#'   `spherecrit`, `minloadcrit`, `printsummary` and, for ad hoc csv files
-#'   and data frames, `rmc.noise`, and ignores the rest. Missing entries take GGIR's defaults
+#'   lists (as from `GGIR::load_params()`); see "GGIR's parameters" for the
+#'   ones that change the result. Missing entries take GGIR's defaults
 #'   (`chunksize = 1`, `spherecrit = 0.3`, `minloadcrit = 168`,
-#'   `printsummary = FALSE`).
+#'   `printsummary = FALSE`, `interpolationType = 1`, `frequency_tol = 0.1`,
+#'   `desiredtz = ""`).
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
 #'   `sf` is used.
 #' @param verbose Print progress (the blocks read) as GGIR does.
 #' @param ... Legacy arguments that override the parameter lists, as in
-#'   GGIR (`chunksize`, `spherecrit`, `minloadcrit`, `printsummary`), `sf`
-#'   for a data frame, and `reader` (`"native"`, the default, or
-#'   `"reference"`).
+#'   GGIR (any parameter of the lists by name, e.g. `chunksize`,
+#'   `interpolationType`), `sf` for a data frame, and `reader` (`"native"`,
+#'   the default, or `"reference"`).
 #' @return GGIR's list: `scale`, `offset`, `tempoffset` (empty when no fit
 #'   ran), `cal.error.start`, `cal.error.end` (rounded to 5 digits),
 #'   `spheredata` (the rest windows: `Euclidean Norm, meanx, meany, meanz,
@@ -89,7 +108,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   if (length(dots) && (is.null(names(dots)) || any(names(dots) == ""))) {
     abort("All arguments in `...` must be named.")
   }
-  pr <- ggir_params(params_rawdata, dots)
+  pr <- ggir_params(params_rawdata, params_general, dots)
   check_flag(verbose, "verbose")
   check_fp_build("`g.calibrate()`")
   sf <- dots$sf
@@ -97,11 +116,14 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     sf <- inspectfileobject$sf
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
+  read_opts <- list(interpolation = pr$interpolationType,
+                    frequency_tol = pr$frequency_tol)
   open <- function() {
     open_source(datafile, sf = sf, chunksize = pr$chunksize,
-                reader = pr$reader, compat = TRUE)
+                reader = pr$reader, compat = TRUE, read_opts = read_opts)
   }
   src <- open()
+  ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor);
   # samples in a data frame, which GGIR does not take, are treated alike
   sdcriter <- if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
@@ -118,21 +140,84 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
 }
 
 # g.calibrate()'s parameters (ggir-params.R) from GGIR's params_rawdata and
-# the legacy arguments in `dots`, which win; other arguments GGIR takes are
-# accepted, anything else warned about.
-ggir_params <- function(params_rawdata, dots) {
-  if (length(params_rawdata) && !is.list(params_rawdata)) {
-    abort("`params_rawdata` must be a list (as from GGIR::load_params()), ",
-          "not ", describe(params_rawdata), ".")
+# params_general (each parameter from its own list, as GGIR reads it) and
+# the legacy arguments in `dots`, which win; other parameters GGIR takes
+# (the table's rows, params_cleaning's) are accepted, anything else in
+# `dots` warned about.
+ggir_params <- function(params_rawdata, params_general, dots) {
+  for (a in c("params_rawdata", "params_general")) {
+    v <- get(a)
+    if (length(v) && !is.list(v)) {
+      abort("`", a, "` must be a list (as from GGIR::load_params()), ",
+            "not ", describe(v), ".")
+    }
   }
-  known <- c(ggir_param_names("ggir"), "sf", "desiredtz", "configtz", "do.cal",
-             "use.temp", "windowsizes", "outputdir", "studyname", "overwrite")
+  rows <- ggir_param_rows("ggir")
+  from <- function(lst, which) {
+    nms <- vapply(Filter(function(p) identical(p$list, which), rows), `[[`, "", "ggir")
+    lst[intersect(names(lst), nms)]
+  }
+  known <- c(ggir_param_known(), "sf", "use.temp", "outputdir", "studyname")
   extra <- setdiff(names(dots), known)
   if (length(extra)) {
     warning("g.calibrate(): ignored argument", if (length(extra) > 1) "s",
             " ", paste0("`", extra, "`", collapse = ", "), call. = FALSE)
   }
-  ggir_param_values("ggir", list(params_rawdata, dots))
+  ggir_param_values("ggir", list(from(params_rawdata, "rawdata"),
+                                 from(params_general, "general"), dots))
+}
+
+# desiredtz / configtz (GGIR's params_general) for a .cwa file: readAxivity
+# converts each block's calendar time to seconds in that zone (configtz,
+# else desiredtz; "" is the session's zone); gravcal's decoder converts in
+# UTC. A constant offset moves every time by the same whole seconds, which
+# leaves GGIR's resampling and so its result to the bit unchanged (times of
+# 2004 to 2038 share one floating-point exponent); a change of offset
+# (daylight saving) during the recording moves the blocks after it, which
+# gravcal does not reproduce: an error naming the parameter. The span looked
+# at is the first block's time to the last block's (calendar times read as
+# UTC), 15 hours either side (more than any zone's offset).
+ggir_check_tz <- function(src, datafile, desiredtz, configtz) {
+  if (!identical(src$format, "cwa") || !is.character(datafile)) return(invisible())
+  tz <- if (length(configtz)) configtz else desiredtz
+  arg <- if (length(configtz)) "configtz" else "desiredtz"
+  span <- cwa_time_span(datafile)
+  if (is.null(span)) return(invisible())
+  # calendar times every half hour, converted as readAxivity converts them
+  # (as.POSIXct() of the text in the zone): by how much each moves
+  at <- seq(span[1] - 15 * 3600, span[2] + 15 * 3600, by = 1800)
+  txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+  off <- at - as.numeric(as.POSIXct(txt, tz = tz))
+  if (anyNA(off) || length(unique(off)) > 1) {
+    abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",
+          ": the recording spans a change of UTC offset in that zone (daylight ",
+          "saving), which moves GGIR's .cwa block times; gravcal's decoder reads ",
+          "them in UTC and does not reproduce that. Give a zone without a ",
+          "change there (\"UTC\", or a fixed offset such as \"Etc/GMT-1\").")
+  }
+  invisible()
+}
+
+# The first and last block times of a .cwa file (seconds since 1970, read
+# as UTC) from the first and the last whole block's packed time; one for
+# both when the other is not a date; NULL when neither is.
+cwa_time_span <- function(file) {
+  size <- file.size(file)
+  if (is.na(size) || size < 1024 + 512) return(NULL)
+  con <- file(file, "rb")
+  on.exit(close(con))
+  at <- function(block) {
+    seek(con, 1024 + 512 * block + 14)
+    b <- as.numeric(readBin(con, "raw", 4))
+    coded <- sum(b * 256^(0:3))
+    field <- function(shift, bits) (coded %/% 2^shift) %% 2^bits
+    as.numeric(ISOdatetime(2000 + field(26, 6), field(22, 4), field(17, 5),
+                           field(12, 5), field(6, 6), field(0, 6), tz = "UTC"))
+  }
+  t <- c(at(0), at((size - 1024) %/% 512 - 1))
+  t <- t[is.finite(t)]
+  if (!length(t)) return(NULL)
+  range(t)
 }
 
 # calibrate(method = "ggir"): the procedure, then a gravcal_fit.

@@ -1,7 +1,24 @@
 # GGIR's parameters, once. Each row: its name in g.calibrate() (GGIR's own
-# name, as in GGIR's params_rawdata; NA where g.calibrate() does not take
+# name, as in GGIR's parameter lists; NA where g.calibrate() does not take
 # it), its name in calibrate(method = "ggir") (NA where that does not take
-# it), its default and its check. The two front doors read names, defaults
+# it), its default and its check; then the audit of GGIR 3.3-9: the list it
+# belongs to (`list`: "rawdata", "general"; NA for gravcal's own), GGIR's
+# default there (`ggir_default`, GGIR::load_params() of GGIR 3.3-9, recorded
+# here: GGIR is only suggested and never asked at run time), what it changes
+# in what GGIR::g.calibrate() returns and for which formats (`effect`), and
+# gravcal's `status`:
+#   "honoured"  g.calibrate() gives GGIR's result for the value (read by
+#               the front doors through ggir_param_values()); where it
+#               cannot, `effect` says so and g.calibrate() stops with an
+#               error naming the parameter (ggir_params(), ggir_check_tz());
+#   "no effect" it does not change what GGIR::g.calibrate() returns: taken
+#               and left alone;
+#   "rmc (h7)"  an ad hoc csv reading parameter (GGIR's read.myacc.csv),
+#               taken as before, being implemented on its own branch.
+# The audit read GGIR 3.3-9's g.calibrate(), g.readaccfile(),
+# g.inspectfile(), g.imputeTimegaps() and GGIRread 1.2.0's readAxivity() and
+# readGENEActiv(). g.calibrate() never reads params_cleaning: every entry of
+# it is "no effect" (not listed). The two front doors read names, defaults
 # and checks from here: g.calibrate() through ggir_params(),
 # calibrate(method = "ggir") through calibrate_ggir(). The constants behind
 # the defaults, with their sources, are in ggir_constants (ggir.R).
@@ -9,38 +26,115 @@
 # the package's files are read in.
 ggir_param_table <- function() {
   k <- ggir_constants
-  row <- function(ggir, own, default, check = NULL) {
-    list(ggir = ggir, own = own, default = default, check = check)
+  row <- function(ggir, own, default, check = NULL, status = "honoured",
+                  list = if (is.na(ggir)) NA_character_ else "rawdata",
+                  ggir_default = default, effect = "") {
+    list(ggir = ggir, own = own, default = default, check = check,
+         status = status, list = list, ggir_default = ggir_default,
+         effect = effect)
+  }
+  # rows GGIR reads nowhere on g.calibrate()'s path, or only for output
+  no_effect <- function(list, defaults, effect) {
+    lapply(names(defaults), function(nm) {
+      row(nm, NA, defaults[[nm]], status = "no effect", list = list,
+          effect = effect)
+    })
+  }
+  rmc <- function(defaults) {
+    lapply(names(defaults), function(nm) {
+      row(nm, NA, defaults[[nm]], status = "rmc (h7)",
+          effect = "ad hoc csv: how the file is read (read.myacc.csv)")
+    })
   }
   at_least_0 <- function(x, arg) check_number(x, arg, min = 0)
   above_0 <- function(x, arg) check_number(x, arg, min = 0, min_inclusive = FALSE)
-  # in calibrate()'s order (its message for an unknown argument lists them)
-  list(
-    row(NA, "use_temp", TRUE, check_flag),
-    row("spherecrit", "spherecrit", k$spherecrit, at_least_0),
-    row("minloadcrit", "minloadcrit", k$minloadcrit, at_least_0),
-    row("chunksize", "chunksize", 1, function(x, arg) {
-      check_number(x, arg, min = 0, max = 1, min_inclusive = FALSE)
-    }),
-    row(NA, "max_sd", k$max_sd, above_0),
-    row(NA, "max_iter", k$max_iter, function(x, arg) {
-      check_number(x, arg, min = 1, max = .Machine$integer.max, integer = TRUE)
-    }),
-    row(NA, "tol", k$tol, at_least_0),
-    row(NA, "verbose", FALSE, check_flag),
-    row("printsummary", NA, FALSE, check_flag),
-    # GGIR reads rmc.noise (ad hoc csv files) only when given
-    row("rmc.noise", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg)),
-    row("rmc.sf", NA, NULL),
-    # checked where the source is opened (open_source())
-    row("reader", "reader", "native")
+  tz_check <- function(x, arg) {
+    if (!is.null(x) && !(is.character(x) && length(x) == 1 && !is.na(x))) {
+      abort("`", arg, "` must be a time zone name (a string), not ", describe(x), ".")
+    }
+  }
+  c(
+    # in calibrate()'s order (its message for an unknown argument lists them)
+    list(
+      row(NA, "use_temp", TRUE, check_flag),
+      row("spherecrit", "spherecrit", k$spherecrit, at_least_0,
+          effect = "all formats: the sphere coverage test"),
+      row("minloadcrit", "minloadcrit", k$minloadcrit, at_least_0,
+          effect = "all formats: hours read before a fit can stop the reading"),
+      row("chunksize", "chunksize", 1, function(x, arg) {
+        check_number(x, arg, min = 0, max = 1, min_inclusive = FALSE)
+      }, effect = "all formats: GGIR's block size, so the block boundaries"),
+      row(NA, "max_sd", k$max_sd, above_0),
+      row(NA, "max_iter", k$max_iter, function(x, arg) {
+        check_number(x, arg, min = 1, max = .Machine$integer.max, integer = TRUE)
+      }),
+      row(NA, "tol", k$tol, at_least_0),
+      row(NA, "verbose", FALSE, check_flag),
+      row("printsummary", NA, FALSE, check_flag,
+          effect = "prints a summary (with verbose = TRUE); the result is the same"),
+      # GGIR reads rmc.noise (ad hoc csv files) only when given
+      row("rmc.noise", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg),
+          ggir_default = 13,
+          effect = "ad hoc csv: the rest threshold (1.2 * rmc.noise)"),
+      row("rmc.sf", NA, NULL, effect = "ad hoc csv: the sampling rate"),
+      row("interpolationType", NA, 1, function(x, arg) {
+        if (!(is.numeric(x) && length(x) == 1 && x %in% c(1, 2))) {
+          abort("`", arg, "` must be 1 (linear) or 2 (nearest neighbour), not ",
+                describe(x), ".")
+        }
+      }, effect = paste0(".cwa (readAxivity's resampling), GENEActiv .bin at a ",
+                         "rate that is not whole (g.readaccfile's resampling); ",
+                         "ad hoc csv with rmc.doresample (rmc, h7)")),
+      row("frequency_tol", NA, 0.1, at_least_0,
+          effect = ".cwa: readAxivity's tolerance on a block's rate before it imputes"),
+      row("desiredtz", NA, "", tz_check, list = "general",
+          effect = paste0(".cwa: the zone of readAxivity's block times (configtz ",
+                          "when that is not given); a change of UTC offset ",
+                          "(daylight saving) during the recording moves them; ",
+                          "honoured where the offset stays the same, refused ",
+                          "otherwise. Ad hoc csv: rmc (h7)")),
+      row("configtz", NA, NULL, tz_check, list = "general",
+          effect = "as desiredtz, which it replaces when given"),
+      # checked where the source is opened (open_source())
+      row("reader", "reader", "native", list = NA_character_)
+    ),
+    no_effect("rawdata", list(
+      do.cal = TRUE, backup.cal.coef = "retrieve", dynrange = NULL,
+      minimumFileSizeMB = 2, nonwear_range_threshold = 150),
+      "read by GGIR's g.part1 and later steps, not by g.calibrate()"),
+    list(row("imputeTimegaps", NA, TRUE, status = "no effect",
+             effect = paste0("g.calibrate() calls g.imputeTimegaps() with ",
+                             "impute = FALSE whatever it is"))),
+    rmc(list(
+      rmc.dec = ".", rmc.firstrow.acc = NULL, rmc.firstrow.header = NULL,
+      rmc.header.length = NULL, rmc.col.acc = 1:3, rmc.col.temp = NULL,
+      rmc.col.time = NULL, rmc.unit.acc = "g", rmc.unit.temp = "C",
+      rmc.unit.time = "POSIX", rmc.format.time = "%Y-%m-%d %H:%M:%OS",
+      rmc.bitrate = NULL, rmc.dynamic_range = NULL, rmc.unsignedbit = TRUE,
+      rmc.origin = "1970-01-01", rmc.desiredtz = NULL, rmc.configtz = NULL,
+      rmc.headername.sf = NULL, rmc.headername.sn = NULL,
+      rmc.headername.recordingid = NULL, rmc.header.structure = NULL,
+      rmc.check4timegaps = FALSE, rmc.col.wear = NULL, rmc.doresample = FALSE,
+      rmc.scalefactor.acc = 1)),
+    no_effect("general", list(
+      overwrite = FALSE, acc.metric = "ENMO", maxNcores = NULL,
+      print.filename = FALSE, do.parallel = TRUE, windowsizes = c(5, 900, 3600),
+      idloc = 1, dayborder = 0, part5_agg2_60seconds = FALSE,
+      sensor.location = "wrist", expand_tail_max_hours = NULL,
+      recordingEndSleepHour = NULL, dataFormat = "raw",
+      maxRecordingInterval = NULL, extEpochData_timeformat = "%d-%m-%Y %H:%M:%S",
+      recording_split_times = NULL, recording_split_timeformat = "%d/%m/%Y %H:%M",
+      recording_split_overlap = 0, recording_split_ignore_edges = FALSE,
+      use_trycatch_serial = FALSE),
+      "read by GGIR's later steps, not on g.calibrate()'s path")
   )
 }
 
 # The rows a front door takes: door "ggir" (g.calibrate()) or "own"
-# (calibrate(method = "ggir")).
+# (calibrate(method = "ggir")): the honoured ones under that door's name.
 ggir_param_rows <- function(door) {
-  Filter(function(p) !is.na(p[[door]]), ggir_param_table())
+  Filter(function(p) !is.na(p[[door]]) && p$status == "honoured",
+         ggir_param_table())
 }
 
 ggir_param_names <- function(door) {
@@ -61,4 +155,13 @@ ggir_param_values <- function(door, given = list()) {
     if (!is.null(p$check)) p$check(out[[p[[door]]]], p[[door]])
   }
   out
+}
+
+# The parameters g.calibrate() takes silently in `...`, by name: every row
+# with a GGIR name but the ad hoc csv ones not yet read ("rmc (h7)"), which
+# are warned about there as before.
+ggir_param_known <- function() {
+  rows <- Filter(function(p) !is.na(p$ggir) && p$status != "rmc (h7)",
+                 ggir_param_table())
+  vapply(rows, `[[`, "", "ggir")
 }

@@ -8,10 +8,15 @@
 # maybe temperature, last = logical), or NULL at the end; one block a unit).
 # Block sizes are GGIR's (g.calibrate / g.readaccfile), so that gravcal cuts a
 # file where GGIR does: `chunksize` scales them (1 = about 12 hours).
+# `read_opts`: GGIR's reading parameters for the native decoders, as decoder
+# options (`interpolation`, GGIR's interpolationType: .cwa and GENEActiv at
+# a rate that is not whole; `frequency_tol`: .cwa); GGIR's own readers
+# (reader = "reference") are called with GGIR's defaults, so another value
+# there is an error naming the parameter.
 
 
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
-                        reader = "native", compat = TRUE) {
+                        reader = "native", compat = TRUE, read_opts = list()) {
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -24,9 +29,10 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   format <- file_format(datafile, arg)
   src <- NULL
   if (reader == "native" && format_has_decoder(format)) {
-    src <- source_native(datafile, format, sf, chunksize, compat, arg)
+    src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts)
   }
   if (is.null(src)) {
+    check_reference_opts(read_opts, format)
     src <- format_entry(format)$source(datafile, sf, chunksize, arg)
   }
   src$filename <- basename(datafile)
@@ -112,8 +118,9 @@ native_open_error <- function(file, format, why, arg) {
 # each block comes as one or more parts (list(cols, from, to)), which hold
 # the samples of GGIR's block together, however many samples that is.
 # `segment()` streams units straight into a segmenter, without R vectors.
-source_native <- function(file, format, sf, chunksize, compat, arg) {
-  opts <- list(compat = as.numeric(isTRUE(compat)))
+source_native <- function(file, format, sf, chunksize, compat, arg,
+                          read_opts = list()) {
+  opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
@@ -140,6 +147,25 @@ source_native <- function(file, format, sf, chunksize, compat, arg) {
 }
 
 `%||%` <- function(a, b) if (is.null(a)) b else a
+
+# GGIR's readers, as gravcal calls them, take GGIR's default reading
+# parameters only: another value, for a format whose reading it changes, is
+# an error naming GGIR's parameter.
+check_reference_opts <- function(read_opts, format) {
+  defaults <- list(interpolation = c(interpolationType = 1),
+                   frequency_tol = c(frequency_tol = 0.1))
+  used <- switch(format, cwa = c("interpolation", "frequency_tol"),
+                 geneactiv = "interpolation", character(0))
+  for (nm in intersect(intersect(names(read_opts), names(defaults)), used)) {
+    d <- defaults[[nm]]
+    if (!identical(as.numeric(read_opts[[nm]]), unname(d))) {
+      abort("`", names(d), "` = ", describe(read_opts[[nm]]), " is taken by ",
+            "gravcal's own decoders only (reader = \"native\"); GGIR's readers ",
+            "are called with its default ", format(d), ".")
+    }
+  }
+  invisible()
+}
 
 source_frame <- function(x, sf, chunksize, arg) {
   s <- as_samples(x, arg)

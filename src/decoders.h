@@ -47,7 +47,8 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
   // GGIR resamples a rate that is not whole onto whole Hz (compat = 1;
   // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
   if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d)));
+  const int interpolation = static_cast<int>(opts.num("interpolation", 1));
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d), interpolation));
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating

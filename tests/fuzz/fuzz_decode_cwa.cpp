@@ -1,5 +1,6 @@
 // libFuzzer harness: the .cwa decoder on arbitrary bytes, in both modes.
-// The first 3 bytes choose the mode, the window size and whether to make the
+// The first 3 bytes choose the mode (bit 0: compat; bit 2: nearest-neighbour
+// interpolation, GGIR's interpolationType = 2), the window size and whether to make the
 // blocks' checksums (and "MD"/"AX" tags) right, so that fuzzed content gets
 // past the checksum. Checks, besides the sanitizers' findings: no read past
 // the buffer's capacity, the report's counts agree with what was given, the
@@ -23,10 +24,11 @@ struct Run {
 };
 
 bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t window,
-         std::size_t cap, Run& r) {
+         std::size_t cap, Run& r, double interpolation = 1) {
   gravcal::MemorySource src(file.data(), file.size());
   gravcal::Options opts;
   opts.set("compat", compat ? 1.0 : 0.0);
+  opts.set("interpolation", interpolation);
   gravcal::CwaDecoder dec(src, opts);
   if (!dec.open()) {
     if (dec.error().empty()) __builtin_trap();
@@ -93,17 +95,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<unsigned char> file(in.p, in.p + in.n);
   if (fix & 1) repair(file, (fix & 2) != 0);
   const bool compat = mode & 1;
+  const double interpolation = (mode & 4) ? 2 : 1;
   if (window == 0) return 0;
   const std::size_t blocks = file.size() > 1024 ? (file.size() - 1024) / 512 : 0;
   Run big, small;
   const std::size_t cap = 4096;
-  const bool ok = run(file, compat, window, cap, big);
-  if (run(file, compat, window, 7, small) != ok) __builtin_trap();
+  const bool ok = run(file, compat, window, cap, big, interpolation);
+  if (run(file, compat, window, 7, small, interpolation) != ok) __builtin_trap();
   // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
   if (gravcal::use_avx2()) {
     Run base;
     gravcal::set_avx2(false);
-    const bool ok2 = run(file, compat, window, cap, base);
+    const bool ok2 = run(file, compat, window, cap, base, interpolation);
     gravcal::set_avx2(true);
     if (ok2 != ok || base.v.size() != big.v.size() || base.units != big.units ||
         base.report.skipped != big.report.skipped || !same(big, base)) {

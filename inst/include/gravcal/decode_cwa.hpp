@@ -7,7 +7,9 @@
 // axes (3 for AX3, 6 for AX6: gx gy gz ax ay az). The 16-bit little-endian
 // word sum of a block is 0. One unit = one data block.
 //
-// Options: "compat" (default 1).
+// Options: "compat" (default 1); with compat = 1 also "interpolation" (1,
+// the default: linear; 2: nearest neighbour, readAxivity's
+// interpolationType) and "frequency_tol" (default 0.1, readAxivity's).
 //  compat = 0: the samples at their own times, no resampling. Sample i of a
 //    block is at start + i / f, start = T + frac / 65536 - offset / f (T the
 //    packed RTC time, frac the block's fraction of a second, offset the
@@ -15,7 +17,7 @@
 //    Each block's time is decoded on its own. Packed samples are scaled by
 //    1/256 g (cwa.h: lightScale's scale bits are for unpacked data only).
 //  compat = 1: what GGIR receives from GGIRread 1.2.0 readAxivity(start,
-//    end, interpolationType = 1, frequency_tol = 0.1) called window after
+//    end, interpolationType, frequency_tol) called window after
 //    window: read(out, B) is one call with start = the previous call's end
 //    (first 0), end = start + B. Per window, as readAxivity does:
 //    - the output grid is startTs + k / f_header (R's seq(): k * step, then
@@ -29,9 +31,11 @@
 //      its "parameters"), and its time from the RTC minute cache (a same-
 //      minute block adds its seconds difference, +60 when they go back).
 //    - block b's samples are spread evenly from its start to the next good
-//      block's start and linearly interpolated onto the grid; when the next
-//      good block's sequence number is not b's + 1 (a skipped block), or the
-//      observed rate is off by more than 10 %, the grid points of b's span
+//      block's start and interpolated onto the grid (linearly, or to the
+//      nearest neighbour: GGIRread::resample's ceil(u - 0.5) in place of
+//      the weight u); when the next good block's sequence number is not
+//      b's + 1 (a skipped block), or the observed rate is off by more than
+//      frequency_tol (10 %), the grid points of b's span
 //      are filled with the last output sample normalised to 1 g (or 0, 0, 1
 //      when its norm is outside 0.8..1.2): "imputed", counted here.
 //    - a window that starts with bad blocks skips them; a window whose end
@@ -79,7 +83,7 @@ constexpr int max_samples = 120;            // 480 data bytes / 4
 constexpr int data_offset = 30;             // first sample byte
 constexpr std::size_t buffer_blocks = 64;   // blocks read at once
 constexpr int max_bad_run = 20;             // readAxivity maxAllowedCorruptBlocks
-constexpr double frequency_tol = 0.1;       // GGIR's frequency_tol
+constexpr double frequency_tol = 0.1;       // GGIR's default frequency_tol
 constexpr double max_impute_s = 259200.0;   // readAxivity refuses gaps over 3 days
 constexpr double gap_tol_s = 1.0;           // a late block beyond this is a gap
 constexpr double anchor_dt = 0.00001;       // readAxivity's first anchor, before the first sample
@@ -235,7 +239,10 @@ struct Block {
 class CwaDecoder : public Decoder {
  public:
   CwaDecoder(ByteSource& src, const Options& opts)
-      : src_(src), compat_(opts.num("compat", 1) != 0) {}
+      : src_(src),
+        compat_(opts.num("compat", 1) != 0),
+        nearest_(opts.num("interpolation", 1) == 2),
+        frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)) {}
 
   bool open() override;
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
@@ -271,6 +278,8 @@ class CwaDecoder : public Decoder {
 
   ByteSource& src_;
   bool compat_;
+  bool nearest_;                   // interpolationType = 2
+  double frequency_tol_;
   bool done_ = false;
   std::int64_t n_blocks_ = -1;     // complete data blocks in the file; -1 unknown
   double header_f_ = 0;            // rate in the header (GGIR's grid rate)
@@ -764,7 +773,7 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   raw_t_[0] = ianchor_t_;
   if (final_block && alone) observed = p.frequency;
   const double bias = std::fabs(observed - p.frequency) / p.frequency;
-  impute_ = (!final_block && seq_break) || bias > cwa::frequency_tol;
+  impute_ = (!final_block && seq_break) || bias > frequency_tol_;
   std::int64_t last = std::min(pos_ + 200, nr_ - 1);
   if (raw_t_[len] > grid(last)) {
     const double add = std::floor((raw_t_[len] - grid(last)) * p.frequency);
@@ -843,7 +852,10 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     sp.step = step_;
     sp.end = end_ts_;
     sp.temp = p.h.temperature;
-    given = kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
+    sp.nearest = nearest_;
+    // nearest neighbour (interpolationType = 2): the scalar reference only
+    given = nearest_ ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
+                     : kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
   }
   pos_ += given;
   out.n += static_cast<std::size_t>(given);

@@ -9,7 +9,9 @@
 // 1e-10)) and round() halving to even, less the grid's last point; every column, temperature included.
 // A grid point g lies in the first interval (t[j-1], t[j]] of raw times
 // with t[j] >= g (j >= 1), and takes u (v[j] - v[j-1]) + v[j-1] with u = (g
-// - t[j-1]) / (t[j] - t[j-1]), as GGIRread::resample computes it.
+// - t[j-1]) / (t[j] - t[j-1]), as GGIRread::resample computes it; with
+// GGIR's interpolationType = 2 (nearest neighbour) u is replaced by
+// ggir_nearest_weight(u) (kernels/decode.hpp).
 //
 // GgirResampler does this while the samples stream: a grid point is computed
 // once its interval has arrived and given on once the grid is known to go
@@ -28,13 +30,15 @@
 
 #include "decode.hpp"
 #include "decode_geneactiv.hpp"
+#include "kernels.hpp"
 
 namespace gravcal {
 
 class GgirResampler : public Decoder {
  public:
-  explicit GgirResampler(std::unique_ptr<GeneactivDecoder> inner)
-      : inner_(std::move(inner)) {}
+  // interpolation: 1 linear, 2 nearest neighbour (GGIR's interpolationType)
+  explicit GgirResampler(std::unique_ptr<GeneactivDecoder> inner, int interpolation = 1)
+      : inner_(std::move(inner)), nearest_(interpolation == 2) {}
 
   bool open() override {
     const bool ok = inner_->open();
@@ -147,7 +151,8 @@ class GgirResampler : public Decoder {
       if (!(g <= cur[4])) break;
       Point p;
       p.k = k_++;
-      const double u = (g - prev_[4]) / (cur[4] - prev_[4]);
+      double u = (g - prev_[4]) / (cur[4] - prev_[4]);
+      if (nearest_) u = ggir_nearest_weight(u);
       for (int c = 0; c < 4; ++c) p.v[c] = u * (cur[c] - prev_[c]) + prev_[c];
       p.v[4] = g;
       pending_.push_back(p);
@@ -188,6 +193,7 @@ class GgirResampler : public Decoder {
   }
 
   std::unique_ptr<GeneactivDecoder> inner_;
+  bool nearest_ = false;
   bool active_ = false;
   double by_ = 0.0;
   std::vector<double> raw_;

@@ -11,12 +11,23 @@
 
 #include "../fp_contract.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include "../simd.hpp"
 
 namespace gravcal {
+
+// GGIR's nearest-neighbour resampling (interpolationType = 2, as
+// GGIRread::resample computes it): the weight u of a grid point between two
+// samples becomes 0 up to u = 0.5 and 1 beyond (0 outside [0, 1]); the value
+// is then computed as the linear one, w * (right - left) + left.
+inline double ggir_nearest_weight(double u) {
+  if (u < 0 || u > 1) u = 0;
+  return std::ceil(u - 0.5);
+}
+
 namespace kernels {
 
 // ---------------------------------------------------------------------------
@@ -183,7 +194,8 @@ constexpr Variants<SpanTimesFn> span_times_variants = {span_times_scalar, nullpt
 // `source`: w = (t - time[k - 1]) / (time[k] - time[k - 1]), then w (v[k] -
 // v[k - 1]) + v[k - 1] per axis. Returns how many were written; source
 // follows, and a (the last point's values) and at (its time) are set when
-// any was.
+// any was. With s.nearest (interpolationType = 2), w becomes
+// ggir_nearest_weight(w): the scalar reference only (the caller chooses it).
 
 struct InterpSpan {
   const double* time = nullptr;  // time[0] the point the span starts from, time[1..len] its samples'
@@ -192,6 +204,7 @@ struct InterpSpan {
   double lim = 0;  // time[len]
   double start = 0, step = 0, end = 0;
   double temp = 0;  // written to o.t when not null
+  bool nearest = false;  // ggir_nearest_weight() on w (the scalar reference only)
 };
 
 struct InterpOut {
@@ -225,7 +238,8 @@ inline std::int64_t cwa_interp_scalar(const InterpSpan& s, std::int64_t pos, std
     t = t < end ? t : end;
     if (!(t <= lim)) break;
     while (src < s.len && T[src] < t) ++src;
-    const double w = (t - T[src - 1]) / (T[src] - T[src - 1]);
+    double w = (t - T[src - 1]) / (T[src] - T[src - 1]);
+    if (s.nearest) w = ggir_nearest_weight(w);
     a0 = w * (X[src] - X[src - 1]) + X[src - 1];
     a1 = w * (Y[src] - Y[src - 1]) + Y[src - 1];
     a2 = w * (Z[src] - Z[src - 1]) + Z[src - 1];

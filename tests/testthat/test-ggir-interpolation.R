@@ -1,0 +1,198 @@
+# GGIR's reading parameters on .cwa files: interpolationType (1 linear, 2
+# nearest neighbour) and frequency_tol, honoured by the native decoder
+# (decode_cwa.hpp); desiredtz / configtz honoured where the zone's UTC offset
+# stays the same over the recording, refused where it changes.
+# References: GGIRread 1.2.0's readAxivity() on the same bytes, called as
+# GGIR 3.3-9's g.readaccfile calls it, and GGIR::g.calibrate() itself.
+
+cwa_testfile <- function(name) {
+  skip_if_not_installed("GGIRread")
+  p <- system.file("testfiles", name, package = "GGIRread")
+  if (!nzchar(p)) skip(paste("GGIRread has no test file", name))
+  p
+}
+
+with_tz <- function(tz, code) {
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = tz)
+  on.exit(if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old))
+  code
+}
+
+# readAxivity window after window (B blocks), as g.readaccfile calls it
+ref_cwa <- function(f, B, interpolationType = 1, frequency_tol = 0.1) {
+  with_tz("UTC", {
+    out <- list()
+    s <- 0
+    header <- NULL
+    repeat {
+      P <- tryCatch(suppressWarnings(GGIRread::readAxivity(
+        f, start = s, end = s + B, progressBar = FALSE, desiredtz = "",
+        configtz = "", interpolationType = interpolationType,
+        frequency_tol = frequency_tol, header = header)),
+        error = function(e) NULL)
+      if (is.null(P) || is.null(P$data)) break
+      header <- P$header
+      out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time")]
+      s <- s + B
+    }
+    d <- do.call(rbind, out)
+    names(d)[4] <- "temperature"
+    rownames(d) <- NULL
+    d
+  })
+}
+
+# the native decoder, one read of B blocks at a time
+nat_cwa <- function(f, B, opts) {
+  h <- gravcal:::native_open(f, "cwa", c(list(compat = 1), opts))
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  out <- list()
+  repeat {
+    b <- gravcal:::native_block(h, B, B * 120 + 1000, TRUE, TRUE)
+    n <- b$to
+    if (n > 0) out[[length(out) + 1]] <- as.data.frame(lapply(b$cols, `[`, seq_len(n)))
+    if (b$done || (n == 0 && b$units == 0)) break
+  }
+  d <- do.call(rbind, out)
+  rownames(d) <- NULL
+  d
+}
+
+# A 30-hour .cwa at 25 Hz from the simulator: rest on several faces, with
+# movement and temperature; `drift`: from hour 3 to hour 20 the block times
+# advance 5 % slower than the samples (readAxivity observes a rate 5 % off
+# the nominal one: imputed when frequency_tol is below 0.05).
+synth_cwa <- function(hours = 30, sf = 25, seed = 61, start = 1.7e9, drift = FALSE) {
+  rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  dt <- rep(1 / sf, nrow(rec))
+  if (drift) dt[(3 * 3600 * sf):(20 * 3600 * sf)] <- 1 / (sf * 1.05)
+  f <- tempfile(fileext = ".cwa")
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = sf,
+                      start = start, temperature = rec$temperature, range = 8,
+                      time = start + cumsum(dt) - dt[1])
+  f
+}
+
+test_that("interpolationType 2: the decoder gives readAxivity's samples to the bit", {
+  for (name in c("ax3_testfile.cwa", "ax6_testfile.cwa",
+                 "ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa")) {
+    f <- cwa_testfile(name)
+    for (B in c(54000, 37)) {
+      ref <- ref_cwa(f, B, interpolationType = 2)
+      nat <- nat_cwa(f, B, list(interpolation = 2))
+      expect_gt(nrow(ref), 11000)
+      expect_identical(nat, ref, label = paste(name, "B =", B))
+      # and it is not the linear result (the parameter is not ignored)
+      lin <- nat_cwa(f, B, list(interpolation = 1))
+      expect_false(identical(lin$x, nat$x), label = paste(name, "B =", B))
+    }
+  }
+})
+
+test_that("frequency_tol: the decoder imputes where readAxivity does", {
+  f <- cwa_testfile("ax3_testfile.cwa")
+  for (tol in c(0.1, 0.001)) {
+    ref <- ref_cwa(f, 37, frequency_tol = tol)
+    nat <- nat_cwa(f, 37, list(frequency_tol = tol))
+    expect_identical(nat, ref, label = paste("frequency_tol =", tol))
+  }
+})
+
+test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
+  skip_if_not_installed("GGIR")
+  files <- c(cwa_testfile("ax3_testfile.cwa"), cwa_testfile("ax6_testfile.cwa"),
+             cwa_testfile("ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa"))
+  long <- synth_cwa()
+  on.exit(unlink(long))
+  n <- 0
+  for (f in c(files, long)) {
+    res <- list()
+    for (it in 1:2) {
+      b <- with_tz("UTC", run_both(f, list(interpolationType = it)))
+      expect_same_as_ggir(b)
+      n <- n + 1
+      res[[it]] <- b$ggir
+    }
+    if (identical(f, long)) {
+      # 30 hours: a fit, and the two interpolations give other numbers
+      expect_gt(res[[2]]$npoints, 50)
+      expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
+    }
+  }
+  expect_identical(n, 8)
+})
+
+test_that("g.calibrate() is GGIR's with frequency_tol 0.1 and 0.02 (.cwa, a clock off by 5 %)", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  f <- synth_cwa(seed = 62, drift = TRUE)
+  on.exit(unlink(f))
+  res <- list()
+  for (tol in c(0.1, 0.02)) {
+    b <- with_tz("UTC", run_both(f, list(frequency_tol = tol)))
+    expect_same_as_ggir(b)
+    res[[length(res) + 1]] <- b$ggir
+  }
+  # the tolerance changes GGIR's result here (imputed hours are not rest
+  # windows of the device's own samples)
+  expect_gt(res[[1]]$npoints, 50)
+  expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
+})
+
+test_that("desiredtz: a zone with a fixed offset over the recording gives GGIR's result", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # GGIR's desiredtz = "" is the session's zone: Europe/Amsterdam (UTC + 1
+  # in November, no change within these 30 hours) moves every block time by
+  # an hour, which leaves the result to the bit
+  f <- synth_cwa(seed = 63)
+  on.exit(unlink(f))
+  for (it in 1:2) {
+    b <- with_tz("Europe/Amsterdam", run_both(f, list(interpolationType = it)))
+    expect_same_as_ggir(b)
+  }
+})
+
+test_that("interpolationType 2: GENEActiv at a rate that is not whole, GGIR's to the bit", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  rec <- simulate_recording(hours = 30, sf = 12.5, seed = 64,
+                            tempoffset = c(0.002, -0.001, 0.0015))
+  f <- tempfile(fileext = ".bin")
+  on.exit(unlink(f))
+  gravcal:::write_geneactiv_bin(rec, f, sf = 12.5)
+  res <- list()
+  for (it in 1:2) {
+    b <- run_both(f, list(interpolationType = it))
+    expect_same_as_ggir(b)
+    res[[it]] <- b$ggir
+  }
+  expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
+})
+
+test_that("desiredtz: across a change of UTC offset GGIR's result moves, and gravcal refuses", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # 30 hours across the end of daylight saving in Europe/Amsterdam
+  # (2023-10-29 01:00 UTC): readAxivity's block times go back an hour there
+  f <- synth_cwa(seed = 65, start = as.numeric(as.POSIXct("2023-10-28 12:00:00", tz = "UTC")))
+  on.exit(unlink(f))
+  quiet_ggir <- function() {
+    pr <- GGIR::load_params()$params_rawdata
+    I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr))
+    suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
+                                       verbose = FALSE))
+  }
+  utc <- with_tz("UTC", quiet_ggir())
+  ams <- with_tz("Europe/Amsterdam", quiet_ggir())
+  expect_false(identical(utc$spheredata, ams$spheredata))
+  # gravcal gives GGIR's UTC result, and refuses the other
+  G <- with_tz("UTC", suppressWarnings(g.calibrate(f, verbose = FALSE)))
+  expect_identical(G$scale, utc$scale)
+  expect_identical(unname(as.matrix(G$spheredata)), unname(as.matrix(utc$spheredata)))
+  expect_error(with_tz("Europe/Amsterdam", g.calibrate(f, verbose = FALSE)),
+               "`desiredtz` = \"\" (the session's time zone): the recording spans a change of UTC offset",
+               fixed = TRUE)
+})
