@@ -1,7 +1,9 @@
 # gravcal: the README's commands.
-#   make demo   set up, install, calibrate the bundled example recording
-#   make test   set up, R CMD build + R CMD check --as-cran (all tests),
-#               then the standalone C++ core tests and the build with a
+#   make demo   set up what gravcal needs to run (tools/setup.sh: R, a
+#               compiler, zlib, Rcpp, RcppEigen), install, calibrate the
+#               bundled example recording
+#   make test   set up the test tools too (tools/setup-test.sh), R CMD
+#               build + R CMD check --as-cran (all tests), then the standalone C++ core tests and the build with a
 #               user's aggressive compiler flags (flags-check)
 #   make site   the pkgdown documentation site (_build/site), checked in
 #               headless Chromium
@@ -23,10 +25,15 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup install demo test check core flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-slurm setup setup-test install demo test check core flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
+# what building and running gravcal needs, nothing more
 setup:
 	bash tools/setup.sh
+
+# and what the tests need: the Suggests, GGIR, the test tools
+setup-test:
+	bash tools/setup-test.sh
 
 install: setup
 	mkdir -p $(LIB)
@@ -41,7 +48,7 @@ test: check core flags-check sanitize valgrind fuzz-short test-slurm site
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
 # instruction counts, and R's fit_gradient() against it bit for bit, built
 # for the host and run on an emulated Cortex-M4
-core: install
+core: install setup-test
 	$(MAKE) -C tests/cpp test arm cost
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r check-m4
 
@@ -56,7 +63,7 @@ core: install
 # sees it and the GGIR-compatible entries refuse. About 5 minutes.
 FLAGS_NATIVE := -O3 -march=native -ffp-contract=fast
 FLAGS_CLANG := -O1 -march=native -ffp-contract=fast
-flags-check: setup
+flags-check: setup-test
 	mkdir -p $(BUILD)/lib-native $(BUILD)/lib-clang-fast
 	printf 'CXX17FLAGS = $(FLAGS_NATIVE)\nCXXFLAGS = $(FLAGS_NATIVE)\n' > $(BUILD)/native.mk
 	printf 'CXX17 = clang++\nCXX17FLAGS = $(FLAGS_CLANG)\nCXXFLAGS = $(FLAGS_CLANG)\n' > $(BUILD)/clang-fast.mk
@@ -75,7 +82,7 @@ flags-check: setup
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not
 # instrumented, so the runtimes are preloaded. Any report fails.
 ASAN_RT = $(shell gcc -print-file-name=libasan.so) $(shell gcc -print-file-name=libubsan.so)
-sanitize: setup
+sanitize: setup-test
 	mkdir -p $(BUILD)/asan
 	R_MAKEVARS_USER=$(abspath tools/sanitize.mk) $(R) CMD INSTALL --preclean --no-multiarch \
 	  --no-test-load -l $(BUILD)/asan . > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
@@ -90,17 +97,17 @@ sanitize: setup
 	@tail -1 $(BUILD)/sanitize.log; echo "sanitize: ASan/UBSan clean"
 
 # the core's unit tests under valgrind
-valgrind:
+valgrind: setup-test
 	$(MAKE) -C tests/cpp valgrind
 
 # libFuzzer harnesses (clang): FUZZ_SECONDS per harness
-fuzz:
+fuzz: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=$${FUZZ_SECONDS:-600}
 
-fuzz-short:
+fuzz-short: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=30
 
-check: setup
+check: setup-test
 	mkdir -p $(BUILD)
 	cd $(BUILD) && $(R) CMD build --no-manual .. > build.log 2>&1 || (cat build.log; exit 1)
 	cd $(BUILD) && env $(CHECK_ENV) $(R) CMD check --as-cran --no-manual $(TARBALL) > check.log 2>&1 || true
@@ -109,24 +116,24 @@ check: setup
 document:
 	$(RSCRIPT) -e 'Rcpp::compileAttributes(); roxygen2::roxygenise()'
 
-bench: install
+bench: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/table2.R
 
 # speed and memory against GGIR (about 30 minutes; results in bench/results)
-bench-speed: install
+bench-speed: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/speed.R
 
 # peak memory calibrating a 7-day device file, against GGIR (about 15 minutes)
-bench-memory: install
+bench-memory: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/memory.R
 
 # end to end from device files against GGIR, each contender in its own
 # process (about 30 minutes; writes about 9 GB of files once, see the script)
-bench-files: install
+bench-files: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/files.R
 
 # recompute the vignettes' cached results (about 10 minutes)
-refresh-vignettes: install
+refresh-vignettes: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) tools/refresh-vignettes.R
 
 # the documentation site (_pkgdown.yml) from the installed package, into
@@ -137,7 +144,7 @@ refresh-vignettes: install
 SITE_ENV := OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2 R_DATATABLE_NUM_THREADS=2 \
             MC_CORES=2 R_PARALLELLY_AVAILABLECORES_FALLBACK=2 \
             GRAVCAL_SHARED_DATA=$(SHARED_DATA)
-site: install
+site: install setup-test
 	rm -rf $(BUILD)/site $(BUILD)/site-shots
 	env $(SITE_ENV) R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) -e \
 	  'options(pkgdown.internet = FALSE, Ncpus = 2); pkgdown::build_site(install = FALSE, new_process = FALSE, preview = FALSE)' \
@@ -151,6 +158,6 @@ clean:
 # calibrate_files() through future.batchtools on a real Slurm: starts a
 # single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort
 # as Slurm jobs, checking the table against a sequential run's
-test-slurm: install
+test-slurm: install setup-test
 	bash tools/slurm-setup.sh
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R
