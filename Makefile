@@ -25,7 +25,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup setup-test install demo test check core flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -51,6 +51,27 @@ test: check core flags-check sanitize valgrind fuzz-short test-slurm site
 core: install setup-test
 	$(MAKE) -C tests/cpp test arm cost
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r check-m4
+
+# the core and the glue where CRAN also builds them (about 4 minutes; not
+# part of make test): tests/cpp's core tests built for Windows with
+# mingw-w64's g++ (not run: no Windows here) and with clang and libc++ (as
+# on macOS; run), -Wall -Wextra -Werror; and src/*.cpp compiled for Windows
+# and with libc++ (syntax only: against this R's headers and Rcpp's, R's
+# Windows and macOS headers are not here; -Wno-cast-function-type for R's
+# routine registration)
+MINGW_CXX ?= x86_64-w64-mingw32-g++
+R_INCLUDE := $(shell $(RSCRIPT) -e 'cat(R.home("include"))' 2>/dev/null)
+RCPP_INC := $(shell $(RSCRIPT) -e 'cat(system.file("include", package = "Rcpp"))' 2>/dev/null)
+RCPPEIGEN_INC := $(shell $(RSCRIPT) -e 'cat(system.file("include", package = "RcppEigen"))' 2>/dev/null)
+cross-check: setup-test
+	$(MAKE) -C tests/cpp cross-check
+	@for f in src/*.cpp; do \
+	  $(MINGW_CXX) -std=gnu++17 -fsyntax-only -Wall -Wextra -Wno-cast-function-type -Werror \
+	    -I$(R_INCLUDE) -Iinst/include -isystem $(RCPP_INC) -isystem $(RCPPEIGEN_INC) $$f || exit 1; \
+	  echo "mingw-w64: $$f compiles (syntax only)"; \
+	  clang++ -stdlib=libc++ -std=gnu++17 -fsyntax-only -Wall -Wextra -Wno-cast-function-type -Werror \
+	    -I$(R_INCLUDE) -Iinst/include -isystem $(RCPP_INC) -isystem $(RCPPEIGEN_INC) $$f || exit 1; \
+	  echo "clang, libc++: $$f compiles (syntax only)"; done
 
 # gravcal built as a user with aggressive flags in ~/.R/Makevars builds it
 # (R_MAKEVARS_USER; a C++17 package is compiled with CXX17FLAGS, not

@@ -17,7 +17,7 @@ deb_pkgs="r-cran-testthat r-cran-knitr
 r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
 r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
 libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev
-libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64"
+libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""
