@@ -1,7 +1,9 @@
 # gravcal: the README's commands.
-#   make demo   set up, install, calibrate the bundled example recording
-#   make test   set up, R CMD build + R CMD check --as-cran (all tests),
-#               then the standalone C++ core tests and the build with a
+#   make demo   set up what gravcal needs to run (tools/setup.sh: R, a
+#               compiler, zlib, Rcpp, RcppEigen), install, calibrate the
+#               bundled example recording
+#   make test   set up the test tools too (tools/setup-test.sh), R CMD
+#               build + R CMD check --as-cran (all tests), then the standalone C++ core tests and the build with a
 #               user's aggressive compiler flags (flags-check)
 #   make site   the pkgdown documentation site (_build/site), checked in
 #               headless Chromium
@@ -23,10 +25,15 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup install demo test check core flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
+# what building and running gravcal needs, nothing more
 setup:
 	bash tools/setup.sh
+
+# and what the tests need: the Suggests, GGIR, the test tools
+setup-test:
+	bash tools/setup-test.sh
 
 install: setup
 	mkdir -p $(LIB)
@@ -41,9 +48,30 @@ test: check core flags-check sanitize valgrind fuzz-short test-slurm site
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
 # instruction counts, and R's fit_gradient() against it bit for bit, built
 # for the host and run on an emulated Cortex-M4
-core: install
+core: install setup-test
 	$(MAKE) -C tests/cpp test arm cost
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(MAKE) -C tests/cpp check-r check-m4
+
+# the core and the glue where CRAN also builds them (about 4 minutes; not
+# part of make test): tests/cpp's core tests built for Windows with
+# mingw-w64's g++ (not run: no Windows here) and with clang and libc++ (as
+# on macOS; run), -Wall -Wextra -Werror; and src/*.cpp compiled for Windows
+# and with libc++ (syntax only: against this R's headers and Rcpp's, R's
+# Windows and macOS headers are not here; -Wno-cast-function-type for R's
+# routine registration)
+MINGW_CXX ?= x86_64-w64-mingw32-g++
+R_INCLUDE := $(shell $(RSCRIPT) -e 'cat(R.home("include"))' 2>/dev/null)
+RCPP_INC := $(shell $(RSCRIPT) -e 'cat(system.file("include", package = "Rcpp"))' 2>/dev/null)
+RCPPEIGEN_INC := $(shell $(RSCRIPT) -e 'cat(system.file("include", package = "RcppEigen"))' 2>/dev/null)
+cross-check: setup-test
+	$(MAKE) -C tests/cpp cross-check
+	@for f in src/*.cpp; do \
+	  $(MINGW_CXX) -std=gnu++17 -fsyntax-only -Wall -Wextra -Wno-cast-function-type -Werror \
+	    -I$(R_INCLUDE) -Iinst/include -isystem $(RCPP_INC) -isystem $(RCPPEIGEN_INC) $$f || exit 1; \
+	  echo "mingw-w64: $$f compiles (syntax only)"; \
+	  clang++ -stdlib=libc++ -std=gnu++17 -fsyntax-only -Wall -Wextra -Wno-cast-function-type -Werror \
+	    -I$(R_INCLUDE) -Iinst/include -isystem $(RCPP_INC) -isystem $(RCPPEIGEN_INC) $$f || exit 1; \
+	  echo "clang, libc++: $$f compiles (syntax only)"; done
 
 # gravcal built as a user with aggressive flags in ~/.R/Makevars builds it
 # (R_MAKEVARS_USER; a C++17 package is compiled with CXX17FLAGS, not
@@ -56,7 +84,7 @@ core: install
 # sees it and the GGIR-compatible entries refuse. About 5 minutes.
 FLAGS_NATIVE := -O3 -march=native -ffp-contract=fast
 FLAGS_CLANG := -O1 -march=native -ffp-contract=fast
-flags-check: setup
+flags-check: setup-test
 	mkdir -p $(BUILD)/lib-native $(BUILD)/lib-clang-fast
 	printf 'CXX17FLAGS = $(FLAGS_NATIVE)\nCXXFLAGS = $(FLAGS_NATIVE)\n' > $(BUILD)/native.mk
 	printf 'CXX17 = clang++\nCXX17FLAGS = $(FLAGS_CLANG)\nCXXFLAGS = $(FLAGS_CLANG)\n' > $(BUILD)/clang-fast.mk
@@ -75,7 +103,7 @@ flags-check: setup
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not
 # instrumented, so the runtimes are preloaded. Any report fails.
 ASAN_RT = $(shell gcc -print-file-name=libasan.so) $(shell gcc -print-file-name=libubsan.so)
-sanitize: setup
+sanitize: setup-test
 	mkdir -p $(BUILD)/asan
 	R_MAKEVARS_USER=$(abspath tools/sanitize.mk) $(R) CMD INSTALL --preclean --no-multiarch \
 	  --no-test-load -l $(BUILD)/asan . > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
@@ -90,17 +118,17 @@ sanitize: setup
 	@tail -1 $(BUILD)/sanitize.log; echo "sanitize: ASan/UBSan clean"
 
 # the core's unit tests under valgrind
-valgrind:
+valgrind: setup-test
 	$(MAKE) -C tests/cpp valgrind
 
 # libFuzzer harnesses (clang): FUZZ_SECONDS per harness
-fuzz:
+fuzz: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=$${FUZZ_SECONDS:-600}
 
-fuzz-short:
+fuzz-short: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=30
 
-check: setup
+check: setup-test
 	mkdir -p $(BUILD)
 	cd $(BUILD) && $(R) CMD build --no-manual .. > build.log 2>&1 || (cat build.log; exit 1)
 	cd $(BUILD) && env $(CHECK_ENV) $(R) CMD check --as-cran --no-manual $(TARBALL) > check.log 2>&1 || true
@@ -109,24 +137,24 @@ check: setup
 document:
 	$(RSCRIPT) -e 'Rcpp::compileAttributes(); roxygen2::roxygenise()'
 
-bench: install
+bench: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/table2.R
 
 # speed and memory against GGIR (about 30 minutes; results in bench/results)
-bench-speed: install
+bench-speed: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/speed.R
 
 # peak memory calibrating a 7-day device file, against GGIR (about 15 minutes)
-bench-memory: install
+bench-memory: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/memory.R
 
 # end to end from device files against GGIR, each contender in its own
 # process (about 30 minutes; writes about 9 GB of files once, see the script)
-bench-files: install
+bench-files: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/files.R
 
 # recompute the vignettes' cached results (about 10 minutes)
-refresh-vignettes: install
+refresh-vignettes: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) $(RSCRIPT) tools/refresh-vignettes.R
 
 # the documentation site (_pkgdown.yml) from the installed package, into
@@ -137,7 +165,7 @@ refresh-vignettes: install
 SITE_ENV := OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2 R_DATATABLE_NUM_THREADS=2 \
             MC_CORES=2 R_PARALLELLY_AVAILABLECORES_FALLBACK=2 \
             GRAVCAL_SHARED_DATA=$(SHARED_DATA)
-site: install
+site: install setup-test
 	rm -rf $(BUILD)/site $(BUILD)/site-shots
 	env $(SITE_ENV) R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) -e \
 	  'options(pkgdown.internet = FALSE, Ncpus = 2); pkgdown::build_site(install = FALSE, new_process = FALSE, preview = FALSE)' \
@@ -151,6 +179,6 @@ clean:
 # calibrate_files() through future.batchtools on a real Slurm: starts a
 # single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort
 # as Slurm jobs, checking the table against a sequential run's
-test-slurm: install
+test-slurm: install setup-test
 	bash tools/slurm-setup.sh
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R

@@ -34,7 +34,9 @@
 #' `outdir` (the folder `outdir/.gravcal/lock`, holding the process id and
 #' host of its owner); a second run on the same `outdir` refuses to start.
 #' A lock left by a run that was killed on the same host is taken over
-#' (the process is checked to be gone); one from another host must be
+#' (the process is checked to be gone, without signalling it: on Windows
+#' through `tasklist`, and a lock whose process cannot be checked there
+#' is kept); one from another host must be
 #' removed by hand, as the error message says.
 #'
 #' Written to `outdir`: `calibration.csv` (the table below) and, for

@@ -213,12 +213,19 @@ lock_describe <- function(owner) {
          owner["started"])
 }
 
-# Stale: taken on this host by a process that no longer exists.
-lock_stale <- function(owner, host) {
+# Stale: taken on this host by a process that no longer exists. `os` and
+# `run` (system2()) are arguments for the tests of the Windows branch.
+lock_stale <- function(owner, host, os = .Platform$OS.type, run = system2) {
   pid <- suppressWarnings(as.integer(owner["pid"]))
   if (is.na(pid) || !identical(unname(owner["host"]), host) ||
       pid == Sys.getpid()) {
     return(FALSE)
+  }
+  if (identical(os, "windows")) {
+    # tools::pskill() terminates the process on Windows whatever the
+    # signal (signal 0 does not probe there): ask tasklist instead, and
+    # keep the lock when it cannot tell
+    return(identical(windows_pid_running(pid, run), FALSE))
   }
   if (dir.exists("/proc/self")) {
     if (!dir.exists(file.path("/proc", pid))) return(TRUE)
@@ -230,6 +237,29 @@ lock_stale <- function(owner, host) {
     return(length(state) == 1L && state %in% c("Z", "X"))
   }
   !isTRUE(suppressWarnings(tools::pskill(pid, 0)))
+}
+
+# Whether process `pid` runs, on Windows, from tasklist's table (one
+# quoted CSV row per process, without header: "image","pid",...), which
+# signals nothing; NA when tasklist fails or says nothing. Its message
+# for no match (kept with stderr) is in the system's language, so only
+# the presence of the process's row is read.
+windows_pid_running <- function(pid, run = system2) {
+  out <- tryCatch(
+    suppressWarnings(run("tasklist", c("/FI", paste0("\"PID eq ", pid, "\""),
+                                       "/FO", "CSV", "/NH"),
+                         stdout = TRUE, stderr = TRUE)),
+    error = function(e) NULL)
+  status <- attr(out, "status")
+  if (is.null(out) || (!is.null(status) && !identical(as.integer(status), 0L))) {
+    return(NA)
+  }
+  rows <- grepl("^\"[^\"]*\",\"[0-9]+\"", out)
+  if (any(rows)) {
+    return(any(grepl(paste0("^\"[^\"]*\",\"", pid, "\""), out[rows])))
+  }
+  # no row: no such process, if tasklist said anything at all
+  if (length(out) && any(nzchar(trimws(out)))) FALSE else NA
 }
 
 unlock_outdir <- function(lock) {

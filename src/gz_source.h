@@ -8,6 +8,7 @@
 #include <climits>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 
 #include "gravcal/decode.hpp"
 
@@ -49,9 +50,25 @@ class GzSource : public gravcal::ByteSource {
   bool failed() const override { return failed_; }
   std::int64_t position() const override { return pos_; }
   // gzseek on a read stream: forward by decoding, back by starting again.
+  // zlib's offset is z_off_t (a long: 32 bits on Windows) unless it was
+  // built with 64-bit offsets (Z_LARGE64: gzseek64); a position beyond
+  // what that type holds is refused (false: this source cannot seek
+  // there) rather than wrapped to another position.
   bool seek(std::int64_t pos) override {
     if (f_ == nullptr || pos < 0) return false;
-    if (gzseek(f_, static_cast<z_off_t>(pos), SEEK_SET) != static_cast<z_off_t>(pos)) return false;
+#if defined(Z_LARGE64)
+    using gz_off = z_off64_t;
+#else
+    using gz_off = z_off_t;
+#endif
+    if (static_cast<std::uint64_t>(pos) >
+        static_cast<std::uint64_t>(std::numeric_limits<gz_off>::max())) return false;
+    const gz_off to = static_cast<gz_off>(pos);
+#if defined(Z_LARGE64)
+    if (gzseek64(f_, to, SEEK_SET) != to) return false;
+#else
+    if (gzseek(f_, to, SEEK_SET) != to) return false;
+#endif
     pos_ = pos;
     failed_ = false;
     return true;

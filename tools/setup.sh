@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# Installs what gravcal needs to build, check and test, when it is missing.
-# Debian's prebuilt r-cran-* packages when we are root on Debian (fast), then
-# anything still missing from CRAN. Safe to run again: it skips what is there.
+# Installs what gravcal needs to be built and run (make install, make demo),
+# when it is missing: R, a C++17 compiler, make, zlib's headers, Rcpp and
+# RcppEigen. Nothing the tests alone need (tools/setup-test.sh adds that).
+# Debian's packages when we are root on Debian (fast), then Rcpp and
+# RcppEigen from CRAN if still missing. Safe to run again: it skips what is
+# there.
 set -euo pipefail
 
 cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
-deb_pkgs="r-cran-rcpp r-cran-rcppeigen r-cran-testthat r-cran-knitr
-r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
-r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
-libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev zlib1g-dev"
+deb_pkgs="r-base-core g++ make zlib1g-dev r-cran-rcpp r-cran-rcppeigen"
 
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   missing=""
@@ -24,15 +24,12 @@ if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
   fi
 fi
 
-# CRAN packages: the Imports and LinkingTo, and the Suggests so that every
-# test runs (tests skip only when a Suggests package is really absent).
+# the LinkingTo and Imports from CRAN (graphics, grDevices, stats and
+# utils come with R)
 Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
-need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
-          "tibble", "data.table", "future", "future.apply", "progressr",
-          "DEoptim", "signal", "batchtools", "future.batchtools")
-have <- rownames(installed.packages())
-miss <- setdiff(need, have)
+need <- c("Rcpp", "RcppEigen")
+miss <- setdiff(need, rownames(installed.packages()))
 if (length(miss)) {
   message("setup: installing from CRAN: ", paste(miss, collapse = ", "))
   install.packages(miss, repos = cran, Ncpus = 2, quiet = TRUE)
@@ -40,7 +37,3 @@ if (length(miss)) {
 still <- setdiff(need, rownames(installed.packages()))
 if (length(still)) stop("setup: could not install ", paste(still, collapse = ", "))
 RSCRIPT
-
-# GGIR and GGIRread (Suggests): the reference implementation the tests
-# compare against; see tools/install-ggir.sh for why it is installed that way.
-bash "$(dirname "$0")/install-ggir.sh"

@@ -5,7 +5,11 @@
 //   on its own: the digits as an integer (at most 18 kept), times 10^e in
 //   long double (the literal's value, as strtold gives it), rounded to
 //   double, the sign applied to the long double product;
-// * parse_number (compat = 0) against std::from_chars (correctly rounded);
+// * parse_number (compat = 0) against std::from_chars (correctly rounded),
+//   and the strtod path (decimal_to_double_strtod, used where the C++
+//   library lacks floating-point from_chars) against it on every number;
+//   `make` builds this file twice, the second time with
+//   GRAVCAL_NO_FROM_CHARS (the decoder on the strtod path throughout);
 // * the plain shape (scan_plain_number + plain_value) against parse_number,
 //   every number of up to 6 digits and random longer ones;
 // * the date-time parser that keeps the last date and second against a
@@ -88,14 +92,42 @@ static double fread_rule(const std::string& s) {
   return static_cast<double>(neg ? -r : r);
 }
 
+// The reference: std::from_chars where this C++ library has it for double
+// (whatever the decoder was built to use); else (libc++ before 20) the C
+// library's strtod, which is then the decoder's path as well.
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
+#define TEST_HAVE_FROM_CHARS 1
+#endif
 static double correctly_rounded(const std::string& s) {
   std::size_t i = 0;
   const bool neg = !s.empty() && s[0] == '-';
   if (!s.empty() && (s[0] == '-' || s[0] == '+')) i = 1;
   double v = NAN;
+#if defined(TEST_HAVE_FROM_CHARS)
   const auto r = std::from_chars(s.data() + i, s.data() + s.size(), v);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return NAN;
+#else
+  char* end = nullptr;
+  v = std::strtod(s.c_str() + i, &end);
+  if (end != s.c_str() + s.size() || std::isinf(v)) return NAN;
+  if (v == 0 && s.find_first_of("123456789") < s.find_first_of("eE")) return NAN;
+#endif
   return neg ? -v : v;
+}
+
+// decimal_to_double_strtod() against the reference on the unsigned text
+// (it is not given a sign): the same success and bits.
+static long strtod_checked = 0;
+static void check_strtod_path(const std::string& s) {
+  const std::string u = !s.empty() && (s[0] == '-' || s[0] == '+') ? s.substr(1) : s;
+  if (u.empty() || u.find_first_not_of("0123456789.eE+-") != std::string::npos) return;
+  const double want = correctly_rounded(u);
+  const bool nonzero = u.find_first_of("123456789") < u.find_first_of("eE");
+  double v = NAN;
+  const bool ok = csv::decimal_to_double_strtod(u.c_str(), u.size(), nonzero, v);
+  ++strtod_checked;
+  CHECK(ok == !std::isnan(want), u + " (strtod path: taken)");
+  if (ok && !std::isnan(want)) CHECK(same_bits(v, want), u + " (strtod path: bits)");
 }
 
 static bool parse(const std::string& s, bool compat, double& v) {
@@ -127,7 +159,8 @@ static bool plain(const std::string& s, bool compat, double& v) {
 
 // What is a number is fread's in both modes; its value fread's (compat = 1)
 // or the correctly rounded one (compat = 0).
-static void check_number(const std::string& s) {
+static void check_number(const std::string& s, bool strtod_too = true) {
+  if (strtod_too) check_strtod_path(s);
   const double fr = fread_rule(s);
   for (int compat = 0; compat <= 1; ++compat) {
     double v = 0;
@@ -154,9 +187,10 @@ static void test_short_numbers(int nd) {
         std::snprintf(buf, sizeof buf, "%0*ld", digits, m);
         std::string s(buf);
         if (point < digits) s.insert(static_cast<std::size_t>(point), ".");
-        check_number(s);
-        check_number("-" + s);
-        if (m % 7 == 0) check_number("+" + s);
+        // (the strtod path on one in 13: short decimals are its easy case)
+        check_number(s, m % 13 == 0);
+        check_number("-" + s, false);
+        if (m % 7 == 0) check_number("+" + s, false);
       }
     }
   }
@@ -418,10 +452,36 @@ int main() {
                         "9007199254740993", "0.1234567890123456789", "00000000000000000001.5"}) {
     check_number(s);
   }
+  // the edges of the double range, where only the general conversion
+  // decides: subnormals are numbers, what rounds to 0 or overflows is not
+  for (const char* s : {"1e-310", "4.9e-324", "2.5e-324", "2.4e-324", "2.4703282292062328e-324",
+                        "2.4703282292062327e-324", "1e-330", "0e-340", "0.0e300", "1e309",
+                        "1.7976931348623157e308", "1.7976931348623158e308",
+                        "1.7976931348623159e308", "2.2250738585072011e-308", "1e+5",
+                        "123456789012345678e-340", "-1e-310", "-1e309"}) {
+    check_strtod_path(s);
+    double v = 0;
+    const bool ok = parse(s, false, v);
+    const double want = correctly_rounded(s);
+    CHECK(ok == !std::isnan(want), std::string(s) + " (range edge: taken)");
+    if (ok && !std::isnan(want)) CHECK(same_bits(v, want), std::string(s) + " (range edge: bits)");
+  }
   test_short_numbers(6);
   test_long_numbers(rng);
   test_stamps(rng);
   test_files(rng);
-  std::printf("csv: %ld checks, %s\n", checked, failures ? "FAILED" : "all passed");
+  std::printf("csv (%s): %ld checks (%ld of the strtod path against %s), %s\n",
+#if defined(GRAVCAL_HAVE_FROM_CHARS)
+              "decoder on from_chars",
+#else
+              "decoder on strtod",
+#endif
+              checked, strtod_checked,
+#if defined(TEST_HAVE_FROM_CHARS)
+              "from_chars",
+#else
+              "the C library's strtod",
+#endif
+              failures ? "FAILED" : "all passed");
   return failures ? 1 : 0;
 }

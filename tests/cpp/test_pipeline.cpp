@@ -112,8 +112,8 @@ class PlainHost : public gravcal::GgirHost {
     gravcal::EigenLeastSquares()(X, y, n, p, coef, rsd);
   }
   bool interrupted() override { return ++calls > stop_after; }
-  long calls = 0;
-  long stop_after = 1L << 40;
+  std::int64_t calls = 0;
+  std::int64_t stop_after = std::int64_t(1) << 40;  // (long: 32 bits on Windows)
 };
 
 static gravcal::GgirOutcome procedure(const Recording& r, bool compat, bool lend,

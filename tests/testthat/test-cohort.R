@@ -156,6 +156,42 @@ test_that("a lock is stale once its process has ended, also before it is reaped"
   expect_false(lock_stale(c(pid = as.character(job$pid), host = "elsewhere"), host))
 })
 
+test_that("on Windows a lock's process is looked up in tasklist, never signalled", {
+  # the Windows branch, on any system: `os` and tasklist's answer given
+  host <- "here"
+  owner <- function(pid) c(pid = as.character(pid), host = host)
+  calls <- list()
+  answer <- function(out, status = NULL) {
+    function(command, args, stdout, stderr) {
+      calls[[length(calls) + 1L]] <<- list(command = command, args = args, stdout = stdout)
+      if (!is.null(status)) attr(out, "status") <- status
+      out
+    }
+  }
+  stale <- function(pid, run) lock_stale(owner(pid), host, os = "windows", run = run)
+  row <- function(pid) sprintf('"Rterm.exe","%d","Console","1","102,400 K"', pid)
+  # running: the lock is kept
+  expect_false(stale(4242L, answer(row(4242L))))
+  expect_identical(calls[[1]]$command, "tasklist")
+  expect_true("\"PID eq 4242\"" %in% calls[[1]]$args)
+  expect_true(isTRUE(calls[[1]]$stdout))
+  # gone: tasklist's message (in any language), or only other processes'
+  # rows (4242 is not 42420)
+  expect_true(stale(4242L, answer("INFO: No tasks are running which match the specified criteria.")))
+  expect_true(stale(4242L, answer("INFORMATION: Es werden keine Aufgaben mit den angegebenen Kriterien ausgef\u00fchrt.")))
+  expect_true(stale(4242L, answer(row(42420L))))
+  # tasklist cannot tell: the lock is kept
+  expect_false(stale(4242L, function(...) stop("'tasklist' not found")))
+  expect_false(stale(4242L, answer("ERROR: Invalid argument/option", status = 1L)))
+  expect_false(stale(4242L, answer(character(0))))
+  # another host's lock, or this process's: tasklist is not asked
+  n <- length(calls)
+  expect_false(lock_stale(c(pid = "4242", host = "elsewhere"), host, os = "windows",
+                          run = answer(character(0))))
+  expect_false(lock_stale(owner(Sys.getpid()), host, os = "windows", run = answer(character(0))))
+  expect_identical(length(calls), n)
+})
+
 test_that("calibrate_files() and calibrate_cli() reject bad input clearly", {
   expect_error(calibrate_files(character(0), outdir = tempdir()), "`files`")
   expect_error(calibrate_files(tempfile(), outdir = tempdir()), "do not exist")

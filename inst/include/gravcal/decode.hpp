@@ -17,7 +17,8 @@
 // an allocation: counts and lengths from headers are checked against fixed
 // limits of the format, and a jump in time is reported as a gap.
 //
-// Header-only, standard headers only, no R. What needs a library (inflating
+// Header-only, standard headers only (and the C library's 64-bit file
+// positions: file_seek64()), no R. What needs a library (inflating
 // a zip entry) is given to the decoder as a ByteSource from outside.
 #ifndef GRAVCAL_DECODE_HPP
 #define GRAVCAL_DECODE_HPP
@@ -33,6 +34,11 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <stdio.h>  // _fseeki64 (Windows), fseeko (POSIX)
+#if !defined(_WIN32)
+#include <sys/types.h>  // off_t
+#endif
 
 namespace gravcal {
 
@@ -56,6 +62,33 @@ class ByteSource {
   virtual bool seek(std::int64_t) { return false; }
 };
 
+// stdio's file position in 64 bits: std::fseek and std::ftell take a
+// long, 32 bits on Windows (and 32-bit Linux), so a file over 2 GiB would
+// lose its size and could not be seeked past 2 GiB. _fseeki64/_ftelli64
+// on Windows (UCRT, msvcrt); fseeko/ftello elsewhere (off_t: 64 bits on
+// 64-bit systems, and on 32-bit ones built with _FILE_OFFSET_BITS=64).
+// Where the offset type is narrower than the position, the call fails
+// rather than wrap.
+inline bool file_seek64(std::FILE* f, std::int64_t pos, int whence) {
+#if defined(_WIN32)
+  return _fseeki64(f, static_cast<__int64>(pos), whence) == 0;
+#else
+  const off_t o = static_cast<off_t>(pos);
+  if (static_cast<std::int64_t>(o) != pos) return false;
+  return fseeko(f, o, whence) == 0;
+#endif
+}
+
+// The position, or -1 when it cannot be told.
+inline std::int64_t file_tell64(std::FILE* f) {
+#if defined(_WIN32)
+  const __int64 p = _ftelli64(f);
+#else
+  const off_t p = ftello(f);
+#endif
+  return p < 0 ? -1 : static_cast<std::int64_t>(p);
+}
+
 // A file, through stdio with a fixed buffer.
 class FileSource : public ByteSource {
  public:
@@ -63,11 +96,8 @@ class FileSource : public ByteSource {
     f_ = std::fopen(path, "rb");
     if (f_ == nullptr) return;
     std::setvbuf(f_, nullptr, _IOFBF, 1u << 20);
-    if (std::fseek(f_, 0, SEEK_END) == 0) {
-      const long s = std::ftell(f_);
-      if (s >= 0) size_ = s;
-    }
-    std::fseek(f_, 0, SEEK_SET);
+    if (file_seek64(f_, 0, SEEK_END)) size_ = file_tell64(f_);
+    file_seek64(f_, 0, SEEK_SET);
   }
   ~FileSource() override {
     if (f_ != nullptr) std::fclose(f_);
@@ -87,7 +117,7 @@ class FileSource : public ByteSource {
   std::int64_t size() const override { return size_; }
   bool seek(std::int64_t pos) override {
     if (f_ == nullptr || pos < 0) return false;
-    if (std::fseek(f_, static_cast<long>(pos), SEEK_SET) != 0) return false;
+    if (!file_seek64(f_, pos, SEEK_SET)) return false;
     pos_ = pos;
     return true;
   }

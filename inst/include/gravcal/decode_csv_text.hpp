@@ -8,20 +8,39 @@
 // value in the last bit (about 1 in 4000 numbers of 6 or more digits; none
 // of 3 or 4 decimals, which ActiLife writes, and none of 17 digits). With
 // compat = 1 the decoder computes fread's product; with compat = 0 it gives
-// the correctly rounded value (std::from_chars). data.table 1.15.0 changed
+// the correctly rounded value (std::from_chars where the C++ library has it
+// for double, else strtod in the "C" locale: see decimal_to_double()).
+// data.table 1.15.0 changed
 // this to a division by the power of ten (its issue 4461), which differs in
 // other last bits: compat follows the installed reference, 1.14.8.
 #ifndef GRAVCAL_DECODE_CSV_TEXT_HPP
 #define GRAVCAL_DECODE_CSV_TEXT_HPP
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
+
+// Floating-point std::from_chars: libstdc++ from GCC 11 (12 on mingw-w64),
+// MSVC; not libc++ before 20 (macOS) nor older Rtools' GCC. The library
+// says so with __cpp_lib_to_chars (set by <charconv>, which every C++17
+// library has for integers). GRAVCAL_NO_FROM_CHARS forces the strtod path
+// (tests/cpp builds the csv tests both ways).
+#include <charconv>
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L && !defined(GRAVCAL_NO_FROM_CHARS)
+#define GRAVCAL_HAVE_FROM_CHARS 1
+#endif
+// strtod with an explicit "C" locale (the decimal point is '.', whatever
+// LC_NUMERIC the session has): _strtod_l on Windows (UCRT, msvcrt),
+// strtod_l from <xlocale.h> on macOS and the BSDs, POSIX 2008's elsewhere.
+#include <locale.h>
+#if defined(__APPLE__) || defined(__FreeBSD__) || defined(__NetBSD__) || defined(__OpenBSD__)
+#include <xlocale.h>
+#endif
 
 #include "gravcal/decode.hpp"
 
@@ -123,6 +142,53 @@ GRAVCAL_CSV_INLINE bool exact_value(std::uint64_t acc, int exp10, bool neg, doub
   return true;
 }
 
+// The correctly rounded double of the unsigned decimal s[0, n) (digits,
+// '.', an exponent; s[n] is '\0'), through strtod in the "C" locale. The C
+// libraries R runs on round correctly (glibc, musl, macOS's, the BSDs',
+// Windows' UCRT since 2015). As std::from_chars, a value beyond the
+// double range fails (infinite; or 0 when `nonzero`, the decimal having a
+// digit other than 0), and a subnormal one does not (strtod's ERANGE for it
+// is ignored). False also when strtod does not take all of s.
+inline bool decimal_to_double_strtod(const char* s, std::size_t n, bool nonzero, double& out) {
+  char* end = nullptr;
+  double v = 0;
+#if defined(_WIN32)
+  static const _locale_t c_locale = _create_locale(LC_ALL, "C");
+  v = c_locale ? _strtod_l(s, &end, c_locale) : std::strtod(s, &end);
+#else
+  static const locale_t c_locale = newlocale(LC_ALL_MASK, "C", static_cast<locale_t>(0));
+  // (newlocale() of "C" does not fail in practice; R keeps LC_NUMERIC "C")
+  v = c_locale ? strtod_l(s, &end, c_locale) : std::strtod(s, &end);
+#endif
+  if (end != s + n) return false;
+  if (std::isinf(v) || (v == 0 && nonzero)) return false;
+  out = v;
+  return true;
+}
+
+#if defined(GRAVCAL_HAVE_FROM_CHARS)
+// The same through std::from_chars (no locale, no terminator needed).
+inline bool decimal_to_double_from_chars(const char* s, std::size_t n, double& out) {
+  double v = 0;
+  const auto r = std::from_chars(s, s + n, v);
+  if (r.ec != std::errc() || r.ptr != s + n) return false;
+  out = v;
+  return true;
+}
+#endif
+
+// The correctly rounded double of s[0, n) as above: std::from_chars where
+// the library has it, else strtod; the same bits and the same failures
+// (tests/cpp/test_csv.cpp compares the two on every number it checks).
+inline bool decimal_to_double(const char* s, std::size_t n, bool nonzero, double& out) {
+#if defined(GRAVCAL_HAVE_FROM_CHARS)
+  (void)nonzero;
+  return decimal_to_double_from_chars(s, n, out);
+#else
+  return decimal_to_double_strtod(s, n, nonzero, out);
+#endif
+}
+
 // A number in [b, e): [+-]digits[<dec>digits][(e|E)[+-]digits], the whole
 // field. compat: fread 1.14.8's value; else the correctly rounded one.
 inline bool parse_number(const char* b, const char* e, char dec, bool compat, double& out) {
@@ -176,18 +242,18 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
   // correctly rounded: one IEEE operation when it is exact (the first
   // digit kept is not 0, so acc < 2^53 means fewer than 18 digits kept)...
   if (exact_value(acc, exp10, neg, out)) return true;
-  // ...else from_chars, which wants '.' and no '+'
+  // ...else the general conversion, which wants '.' and no sign
   char tmp[128];
   const std::size_t n = static_cast<std::size_t>(e - start);
   if (n >= sizeof tmp) return false;
   std::memcpy(tmp, start, n);
+  tmp[n] = '\0';
   if (dec != '.') {
     const std::size_t d = static_cast<std::size_t>(mant_end - start);
     for (std::size_t i = 0; i < d; ++i) if (tmp[i] == dec) tmp[i] = '.';
   }
   double v = 0;
-  const auto r = std::from_chars(tmp, tmp + n, v);
-  if (r.ec != std::errc() || r.ptr != tmp + n) return false;
+  if (!decimal_to_double(tmp, n, acc != 0, v)) return false;
   out = neg ? -v : v;
   return true;
 }

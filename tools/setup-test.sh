@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Installs what gravcal's tests need (make test and the targets it calls),
+# when it is missing: first what it needs to be built and run
+# (tools/setup.sh), then the Suggests, the tools of the test targets
+# (Chromium, pandoc, qpdf, tidy, valgrind, clang with libFuzzer and libc++,
+# the Cortex-M and mingw-w64 cross compilers, qemu, 32-bit multilib) and
+# GGIR. Debian's prebuilt r-cran-* packages when we are root on Debian
+# (fast), then anything still missing from CRAN. Safe to run again: it
+# skips what is there.
+set -euo pipefail
+
+bash "$(dirname "$0")/setup.sh"
+
+cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
+
+deb_pkgs="r-cran-testthat r-cran-knitr
+r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
+r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
+libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev
+libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev"
+
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+  missing=""
+  for p in $deb_pkgs; do
+    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+  done
+  if [ -n "$missing" ]; then
+    echo "setup: installing Debian packages:$missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq >/dev/null
+    apt-get install -y -qq --no-install-recommends $missing >/dev/null
+  fi
+fi
+
+# CRAN packages: the Imports and LinkingTo, and the Suggests so that every
+# test runs (tests skip only when a Suggests package is really absent).
+Rscript --vanilla - "$cran" <<'RSCRIPT'
+cran <- commandArgs(TRUE)[1]
+need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
+          "tibble", "data.table", "future", "future.apply", "progressr",
+          "DEoptim", "signal", "batchtools", "future.batchtools")
+have <- rownames(installed.packages())
+miss <- setdiff(need, have)
+if (length(miss)) {
+  message("setup: installing from CRAN: ", paste(miss, collapse = ", "))
+  install.packages(miss, repos = cran, Ncpus = 2, quiet = TRUE)
+}
+still <- setdiff(need, rownames(installed.packages()))
+if (length(still)) stop("setup: could not install ", paste(still, collapse = ", "))
+RSCRIPT
+
+# GGIR and GGIRread (Suggests): the reference implementation the tests
+# compare against; see tools/install-ggir.sh for why it is installed that way.
+bash "$(dirname "$0")/install-ggir.sh"
