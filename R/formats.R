@@ -39,6 +39,20 @@ recording_formats <- list(
     decoder = "csv",
     read = function(file, sf, reader, arg) read_plain_csv(file, arg),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  # GGIR's ad hoc csv: never found from the file itself, but chosen by the
+  # rmc.* parameters (rmc.firstrow.acc; R/adhoc-csv.R), which give its
+  # layout to the csv decoder (and to `source`, as `layout`)
+  adhoc_csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = function(file) FALSE,
+    label = "an ad hoc csv file (GGIR's rmc.* parameters)", unit = "line",
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    decoder = "adhoc_csv",
+    read = function(file, sf, reader, arg) {
+      abort("Reading \"", file, "\" as an ad hoc csv file needs its rmc.* parameters.")
+    },
+    source = function(file, sf, chunksize, arg, layout = NULL) {
+      source_adhoc(file, sf, chunksize, arg, layout)
+    }),
   rds = list(
     ext = c(rds = ".rds"), detect = NULL,
     label = "an .rds file", unit = "unit", block_units = NULL, decoder = NULL,

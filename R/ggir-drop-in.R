@@ -97,14 +97,21 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     sf <- inspectfileobject$sf
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
+  # rmc.firstrow.acc: an ad hoc csv file, read by the rmc.* parameters
+  rmc <- if (!is.null(pr$rmc.firstrow.acc) && is.character(datafile)) {
+    pr[grepl("^rmc[.]", names(pr))]
+  }
   open <- function() {
     open_source(datafile, sf = sf, chunksize = pr$chunksize,
-                reader = pr$reader, compat = TRUE)
+                reader = pr$reader, compat = TRUE, rmc = rmc)
   }
   src <- open()
-  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor);
+  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
+  # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike
-  sdcriter <- if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
+  sdcriter <- if (src$format == "adhoc_csv") {
+    (pr$rmc.noise %||% ggir_constants$rmc_noise) * 1.2
+  } else if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
     pr$rmc.noise * 1.2
   } else {
     ggir_constants$max_sd

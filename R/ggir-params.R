@@ -31,10 +31,89 @@ ggir_param_table <- function() {
     row("printsummary", NA, FALSE, check_flag),
     # GGIR reads rmc.noise (ad hoc csv files) only when given
     row("rmc.noise", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg)),
-    row("rmc.sf", NA, NULL),
+    row("rmc.sf", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg)),
+    # GGIR's ad hoc csv files (R/adhoc-csv.R): GGIR 3.3-9's load_params()
+    # defaults; rmc.firstrow.acc makes a file one
+    row("rmc.firstrow.acc", NA, NULL, rmc_whole),
+    row("rmc.firstrow.header", NA, NULL, rmc_whole),
+    row("rmc.header.length", NA, NULL, rmc_whole),
+    row("rmc.col.acc", NA, 1:3, function(x, arg) {
+      if (!is.numeric(x) || length(x) != 3 || anyNA(x) || any(x < 1) ||
+          any(x != round(x)) || anyDuplicated(x)) {
+        abort("`", arg, "` must be 3 different column numbers, not ", describe(x), ".")
+      }
+    }),
+    row("rmc.col.temp", NA, NULL, rmc_whole),
+    row("rmc.col.time", NA, NULL, rmc_whole),
+    row("rmc.unit.acc", NA, "g", rmc_choice(c("g", "mg", "bit"))),
+    row("rmc.unit.temp", NA, "C", rmc_choice(c("C", "K", "F"))),
+    row("rmc.unit.time", NA, "POSIX",
+        rmc_choice(c("POSIX", "character", "UNIXsec", "UNIXmsec", "ActivPAL"))),
+    row("rmc.format.time", NA, "%Y-%m-%d %H:%M:%OS", rmc_string),
+    row("rmc.bitrate", NA, NULL, rmc_number_or_name),
+    row("rmc.dynamic_range", NA, NULL, rmc_number_or_name),
+    row("rmc.unsignedbit", NA, TRUE, check_flag),
+    row("rmc.origin", NA, "1970-01-01", rmc_string),
+    # time zones move time stamps only, which the calibration does not use
+    row("rmc.desiredtz", NA, NULL, rmc_string),
+    row("rmc.configtz", NA, NULL, rmc_string),
+    row("rmc.headername.sf", NA, NULL, rmc_string),
+    row("rmc.headername.sn", NA, NULL, rmc_string),
+    row("rmc.headername.recordingid", NA, NULL, rmc_string),
+    row("rmc.header.structure", NA, NULL, rmc_string),
+    # not implemented: TRUE is refused where a file is read (rmc_layout())
+    row("rmc.check4timegaps", NA, FALSE, check_flag),
+    row("rmc.doresample", NA, FALSE, check_flag),
+    # a wear column: g.calibrate() does not use it
+    row("rmc.col.wear", NA, NULL, rmc_whole),
+    row("rmc.dec", NA, ".", rmc_choice(c(".", ","))),
+    row("rmc.scalefactor.acc", NA, 1, function(x, arg) check_number(x, arg)),
     # checked where the source is opened (open_source())
     row("reader", "reader", "native")
   )
+}
+
+# Checks of the rmc.* rows (NULL is each one's "not given").
+rmc_whole <- function(x, arg) {
+  if (!is.null(x)) check_number(x, arg, min = 1, integer = TRUE)
+}
+rmc_string <- function(x, arg) {
+  if (!is.null(x) && !(is.character(x) && length(x) == 1 && !is.na(x))) {
+    abort("`", arg, "` must be a string, not ", describe(x), ".")
+  }
+}
+rmc_choice <- function(choices) {
+  function(x, arg) {
+    if (!(is.character(x) && length(x) == 1 && x %in% choices)) {
+      abort("`", arg, "` must be one of ", paste0("\"", choices, "\"", collapse = ", "),
+            ", not ", describe(x), ".")
+    }
+  }
+}
+rmc_number_or_name <- function(x, arg) {
+  if (is.character(x)) rmc_string(x, arg) else if (!is.null(x)) check_number(x, arg, min = 0)
+}
+
+# The rmc.* parameters, checked, with GGIR's defaults: from `rmc` (a list;
+# calibrate(), read_recording()) or from the values of g.calibrate()'s
+# table. An unknown name is an error.
+rmc_values <- function(rmc, arg = "rmc") {
+  if (is.null(rmc)) return(NULL)
+  if (!is.list(rmc) || (length(rmc) && is.null(names(rmc)))) {
+    abort("`", arg, "` must be a named list of GGIR's rmc.* parameters, not ",
+          describe(rmc), ".")
+  }
+  rows <- Filter(function(p) grepl("^rmc[.]", p$ggir), ggir_param_table())
+  nms <- vapply(rows, `[[`, "", "ggir")
+  bad <- setdiff(names(rmc), nms)
+  if (length(bad)) {
+    abort("Unknown parameter", if (length(bad) > 1) "s", " in `", arg, "`: ",
+          paste0("`", bad, "`", collapse = ", "), ". Known: ", paste(nms, collapse = ", "), ".")
+  }
+  out <- stats::setNames(lapply(rows, `[[`, "default"), nms)
+  for (nm in names(rmc)) out[nm] <- list(rmc[[nm]])
+  for (p in rows) if (!is.null(p$check)) p$check(out[[p$ggir]], p$ggir)
+  out
 }
 
 # The rows a front door takes: door "ggir" (g.calibrate()) or "own"

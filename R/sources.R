@@ -10,8 +10,10 @@
 # file where GGIR does: `chunksize` scales them (1 = about 12 hours).
 
 
+# `rmc`: GGIR's rmc.* parameters (their checked values, rmc_values()); with
+# rmc.firstrow.acc the file is read as an ad hoc csv file (R/adhoc-csv.R).
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
-                        reader = "native", compat = TRUE) {
+                        reader = "native", compat = TRUE, rmc = NULL) {
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -21,14 +23,24 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   }
   check_file(datafile, arg)
   reader <- match_choice(reader, "reader", c("native", "reference"))
-  format <- file_format(datafile, arg)
+  layout <- NULL
+  if (!is.null(rmc$rmc.firstrow.acc)) {
+    format <- "adhoc_csv"
+    layout <- rmc_layout(rmc, datafile)
+    sf <- layout$sf
+  } else {
+    format <- file_format(datafile, arg)
+  }
   src <- NULL
   if (reader == "native" && format_has_decoder(format)) {
-    src <- source_native(datafile, format, sf, chunksize, compat, arg)
+    src <- source_native(datafile, format, sf, chunksize, compat, arg,
+                         extra = layout$opts)
   }
   if (is.null(src)) {
-    src <- format_entry(format)$source(datafile, sf, chunksize, arg)
+    src <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg) else
+      format_entry(format)$source(datafile, sf, chunksize, arg, layout = layout)
   }
+  if (!is.null(layout$serial)) src$info$serial <- layout$serial
   src$filename <- basename(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
@@ -112,9 +124,11 @@ native_open_error <- function(file, format, why, arg) {
 # each block comes as one or more parts (list(cols, from, to)), which hold
 # the samples of GGIR's block together, however many samples that is.
 # `segment()` streams units straight into a segmenter, without R vectors.
-source_native <- function(file, format, sf, chunksize, compat, arg) {
+# `extra`: more options for the decoder (an ad hoc csv file's layout).
+source_native <- function(file, format, sf, chunksize, compat, arg, extra = NULL) {
   opts <- list(compat = as.numeric(isTRUE(compat)))
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  opts[names(extra)] <- extra
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
   if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1

@@ -62,6 +62,7 @@ inline const DecoderKind* find_decoder(const std::string& format) {
   static const DecoderKind kinds[] = {
       {"actigraph_csv", true, make_csv},
       {"csv", true, make_csv},
+      {"adhoc_csv", true, make_csv},
       {"gt3x", false, make_gt3x},
       {"cwa", false, make_cwa},
       {"geneactiv", false, make_geneactiv},
