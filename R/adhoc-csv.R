@@ -26,7 +26,11 @@
 # The rmc.* parameters (their values from the parameter table,
 # ggir-params.R) as the decoder's layout for `file`: list(opts = decoder
 # options, sf, skip, cols, temperature, ...). Errors name the parameter.
-rmc_layout <- function(p, file, tz = "") {
+# `ggir`: the lines as GGIR's blocks have them (g.readaccfile skips line
+# rmc.firstrow.acc when its first field is not a number, be it a column
+# name or a text time stamp); FALSE (read_recording()): only a line whose
+# x field is not a number is skipped (a column-name line).
+rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   if (is.null(p$rmc.firstrow.acc)) {
     abort("`rmc.firstrow.acc` must be given to read \"", file, "\" as an ad hoc csv file.")
   }
@@ -80,7 +84,9 @@ rmc_layout <- function(p, file, tz = "") {
   }
   skip <- p$rmc.firstrow.acc - 1
   f1 <- rmc_fields(first[skip + 1])
-  if (is.na(suppressWarnings(as.numeric(f1[1])))) skip <- skip + 1
+  lead <- if (ggir) f1[1] else f1[cols[1]]
+  if (p$rmc.dec == ",") lead <- if (ggir) lead else sub(",", ".", lead, fixed = TRUE)
+  if (is.na(suppressWarnings(as.numeric(lead)))) skip <- skip + 1
   opts$skip <- skip
   if (length(p$rmc.col.time)) {
     opts$col_time <- as.numeric(p$rmc.col.time)
@@ -110,11 +116,12 @@ rmc_layout <- function(p, file, tz = "") {
        })
 }
 
-# The fields of a line, split at the first of ',', ';' or tab it holds,
-# blanks and double quotes around them removed.
+# The fields of a line, split at the first of ';', tab or ',' it holds
+# (a line with ';' or tabs may hold decimal commas), blanks and double
+# quotes around them removed.
 rmc_fields <- function(line) {
   if (is.na(line)) return(NA_character_)
-  sep <- c(",", ";", "\t")
+  sep <- c(";", "\t", ",")
   sep <- sep[vapply(sep, grepl, NA, x = line, fixed = TRUE)]
   f <- if (length(sep)) strsplit(line, sep[1], fixed = TRUE)[[1]] else line
   gsub("^[[:space:]\"]+|[[:space:]\"]+$", "", f)

@@ -51,11 +51,30 @@
 #' samples where GGIR's readers stop. `reader = "reference"` in `...` reads
 #' through GGIR's readers themselves (GGIRread, read.gt3x, data.table).
 #'
+#' @section Ad hoc csv files (GGIR's `rmc.*` parameters):
+#' With `rmc.firstrow.acc` in `params_rawdata`, the file is read as GGIR
+#' reads an "ad hoc" csv file, by gravcal's csv decoder in GGIR's blocks:
+#'
+#' | parameter | |
+#' |---|---|
+#' | `rmc.firstrow.acc` | honoured: line of the first sample (GGIR starts one line later when that line's first field is not a number) |
+#' | `rmc.col.acc`, `rmc.col.temp` | honoured |
+#' | `rmc.unit.acc` | honoured: `"g"`, `"mg"`, `"bit"` (with `rmc.bitrate`, `rmc.dynamic_range`, `rmc.unsignedbit`; the first two may name header rows) |
+#' | `rmc.scalefactor.acc` | honoured |
+#' | `rmc.unit.temp` | honoured: `"C"`, `"K"` (GGIR adds 272.15), `"F"` |
+#' | `rmc.sf`, `rmc.firstrow.header`, `rmc.header.length`, `rmc.headername.sf`, `rmc.header.structure` | honoured: the sampling rate from the header, else `rmc.sf` |
+#' | `rmc.dec` | honoured (`","` with `;` or tab separated fields) |
+#' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
+#' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
+#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration |
+#' | `rmc.check4timegaps = TRUE`; `rmc.doresample = TRUE` with a time column | refused with an error |
+#'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
 #'   lists (as from `GGIR::load_params()`); gravcal uses `chunksize`,
-#'   `spherecrit`, `minloadcrit`, `printsummary` and, for ad hoc csv files
-#'   and data frames, `rmc.noise`, and ignores the rest. Missing entries take GGIR's defaults
+#'   `spherecrit`, `minloadcrit`, `printsummary`, the `rmc.*` parameters of
+#'   ad hoc csv files (see below) and, for data frames, `rmc.noise`, and
+#'   ignores the rest. Missing entries take GGIR's defaults
 #'   (`chunksize = 1`, `spherecrit = 0.3`, `minloadcrit = 168`,
 #'   `printsummary = FALSE`).
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
@@ -153,7 +172,8 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   }
   open <- function() {
     src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
-                       reader = a$reader, compat = compat)
+                       reader = a$reader, compat = compat,
+                       rmc = if (is.character(x)) rmc_values(a$rmc))
     if (!a$use_temp) src$temperature <- FALSE
     src
   }

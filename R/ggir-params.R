@@ -69,7 +69,9 @@ ggir_param_table <- function() {
     row("rmc.dec", NA, ".", rmc_choice(c(".", ","))),
     row("rmc.scalefactor.acc", NA, 1, function(x, arg) check_number(x, arg)),
     # checked where the source is opened (open_source())
-    row("reader", "reader", "native")
+    row("reader", "reader", "native"),
+    # calibrate(method = "ggir")'s ad hoc csv files: GGIR's rmc.* list
+    row(NA, "rmc", NULL, function(x, arg) rmc_values(x, arg))
   )
 }
 

@@ -26,7 +26,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   layout <- NULL
   if (!is.null(rmc$rmc.firstrow.acc)) {
     format <- "adhoc_csv"
-    layout <- rmc_layout(rmc, datafile)
+    layout <- rmc_layout(rmc, datafile, ggir = compat)
     sf <- layout$sf
   } else {
     format <- file_format(datafile, arg)

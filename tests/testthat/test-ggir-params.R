@@ -22,9 +22,24 @@ test_that("both front doors take their defaults and checks from one table", {
   expect_identical(names(own), c("use_temp", "spherecrit", "minloadcrit",
                                  "chunksize", "max_sd", "max_iter", "tol",
                                  "verbose", "reader"))
+  # GGIR's rmc.* parameters of ad hoc csv files (GGIR 3.3-9 load_params()),
+  # with GGIR's defaults
+  rmc <- c("rmc.firstrow.acc", "rmc.firstrow.header", "rmc.header.length",
+           "rmc.col.acc", "rmc.col.temp", "rmc.col.time", "rmc.unit.acc",
+           "rmc.unit.temp", "rmc.unit.time", "rmc.format.time", "rmc.bitrate",
+           "rmc.dynamic_range", "rmc.unsignedbit", "rmc.origin", "rmc.desiredtz",
+           "rmc.configtz", "rmc.headername.sf", "rmc.headername.sn",
+           "rmc.headername.recordingid", "rmc.header.structure",
+           "rmc.check4timegaps", "rmc.doresample", "rmc.col.wear", "rmc.dec",
+           "rmc.scalefactor.acc")
   expect_identical(names(ggir), c("spherecrit", "minloadcrit", "chunksize",
-                                  "printsummary", "rmc.noise", "rmc.sf",
+                                  "printsummary", "rmc.noise", "rmc.sf", rmc,
                                   "reader"))
+  if (requireNamespace("GGIR", quietly = TRUE)) {
+    d <- GGIR::load_params()$params_rawdata
+    expect_true(all(rmc %in% names(d)))
+    for (nm in rmc) expect_identical(ggir[[nm]], d[[nm]], label = nm)
+  }
 })
 
 test_that("a later source wins, and a value is checked wherever it comes from", {
