@@ -32,6 +32,16 @@ recording_formats <- list(
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  # Axivity's csv export (OMGUI): no header, lines of UNIX time stamp, x,
+  # y, z; GGIR resamples each block onto the rate it finds from the first
+  # 100000 time stamps (R/axivity-csv.R)
+  axivity_csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = function(file) is_axivity_csv(file),
+    label = "an Axivity csv export", unit = "line",
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    decoder = "axivity_csv",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_axivity_csv(file, sf, chunksize)),
   csv = list(
     ext = c(csv = NA, csv.gz = NA), detect = NULL,
     label = "a csv file of samples", unit = "line",

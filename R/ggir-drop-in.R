@@ -43,8 +43,9 @@
 #' optional `temperature`), read in the blocks GGIR uses for csv files, with
 #' the sampling rate given as `sf = ` in `...` (or from a `time` column).
 #'
-#' Formats: ActiGraph csv exports, csv files with `x`, `y`, `z` columns,
-#' `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
+#' Formats: ActiGraph csv exports, Axivity csv exports (OMGUI, UNIX time
+#' stamps; resampled block by block as GGIR does, linearly), csv files with
+#' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
 #' `.bin`. They are read by gravcal's own decoders, which give what GGIR's
 #' readers give (GGIRread's resampling of `.cwa` included), block by block
 #' as GGIR reads them, in bounded memory; a damaged file keeps its good
@@ -125,6 +126,13 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                 reader = pr$reader, compat = TRUE, rmc = rmc)
   }
   src <- open()
+  # GGIR resamples Axivity csv exports as interpolationType says; gravcal
+  # linearly only (GGIR's default, 1)
+  it <- dots$interpolationType %||% params_rawdata[["interpolationType"]]
+  if (identical(src$format, "axivity_csv") && !is.null(it) && !identical(as.numeric(it), 1)) {
+    abort("`interpolationType` = ", deparse(it), " is not supported for Axivity csv ",
+          "exports (gravcal resamples them linearly, interpolationType = 1).")
+  }
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
   # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike

@@ -6,7 +6,9 @@
 #'   example, see [gravcal_example()]); `sf` from its `sf` attribute or its
 #'   `time` column;
 #' * `.csv`, `.csv.gz`: an ActiGraph csv export (ActiLife's 10-line header,
-#'   with or without time stamps; `sf` from the header), or a header line with
+#'   with or without time stamps; `sf` from the header), an Axivity csv
+#'   export (no header; UNIX time stamp, x, y, z; `sf` as GGIR finds it from
+#'   the time stamps, the samples as stored), or a header line with
 #'   columns `x`, `y`, `z` and optionally `time` and `temperature`; `sf` from
 #'   `time` or the argument;
 #' * `.gt3x` (ActiGraph; current `log.bin` and older `activity.bin`
@@ -201,6 +203,11 @@ read_native <- function(file, format, sf, arg = "file", extra = NULL) {
   if (format == "gt3x") opts <- list(compat = 1, impute_zeroes = 1)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
+  if (format == "axivity_csv") {
+    lay <- axivity_csv_layout(file, sf)
+    sf <- lay$sf
+    opts[names(lay$opts)] <- lay$opts
+  }
   h <- gc_decoder_open(path.expand(file), format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)

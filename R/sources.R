@@ -129,6 +129,11 @@ source_native <- function(file, format, sf, chunksize, compat, arg, extra = NULL
   opts <- list(compat = as.numeric(isTRUE(compat)))
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
+  if (format == "axivity_csv") {
+    lay <- axivity_csv_layout(file, sf)
+    sf <- lay$sf
+    opts[names(lay$opts)] <- lay$opts
+  }
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
   if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1

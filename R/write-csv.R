@@ -129,6 +129,19 @@ write_plain_csv <- function(d, file, sep = ",", dec = ".") {
   invisible(file)
 }
 
+# Writes samples x, y, z (in g) as Axivity's csv export (OMGUI, UNIX time
+# stamps): no header, lines "time,x,y,z" with the time in seconds (3
+# decimals) of sample i at `start` + i / `true_sf` (a device's clock runs a
+# little off its nominal rate) and `digits` decimals.
+write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
+                              digits = 4) {
+  s <- as_samples(x)
+  t <- as.numeric(as.POSIXct(start, tz = "UTC")) + (seq_len(s$n) - 1) / true_sf
+  data.table::fwrite(list(sprintf("%.3f", t), round(s$x, digits), round(s$y, digits),
+                          round(s$z, digits)), file, col.names = FALSE, quote = FALSE)
+  invisible(file)
+}
+
 # Writes samples (x, y, z in g, optional temperature in C) as an "ad hoc"
 # csv file, the kind GGIR reads with its rmc.* parameters, and returns those
 # parameters (a list for params_rawdata). Layout, from top: the `header`

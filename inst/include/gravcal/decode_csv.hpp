@@ -120,7 +120,10 @@ class CsvDecoder : public Decoder {
     compat_ = opts.num("compat", 1) != 0;
     sf_option_ = opts.num("sf", 0);
     fast_ = opts.num("fast", 1) != 0;
-    adhoc_ = format == "adhoc_csv";
+    // an Axivity csv export (time stamp, x, y, z) is read by the same layout
+    // options (R/formats.R gives them)
+    adhoc_ = format == "adhoc_csv" || format == "axivity_csv";
+    adhoc_format_ = format;
     if (adhoc_) {
       adhoc_skip_ = static_cast<std::int64_t>(opts.num("skip", 0));
       const double c[5] = {opts.num("col_x", 1), opts.num("col_y", 2), opts.num("col_z", 3),
@@ -198,6 +201,8 @@ class CsvDecoder : public Decoder {
 
   bool done() const override { return !opened_ || done_; }
   std::size_t max_samples_per_unit() const override { return 1; }
+  // (GgirResamplerOf's interface: a csv read has no state across calls)
+  void continue_call(bool) {}
 
  private:
   static std::size_t buffer_bytes(const Options& opts) {
@@ -453,7 +458,7 @@ class CsvDecoder : public Decoder {
   // Ad hoc csv: the lines before the data skipped, the separator learnt
   // from the data lines, the columns as the options give them.
   bool open_adhoc() {
-    info_.format = "adhoc_csv";
+    info_.format = adhoc_format_;
     csv_text::Line ln;
     for (std::int64_t i = 0; i < adhoc_skip_; ++i) {
       if (!lines_.next(ln)) {
@@ -845,6 +850,7 @@ class CsvDecoder : public Decoder {
   std::int64_t run_ = 0;
   // ad hoc csv (format "adhoc_csv"): its layout and units, from options
   bool adhoc_ = false;
+  std::string adhoc_format_;
   std::int64_t adhoc_skip_ = 0;
   char adhoc_dec_ = '.';
   double time_div_ = 0, time_offset_ = 0;
