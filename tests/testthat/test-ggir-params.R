@@ -21,7 +21,7 @@ test_that("both front doors take their defaults and checks from one table", {
   # each door under its own names only
   expect_identical(names(own), c("use_temp", "spherecrit", "minloadcrit",
                                  "chunksize", "max_sd", "max_iter", "tol",
-                                 "verbose", "reader"))
+                                 "verbose", "reader", "rmc"))
   # GGIR's rmc.* parameters of ad hoc csv files (GGIR 3.3-9 load_params()),
   # with GGIR's defaults
   rmc <- c("rmc.firstrow.acc", "rmc.firstrow.header", "rmc.header.length",
