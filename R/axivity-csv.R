@@ -14,9 +14,16 @@
 # (so not a line of column names) and a number or date-time in field 1.
 is_axivity_csv <- function(file) {
   if (is_actigraph_csv(file)) return(FALSE)
-  first <- tryCatch(readLines(file, n = 1, warn = FALSE), error = function(e) character())
-  if (!length(first)) return(FALSE)
-  f <- trimws(strsplit(first, ",", fixed = TRUE)[[1]])
+  # the first line's bytes: a binary file named .csv is not text
+  con <- if (grepl("\\.gz$", file, ignore.case = TRUE)) gzfile(file, "rb") else file(file, "rb")
+  on.exit(close(con))
+  b <- readBin(con, "raw", 512)
+  nl <- match(as.raw(10), b)
+  if (is.na(nl)) return(FALSE)
+  b <- b[seq_len(nl - 1)]
+  b <- b[b != as.raw(13)]
+  if (!length(b) || any(b < as.raw(32) | b >= as.raw(127))) return(FALSE)
+  f <- trimws(strsplit(rawToChar(b), ",", fixed = TRUE)[[1]])
   if (length(f) < 4) return(FALSE)
   num <- !is.na(suppressWarnings(as.numeric(f[1:4])))
   all(num[2:4]) && (num[1] || grepl("^[0-9]{4}-[0-9]{2}-[0-9]{2}", f[1]))
