@@ -126,6 +126,16 @@ test_that("calibrate() and rest_windows() read ad hoc csv files by the same rmc 
   l1 <- calibrate(f, rmc = pr)
   expect_identical(l1$status, "ok")
   expect_lt(l1$error_after, l1$error_before)
+  # a cohort of such files, by the same list
+  d <- tempfile("adhoc")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  file.copy(f, file.path(d, "rec1.csv"))
+  res <- calibrate_files(d, outdir = file.path(d, "out"), method = "ggir", rmc = pr)
+  own <- calibrate(f, rmc = pr, method = "ggir")
+  expect_identical(res$format, "adhoc_csv")
+  expect_identical(res$scale.x, unname(coef(own)[1]))
+  expect_identical(res$status, own$status)
 })
 
 test_that("rmc.* parameters gravcal does not implement, or cannot use, are errors naming them", {
