@@ -136,6 +136,21 @@ test_that("calibrate() and rest_windows() read ad hoc csv files by the same rmc 
   expect_identical(res$format, "adhoc_csv")
   expect_identical(res$scale.x, unname(coef(own)[1]))
   expect_identical(res$status, own$status)
+  # and from the command line, the list as R arguments or an .rds file
+  arg <- paste0("rmc.firstrow.acc = ", pr$rmc.firstrow.acc, ", rmc.col.acc = 2:4, ",
+                "rmc.col.temp = 5, rmc.col.time = 1, rmc.unit.time = \"UNIXsec\", ",
+                "rmc.unit.acc = \"mg\", rmc.sf = 10")
+  utils::capture.output(type = "message", tab <- calibrate_cli(
+    c("--out", file.path(d, "cli"), "--rmc", arg, d), quit = FALSE))
+  expect_identical(tab$scale.x, res$scale.x)
+  rds <- tempfile(fileext = ".rds")  # not in the folder of recordings
+  on.exit(unlink(rds), add = TRUE)
+  saveRDS(pr, rds)
+  utils::capture.output(type = "message", tab <- calibrate_cli(
+    c("--out", file.path(d, "cli2"), "--rmc", rds, d), quit = FALSE))
+  expect_identical(tab$scale.x, res$scale.x)
+  expect_error(calibrate_cli(c("--out", file.path(d, "cli3"), "--rmc", "rmc.unit.acc = \"kg\"", d),
+                             quit = FALSE), "`rmc.unit.acc` must be one of")
 })
 
 test_that("rmc.* parameters gravcal does not implement, or cannot use, are errors naming them", {
