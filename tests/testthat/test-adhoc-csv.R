@@ -75,6 +75,19 @@ test_that("ad hoc csv: text time stamps first, Kelvin, decimal commas", {
   expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
 })
 
+test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # GGIR drops x = y = z = 0 rows (g.imputeTimegaps, impute = FALSE), here
+  # with the time column beside them: a long run and a short one
+  rec <- adhoc_rec(seed = 16)
+  for (i in list(50000:80000, 500000:500003)) rec[i, c("x", "y", "z")] <- 0
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "UNIXsec")
+  expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
+})
+
 test_that("ad hoc csv samples equal GGIR's read.myacc.csv, sample for sample", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
