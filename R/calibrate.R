@@ -151,7 +151,7 @@
 #'   corrected procedure (`FALSE`, default).
 #' @param ... For the lightweight method, arguments passed on to
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
-#'   `chunk_size`, `progress`, `reader`), the guards (`max_norm_error`, in g,
+#'   `chunk_size`, `progress`, `reader`, `rmc`), the guards (`max_norm_error`, in g,
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
 #'   file or unknown; see Details), the choice of points and model
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
@@ -166,8 +166,10 @@
 #'   `use_temp` (fit the temperature term when there is one, default TRUE),
 #'   `spherecrit` (0.3 g), `minloadcrit` (168 h), `chunksize` (1, about 12 h
 #'   blocks), `max_sd` (0.013 g), `max_iter` (1000), `tol` (1e-10),
-#'   `reader` (`"native"` or `"reference"`, see [rest_windows()]) and
-#'   `verbose`.
+#'   `reader` (`"native"` or `"reference"`, see [rest_windows()]),
+#'   `rmc` (GGIR's `rmc.*` parameters of an ad hoc csv file, see
+#'   [rest_windows()]; the rest rule stays `max_sd`, where
+#'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`) and `verbose`.
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
 #' [g.calibrate()] for the steps) and returns a `gravcal_fit` whose `K` is

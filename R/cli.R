@@ -13,7 +13,11 @@
 #' `--sf HZ` (for files that do not give their sampling rate), `--pattern
 #' REGEX` (the recordings taken from a directory), `--recursive` (a
 #' directory's subfolders too; recordings are then named by their path
-#' relative to it), `--no-resume` (redo recordings already done), `--help`. The other arguments are the
+#' relative to it), `--rmc LIST` (ad hoc
+#' csv files: GGIR's `rmc.*` parameters as R arguments, `'rmc.firstrow.acc
+#' = 2, rmc.sf = 50'`, or an `.rds` file of their list; see
+#' [rest_windows()]), `--no-resume` (redo
+#' recordings already done), `--help`. The other arguments are the
 #' recordings (or one directory).
 #'
 #' It prints a summary line, `gravcal: N recording(s): a calibrated, b not
@@ -63,6 +67,9 @@ cli_help <- function() {
     "  --sf HZ          sampling rate, for files that do not give it",
     "  --pattern REGEX  for a directory: the file names to take",
     "  --recursive      for a directory: its subfolders too",
+    "  --rmc LIST       ad hoc csv files: GGIR's rmc.* parameters, as R arguments",
+    "                   ('rmc.firstrow.acc = 2, rmc.unit.acc = \"mg\", rmc.sf = 50')",
+    "                   or an .rds file holding their list",
     "  --no-resume      redo recordings already done in DIR",
     "  --help           this text",
     "",
@@ -81,6 +88,7 @@ cli_run <- function(args) {
     extra$sf <- sf
   }
   if (!is.null(opt$pattern)) extra$pattern <- opt$pattern
+  if (!is.null(opt$rmc)) extra$rmc <- cli_rmc(opt$rmc)
   if (!is.null(opt$workers)) {
     w <- suppressWarnings(as.numeric(opt$workers))
     if (!isTRUE(is.finite(w) && w >= 1 && w == round(w))) {
@@ -106,11 +114,27 @@ cli_run <- function(args) {
   tab
 }
 
+# --rmc: an .rds file of the list, or its entries as R arguments; checked
+# as calibrate()'s `rmc`.
+cli_rmc <- function(value) {
+  rmc <- if (grepl("\\.rds$", value, ignore.case = TRUE) && file.exists(value)) {
+    readRDS(value)
+  } else {
+    tryCatch(eval(parse(text = paste0("list(", value, ")")), envir = new.env(parent = baseenv())),
+             error = function(e) {
+               abort("`--rmc` must be rmc.* arguments (\"rmc.firstrow.acc = 2, rmc.sf = 50\") ",
+                     "or an .rds file of their list, not \"", value, "\": ", conditionMessage(e))
+             })
+  }
+  rmc_values(rmc, "--rmc")
+  rmc
+}
+
 cli_parse <- function(args) {
   opt <- list(method = "ggir", resume = TRUE, recursive = FALSE)
   files <- character(0)
   given <- character(0)
-  takes <- c("--method", "--out", "--workers", "--sf", "--pattern")
+  takes <- c("--method", "--out", "--workers", "--sf", "--pattern", "--rmc")
   i <- 1
   while (i <= length(args)) {
     a <- args[i]

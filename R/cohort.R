@@ -456,7 +456,9 @@ cohort_row <- function(file, id, fit, error, warnings, seconds, method) {
   num <- function(v) if (is.null(v)) NA_real_ else as.numeric(v)[1]
   inp <- if (na) NULL else fit$input
   rep <- inp$report
-  format <- tryCatch(file_format(file), error = function(e) NA_character_)
+  # the reader's (an ad hoc csv file is one by its rmc.* list, not its name)
+  format <- if (is.character(inp$format)) inp$format else
+    tryCatch(file_format(file), error = function(e) NA_character_)
   rest <- if (na) NA_real_ else if (method == "ggir") {
     as.numeric(NROW(fit$points))
   } else as.numeric(NROW(fit$windows))

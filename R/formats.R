@@ -32,6 +32,16 @@ recording_formats <- list(
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  # Axivity's csv export (OMGUI): no header, lines of UNIX time stamp, x,
+  # y, z; GGIR resamples each block onto the rate it finds from the first
+  # 100000 time stamps (R/axivity-csv.R)
+  axivity_csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = function(file) is_axivity_csv(file),
+    label = "an Axivity csv export", unit = "line",
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    decoder = "axivity_csv",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_axivity_csv(file, sf, chunksize)),
   csv = list(
     ext = c(csv = NA, csv.gz = NA), detect = NULL,
     label = "a csv file of samples", unit = "line",
@@ -39,6 +49,20 @@ recording_formats <- list(
     decoder = "csv",
     read = function(file, sf, reader, arg) read_plain_csv(file, arg),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  # GGIR's ad hoc csv: never found from the file itself, but chosen by the
+  # rmc.* parameters (rmc.firstrow.acc; R/adhoc-csv.R), which give its
+  # layout to the csv decoder (and to `source`, as `layout`)
+  adhoc_csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = function(file) FALSE,
+    label = "an ad hoc csv file (GGIR's rmc.* parameters)", unit = "line",
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    decoder = "adhoc_csv",
+    read = function(file, sf, reader, arg) {
+      abort("Reading \"", file, "\" as an ad hoc csv file needs its rmc.* parameters.")
+    },
+    source = function(file, sf, chunksize, arg, layout = NULL) {
+      source_adhoc(file, sf, chunksize, arg, layout)
+    }),
   rds = list(
     ext = c(rds = ".rds"), detect = NULL,
     label = "an .rds file", unit = "unit", block_units = NULL, decoder = NULL,

@@ -43,8 +43,9 @@
 #' optional `temperature`), read in the blocks GGIR uses for csv files, with
 #' the sampling rate given as `sf = ` in `...` (or from a `time` column).
 #'
-#' Formats: ActiGraph csv exports, csv files with `x`, `y`, `z` columns,
-#' `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
+#' Formats: ActiGraph csv exports, Axivity csv exports (OMGUI, UNIX time
+#' stamps; resampled block by block as GGIR does, linearly), csv files with
+#' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
 #' `.bin`. They are read by gravcal's own decoders, which give what GGIR's
 #' readers give (GGIRread's resampling of `.cwa` included), block by block
 #' as GGIR reads them, in bounded memory; a damaged file keeps its good
@@ -68,7 +69,25 @@
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
-#' | other `rmc.*` | ad hoc csv | as the ad hoc csv reader takes them |
+#' | other `rmc.*` | ad hoc csv | see "Ad hoc csv files" |
+#'
+#' @section Ad hoc csv files (GGIR's `rmc.*` parameters):
+#' With `rmc.firstrow.acc` in `params_rawdata`, the file is read as GGIR
+#' reads an "ad hoc" csv file, by gravcal's csv decoder in GGIR's blocks:
+#'
+#' | parameter | |
+#' |---|---|
+#' | `rmc.firstrow.acc` | honoured: line of the first sample (GGIR starts one line later when that line's first field is not a number) |
+#' | `rmc.col.acc`, `rmc.col.temp` | honoured |
+#' | `rmc.unit.acc` | honoured: `"g"`, `"mg"`, `"bit"` (with `rmc.bitrate`, `rmc.dynamic_range`, `rmc.unsignedbit`; the first two may name header rows) |
+#' | `rmc.scalefactor.acc` | honoured |
+#' | `rmc.unit.temp` | honoured: `"C"`, `"K"` (GGIR adds 272.15), `"F"` |
+#' | `rmc.sf`, `rmc.firstrow.header`, `rmc.header.length`, `rmc.headername.sf`, `rmc.header.structure` | honoured: the sampling rate from the header, else `rmc.sf` |
+#' | `rmc.dec` | honoured (`","` with `;` or tab separated fields) |
+#' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
+#' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
+#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration |
+#' | `rmc.check4timegaps = TRUE`; `rmc.doresample = TRUE` with a time column | refused with an error |
 #'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
@@ -116,17 +135,30 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     sf <- inspectfileobject$sf
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
+  # rmc.firstrow.acc: an ad hoc csv file, read by the rmc.* parameters
+  rmc <- if (!is.null(pr$rmc.firstrow.acc) && is.character(datafile)) {
+    pr[grepl("^rmc[.]", names(pr))]
+  }
   read_opts <- list(interpolation = pr$interpolationType,
                     frequency_tol = pr$frequency_tol)
   open <- function() {
     open_source(datafile, sf = sf, chunksize = pr$chunksize,
-                reader = pr$reader, compat = TRUE, read_opts = read_opts)
+                reader = pr$reader, compat = TRUE, read_opts = read_opts, rmc = rmc)
   }
   src <- open()
   ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
-  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor);
+  # GGIR resamples Axivity csv exports as interpolationType says; gravcal
+  # linearly only (GGIR's default, 1)
+  if (identical(src$format, "axivity_csv") && !identical(as.numeric(pr$interpolationType), 1)) {
+    abort("`interpolationType` = ", deparse(pr$interpolationType), " is not supported for ",
+          "Axivity csv exports (gravcal resamples them linearly, interpolationType = 1).")
+  }
+  # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
+  # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike
-  sdcriter <- if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
+  sdcriter <- if (src$format == "adhoc_csv") {
+    (pr$rmc.noise %||% ggir_constants$rmc_noise) * 1.2
+  } else if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
     pr$rmc.noise * 1.2
   } else {
     ggir_constants$max_sd
@@ -231,7 +263,8 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   }
   open <- function() {
     src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
-                       reader = a$reader, compat = compat)
+                       reader = a$reader, compat = compat,
+                       rmc = if (is.character(x)) rmc_values(a$rmc))
     if (!a$use_temp) src$temperature <- FALSE
     src
   }

@@ -13,8 +13,6 @@
 #               error naming the parameter (ggir_params(), ggir_check_tz());
 #   "no effect" it does not change what GGIR::g.calibrate() returns: taken
 #               and left alone;
-#   "rmc (h7)"  an ad hoc csv reading parameter (GGIR's read.myacc.csv),
-#               taken as before, being implemented on its own branch.
 # The audit read GGIR 3.3-9's g.calibrate(), g.readaccfile(),
 # g.inspectfile(), g.imputeTimegaps() and GGIRread 1.2.0's readAxivity() and
 # readGENEActiv(). g.calibrate() never reads params_cleaning: every entry of
@@ -40,10 +38,10 @@ ggir_param_table <- function() {
           effect = effect)
     })
   }
-  rmc <- function(defaults) {
-    lapply(names(defaults), function(nm) {
-      row(nm, NA, defaults[[nm]], status = "rmc (h7)",
-          effect = "ad hoc csv: how the file is read (read.myacc.csv)")
+  # rows of the ad hoc csv parameters: name, default, check, effect
+  rmc_rows <- function(specs) {
+    lapply(specs, function(r) {
+      row(r[[1]], NA, r[[2]], r[[3]], effect = paste("ad hoc csv:", r[[4]]))
     })
   }
   at_least_0 <- function(x, arg) check_number(x, arg, min = 0)
@@ -76,7 +74,8 @@ ggir_param_table <- function() {
       row("rmc.noise", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg),
           ggir_default = 13,
           effect = "ad hoc csv: the rest threshold (1.2 * rmc.noise)"),
-      row("rmc.sf", NA, NULL, effect = "ad hoc csv: the sampling rate"),
+      row("rmc.sf", NA, NULL, function(x, arg) if (!is.null(x)) above_0(x, arg),
+          effect = "ad hoc csv: the sampling rate"),
       row("interpolationType", NA, 1, function(x, arg) {
         if (!(is.numeric(x) && length(x) == 1 && x %in% c(1, 2))) {
           abort("`", arg, "` must be 1 (linear) or 2 (nearest neighbour), not ",
@@ -84,7 +83,7 @@ ggir_param_table <- function() {
         }
       }, effect = paste0(".cwa (readAxivity's resampling), GENEActiv .bin at a ",
                          "rate that is not whole (g.readaccfile's resampling); ",
-                         "ad hoc csv with rmc.doresample (rmc, h7)")),
+                         "ad hoc csv with rmc.doresample (refused there)")),
       row("frequency_tol", NA, 0.1, at_least_0,
           effect = ".cwa: readAxivity's tolerance on a block's rate before it imputes"),
       row("desiredtz", NA, "", tz_check, list = "general",
@@ -92,11 +91,13 @@ ggir_param_table <- function() {
                           "when that is not given); a change of UTC offset ",
                           "(daylight saving) during the recording moves them; ",
                           "honoured where the offset stays the same, refused ",
-                          "otherwise. Ad hoc csv: rmc (h7)")),
+                          "otherwise. Ad hoc csv: time stamps only (rmc.desiredtz)")),
       row("configtz", NA, NULL, tz_check, list = "general",
           effect = "as desiredtz, which it replaces when given"),
       # checked where the source is opened (open_source())
-      row("reader", "reader", "native", list = NA_character_)
+      row("reader", "reader", "native", list = NA_character_),
+      # calibrate(method = "ggir")'s ad hoc csv files: GGIR's rmc.* list
+      row(NA, "rmc", NULL, function(x, arg) rmc_values(x, arg))
     ),
     no_effect("rawdata", list(
       do.cal = TRUE, backup.cal.coef = "retrieve", dynrange = NULL,
@@ -105,17 +106,47 @@ ggir_param_table <- function() {
     list(row("imputeTimegaps", NA, TRUE, status = "no effect",
              effect = paste0("g.calibrate() calls g.imputeTimegaps() with ",
                              "impute = FALSE whatever it is"))),
-    rmc(list(
-      rmc.dec = ".", rmc.firstrow.acc = NULL, rmc.firstrow.header = NULL,
-      rmc.header.length = NULL, rmc.col.acc = 1:3, rmc.col.temp = NULL,
-      rmc.col.time = NULL, rmc.unit.acc = "g", rmc.unit.temp = "C",
-      rmc.unit.time = "POSIX", rmc.format.time = "%Y-%m-%d %H:%M:%OS",
-      rmc.bitrate = NULL, rmc.dynamic_range = NULL, rmc.unsignedbit = TRUE,
-      rmc.origin = "1970-01-01", rmc.desiredtz = NULL, rmc.configtz = NULL,
-      rmc.headername.sf = NULL, rmc.headername.sn = NULL,
-      rmc.headername.recordingid = NULL, rmc.header.structure = NULL,
-      rmc.check4timegaps = FALSE, rmc.col.wear = NULL, rmc.doresample = FALSE,
-      rmc.scalefactor.acc = 1)),
+    # GGIR's ad hoc csv files (R/adhoc-csv.R; GGIR's read.myacc.csv):
+    # GGIR 3.3-9's load_params() defaults; rmc.firstrow.acc makes a file one.
+    # Values gravcal does not implement are refused where a file is read
+    # (rmc_layout()).
+    rmc_rows(list(
+      list("rmc.firstrow.acc", NULL, rmc_whole, "the first row of samples; makes a csv file ad hoc"),
+      list("rmc.firstrow.header", NULL, rmc_whole, "the header's first row"),
+      list("rmc.header.length", NULL, rmc_whole, "the header's length"),
+      list("rmc.col.acc", 1:3, function(x, arg) {
+        if (!is.numeric(x) || length(x) != 3 || anyNA(x) || any(x < 1) ||
+            any(x != round(x)) || anyDuplicated(x)) {
+          abort("`", arg, "` must be 3 different column numbers, not ", describe(x), ".")
+        }
+      }, "the acceleration columns"),
+      list("rmc.col.temp", NULL, rmc_whole, "the temperature column"),
+      list("rmc.col.time", NULL, rmc_whole, "the time column (time stamps only)"),
+      list("rmc.unit.acc", "g", rmc_choice(c("g", "mg", "bit")), "the acceleration unit"),
+      list("rmc.unit.temp", "C", rmc_choice(c("C", "K", "F")), "the temperature unit"),
+      list("rmc.unit.time", "POSIX",
+           rmc_choice(c("POSIX", "character", "UNIXsec", "UNIXmsec", "ActivPAL")),
+           "the time column's unit (time stamps only)"),
+      list("rmc.format.time", "%Y-%m-%d %H:%M:%OS", rmc_string, "text time's format"),
+      list("rmc.bitrate", NULL, rmc_number_or_name, "unit bit: the bits per sample"),
+      list("rmc.dynamic_range", NULL, rmc_number_or_name, "unit bit: the range in g"),
+      list("rmc.unsignedbit", TRUE, check_flag, "unit bit: unsigned or signed"),
+      list("rmc.origin", "1970-01-01", rmc_string, "UNIX time's origin (time stamps only)"),
+      # time zones move time stamps only, which the calibration does not use
+      list("rmc.desiredtz", NULL, rmc_string, "time stamps only"),
+      list("rmc.configtz", NULL, rmc_string, "time stamps only"),
+      list("rmc.headername.sf", NULL, rmc_string, "the header's name of the rate"),
+      list("rmc.headername.sn", NULL, rmc_string, "the header's serial number (not used)"),
+      list("rmc.headername.recordingid", NULL, rmc_string, "the header's recording id (not used)"),
+      list("rmc.header.structure", NULL, rmc_string, "how header names and values are separated"),
+      list("rmc.check4timegaps", FALSE, check_flag, "TRUE refused: not implemented"),
+      list("rmc.doresample", FALSE, check_flag, "TRUE with a time column refused: not implemented"),
+      # a wear column: g.calibrate() does not use it
+      list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),
+      list("rmc.dec", ".", rmc_choice(c(".", ",")), "the decimal mark"),
+      list("rmc.scalefactor.acc", 1, function(x, arg) check_number(x, arg),
+           "a factor on the acceleration")
+    )),
     no_effect("general", list(
       overwrite = FALSE, acc.metric = "ENMO", maxNcores = NULL,
       print.filename = FALSE, do.parallel = TRUE, windowsizes = c(5, 900, 3600),
@@ -128,6 +159,49 @@ ggir_param_table <- function() {
       use_trycatch_serial = FALSE),
       "read by GGIR's later steps, not on g.calibrate()'s path")
   )
+}
+
+# Checks of the rmc.* rows (NULL is each one's "not given").
+rmc_whole <- function(x, arg) {
+  if (!is.null(x)) check_number(x, arg, min = 1, integer = TRUE)
+}
+rmc_string <- function(x, arg) {
+  if (!is.null(x) && !(is.character(x) && length(x) == 1 && !is.na(x))) {
+    abort("`", arg, "` must be a string, not ", describe(x), ".")
+  }
+}
+rmc_choice <- function(choices) {
+  function(x, arg) {
+    if (!(is.character(x) && length(x) == 1 && x %in% choices)) {
+      abort("`", arg, "` must be one of ", paste0("\"", choices, "\"", collapse = ", "),
+            ", not ", describe(x), ".")
+    }
+  }
+}
+rmc_number_or_name <- function(x, arg) {
+  if (is.character(x)) rmc_string(x, arg) else if (!is.null(x)) check_number(x, arg, min = 0)
+}
+
+# The rmc.* parameters, checked, with GGIR's defaults: from `rmc` (a list;
+# calibrate(), read_recording()) or from the values of g.calibrate()'s
+# table. An unknown name is an error.
+rmc_values <- function(rmc, arg = "rmc") {
+  if (is.null(rmc)) return(NULL)
+  if (!is.list(rmc) || (length(rmc) && is.null(names(rmc)))) {
+    abort("`", arg, "` must be a named list of GGIR's rmc.* parameters, not ",
+          describe(rmc), ".")
+  }
+  rows <- Filter(function(p) grepl("^rmc[.]", p$ggir), ggir_param_table())
+  nms <- vapply(rows, `[[`, "", "ggir")
+  bad <- setdiff(names(rmc), nms)
+  if (length(bad)) {
+    abort("Unknown parameter", if (length(bad) > 1) "s", " in `", arg, "`: ",
+          paste0("`", bad, "`", collapse = ", "), ". Known: ", paste(nms, collapse = ", "), ".")
+  }
+  out <- stats::setNames(lapply(rows, `[[`, "default"), nms)
+  for (nm in names(rmc)) out[nm] <- list(rmc[[nm]])
+  for (p in rows) if (!is.null(p$check)) p$check(out[[p$ggir]], p$ggir)
+  out
 }
 
 # The rows a front door takes: door "ggir" (g.calibrate()) or "own"
@@ -157,11 +231,9 @@ ggir_param_values <- function(door, given = list()) {
   out
 }
 
-# The parameters g.calibrate() takes silently in `...`, by name: every row
-# with a GGIR name but the ad hoc csv ones not yet read ("rmc (h7)"), which
-# are warned about there as before.
+# The parameters g.calibrate() takes in `...`, by name: every row with a
+# GGIR name.
 ggir_param_known <- function() {
-  rows <- Filter(function(p) !is.na(p$ggir) && p$status != "rmc (h7)",
-                 ggir_param_table())
+  rows <- Filter(function(p) !is.na(p$ggir), ggir_param_table())
   vapply(rows, `[[`, "", "ggir")
 }

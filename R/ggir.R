@@ -40,7 +40,10 @@ ggir_constants <- list(
   tol = 1e-10,            # ICP stopping tolerance (g.calibrate)
   max_weight = 100,       # ICP weights capped at 1 / 0.01 (g.calibrate)
   block_hours = 12,       # GGIR reads about 12 h per block (chunksize = 1)
-  refit_growth = 1.25     # gravcal's own mode: refit once the table grew by this
+  refit_growth = 1.25,    # gravcal's own mode: refit once the table grew by this
+  rmc_noise = 13          # g, GGIR's rmc.noise for ad hoc csv files when none is
+                          # given (load_params(), GGIR 3.3-9): rest is then
+                          # sd < 15.6 g, so |mean| < 2 g alone decides
 )
 
 # The memory in use, in MB, for GGIR's bsc_qc record: the process's

@@ -6,7 +6,9 @@
 #'   example, see [gravcal_example()]); `sf` from its `sf` attribute or its
 #'   `time` column;
 #' * `.csv`, `.csv.gz`: an ActiGraph csv export (ActiLife's 10-line header,
-#'   with or without time stamps; `sf` from the header), or a header line with
+#'   with or without time stamps; `sf` from the header), an Axivity csv
+#'   export (no header; UNIX time stamp, x, y, z; `sf` as GGIR finds it from
+#'   the time stamps, the samples as stored), or a header line with
 #'   columns `x`, `y`, `z` and optionally `time` and `temperature`; `sf` from
 #'   `time` or the argument;
 #' * `.gt3x` (ActiGraph; current `log.bin` and older `activity.bin`
@@ -34,6 +36,15 @@
 #'   `.bin`, `.gt3x` and csv, which give the samples as the device stored
 #'   them and count what they had to skip; `"reference"`: the readers GGIR
 #'   uses (GGIRread, read.gt3x, data.table).
+#' @param rmc For an "ad hoc" csv file (any layout of columns and units):
+#'   GGIR's `rmc.*` parameters as a named list, as in GGIR's
+#'   `params_rawdata` (`rmc.firstrow.acc`, required, `rmc.col.acc`,
+#'   `rmc.unit.acc`, `rmc.col.temp`, `rmc.col.time`, `rmc.sf`, ...; see
+#'   [g.calibrate()]). The samples are those GGIR's `read.myacc.csv()` gives
+#'   (converted to g and C as it converts them; a text time stamp in the
+#'   first column makes GGIR, and so gravcal, skip the first line). `time`
+#'   is the file's for UNIX or ActivPAL time stamps, else the first stamp
+#'   plus the sample index over `sf`.
 #' @return A list with `data` (a data frame with `x`, `y`, `z` and, where the
 #'   file has them, `time` and `temperature`), `sf` and `input` (for the
 #'   native reader: the samples read and what was skipped, and why).
@@ -42,10 +53,36 @@
 #' rec <- read_recording(gravcal_example())
 #' rec$sf
 #' head(rec$data)
-read_recording <- function(file, sf = NULL, reader = c("native", "reference")) {
+read_recording <- function(file, sf = NULL, reader = c("native", "reference"),
+                           rmc = NULL) {
   check_file(file, "file")
   reader <- match_choice(reader, "reader")
+  if (!is.null(rmc)) return(read_adhoc(file, reader, rmc_values(rmc)))
   read_file(file, sf, reader, "file")
+}
+
+# read_recording() of an ad hoc csv file: its decoder (numbers as fread reads
+# them, so that the samples are GGIR's) or data.table::fread().
+read_adhoc <- function(file, reader, p) {
+  if (is.null(p$rmc.firstrow.acc)) {
+    abort("`rmc` must give `rmc.firstrow.acc` (the line where the samples start).")
+  }
+  if (reader == "native") {
+    layout <- rmc_layout(p, file, ggir = FALSE)
+    d <- read_native(file, "adhoc_csv", layout$sf, "file",
+                     extra = c(layout$opts, compat = 1))
+    if (is.null(d)) reader <- "reference"
+  }
+  if (reader == "reference") {
+    src <- open_source(file, arg = "file", reader = "reference", compat = FALSE,
+                       rmc = p)
+    d <- as.data.frame(gc_pump(src$pump(), "samples", list(time = 0)))
+    attr(d, "sf") <- src$sf
+    attr(d, "input") <- list(source = basename(file), format = "adhoc_csv",
+                             reader = "reference", samples = nrow(d))
+  }
+  if (!nrow(d)) abort("`file` holds no samples: \"", file, "\".")
+  list(data = d, sf = attr(d, "sf"), input = attr(d, "input"))
 }
 
 # `file` must name one existing file (not a folder): an error naming the
@@ -158,13 +195,19 @@ no_samples_error <- function(data, file, format, arg) {
 
 # A whole file through its native decoder (raw samples, not resampled), time
 # as POSIXct; NULL when this build has no decoder for the format.
-read_native <- function(file, format, sf, arg = "file") {
+read_native <- function(file, format, sf, arg = "file", extra = NULL) {
   opts <- list(compat = 0)
   # a whole .gt3x read gives idle-sleep periods as zeros at their times, as
   # read.gt3x(imputeZeroes = TRUE) does, to its last sample time; calibration
   # skips them
   if (format == "gt3x") opts <- list(compat = 1, impute_zeroes = 1)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  opts[names(extra)] <- extra
+  if (format == "axivity_csv") {
+    lay <- axivity_csv_layout(file, sf)
+    sf <- lay$sf
+    opts[names(lay$opts)] <- lay$opts
+  }
   h <- gc_decoder_open(path.expand(file), format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)

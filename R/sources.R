@@ -15,8 +15,11 @@
 # there is an error naming the parameter.
 
 
+# `rmc`: GGIR's rmc.* parameters (their checked values, rmc_values()); with
+# rmc.firstrow.acc the file is read as an ad hoc csv file (R/adhoc-csv.R).
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
-                        reader = "native", compat = TRUE, read_opts = list()) {
+                        reader = "native", compat = TRUE, read_opts = list(),
+                        rmc = NULL) {
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -26,15 +29,25 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   }
   check_file(datafile, arg)
   reader <- match_choice(reader, "reader", c("native", "reference"))
-  format <- file_format(datafile, arg)
+  layout <- NULL
+  if (!is.null(rmc$rmc.firstrow.acc)) {
+    format <- "adhoc_csv"
+    layout <- rmc_layout(rmc, datafile, ggir = compat)
+    sf <- layout$sf
+  } else {
+    format <- file_format(datafile, arg)
+  }
   src <- NULL
   if (reader == "native" && format_has_decoder(format)) {
-    src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts)
+    src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
+                         extra = layout$opts)
   }
   if (is.null(src)) {
     check_reference_opts(read_opts, format)
-    src <- format_entry(format)$source(datafile, sf, chunksize, arg)
+    src <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg) else
+      format_entry(format)$source(datafile, sf, chunksize, arg, layout = layout)
   }
+  if (!is.null(layout$serial)) src$info$serial <- layout$serial
   src$filename <- basename(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
@@ -118,10 +131,17 @@ native_open_error <- function(file, format, why, arg) {
 # each block comes as one or more parts (list(cols, from, to)), which hold
 # the samples of GGIR's block together, however many samples that is.
 # `segment()` streams units straight into a segmenter, without R vectors.
+# `extra`: more options for the decoder (an ad hoc csv file's layout).
 source_native <- function(file, format, sf, chunksize, compat, arg,
-                          read_opts = list()) {
+                          read_opts = list(), extra = NULL) {
   opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
+  opts[names(extra)] <- extra
+  if (format == "axivity_csv") {
+    lay <- axivity_csv_layout(file, sf)
+    sf <- lay$sf
+    opts[names(lay$opts)] <- lay$opts
+  }
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
   if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1

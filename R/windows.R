@@ -49,6 +49,11 @@
 #'   stream the file in bounded memory and count what they skip; or
 #'   `"reference"`, the readers GGIR uses (GGIRread, read.gt3x,
 #'   data.table), block by block.
+#' @param rmc For an "ad hoc" csv file (any layout of columns and units):
+#'   GGIR's `rmc.*` parameters as a named list, as GGIR's `params_rawdata`
+#'   gives them (`rmc.firstrow.acc`, which is required, `rmc.col.acc`,
+#'   `rmc.unit.acc`, `rmc.sf`, ...; see [g.calibrate()]); `NULL` (default):
+#'   the format is found from the file.
 #' @param stop `NULL` (read everything), or a function called with the
 #'   windows read so far (a data frame as returned) after every block or
 #'   chunk that ends at least `stop_every` hours of samples after the last
@@ -84,8 +89,8 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          axes = c("x", "y", "z"), max_sd = 0.013,
                          max_abs_mean = 2, skip_zero = TRUE,
                          chunk_size = 1e6, progress = NULL,
-                         reader = c("native", "reference"), stop = NULL,
-                         stop_every = 6) {
+                         reader = c("native", "reference"), rmc = NULL,
+                         stop = NULL, stop_every = 6) {
   method <- match_choice(method, "method")
   if (!is.null(stop) && !is.function(stop)) {
     abort("`stop` must be NULL or a function, not ", describe(stop), ".")
@@ -98,6 +103,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
     # more often
     src <- open_source(x, sf = if (missing(sf)) NULL else sf, arg = "x",
                        reader = reader, compat = FALSE,
+                       rmc = rmc_values(rmc),
                        chunksize = if (is.null(stop)) 1 else
                          min(1, stop_every / 12))
     sf <- src$sf

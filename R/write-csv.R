@@ -128,3 +128,80 @@ write_plain_csv <- function(d, file, sep = ",", dec = ".") {
   data.table::fwrite(d, file, sep = sep, dec = dec, dateTimeAs = "ISO")
   invisible(file)
 }
+
+# Writes samples x, y, z (in g) as Axivity's csv export (OMGUI, UNIX time
+# stamps): no header, lines "time,x,y,z" with the time in seconds (3
+# decimals) of sample i at `start` + i / `true_sf` (a device's clock runs a
+# little off its nominal rate) and `digits` decimals.
+write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
+                              digits = 4) {
+  s <- as_samples(x)
+  t <- as.numeric(as.POSIXct(start, tz = "UTC")) + (seq_len(s$n) - 1) / true_sf
+  data.table::fwrite(list(sprintf("%.3f", t), round(s$x, digits), round(s$y, digits),
+                          round(s$z, digits)), file, col.names = FALSE, quote = FALSE)
+  invisible(file)
+}
+
+# Writes samples (x, y, z in g, optional temperature in C) as an "ad hoc"
+# csv file, the kind GGIR reads with its rmc.* parameters, and returns those
+# parameters (a list for params_rawdata). Layout, from top: the `header`
+# lines ("name,value"), a column-name line (`colnames`), then one line per
+# sample: [time,] x, y, z[, temperature]. `unit`: "g" (`digits` decimals),
+# "mg" (`digits` - 3 decimals) or "bit" (unsigned counts of `bitrate` bits
+# over +-`dynamic_range` g); `time`: "none", "UNIXsec", "UNIXmsec" or
+# "POSIX" ("%Y-%m-%d %H:%M:%OS" text, millisecond decimals); `temp_unit`:
+# "C", "K" (written as GGIR reads it back: t - 272.15) or "F"; `sep` and
+# `dec`: separator and decimal mark. The sampling rate goes to rmc.sf, or
+# with `sf_header = TRUE` to a header line "sample_rate_hz,<sf>" read by
+# rmc.headername.sf.
+write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
+                            unit = "g", time = "none", temperature = TRUE,
+                            temp_unit = "C", bitrate = 12, dynamic_range = 8,
+                            digits = 4, sep = ",", dec = ".", sf_header = FALSE,
+                            start = "2024-01-01 00:00:00") {
+  s <- as_samples(x)
+  if (sf_header) header <- c(header, paste0("sample_rate_hz", sep, format(sf)))
+  acc <- switch(unit,
+    g = function(a) round(a, digits),
+    mg = function(a) round(a * 1000, max(digits - 3, 0)),
+    bit = function(a) round((a / (2 * dynamic_range) + 0.5) * 2^bitrate))
+  d <- list(x = acc(s$x), y = acc(s$y), z = acc(s$z))
+  if (temperature) {
+    if (is.null(s$temperature)) abort("`x` has no temperature column.")
+    tc <- round(s$temperature, 2)
+    d$temperature <- switch(temp_unit, C = tc, K = tc - 272.15, F = tc * 9 / 5 + 32)
+  }
+  t <- as.numeric(as.POSIXct(start, tz = "UTC")) + (seq_len(s$n) - 1) / sf
+  tcol <- switch(time, none = NULL,
+    UNIXsec = round(t, 3),
+    UNIXmsec = round(t * 1000),
+    POSIX = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,
+                   "%Y-%m-%d %H:%M:%OS3"))
+  if (!is.null(tcol)) d <- c(list(time = tcol), d)
+  writeLines(c(header, if (colnames) paste(names(d), collapse = sep)), file)
+  data.table::fwrite(d, file, append = TRUE, col.names = FALSE, sep = sep, dec = dec)
+  first <- length(header) + as.integer(colnames) + 1
+  k <- if (is.null(tcol)) 0 else 1
+  p <- list(rmc.firstrow.acc = first, rmc.col.acc = k + 1:3, rmc.unit.acc = unit,
+            rmc.dec = dec)
+  if (temperature) {
+    p$rmc.col.temp <- k + 4
+    p$rmc.unit.temp <- temp_unit
+  }
+  if (!is.null(tcol)) {
+    p$rmc.col.time <- 1
+    p$rmc.unit.time <- time
+  }
+  if (unit == "bit") {
+    p$rmc.bitrate <- bitrate
+    p$rmc.dynamic_range <- dynamic_range
+  }
+  if (sf_header) {
+    p$rmc.firstrow.header <- 1
+    p$rmc.header.length <- length(header)
+    p$rmc.headername.sf <- "sample_rate_hz"
+  } else {
+    p$rmc.sf <- sf
+  }
+  p
+}

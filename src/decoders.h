@@ -48,7 +48,18 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
   // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
   if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
   const int interpolation = static_cast<int>(opts.num("interpolation", 1));
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d), interpolation));
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation));
+}
+
+// An Axivity csv export: the csv decoder with the layout in the options;
+// GGIR resamples it block by block onto the rate found from its time
+// stamps (option grid_sf; compat = 1), gravcal's own reads keep it as it is.
+inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                                   const std::string& name) {
+  std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
+  if (opts.num("compat", 1) == 0) return d;
+  return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
+      std::move(d), opts.num("grid_sf", opts.num("sf", 0))));
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating
@@ -63,6 +74,8 @@ inline const DecoderKind* find_decoder(const std::string& format) {
   static const DecoderKind kinds[] = {
       {"actigraph_csv", true, make_csv},
       {"csv", true, make_csv},
+      {"adhoc_csv", true, make_csv},
+      {"axivity_csv", true, make_axivity_csv},
       {"gt3x", false, make_gt3x},
       {"cwa", false, make_cwa},
       {"geneactiv", false, make_geneactiv},

@@ -1,5 +1,5 @@
 // libFuzzer harness: arbitrary bytes through MemorySource to the csv decoder
-// (both formats, both compat modes, blocks of varying size). Checks: no
+// (its three formats, both compat modes, blocks of varying size). Checks: no
 // crash, n <= capacity, every block's units within its limit, the report's
 // counts consistent (samples given = samples counted, samples + skipped <=
 // units, no sample without a unit). And the lines parsed in place give
@@ -63,7 +63,31 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.set("buffer", 64.0 + 61.0 * (mode >> 3));  // small buffers: lines cross refills
   gravcal::Options o_ref = o;
   o_ref.set("fast", 0.0);
-  const std::string format = (mode & 4) ? "actigraph_csv" : "csv";
+  std::string format = (mode & 4) ? "actigraph_csv" : "csv";
+  // GGIR's ad hoc csv (sf given, bits 1, 2 and 7 set): its layout and
+  // units from the other bits (lines skipped, mg, bits, time and
+  // temperature columns)
+  if ((mode & 0x86) == 0x86) {
+    format = "adhoc_csv";
+    o.set("skip", static_cast<double>((mode >> 3) & 1));
+    if (mode & 0x10) o.set("acc_div", 1000.0);
+    if (mode & 0x20) {
+      o.set("bit", 1.0);
+      o.set("bit_pow", 4096.0);
+      o.set("bit_range", 8.0);
+      o.set("temp_unit", 2.0);
+    }
+    if (mode & 0x40) {
+      o.set("col_time", 1.0);
+      o.set("time_div", 1000.0);
+      o.set("col_x", 2.0);
+      o.set("col_y", 3.0);
+      o.set("col_z", 4.0);
+      o.set("col_temp", 5.0);
+    }
+    o_ref = o;
+    o_ref.set("fast", 0.0);
+  }
   gravcal::CsvDecoder dec(src, o, format), ref(src_ref, o_ref, format);
   const bool opened = dec.open();
   if (opened != ref.open() || dec.error() != ref.error()) __builtin_trap();

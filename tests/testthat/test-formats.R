@@ -60,7 +60,8 @@ test_that("R's registry and the C++ table of decoders name the same decoders", {
   on.exit(unlink(f))
   reg <- gravcal:::recording_formats
   decoders <- unlist(lapply(reg, `[[`, "decoder"), use.names = FALSE)
-  expect_setequal(decoders, c("actigraph_csv", "csv", "gt3x", "cwa", "geneactiv"))
+  expect_setequal(decoders, c("actigraph_csv", "axivity_csv", "csv", "adhoc_csv", "gt3x",
+                              "cwa", "geneactiv"))
   for (d in decoders) {
     # a decoder that exists fails on these bytes, as its format
     h <- gravcal:::gc_decoder_open(f, d, list())

@@ -21,14 +21,29 @@ test_that("both front doors take their defaults and checks from one table", {
   # each door under its own names only
   expect_identical(names(own), c("use_temp", "spherecrit", "minloadcrit",
                                  "chunksize", "max_sd", "max_iter", "tol",
-                                 "verbose", "reader"))
+                                 "verbose", "reader", "rmc"))
+  # GGIR's rmc.* parameters of ad hoc csv files (GGIR 3.3-9 load_params()),
+  # with GGIR's defaults
+  rmc <- c("rmc.firstrow.acc", "rmc.firstrow.header", "rmc.header.length",
+           "rmc.col.acc", "rmc.col.temp", "rmc.col.time", "rmc.unit.acc",
+           "rmc.unit.temp", "rmc.unit.time", "rmc.format.time", "rmc.bitrate",
+           "rmc.dynamic_range", "rmc.unsignedbit", "rmc.origin", "rmc.desiredtz",
+           "rmc.configtz", "rmc.headername.sf", "rmc.headername.sn",
+           "rmc.headername.recordingid", "rmc.header.structure",
+           "rmc.check4timegaps", "rmc.doresample", "rmc.col.wear", "rmc.dec",
+           "rmc.scalefactor.acc")
   expect_identical(names(ggir), c("spherecrit", "minloadcrit", "chunksize",
                                   "printsummary", "rmc.noise", "rmc.sf",
                                   "interpolationType", "frequency_tol",
-                                  "desiredtz", "configtz", "reader"))
+                                  "desiredtz", "configtz", "reader", rmc))
   expect_identical(ggir[c("interpolationType", "frequency_tol", "desiredtz")],
                    list(interpolationType = 1, frequency_tol = 0.1, desiredtz = ""))
   expect_null(ggir$configtz)
+  if (requireNamespace("GGIR", quietly = TRUE)) {
+    d <- GGIR::load_params()$params_rawdata
+    expect_true(all(rmc %in% names(d)))
+    for (nm in rmc) expect_identical(ggir[[nm]], d[[nm]], label = nm)
+  }
 })
 
 test_that("a later source wins, and a value is checked wherever it comes from", {
@@ -65,7 +80,7 @@ test_that("the audit covers every parameter of GGIR's params_rawdata and params_
   audited <- Filter(function(p) !is.na(p$ggir), tab)
   nm <- vapply(audited, `[[`, "", "ggir")
   expect_false(anyDuplicated(nm) > 0)
-  expect_true(all(vapply(tab, function(p) p$status %in% c("honoured", "no effect", "rmc (h7)"), TRUE)))
+  expect_true(all(vapply(tab, function(p) p$status %in% c("honoured", "no effect"), TRUE)))
   p <- GGIR::load_params()
   num <- function(v) if (is.numeric(v)) as.numeric(v) else v
   for (lst in c("rawdata", "general")) {

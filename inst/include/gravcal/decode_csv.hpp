@@ -21,6 +21,20 @@
 // (R/read.R): 1 / median step of the first 100000 time stamps, signif 6; for
 // whole-second stamps, samples counted between the first and last change.
 //
+// Ad hoc csv (format "adhoc_csv", GGIR's rmc.* files): no detection; the
+// layout comes in options: skip (lines before the data), col_x, col_y,
+// col_z, col_temp, col_time (1-based; 0: none), time_div (1: the time
+// column holds seconds, 1000: milliseconds; 0: text, not read: time is
+// start_time + i / sf), time_offset (seconds added to numeric time), dec
+// ("," for decimal commas), sf (required), and the units: acc_div (1000
+// for mg), acc_scale, bit (1 unsigned, 2 signed) with bit_pow (2^bitrate)
+// and bit_range, temp_unit (1 K, 2 F). Values are converted as GGIR's
+// read.myacc.csv converts them, in its order and arithmetic: x / acc_div,
+// then * acc_scale, then ((x / bit_pow) - 0.5) * 2 * bit_range (unsigned)
+// or (x / (bit_pow / 2)) * bit_range (signed); temperature + 272.15 (K, as
+// GGIR) or (t - 32) * (5 / 9) (F). The separator is learnt from the data
+// lines (',', ';' or tab).
+//
 // Unit = one line after the header (and after the column-name line):
 // read(out, B) consumes B lines and gives one sample for each good one.
 // GGIR (g.readaccfile, 3.3.9) reads an ActiGraph csv as
@@ -106,9 +120,41 @@ class CsvDecoder : public Decoder {
     compat_ = opts.num("compat", 1) != 0;
     sf_option_ = opts.num("sf", 0);
     fast_ = opts.num("fast", 1) != 0;
+    // an Axivity csv export (time stamp, x, y, z) is read by the same layout
+    // options (R/formats.R gives them)
+    adhoc_ = format == "adhoc_csv" || format == "axivity_csv";
+    adhoc_format_ = format;
+    if (adhoc_) {
+      adhoc_skip_ = static_cast<std::int64_t>(opts.num("skip", 0));
+      const double c[5] = {opts.num("col_x", 1), opts.num("col_y", 2), opts.num("col_z", 3),
+                           opts.num("col_temp", 0), opts.num("col_time", 0)};
+      int* const to[5] = {&col_x_, &col_y_, &col_z_, &col_temp_, &col_time_};
+      for (int i = 0; i < 5; ++i) *to[i] = c[i] >= 1 && c[i] <= kMaxFields ? static_cast<int>(c[i]) - 1 : -1;
+      time_div_ = opts.num("time_div", 0);
+      time_offset_ = opts.num("time_offset", 0);
+      if (!(time_div_ > 0)) col_time_ = -1;  // text time: not read (start_time + i / sf)
+      time_text_ = false;
+      info_.start_time = opts.num("start_time", std::numeric_limits<double>::quiet_NaN());
+      adhoc_dec_ = opts.str("dec", ".") == "," ? ',' : '.';
+      acc_div_ = opts.num("acc_div", 1);
+      acc_scale_ = opts.num("acc_scale", 1);
+      bit_ = static_cast<int>(opts.num("bit", 0));
+      bit_pow_ = opts.num("bit_pow", 1);
+      bit_range_ = opts.num("bit_range", 1);
+      temp_unit_ = static_cast<int>(opts.num("temp_unit", 0));
+    }
   }
 
   bool open() override {
+    if (adhoc_) {
+      if (!open_adhoc()) return false;
+      info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
+      info_.has_temperature = col_temp_ >= 0;
+      learn_roles();
+      opened_ = true;
+      done_ = lines_.exhausted();
+      return true;
+    }
     csv_text::Line ln;
     if (!lines_.next(ln)) return fail(lines_.read_failed() ? "the file cannot be read" : "the file is empty");
     std::string first(ln.p, ln.n);
@@ -155,6 +201,8 @@ class CsvDecoder : public Decoder {
 
   bool done() const override { return !opened_ || done_; }
   std::size_t max_samples_per_unit() const override { return 1; }
+  // (GgirResamplerOf's interface: a csv read has no state across calls)
+  void continue_call(bool) {}
 
  private:
   static std::size_t buffer_bytes(const Options& opts) {
@@ -407,6 +455,60 @@ class CsvDecoder : public Decoder {
     return choose_sf(0);
   }
 
+  // Ad hoc csv: the lines before the data skipped, the separator learnt
+  // from the data lines, the columns as the options give them.
+  bool open_adhoc() {
+    info_.format = adhoc_format_;
+    csv_text::Line ln;
+    for (std::int64_t i = 0; i < adhoc_skip_; ++i) {
+      if (!lines_.next(ln)) {
+        return fail(lines_.read_failed() ? "the file cannot be read"
+                                         : "the file ends before its data (line " +
+                                               std::to_string(adhoc_skip_ + 1) + ")");
+      }
+    }
+    const auto v = peek_lines();
+    if (v.empty()) return fail("no data lines after line " + std::to_string(adhoc_skip_));
+    if (!learn_separator(v, 0)) {
+      return fail("data lines do not have 3 fields: line " + std::to_string(adhoc_skip_ + 1) + " is \"" +
+                  csv_text::excerpt(v[0].first, v[0].second) + "\"");
+    }
+    if (adhoc_dec_ == ',' && sep_ == ',') {
+      return fail("decimal commas (rmc.dec = \",\") in a file whose fields are separated by commas");
+    }
+    dec_ = adhoc_dec_;
+    const int cols[5] = {col_x_, col_y_, col_z_, col_temp_, col_time_};
+    for (int c : cols) {
+      if (c >= nfields_) {
+        return fail("column " + std::to_string(c + 1) + " asked for, but data lines have " +
+                    std::to_string(nfields_) + " fields");
+      }
+    }
+    if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return fail("no x, y, z columns given");
+    if (!(sf_option_ > 0)) return fail("the sampling rate is unknown: no option sf");
+    info_.sf = sf_option_;
+    step_ = 1 / info_.sf;
+    return true;
+  }
+
+  // GGIR's conversions of an ad hoc csv's values (read.myacc.csv's order
+  // and arithmetic; see the top of this file).
+  double adhoc_acc(double a) const {
+    if (acc_div_ != 1) a = a / acc_div_;
+    if (acc_scale_ != 1) a = a * acc_scale_;
+    if (bit_ == 1) {
+      a = ((a / bit_pow_) - 0.5) * 2 * bit_range_;
+    } else if (bit_ == 2) {
+      a = (a / (bit_pow_ / 2)) * bit_range_;
+    }
+    return a;
+  }
+  double adhoc_temp(double t) const {
+    if (temp_unit_ == 1) return t + 272.15;
+    if (temp_unit_ == 2) return (t - 32) * (5.0 / 9.0);
+    return t;
+  }
+
   // sf: option sf, else the header's, else from the time stamps.
   bool choose_sf(double from_header) {
     if (col_x_ >= 0 && col_y_ < 0) {
@@ -427,7 +529,9 @@ class CsvDecoder : public Decoder {
   bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
     if (!time_text_) {
       frac_digits = 9;
-      return csv_text::parse_number(f.b, f.e, dec_, compat_, t);
+      if (!csv_text::parse_number(f.b, f.e, dec_, compat_, t)) return false;
+      if (adhoc_) t = t / time_div_ + time_offset_;
+      return true;
     }
     return dt_.parse(f.b, f.e, t, frac_digits);
   }
@@ -534,6 +638,12 @@ class CsvDecoder : public Decoder {
         t = stamp_time(tf, ln);
       } else if (time != nullptr) {
         t = info_.start_time + static_cast<double>(index_ + static_cast<std::int64_t>(i - first)) / info_.sf;
+      }
+      if (adhoc_) {
+        v[kX] = adhoc_acc(v[kX]);
+        v[kY] = adhoc_acc(v[kY]);
+        v[kZ] = adhoc_acc(v[kZ]);
+        if (!kXyz) v[kTemp] = adhoc_temp(v[kTemp]);
       }
       x[i] = v[kX];
       y[i] = v[kY];
@@ -654,6 +764,12 @@ class CsvDecoder : public Decoder {
                    "): the last line has no line end; kept");
     }
     const double t = col_time_ >= 0 ? stamp_time(f[col_time_], ln) : info_.start_time + static_cast<double>(index_) / info_.sf;
+    if (adhoc_) {
+      x = adhoc_acc(x);
+      y = adhoc_acc(y);
+      z = adhoc_acc(z);
+      temp = adhoc_temp(temp);
+    }
     out.put(x, y, z, temp, t);
     ++report_.samples;
   }
@@ -732,6 +848,14 @@ class CsvDecoder : public Decoder {
   double last_time_ = std::numeric_limits<double>::quiet_NaN();
   double last_stamp_ = std::numeric_limits<double>::quiet_NaN();
   std::int64_t run_ = 0;
+  // ad hoc csv (format "adhoc_csv"): its layout and units, from options
+  bool adhoc_ = false;
+  std::string adhoc_format_;
+  std::int64_t adhoc_skip_ = 0;
+  char adhoc_dec_ = '.';
+  double time_div_ = 0, time_offset_ = 0;
+  double acc_div_ = 1, acc_scale_ = 1, bit_pow_ = 1, bit_range_ = 1;
+  int bit_ = 0, temp_unit_ = 0;
 };
 
 }  // namespace gravcal

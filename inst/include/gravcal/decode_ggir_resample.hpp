@@ -19,6 +19,13 @@
 // never a block. Whole-Hz recordings pass through unchanged. Used only in
 // GGIR-compatible mode (compat = 1); gravcal's own reads keep the samples
 // as the device stored them.
+//
+// The same for Axivity csv exports (time stamp, x, y, z), which GGIR
+// resamples block by block whatever their rate, onto the grid of the rate
+// it found from the time stamps: GgirResamplerOf<CsvDecoder> with that
+// `grid_rate` (> 0: always resample, at that rate). The inner decoder
+// gives its time stamps and has continue_call() (one reader call in
+// several reads; a no-op for csv).
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 
@@ -34,11 +41,14 @@
 
 namespace gravcal {
 
-class GgirResampler : public Decoder {
+template <class Inner>
+class GgirResamplerOf : public Decoder {
  public:
-  // interpolation: 1 linear, 2 nearest neighbour (GGIR's interpolationType)
-  explicit GgirResampler(std::unique_ptr<GeneactivDecoder> inner, int interpolation = 1)
-      : inner_(std::move(inner)), nearest_(interpolation == 2) {}
+  // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
+  // linear, 2 nearest neighbour (GGIR's interpolationType)
+  explicit GgirResamplerOf(std::unique_ptr<Inner> inner, double grid_rate = 0,
+                           int interpolation = 1)
+      : inner_(std::move(inner)), grid_rate_(grid_rate), nearest_(interpolation == 2) {}
 
   bool open() override {
     const bool ok = inner_->open();
@@ -49,9 +59,9 @@ class GgirResampler : public Decoder {
     const double rate = info_.sf;
     // R's round(): halves to even (12.5 Hz becomes 12), as nearbyint in
     // the default rounding mode
-    active_ = rate > 0 && rate != std::nearbyint(rate);
+    active_ = grid_rate_ > 0 || (rate > 0 && rate != std::nearbyint(rate));
     if (active_) {
-      info_.sf = std::nearbyint(rate);
+      info_.sf = grid_rate_ > 0 ? grid_rate_ : std::nearbyint(rate);
       by_ = 1.0 / info_.sf;
       raw_.assign(kRawCols * kRawChunk, 0.0);
     }
@@ -192,7 +202,8 @@ class GgirResampler : public Decoder {
     }
   }
 
-  std::unique_ptr<GeneactivDecoder> inner_;
+  std::unique_ptr<Inner> inner_;
+  double grid_rate_ = 0.0;
   bool nearest_ = false;
   bool active_ = false;
   double by_ = 0.0;
@@ -209,6 +220,8 @@ class GgirResampler : public Decoder {
   std::size_t head_ = 0;
   std::int64_t given_ = 0;
 };
+
+using GgirResampler = GgirResamplerOf<GeneactivDecoder>;
 
 }  // namespace gravcal
 

@@ -1,0 +1,219 @@
+# GGIR's "ad hoc" csv files: a csv of samples whose layout and units GGIR's
+# rmc.* parameters describe (GGIR 3.3-9: read.myacc.csv(), g.readaccfile(),
+# g.inspectfile()). Here the parameters become a layout for gravcal's csv
+# decoder (decode_csv.hpp, format "adhoc_csv"): the lines to skip, the
+# columns, the units and the sampling rate. The file is then read in GGIR's
+# blocks like any csv (R/formats.R), by the native decoder or, with
+# reader = "reference", by data.table::fread() block by block.
+#
+# What GGIR does that this reproduces:
+# * the data start at line rmc.firstrow.acc; when that line's first field
+#   is not a number (column names, or a text time stamp in the first
+#   column), GGIR starts one line later (g.readaccfile's test of the column
+#   names), so a text time stamp first loses the first sample, as in GGIR;
+# * units: mg divided by 1000, then rmc.scalefactor.acc, then bits with
+#   rmc.bitrate and rmc.dynamic_range (rmc.unsignedbit); temperature in K
+#   gets 272.15 added (GGIR's constant), in F (t - 32) * 5 / 9;
+# * the sampling rate from the header (rmc.firstrow.header,
+#   rmc.header.length, rmc.headername.sf, rmc.header.structure; a row named
+#   sample_rate; else rmc.sf); rmc.bitrate and rmc.dynamic_range may name
+#   header rows too;
+# * the rest threshold is rmc.noise * 1.2 (R/ggir-drop-in.R).
+# Time stamps do not enter the calibration; they give read_recording() its
+# time column (UNIXsec, UNIXmsec and ActivPAL read per sample, POSIX and
+# character text from the first stamp on, start + i / sf).
+
+# The rmc.* parameters (their values from the parameter table,
+# ggir-params.R) as the decoder's layout for `file`: list(opts = decoder
+# options, sf, skip, cols, temperature, ...). Errors name the parameter.
+# `ggir`: the lines as GGIR's blocks have them (g.readaccfile skips line
+# rmc.firstrow.acc when its first field is not a number, be it a column
+# name or a text time stamp); FALSE (read_recording()): only a line whose
+# x field is not a number is skipped (a column-name line).
+rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
+  if (is.null(p$rmc.firstrow.acc)) {
+    abort("`rmc.firstrow.acc` must be given to read \"", file, "\" as an ad hoc csv file.")
+  }
+  refuse <- function(nm, why) {
+    abort("`", nm, "` = ", deparse(p[[nm]]), " is not supported by gravcal (", why,
+          "); GGIR::g.calibrate() reads such files.")
+  }
+  if (isTRUE(p$rmc.check4timegaps)) refuse("rmc.check4timegaps", "time gaps in ad hoc csv files are not imputed")
+  if (isTRUE(p$rmc.doresample) && length(p$rmc.col.time)) {
+    refuse("rmc.doresample", "ad hoc csv files are not resampled")
+  }
+  header <- rmc_header(p, file)
+  sf <- rmc_sf(p, header, file)
+  from_header <- function(nm) {
+    v <- p[[nm]]
+    if (is.character(v)) {
+      got <- suppressWarnings(as.numeric(header$value[header$name == v[1]]))
+      if (length(got) != 1 || is.na(got)) {
+        abort("`", nm, "` = \"", v[1], "\" names no numeric row of the header of \"", file, "\".")
+      }
+      v <- got
+    }
+    v
+  }
+  opts <- list(sf = as.numeric(sf))
+  if (p$rmc.unit.acc == "bit") {
+    bitrate <- from_header("rmc.bitrate")
+    range <- from_header("rmc.dynamic_range")
+    if (!length(bitrate) || !length(range)) {
+      abort("`rmc.unit.acc` = \"bit\" needs `rmc.bitrate` and `rmc.dynamic_range`.")
+    }
+    opts$bit <- if (isTRUE(p$rmc.unsignedbit)) 1 else 2
+    opts$bit_pow <- 2^bitrate
+    opts$bit_range <- as.numeric(range)
+  }
+  if (p$rmc.unit.acc == "mg") opts$acc_div <- 1000
+  if (p$rmc.scalefactor.acc != 1) opts$acc_scale <- as.numeric(p$rmc.scalefactor.acc)
+  opts$temp_unit <- match(p$rmc.unit.temp, c("C", "K", "F")) - 1
+  cols <- as.numeric(p$rmc.col.acc)
+  opts$col_x <- cols[1]
+  opts$col_y <- cols[2]
+  opts$col_z <- cols[3]
+  if (length(p$rmc.col.temp)) opts$col_temp <- as.numeric(p$rmc.col.temp)
+  if (p$rmc.dec == ",") opts$dec <- ","
+  # the first data line: after the column-name line, if any (GGIR's test:
+  # the first field of line rmc.firstrow.acc read as a number)
+  first <- readLines(file, n = p$rmc.firstrow.acc + 1, warn = FALSE)
+  if (length(first) < p$rmc.firstrow.acc) {
+    abort("`rmc.firstrow.acc` = ", p$rmc.firstrow.acc, ", but \"", file, "\" has ",
+          length(first), " lines.")
+  }
+  skip <- p$rmc.firstrow.acc - 1
+  f1 <- rmc_fields(first[skip + 1])
+  lead <- if (ggir) f1[1] else f1[cols[1]]
+  if (p$rmc.dec == ",") lead <- if (ggir) lead else sub(",", ".", lead, fixed = TRUE)
+  if (is.na(suppressWarnings(as.numeric(lead)))) skip <- skip + 1
+  opts$skip <- skip
+  if (length(p$rmc.col.time)) {
+    opts$col_time <- as.numeric(p$rmc.col.time)
+    unit <- p$rmc.unit.time
+    origin <- rmc_origin(p$rmc.origin, tz)
+    if (unit %in% c("UNIXsec", "UNIXmsec")) {
+      opts$time_div <- if (unit == "UNIXmsec") 1000 else 1
+      opts$time_offset <- origin
+    } else if (unit == "ActivPAL") {
+      opts$time_div <- 1 / 86400  # days since 1899-12-30
+      opts$time_offset <- as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))
+    } else {
+      line <- if (length(first) > skip) first[skip + 1] else NA_character_
+      stamp <- rmc_fields(line)[p$rmc.col.time]
+      t0 <- as.POSIXct(stamp, format = p$rmc.format.time, tz = tz)
+      if (is.na(t0)) {
+        abort("`rmc.format.time` = \"", p$rmc.format.time, "\" does not read the ",
+              "time column (", p$rmc.col.time, ") of \"", file, "\": its first value is \"",
+              stamp, "\".")
+      }
+      opts$start_time <- as.numeric(t0)
+    }
+  }
+  list(opts = opts, sf = sf, skip = skip, header = header,
+       serial = if (length(p$rmc.headername.sn)) {
+         header$value[match(p$rmc.headername.sn[1], header$name)]
+       })
+}
+
+# The fields of a line, split at the first of ';', tab or ',' it holds
+# (a line with ';' or tabs may hold decimal commas), blanks and double
+# quotes around them removed.
+rmc_fields <- function(line) {
+  if (is.na(line)) return(NA_character_)
+  sep <- c(";", "\t", ",")
+  sep <- sep[vapply(sep, grepl, NA, x = line, fixed = TRUE)]
+  f <- if (length(sep)) strsplit(line, sep[1], fixed = TRUE)[[1]] else line
+  gsub("^[[:space:]\"]+|[[:space:]\"]+$", "", f)
+}
+
+# rmc.origin in seconds since 1970 (added to UNIX time stamps; 0 for GGIR's
+# default).
+rmc_origin <- function(origin, tz) {
+  if (identical(origin, "1970-01-01")) return(0)
+  o <- tryCatch(as.numeric(as.POSIXct(origin, tz = if (nzchar(tz)) tz else "UTC")),
+                error = function(e) NA)
+  if (is.na(o)) abort("`rmc.origin` must be a date (\"1970-01-01\"), not \"", origin, "\".")
+  o
+}
+
+# The header's rows as name and value: lines rmc.firstrow.header to
+# rmc.firstrow.header + rmc.header.length - 1 (GGIR's default length:
+# the lines up to the data), fields 1 and 2, or field 1 split by
+# rmc.header.structure. NULL without rmc.firstrow.header.
+rmc_header <- function(p, file) {
+  if (!length(p$rmc.firstrow.header)) return(NULL)
+  n <- if (length(p$rmc.header.length)) p$rmc.header.length else p$rmc.firstrow.acc - 1
+  lines <- readLines(file, n = p$rmc.firstrow.header - 1 + n, warn = FALSE)
+  lines <- lines[seq_along(lines) >= p$rmc.firstrow.header]
+  lines <- lines[nzchar(trimws(lines))]
+  rows <- lapply(lines, function(l) {
+    f <- rmc_fields(l)
+    if (length(p$rmc.header.structure)) {
+      f <- trimws(strsplit(f[1], p$rmc.header.structure[1])[[1]])
+    }
+    c(f[1], if (length(f) > 1) f[2] else NA_character_)
+  })
+  data.frame(name = vapply(rows, `[`, "", 1), value = vapply(rows, `[`, "", 2),
+             stringsAsFactors = FALSE)
+}
+
+# The sampling rate: the header's row rmc.headername.sf, else its row
+# "sample_rate", else rmc.sf (GGIR's g.inspectfile and read.myacc.csv).
+rmc_sf <- function(p, header, file) {
+  sf <- NA_real_
+  if (!is.null(header)) {
+    for (nm in c(if (length(p$rmc.headername.sf)) p$rmc.headername.sf[1], "sample_rate")) {
+      v <- suppressWarnings(as.numeric(header$value[match(nm, header$name)]))
+      if (!is.na(v)) {
+        sf <- v
+        break
+      }
+    }
+  }
+  if (is.na(sf) && length(p$rmc.sf)) sf <- p$rmc.sf
+  if (is.na(sf) || !(sf > 0)) {
+    abort("The sampling frequency of the ad hoc csv file \"", file, "\" is unknown: ",
+          "give `rmc.sf`", if (length(p$rmc.firstrow.header)) " or `rmc.headername.sf`", ".")
+  }
+  check_sf(sf)
+  sf
+}
+
+# An ad hoc csv file block by block through data.table::fread() (reader =
+# "reference"): the same blocks, columns and units as the native decoder,
+# in R.
+source_adhoc <- function(file, sf, chunksize, arg, layout) {
+  if (!requireNamespace("data.table", quietly = TRUE)) {
+    abort("Reading ad hoc csv files with reader = \"reference\" needs the data.table package.")
+  }
+  o <- layout$opts
+  sf <- layout$sf
+  B <- format_block_units("adhoc_csv", sf, chunksize)
+  acc <- function(a) {
+    if (!is.null(o$acc_div)) a <- a / o$acc_div
+    if (!is.null(o$acc_scale)) a <- a * o$acc_scale
+    if (identical(o$bit, 1)) a <- ((a / o$bit_pow) - 0.5) * 2 * o$bit_range
+    if (identical(o$bit, 2)) a <- (a / (o$bit_pow / 2)) * o$bit_range
+    a
+  }
+  temp <- function(t) {
+    switch(o$temp_unit + 1, t, t + 272.15, (t - 32) * (5 / 9))
+  }
+  cols <- c(o$col_x, o$col_y, o$col_z, o$col_temp)
+  list(format = "adhoc_csv", sf = sf, temperature = !is.null(o$col_temp),
+       read = function(i) {
+         d <- tryCatch(data.table::fread(file, skip = layout$skip + (i - 1) * B, nrows = B,
+                                         header = FALSE, dec = if (is.null(o$dec)) "." else o$dec,
+                                         showProgress = FALSE, data.table = FALSE),
+                       error = function(e) NULL)
+         if (is.null(d) || !nrow(d) || ncol(d) < max(cols)) return(NULL)
+         d <- d[, cols]
+         names(d) <- c("x", "y", "z", if (!is.null(o$col_temp)) "temperature")
+         for (v in names(d)) {
+           if (!is.numeric(d[[v]])) abort("Corrupt file \"", file, "\": column ", v, " is not numeric.")
+           d[[v]] <- if (v == "temperature") temp(as.numeric(d[[v]])) else acc(as.numeric(d[[v]]))
+         }
+         list(data = d, last = nrow(d) < B)
+       })
+}

@@ -1,0 +1,190 @@
+# GGIR's "ad hoc" csv files (rmc.* parameters; R/adhoc-csv.R, the csv
+# decoder's format "adhoc_csv"): files written by write_adhoc_csv()
+# (R/write-csv.R) from simulated recordings, read by GGIR 3.3-9 and by
+# gravcal. The reference numbers are GGIR's own, computed in the test.
+
+adhoc_rec <- function(hours = 30, sf = 10, seed = 11) {
+  simulate_recording(hours = hours, sf = sf, seed = seed, params = known_params(),
+                     tempoffset = c(0.002, -0.001, 0.0015))
+}
+
+# GGIR's g.calibrate() and gravcal's on `file` with the rmc.* list `pr`
+# (GGIR gets load_params()'s list with pr in it, gravcal pr alone unless
+# `full`), every element but bsc_qc compared.
+expect_adhoc_same <- function(file, pr, full = TRUE, ...) {
+  b <- run_both(file, pr)
+  if (!full) {
+    utils::capture.output(b$gravcal <- suppressWarnings(
+      gravcal::g.calibrate(file, params_rawdata = pr, verbose = FALSE, ...)))
+  }
+  expect_same_as_ggir(b)
+  for (nm in setdiff(names(b$ggir), "bsc_qc")) {
+    expect_identical(b$gravcal[[nm]], b$ggir[[nm]], label = nm)
+  }
+  invisible(b)
+}
+
+test_that("g.calibrate() on ad hoc csv files is GGIR's, unit by unit and layout by layout", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  rec <- adhoc_rec()
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  noise <- list(rmc.noise = 0.013 / 1.2)  # GGIR's rest rule for other devices
+  # mg, two header lines and a column-name line: samples from line 4
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "mg", header = c("device,sim", "serial,S1"))
+  expect_equal(pr$rmc.firstrow.acc, 4)
+  b <- expect_adhoc_same(f, c(pr, noise))
+  expect_gt(b$ggir$npoints, 100)
+  expect_true(b$ggir$use.temp)
+  # the same file through data.table::fread (reader = "reference"), and in
+  # half-size blocks
+  utils::capture.output(G <- gravcal::g.calibrate(
+    f, params_rawdata = utils::modifyList(GGIR::load_params()$params_rawdata, c(pr, noise)),
+    verbose = FALSE, reader = "reference"))
+  for (nm in setdiff(names(b$ggir), "bsc_qc")) expect_identical(G[[nm]], b$ggir[[nm]], label = nm)
+  expect_adhoc_same(f, c(pr, noise, list(chunksize = 0.5)))
+  # g with a UNIX-seconds time column, no column names; gravcal given the
+  # rmc.* list alone takes GGIR's default rmc.noise (13) as GGIR does
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "g", time = "UNIXsec", colnames = FALSE)
+  expect_adhoc_same(f, pr, full = FALSE)
+  # 12-bit unsigned counts over +-8 g
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "bit", bitrate = 12, dynamic_range = 8)
+  expect_adhoc_same(f, c(pr, noise))
+  # sf from a header row (rmc.headername.sf), time in ms, values in g read
+  # as mg times rmc.scalefactor.acc = 1000, temperature in F
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "g", time = "UNIXmsec", sf_header = TRUE,
+                        header = c("device,sim"), temp_unit = "F")
+  expect_null(pr$rmc.sf)
+  pr$rmc.unit.acc <- "mg"
+  pr$rmc.scalefactor.acc <- 1000
+  expect_adhoc_same(f, c(pr, noise))
+})
+
+test_that("ad hoc csv: text time stamps first, Kelvin, decimal commas", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # a text time stamp in the first column: GGIR starts one line later
+  rec <- adhoc_rec(sf = 5, seed = 12)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 5, time = "POSIX", temp_unit = "K", colnames = FALSE)
+  expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
+  # semicolons and decimal commas
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 5, sep = ";", dec = ",", time = "UNIXsec")
+  expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
+})
+
+test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # GGIR drops x = y = z = 0 rows (g.imputeTimegaps, impute = FALSE), here
+  # with the time column beside them: a long run and a short one
+  rec <- adhoc_rec(seed = 16)
+  for (i in list(50000:80000, 500000:500003)) rec[i, c("x", "y", "z")] <- 0
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "UNIXsec")
+  expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
+})
+
+test_that("ad hoc csv samples equal GGIR's read.myacc.csv, sample for sample", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  rec <- adhoc_rec(hours = 0.25, sf = 10, seed = 13)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  layouts <- list(
+    list(unit = "mg", header = c("a,1", "b,2"), time = "POSIX", temp_unit = "K"),
+    list(unit = "bit", time = "UNIXmsec", temp_unit = "F", bitrate = 16, dynamic_range = 4),
+    list(unit = "g", sep = ";", dec = ",", time = "UNIXsec", colnames = FALSE))
+  for (l in layouts) {
+    pr <- do.call(gravcal:::write_adhoc_csv, c(list(rec, f, sf = 10), l))
+    args <- c(list(rmc.file = f, desiredtz = "UTC"),
+              pr[intersect(names(pr), names(formals(GGIR:::read.myacc.csv)))])
+    G <- do.call(GGIR:::read.myacc.csv, args)$data
+    expect_identical(nrow(G), nrow(rec))
+    for (rd in c("native", "reference")) {
+      r <- read_recording(f, rmc = pr, reader = rd)
+      expect_identical(r$sf, 10)
+      for (v in c("x", "y", "z", "temperature")) {
+        expect_identical(r$data[[v]], G[[v]], label = paste(l$unit, rd, v))
+      }
+    }
+    # UNIX time stamps are the file's; text ones start at the first stamp
+    r <- read_recording(f, rmc = pr)
+    expect_equal(as.numeric(r$data$time[c(1, 100)]),
+                 as.numeric(G$time[c(1, 100)]), tolerance = 1e-3 / 1.7e9)
+  }
+})
+
+test_that("calibrate() and rest_windows() read ad hoc csv files by the same rmc list", {
+  rec <- adhoc_rec(hours = 14, sf = 10, seed = 14)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "mg", time = "UNIXsec",
+                        header = c("device,sim"), digits = 6)
+  d <- read_recording(f, rmc = pr)$data
+  expect_identical(nrow(d), nrow(rec))
+  # the file and its samples in memory give the same fits
+  a <- calibrate(f, rmc = pr, method = "ggir", ggir_compat = TRUE)
+  m <- calibrate(d[c("x", "y", "z", "temperature")], sf = 10, method = "ggir",
+                 ggir_compat = TRUE)
+  expect_identical(a$ggir[c("scale", "offset", "tempoffset", "npoints")],
+                   m$ggir[c("scale", "offset", "tempoffset", "npoints")])
+  w1 <- rest_windows(f, rmc = pr)
+  w2 <- rest_windows(d[c("x", "y", "z")], sf = 10)
+  expect_identical(w1$mean_x, w2$mean_x)
+  expect_identical(w1$rest, w2$rest)
+  l1 <- calibrate(f, rmc = pr)
+  expect_identical(l1$status, "ok")
+  expect_lt(l1$error_after, l1$error_before)
+  # a cohort of such files, by the same list
+  d <- tempfile("adhoc")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  file.copy(f, file.path(d, "rec1.csv"))
+  res <- calibrate_files(d, outdir = file.path(d, "out"), method = "ggir", rmc = pr)
+  own <- calibrate(f, rmc = pr, method = "ggir")
+  expect_identical(res$format, "adhoc_csv")
+  expect_identical(res$scale.x, unname(coef(own)[1]))
+  expect_identical(res$status, own$status)
+  # and from the command line, the list as R arguments or an .rds file
+  arg <- paste0("rmc.firstrow.acc = ", pr$rmc.firstrow.acc, ", rmc.col.acc = 2:4, ",
+                "rmc.col.temp = 5, rmc.col.time = 1, rmc.unit.time = \"UNIXsec\", ",
+                "rmc.unit.acc = \"mg\", rmc.sf = 10")
+  utils::capture.output(type = "message", tab <- calibrate_cli(
+    c("--out", file.path(d, "cli"), "--rmc", arg, d), quit = FALSE))
+  expect_identical(tab$scale.x, res$scale.x)
+  rds <- tempfile(fileext = ".rds")  # not in the folder of recordings
+  on.exit(unlink(rds), add = TRUE)
+  saveRDS(pr, rds)
+  utils::capture.output(type = "message", tab <- calibrate_cli(
+    c("--out", file.path(d, "cli2"), "--rmc", rds, d), quit = FALSE))
+  expect_identical(tab$scale.x, res$scale.x)
+  expect_error(calibrate_cli(c("--out", file.path(d, "cli3"), "--rmc", "rmc.unit.acc = \"kg\"", d),
+                             quit = FALSE), "`rmc.unit.acc` must be one of")
+})
+
+test_that("rmc.* parameters gravcal does not implement, or cannot use, are errors naming them", {
+  rec <- adhoc_rec(hours = 0.1, sf = 10, seed = 15)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "POSIX")
+  gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
+                                  verbose = FALSE)
+  expect_error(gc(rmc.check4timegaps = TRUE), "`rmc.check4timegaps` = TRUE is not supported")
+  expect_error(gc(rmc.doresample = TRUE), "`rmc.doresample` = TRUE is not supported")
+  expect_error(gc(rmc.unit.acc = "kg"), "`rmc.unit.acc` must be one of \"g\", \"mg\", \"bit\"")
+  expect_error(gc(rmc.unit.acc = "bit"), "`rmc.unit.acc` = \"bit\" needs `rmc.bitrate`")
+  expect_error(gc(rmc.col.acc = c(2, 2, 3)), "`rmc.col.acc` must be 3 different column numbers")
+  expect_error(gc(rmc.format.time = "%d/%m/%Y"), "`rmc.format.time` = \"%d/%m/%Y\" does not read")
+  expect_error(gc(rmc.col.temp = 9), "column 9 asked for, but data lines have 5 fields")
+  expect_error(gc(rmc.sf = NULL), "`rmc.sf`", fixed = TRUE)
+  expect_error(gc(rmc.bitrate = "bits", rmc.dynamic_range = 8, rmc.unit.acc = "bit"),
+               "`rmc.bitrate` = \"bits\" names no numeric row of the header")
+  expect_error(read_recording(f, rmc = list(rmc.firstrow.acc = 2, rmc.sf = 10, rmc.nosuch = 1)),
+               "Unknown parameter in `rmc`: `rmc.nosuch`")
+  expect_error(read_recording(f, rmc = list(rmc.sf = 10)), "`rmc` must give `rmc.firstrow.acc`")
+  expect_error(calibrate(f, rmc = "x"), "`rmc` must be a named list")
+})
