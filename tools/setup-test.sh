@@ -19,18 +19,9 @@ r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cra
 libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev
 libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev"
 
-if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
-  missing=""
-  for p in $deb_pkgs; do
-    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
-  done
-  if [ -n "$missing" ]; then
-    echo "setup: installing Debian packages:$missing"
-    export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq >/dev/null
-    apt-get install -y -qq --no-install-recommends $missing >/dev/null
-  fi
-fi
+. "$(dirname "$0")/apt-missing.sh"
+# shellcheck disable=SC2086
+apt_missing $deb_pkgs
 
 # CRAN packages: the Imports and LinkingTo, and the Suggests so that every
 # test runs (tests skip only when a Suggests package is really absent).

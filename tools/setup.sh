@@ -11,18 +11,9 @@ cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
 deb_pkgs="r-base-core g++ make zlib1g-dev r-cran-rcpp r-cran-rcppeigen"
 
-if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
-  missing=""
-  for p in $deb_pkgs; do
-    dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
-  done
-  if [ -n "$missing" ]; then
-    echo "setup: installing Debian packages:$missing"
-    export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq >/dev/null
-    apt-get install -y -qq --no-install-recommends $missing >/dev/null
-  fi
-fi
+. "$(dirname "$0")/apt-missing.sh"
+# shellcheck disable=SC2086
+apt_missing $deb_pkgs
 
 # the LinkingTo and Imports from CRAN (graphics, grDevices, stats and
 # utils come with R)

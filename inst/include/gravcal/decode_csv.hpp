@@ -146,15 +146,17 @@ class CsvDecoder : public Decoder {
   }
 
   bool open() override {
-    if (adhoc_) {
-      if (!open_adhoc()) return false;
-      info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
-      info_.has_temperature = col_temp_ >= 0;
-      learn_roles();
-      opened_ = true;
-      done_ = lines_.exhausted();
-      return true;
-    }
+    if (!(adhoc_ ? open_adhoc() : open_header())) return false;
+    info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
+    info_.has_temperature = col_temp_ >= 0;
+    learn_roles();
+    opened_ = true;
+    done_ = lines_.exhausted();
+    return true;
+  }
+
+  // the first line: an ActiGraph export's header or a plain csv's names
+  bool open_header() {
     csv_text::Line ln;
     if (!lines_.next(ln)) return fail(lines_.read_failed() ? "the file cannot be read" : "the file is empty");
     std::string first(ln.p, ln.n);
@@ -164,14 +166,7 @@ class CsvDecoder : public Decoder {
       return fail("not an ActiGraph csv export: first line is \"" +
                   csv_text::excerpt(first.data(), first.size()) + "\"");
     }
-    const bool ok = actigraph ? open_actigraph(first) : open_plain(first);
-    if (!ok) return false;
-    info_.has_time = col_time_ >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
-    info_.has_temperature = col_temp_ >= 0;
-    learn_roles();
-    opened_ = true;
-    done_ = lines_.exhausted();
-    return true;
+    return actigraph ? open_actigraph(first) : open_plain(first);
   }
 
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
