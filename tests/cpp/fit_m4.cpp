@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "gravcal/gravcal.hpp"
+#include "gravcal/mcu.hpp"
 
 namespace {
 

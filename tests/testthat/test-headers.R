@@ -1,4 +1,4 @@
-# The header tiers (ARCHITECTURE.md): what gravcal.hpp includes, and all
+# The header tiers (ARCHITECTURE.md): what mcu.hpp includes, and all
 # that those include in turn, is the microcontroller core; it may include
 # only C++ standard headers and other headers of that tier (no R, no Eigen,
 # no decoders, no GGIR emulation). tests/cpp builds it for a Cortex-M4.
@@ -29,7 +29,7 @@ local_includes <- function(dir, h) {
 
 core_tier <- function(dir) {
   seen <- character(0)
-  todo <- "gravcal.hpp"
+  todo <- "mcu.hpp"
   while (length(todo)) {
     h <- todo[1]
     todo <- todo[-1]
@@ -53,6 +53,8 @@ test_that("the microcontroller core includes only standard headers", {
                      "icp.hpp", "pipeline.hpp", "ggir_procedure.hpp",
                      "ggir_blocks.hpp", "decode.hpp") %in% tier))
   expect_false(any(startsWith(tier, "kernels/")))
+  # gravcal.hpp, the host's umbrella, is the tier and the host's Segmenter
+  expect_setequal(local_includes(dir, "gravcal.hpp"), c("mcu.hpp", "segmenter.hpp"))
   for (h in tier) {
     inc <- includes_of(file.path(dir, h))
     expect_identical(setdiff(inc$system, std_headers), character(0),

@@ -1,19 +1,14 @@
 // gravcal: auto-calibration of triaxial accelerometers against gravity.
-// The header-only core's microcontroller tier (no Eigen, no heap, no vector
-// kernels, standard headers only), in double, float or fixed point
-// (fixed_point.hpp): model.hpp, window_cutter.hpp with stats_streaming.hpp
-// (StreamSegmenter), bins.hpp, gradient.hpp. The tiers above it include it:
-// segmenter.hpp (the host's Segmenter: R's arithmetic, stats_r.hpp, and
-// the vector kernels, kernels.hpp), the GGIR fit (icp.hpp, Eigen), the
-// decoders and GGIR's procedure (ARCHITECTURE.md).
+// The header-only core for a host: the microcontroller tier (mcu.hpp: the
+// model, the window cutter with streaming statistics, bins, the gradient
+// fit, fixed point) and the host's Segmenter (segmenter.hpp: the streaming
+// or R's exact arithmetic chosen at run time, with the vector kernels). The
+// tiers above (ARCHITECTURE.md): the GGIR fit (icp.hpp, Eigen), the
+// decoders, GGIR's procedure.
 #ifndef GRAVCAL_GRAVCAL_HPP
 #define GRAVCAL_GRAVCAL_HPP
 
-#include "model.hpp"
-#include "stats_streaming.hpp"
-#include "window_cutter.hpp"
-#include "bins.hpp"
-#include "gradient.hpp"
-#include "fixed_point.hpp"
+#include "mcu.hpp"
+#include "segmenter.hpp"
 
 #endif  // GRAVCAL_GRAVCAL_HPP
