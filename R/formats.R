@@ -13,6 +13,8 @@
 # * detect: for formats that share an extension, whether a file is this one
 #   (a file is the first format of its extension whose detector says yes or
 #   that has none);
+# * own_rate: TRUE for a device format whose file records its sampling
+#   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
 # * unit: what its native decoder reads and skips by (".. blocks skipped");
 # * block_units: the size of one of GGIR's blocks in those units, from the
@@ -49,14 +51,14 @@ recording_formats <- list(
     }),
   gt3x = list(
     ext = c(gt3x = ".gt3x"), detect = NULL,
-    label = "an ActiGraph .gt3x file", unit = "record",
+    label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),
     source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
   cwa = list(
     ext = c(cwa = ".cwa"), detect = NULL,
-    label = "an Axivity .cwa file", unit = "block",
+    label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
     block_units = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
     decoder = "cwa",
@@ -64,7 +66,7 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = NULL,
-    label = "a GENEActiv .bin file", unit = "page",
+    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE,
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),

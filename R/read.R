@@ -60,6 +60,7 @@ check_file <- function(file, arg) {
   if (!file.exists(file)) {
     abort("`", arg, "` does not exist: \"", file, "\".")
   }
+  check_regular_file(file, arg)
   invisible(file)
 }
 
@@ -77,9 +78,11 @@ read_file <- function(file, sf, reader, arg) {
     abort("`", arg, "` does not hold a data frame of samples: \"", file,
           "\" holds ", describe(data), ".")
   }
+  check_column_case(names(data), arg)
   names(data) <- tolower(names(data))
   check_sample_columns(data, file, arg)
   if (nrow(data) == 0) no_samples_error(data, file, format, arg)
+  check_sf_agrees(sf, attr(data, "sf") %||% attr(data, "sample_rate"), format, file)
   if (is.null(sf)) sf <- attr(data, "sf")
   if (is.null(sf) && !is.null(attr(data, "sample_rate"))) {
     sf <- attr(data, "sample_rate")

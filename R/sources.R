@@ -35,6 +35,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
     check_reference_opts(read_opts, format)
     src <- format_entry(format)$source(datafile, sf, chunksize, arg)
   }
+  check_sf_agrees(sf, src$sf, format, datafile)
   src$filename <- basename(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
@@ -130,7 +131,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)
   }
-  if (is.null(sf) || format %in% c("cwa", "geneactiv", "gt3x")) sf <- h$info$sf
+  if (is.null(sf) || isTRUE(format_entry(format)$own_rate)) sf <- h$info$sf
   if (!isTRUE(is.finite(sf) && sf > 0)) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
