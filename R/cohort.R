@@ -423,7 +423,8 @@ calibrate_one <- function(file, id, method, args) {
   err <- NULL
   fit <- tryCatch(
     withCallingHandlers(
-      do.call(calibrate, c(list(x = file, method = method), args)),
+      do.call(calibrate, c(list(x = file, method = method),
+                           utils::modifyList(args, list(sf = sf_for_file(file, args$sf))))),
       warning = function(w) {
         warns <<- c(warns, conditionMessage(w))
         invokeRestart("muffleWarning")

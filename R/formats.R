@@ -73,6 +73,15 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize))
 )
 
+# The `sf` a cohort's setting gives `file`: none for a file that records
+# its own rate (the setting is for the files that do not; see
+# check_sf_agrees()).
+sf_for_file <- function(file, sf) {
+  if (is.null(sf)) return(NULL)
+  format <- tryCatch(file_format(file, "files"), error = function(e) NA)
+  if (isTRUE(format_entry(format)$own_rate)) NULL else sf
+}
+
 # The registry's entry for `format`; NULL for a format it does not hold
 # (samples in memory: "data.frame").
 format_entry <- function(format) {

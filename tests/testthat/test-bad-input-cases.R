@@ -101,6 +101,22 @@ test_that("`sf` that disagrees with a device file's own rate: an error naming bo
                "`sf` = 20 Hz, but .* 25 Hz")
 })
 
+test_that("a cohort's `sf` is for its files that do not record their rate", {
+  dir <- tempfile("mixed")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  # a 25 Hz .cwa beside a csv of samples at 10 Hz without time stamps
+  gravcal:::write_cwa(as.matrix(rec[1:90000, c("x", "y", "z")]), file.path(dir, "a.cwa"),
+                      sf = 25)
+  utils::write.csv(rec[1:36000, c("x", "y", "z")], file.path(dir, "b.csv"), row.names = FALSE)
+  tab <- calibrate_files(dir, method = "lightweight", outdir = file.path(dir, "out"),
+                         sf = 10)
+  expect_false(any(tab$status == "failed"))
+  fits <- attr(tab, "fits")
+  expect_identical(vapply(fits, function(f) as.numeric(attr(f$windows, "sf")), 0),
+                   c(a.cwa = 25, b.csv = 10)[names(fits)])
+})
+
 test_that("x (g) and X (mg) in one data frame: an error naming both columns", {
   d <- rec[c("x", "y", "z")]
   d$X <- d$x * 1000
