@@ -29,7 +29,9 @@
 #' [rest_windows()] instead: they read it block by block, in bounded memory.
 #'
 #' @param file Path of the file.
-#' @param sf Sampling frequency in Hz, when the file does not give it.
+#' @param sf Sampling frequency in Hz, when the file does not give it (a
+#'   `.cwa`, `.bin` or `.gt3x` file's own rate is always used, and an `sf`
+#'   that disagrees with it is an error).
 #' @param reader `"native"` (default): gravcal's own decoders for `.cwa`,
 #'   `.bin`, `.gt3x` and csv, which give the samples as the device stored
 #'   them and count what they had to skip; `"reference"`: the readers GGIR

@@ -194,8 +194,10 @@ test_that("one Inf temperature sample is left out, not the temperature model", {
     expect_equal(dirty[[m]]$tempoffset, clean[[m]]$tempoffset, tolerance = 1e-3, label = m)
     expect_equal(dirty[[m]]$offset, clean[[m]]$offset, tolerance = 1e-3, label = m)
   }
-  # GGIR-compatible mode keeps GGIR's rule: an Inf makes the block's sd NaN
-  # and GGIR 3.3.9's g.calibrate then calibrates without the temperature
+  # GGIR-compatible mode is unchanged: an Inf makes the block's sd NaN, on
+  # which GGIR 3.3.9's g.calibrate stops (`sd(...) < 0.01` is NA in its
+  # `if`); gravcal's compatible mode calibrates without the temperature and
+  # says so
   expect_warning(g <- g.calibrate(bad, sf = 10, verbose = FALSE), "temperature not used")
   expect_false(g$use.temp)
 })
