@@ -230,7 +230,9 @@ cohort_files <- function(files, pattern, recursive, outdir) {
     rel <- list.files(root, pattern = pattern, recursive = recursive,
                       ignore.case = TRUE)
     path <- file.path(root, rel)
-    keep <- !dir.exists(path)
+    # regular files only: a folder is not a recording, and opening a named
+    # pipe would wait for a writer
+    keep <- vapply(path, file_kind, "") == "file"
     if (recursive) keep <- keep & !under_output(path, root, outdir)
     rel <- rel[keep]
     if (!length(rel)) {
@@ -252,6 +254,7 @@ cohort_files <- function(files, pattern, recursive, outdir) {
           "directories: ", paste0("\"", utils::head(files[folders], 3), "\"",
                                    collapse = ", "), ".")
   }
+  for (f in files) check_regular_file(f, "files")
   files <- normalizePath(files, winslash = "/", mustWork = TRUE)
   if (anyDuplicated(files)) {
     abort("`files` lists a file twice: \"", files[anyDuplicated(files)], "\".")

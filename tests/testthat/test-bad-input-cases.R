@@ -170,6 +170,13 @@ test_that("a named pipe, a folder or a device as the recording: an error before 
   expect_error(read_recording(pipe), paste0("`file` ", msg))
   expect_error(rest_windows(pipe), paste0("`x` ", msg))
   expect_error(calibrate("/dev/null"), "`x` must be a regular file, not a device")
+  # a cohort: a pipe named explicitly is refused, one in a folder not taken
+  expect_error(calibrate_files(pipe, outdir = file.path(dir, "out")),
+               "`files` must be a regular file, not a named pipe")
+  utils::write.csv(rec[1:36000, c("x", "y", "z")], file.path(dir, "b.csv"), row.names = FALSE)
+  tab <- calibrate_files(dir, method = "lightweight", outdir = file.path(dir, "out"),
+                         sf = 10)
+  expect_identical(tab$file, "b.csv")
   expect_identical(gravcal:::file_kind(dir), "directory")
   expect_identical(gravcal:::file_kind(file.path(dir, "none")), "missing")
 })
