@@ -5,6 +5,10 @@ gc_fp_probe <- function(a, b, c) {
     .Call(`_gravcal_gc_fp_probe`, a, b, c)
 }
 
+gc_file_kind <- function(path) {
+    .Call(`_gravcal_gc_file_kind`, path)
+}
+
 gc_decoder_open <- function(path, format, options) {
     .Call(`_gravcal_gc_decoder_open`, path, format, options)
 }

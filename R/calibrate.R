@@ -143,7 +143,8 @@
 #'   `z` in g and optionally `temperature` and `time`; or the path of a file
 #'   that [read_recording()] reads.
 #' @param sf Sampling frequency in Hz (taken from the file when `x` is a path
-#'   and `sf` is missing).
+#'   and `sf` is missing; a `.cwa`, `.bin` or `.gt3x` file's own rate is
+#'   always used, and an `sf` that disagrees with it is an error).
 #' @param method `"lightweight"` (Farago et al. 2024) or `"ggir"` (van Hees
 #'   et al. 2014; see the section "The GGIR method").
 #' @param ggir_compat For `method = "ggir"`: reproduce GGIR's
@@ -198,9 +199,10 @@
 #' 2. A window is dropped as a duplicate of the next one only when all six
 #'    of its means and standard deviations are equal. GGIR drops it when
 #'    exactly three are equal, and keeps fully identical windows.
-#' 3. "Enough data" means at least one hour of distinct windows. GGIR
-#'    compares the number of 10 s windows with `minloadcrit - 21`, a number
-#'    of hours.
+#' 3. "Enough data" means at least one hour of distinct windows, in a
+#'    recording of at least two hours. GGIR compares the number of 10 s
+#'    windows with `minloadcrit - 21`, a number of hours, and asks two hours
+#'    of its first block, whose size `chunksize` scales.
 #' 4. Samples left over after the last whole hour of a block always carry
 #'    over to the next block, and the sample before a trailing run of
 #'    idle-sleep zeros keeps its value. (GGIR re-reads stale leftovers when a

@@ -48,6 +48,54 @@ check_sf <- function(sf) {
   check_number(sf, "sf", min = 0, min_inclusive = FALSE)
 }
 
+# `sf` given for a file that records its own sampling rate (the registry's
+# `own_rate`, R/formats.R) must be that rate: the file's rate is the one
+# used, so another would silently change nothing the user asked for. The
+# same rate rounded to whole Hz agrees too (GGIR rounds GENEActiv's rate).
+check_sf_agrees <- function(sf, file_sf, format, file) {
+  if (is.null(sf) || !isTRUE(format_entry(format)$own_rate)) return(invisible())
+  if (isTRUE(sf == file_sf || round(sf) == round(file_sf))) return(invisible())
+  abort("`sf` = ", format(sf), " Hz, but \"", basename(file), "\" records its ",
+        "own rate, ", format(file_sf), " Hz, which is the one used; leave `sf` ",
+        "out or give ", format(file_sf), ".")
+}
+
+# What `path` is, without opening it: "file", "directory", "fifo" (a named
+# pipe: opening it waits for a writer), "device", "other" or "missing".
+file_kind <- function(path) {
+  if (!file.exists(path)) return("missing")
+  k <- gc_file_kind(path.expand(path))
+  if (k == "unknown") k <- if (dir.exists(path)) "directory" else "file"
+  k
+}
+
+# An error naming `arg` unless `path` is a regular file (or does not exist
+# and `missing_ok`).
+check_regular_file <- function(path, arg, missing_ok = FALSE) {
+  k <- file_kind(path)
+  if (k == "file" || (missing_ok && k == "missing")) return(invisible(path))
+  what <- switch(k, fifo = "a named pipe", device = "a device",
+                 directory = "a folder", missing = "a missing file",
+                 "a special file")
+  abort("`", arg, "` must be a regular file, not ", what, ": \"", path, "\".")
+}
+
+# Sample columns are matched ignoring case: two columns that differ only in
+# case (`x` in g beside `X` in mg) leave it unclear which is meant.
+check_column_case <- function(nms, arg) {
+  low <- tolower(nms)
+  for (want in c("x", "y", "z", "temperature", "time")) {
+    hit <- nms[low == want]
+    if (length(hit) > 1) {
+      abort("`", arg, "` has columns ", paste0("`", hit, "`", collapse = " and "),
+            "; names are matched ignoring case, so it is not clear which is ",
+            if (want %in% c("x", "y", "z")) "the acceleration in g" else
+              paste("the", want), ".")
+    }
+  }
+  invisible()
+}
+
 # Raw samples: a data frame or matrix with numeric columns x, y, z (any case),
 # optional temperature and time. Returns a list of plain numeric vectors that
 # point at the caller's memory (no copy for double columns).
@@ -70,6 +118,7 @@ as_samples <- function(x, arg = "x", temperature = c("use", "ignore")) {
     abort("`", arg, "` must be a data frame or matrix of raw samples with ",
           "columns x, y, z (in g), not ", describe(x), ".")
   }
+  check_column_case(names(x), arg)
   nm <- tolower(names(x))
   col <- function(name, required = TRUE) {
     i <- match(name, nm)

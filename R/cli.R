@@ -43,6 +43,10 @@ calibrate_cli <- function(args = commandArgs(trailingOnly = TRUE),
                           quit = !interactive()) {
   check_flag(quit, "quit")
   args <- as.character(args)
+  if (anyNA(args)) {
+    abort("`args` must be character strings without NA; element ",
+          which(is.na(args))[1], " is NA.")
+  }
   if (length(args) && args[1] == "--") args <- args[-1]
   if (!length(args) || any(args %in% c("--help", "-h"))) {
     writeLines(cli_help())

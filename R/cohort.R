@@ -232,7 +232,9 @@ cohort_files <- function(files, pattern, recursive, outdir) {
     rel <- list.files(root, pattern = pattern, recursive = recursive,
                       ignore.case = TRUE)
     path <- file.path(root, rel)
-    keep <- !dir.exists(path)
+    # regular files only: a folder is not a recording, and opening a named
+    # pipe would wait for a writer
+    keep <- vapply(path, file_kind, "") == "file"
     if (recursive) keep <- keep & !under_output(path, root, outdir)
     rel <- rel[keep]
     if (!length(rel)) {
@@ -254,6 +256,7 @@ cohort_files <- function(files, pattern, recursive, outdir) {
           "directories: ", paste0("\"", utils::head(files[folders], 3), "\"",
                                    collapse = ", "), ".")
   }
+  for (f in files) check_regular_file(f, "files")
   files <- normalizePath(files, winslash = "/", mustWork = TRUE)
   if (anyDuplicated(files)) {
     abort("`files` lists a file twice: \"", files[anyDuplicated(files)], "\".")
@@ -425,7 +428,8 @@ calibrate_one <- function(file, id, method, args) {
   err <- NULL
   fit <- tryCatch(
     withCallingHandlers(
-      do.call(calibrate, c(list(x = file, method = method), args)),
+      do.call(calibrate, c(list(x = file, method = method),
+                           utils::modifyList(args, list(sf = sf_for_file(file, args$sf))))),
       warning = function(w) {
         warns <<- c(warns, conditionMessage(w))
         invokeRestart("muffleWarning")

@@ -13,6 +13,8 @@
 # * detect: for formats that share an extension, whether a file is this one
 #   (a file is the first format of its extension whose detector says yes or
 #   that has none);
+# * own_rate: TRUE for a device format whose file records its sampling
+#   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
 # * unit: what its native decoder reads and skips by (".. blocks skipped");
 # * block_units: the size of one of GGIR's blocks in those units, from the
@@ -73,14 +75,14 @@ recording_formats <- list(
     }),
   gt3x = list(
     ext = c(gt3x = ".gt3x"), detect = NULL,
-    label = "an ActiGraph .gt3x file", unit = "record",
+    label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),
     source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
   cwa = list(
     ext = c(cwa = ".cwa"), detect = NULL,
-    label = "an Axivity .cwa file", unit = "block",
+    label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
     block_units = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
     decoder = "cwa",
@@ -88,12 +90,21 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = NULL,
-    label = "a GENEActiv .bin file", unit = "page",
+    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE,
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize))
 )
+
+# The `sf` a cohort's setting gives `file`: none for a file that records
+# its own rate (the setting is for the files that do not; see
+# check_sf_agrees()).
+sf_for_file <- function(file, sf) {
+  if (is.null(sf)) return(NULL)
+  format <- tryCatch(file_format(file, "files"), error = function(e) NA)
+  if (isTRUE(format_entry(format)$own_rate)) NULL else sf
+}
 
 # The registry's entry for `format`; NULL for a format it does not hold
 # (samples in memory: "data.frame").

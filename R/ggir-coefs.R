@@ -44,6 +44,8 @@ write_ggir_coefs <- function(fits, file) {
   if (!dir.exists(dirname(file))) {
     abort("`file`: the folder \"", dirname(file), "\" does not exist.")
   }
+  # the file is replaced by a rename: never a pipe's or a device's node
+  check_regular_file(file, "file", missing_ok = TRUE)
   out <- ggir_coef_table(fits)
   write_bytes_atomic(csv_bytes(out), file)
   invisible(out)

@@ -131,8 +131,13 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   check_flag(verbose, "verbose")
   check_fp_build("`g.calibrate()`")
   sf <- dots$sf
+  if (length(inspectfileobject) && !is.list(inspectfileobject)) {
+    abort("`inspectfileobject` must be a list (GGIR's g.inspectfile() result), ",
+          "not ", describe(inspectfileobject), ".")
+  }
   if (is.null(sf) && length(inspectfileobject) && !is.null(inspectfileobject$sf)) {
     sf <- inspectfileobject$sf
+    check_number(sf, "inspectfileobject$sf", min = 0, min_inclusive = FALSE)
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
   # rmc.firstrow.acc: an ad hoc csv file, read by the rmc.* parameters

@@ -12,7 +12,8 @@
 #      values match, and keeps fully identical ones);
 #   3. "enough data" means at least one hour of distinct windows (GGIR
 #      compares the number of windows with minloadcrit - 21, a number of
-#      hours);
+#      hours), in a recording of at least two hours (GGIR asks that of its
+#      first block, whose size chunksize scales);
 #   4. samples left over at the end of a block always carry to the next
 #      block, and the last sample before a run of idle-sleep zeros keeps its
 #      own value (GGIR overwrites it with the sample before it).

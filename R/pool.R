@@ -78,7 +78,7 @@ pooled_fit <- function(paths, fits, method, args) {
                                           c("window", "max_range", "axes",
                                             "skip_zero", "reader"))]
   ws <- lapply(paths, function(f) {
-    do.call(rest_windows, c(list(x = f, sf = args$sf), rargs))
+    do.call(rest_windows, c(list(x = f, sf = sf_for_file(f, args$sf)), rargs))
   })
   w <- do.call(rbind, ws)
   attr(w, "sf") <- attr(ws[[1]], "sf")

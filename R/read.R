@@ -31,7 +31,9 @@
 #' [rest_windows()] instead: they read it block by block, in bounded memory.
 #'
 #' @param file Path of the file.
-#' @param sf Sampling frequency in Hz, when the file does not give it.
+#' @param sf Sampling frequency in Hz, when the file does not give it (a
+#'   `.cwa`, `.bin` or `.gt3x` file's own rate is always used, and an `sf`
+#'   that disagrees with it is an error).
 #' @param reader `"native"` (default): gravcal's own decoders for `.cwa`,
 #'   `.bin`, `.gt3x` and csv, which give the samples as the device stored
 #'   them and count what they had to skip; `"reference"`: the readers GGIR
@@ -97,6 +99,7 @@ check_file <- function(file, arg) {
   if (!file.exists(file)) {
     abort("`", arg, "` does not exist: \"", file, "\".")
   }
+  check_regular_file(file, arg)
   invisible(file)
 }
 
@@ -114,9 +117,11 @@ read_file <- function(file, sf, reader, arg) {
     abort("`", arg, "` does not hold a data frame of samples: \"", file,
           "\" holds ", describe(data), ".")
   }
+  check_column_case(names(data), arg)
   names(data) <- tolower(names(data))
   check_sample_columns(data, file, arg)
   if (nrow(data) == 0) no_samples_error(data, file, format, arg)
+  check_sf_agrees(sf, attr(data, "sf") %||% attr(data, "sample_rate"), format, file)
   if (is.null(sf)) sf <- attr(data, "sf")
   if (is.null(sf) && !is.null(attr(data, "sample_rate"))) {
     sf <- attr(data, "sample_rate")

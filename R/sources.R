@@ -48,6 +48,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
       format_entry(format)$source(datafile, sf, chunksize, arg, layout = layout)
   }
   if (!is.null(layout$serial)) src$info$serial <- layout$serial
+  check_sf_agrees(sf, src$sf, format, datafile)
   src$filename <- basename(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
@@ -150,7 +151,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)
   }
-  if (is.null(sf) || format %in% c("cwa", "geneactiv", "gt3x")) sf <- h$info$sf
+  if (is.null(sf) || isTRUE(format_entry(format)$own_rate)) sf <- h$info$sf
   if (!isTRUE(is.finite(sf) && sf > 0)) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }

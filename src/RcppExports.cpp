@@ -23,6 +23,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_file_kind
+std::string gc_file_kind(std::string path);
+RcppExport SEXP _gravcal_gc_file_kind(SEXP pathSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_file_kind(path));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_decoder_open
 Rcpp::List gc_decoder_open(const std::string& path, const std::string& format, const Rcpp::List& options);
 RcppExport SEXP _gravcal_gc_decoder_open(SEXP pathSEXP, SEXP formatSEXP, SEXP optionsSEXP) {
@@ -268,6 +278,7 @@ END_RCPP
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
+    {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},

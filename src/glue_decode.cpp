@@ -5,6 +5,8 @@
 
 #include <Rcpp.h>
 
+#include <sys/stat.h>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +37,35 @@ gravcal::Options to_options(const Rcpp::List& opts) {
 }
 
 using gravcal_glue::OpenFile;
+
+}  // namespace
+
+// What `path` is, without opening it (opening a named pipe blocks until a
+// writer comes): "file", "directory", "fifo", "device", "other", or
+// "unknown" when the system cannot say (stat() fails, e.g. a path Windows'
+// narrow stat() cannot spell; the caller's file.exists() judges then).
+// [[Rcpp::export(rng = false)]]
+std::string gc_file_kind(std::string path) {
+#ifdef _WIN32
+  struct _stat64 st;
+  if (_stat64(path.c_str(), &st) != 0) return "unknown";
+  const unsigned mode = st.st_mode;
+  if ((mode & _S_IFMT) == _S_IFREG) return "file";
+  if ((mode & _S_IFMT) == _S_IFDIR) return "directory";
+  if ((mode & _S_IFMT) == _S_IFCHR) return "device";
+  return "other";
+#else
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) return "unknown";
+  if (S_ISREG(st.st_mode)) return "file";
+  if (S_ISDIR(st.st_mode)) return "directory";
+  if (S_ISFIFO(st.st_mode)) return "fifo";
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "device";
+  return "other";
+#endif
+}
+
+namespace {
 
 OpenFile* get(SEXP ptr) { return gravcal_glue::open_file(ptr); }
 

@@ -399,10 +399,20 @@ class GgirBlocks {
   // value, so that a block at the threshold goes GGIR's way.
   void temperature_stats(std::int64_t use) {
     if (!temp_) return;
+    // gravcal's own mode leaves non-finite temperatures out (as the
+    // windows' temperatures do); GGIR's R arithmetic keeps an Inf, whose sd
+    // is NaN, and so drops the temperature of the whole recording
+    const bool keep_all = compat_;
     info_.first_mean = r_mean_sd([&](auto&& f) {
-      for (double v : first_) f(v);
+      for (double v : first_) {
+        if (keep_all || std::isfinite(v)) f(v);
+      }
     }).mean;
-    const RunsSd fast = runs_sd([&](auto&& f) { each_run(use, f); });
+    const RunsSd fast = runs_sd([&](auto&& f) {
+      each_run(use, [&](double v, std::uint64_t c) {
+        if (keep_all || std::isfinite(v)) f(v, c);
+      });
+    });
     if (!compat_) {
       info_.temp_sd = fast.sd;
       return;

@@ -197,11 +197,17 @@ class GgirProcedure {
                   (cfg_.short_block_rows > 0 && static_cast<double>(b.rows) < cfg_.short_block_rows);
       if (present) {
         o.samples += b.rows;
-        if (static_cast<double>(b.rows) < per_hour * 2 + 1) {
+        const double two_hours = per_hour * 2 + 1;
+        if (cfg_.compat && static_cast<double>(b.rows) < two_hours) {
           // GGIR: a short block is the last one; a short first block means
           // the file is too short to use
           last = true;
           if (i == 1) present = false;
+        } else if (!cfg_.compat && last && static_cast<double>(o.samples) < two_hours) {
+          // own mode: the recording, not its first block (whose size
+          // chunksize scales), must hold two hours
+          present = false;
+          too_short_ = true;
         }
       }
       if (i == 1) o.use_temp = o.temp_available = present && temp;
@@ -319,7 +325,7 @@ class GgirProcedure {
     o.nhoursused = 0;
     const double n = static_cast<double>(idx.size());
     const bool enough = cfg_.compat ? n > (cfg_.minloadcrit - cfg_.enough_offset)
-                                    : n * 10 >= cfg_.min_hours * 3600;
+                                    : !too_short_ && n * 10 >= cfg_.min_hours * 3600;
     if (!enough) {
       o.qc = GgirQc::no_data;
       take_table(o, idx);
@@ -496,6 +502,7 @@ class GgirProcedure {
   std::vector<double> col_[8];
   std::vector<bool> rest_;
   bool pending_ = false;
+  bool too_short_ = false;  // own mode: the recording holds under two hours
   double next_fit_ = 0.0;
   double error_ = 0.0;
 };
