@@ -18,7 +18,10 @@
 #' @param x Raw samples: a data frame or matrix with columns `x`, `y`, `z`
 #'   (case-insensitive), as given to [calibrate()].
 #' @param fit A `gravcal_fit` from [calibrate()], [fit_gradient()] or
-#'   `fit_icp()`.
+#'   `fit_icp()`, or one row of coefficients: a one-row data frame from
+#'   [read_coefs()] (another tool's coefficients, converted to gravcal's
+#'   model) or of a [calibrate_files()] table of GGIR's model. A row is
+#'   applied as a fit of GGIR's model (GGIR's operation order).
 #' @return `x` with calibrated `x`, `y`, `z`.
 #' @export
 #' @examples
@@ -27,6 +30,7 @@
 #' cal <- apply_calibration(rec, fit)
 #' head(cal)
 apply_calibration <- function(x, fit) {
+  if (is.data.frame(fit)) fit <- coefs_fit(fit, "fit")
   check_fit(fit)
   s <- as_samples(x)
   uses_temp <- any(fit$tempoffset != 0)

@@ -1,0 +1,846 @@
+# Coefficients that travel between tools: the coefficient files and
+# conventions of GGIR, actipy, the UK Biobank pipeline
+# (biobankAccelerometerAnalysis), omconvert and scikit-digital-health,
+# converted exactly to gravcal's model, and two tools' coefficients compared.
+#
+# gravcal's model, per axis i (diagonal K, the only one the other tools
+# have): a_i = s_i (v_i + o_i) + t_i (T - m). The tools' conventions, from
+# their sources:
+#   GGIR (g.calibrate, backup.cal.coef): the same, m = meantempcal, the mean
+#     temperature of the recording's rest windows.
+#   omconvert (omcalibrate.c, OmCalibrateFindAutoCalibration and its info
+#     file's "Calibration:" line): (v + offset) * scale + (T -
+#     referenceTemperature) * tempOffset, referenceTemperature the mean
+#     temperature of its stationary points: the same as GGIR's.
+#   scikit-digital-health (skdh.preprocessing.CalibrateAccelerometer.predict,
+#     its documented formula): (y + d) s + (T - mean T) m: the same as GGIR's;
+#     its results hold "offset", "scale" and "temperature scale" but not the
+#     mean temperature.
+#   actipy (processing.calibrate_gravity, its info dict) and the UK Biobank
+#     pipeline since biobankAccelerometerAnalysis pull request #184 (summary
+#     json): intercept + slope v + slopeT T, temperature not centred and the
+#     intercept after the slope. Hence s = slope, t = slopeT, and with m = 0,
+#     o = intercept / slope.
+#   The UK Biobank pipeline before #184 (summary json with
+#     "calibration-meanDeviceTemp(C)"; files.csv with a meanTemp column):
+#     intercept + slope v + temp (T - meanTemp): s = slope, t = temp, m =
+#     meanTemp, o = intercept / slope.
+
+coef_tools <- c("ggir", "actipy", "ukb", "omconvert", "skdh")
+
+coef_names <- function() {
+  c("scale.x", "scale.y", "scale.z", "offset.x", "offset.y", "offset.z",
+    "temperature.offset.x", "temperature.offset.y", "temperature.offset.z")
+}
+
+#' Read and write the calibration coefficients of other tools
+#'
+#' `read_coefs()` reads the coefficient files of GGIR, actipy, the UK
+#' Biobank pipeline (biobankAccelerometerAnalysis), omconvert and
+#' scikit-digital-health, and converts them exactly to gravcal's model
+#' `a = scale * (v + offset) + (T - meantemp) * tempoffset` per axis;
+#' `write_coefs()` writes gravcal's fits (or coefficients read from another
+#' tool) in each tool's form. The data frame `read_coefs()` returns can be
+#' given to [apply_calibration()] (one row) and to [compare_coefs()].
+#'
+#' The tools and the forms read and written:
+#' * `"ggir"`: GGIR's `backup.cal.coef` csv file, one row per recording
+#'   (written by [write_ggir_coefs()]); temperature centred on `meantempcal`,
+#'   the mean temperature of the recording's rest windows.
+#' * `"actipy"`: actipy's calibration info (the dict
+#'   `actipy.processing.calibrate_gravity()` returns, saved as json),
+#'   keys `CalibxIntercept`, `CalibxSlope`, `CalibxSlopeT` (and `y`, `z`),
+#'   `CalibOK`: `intercept + slope * v + slopeT * T`, temperature not
+#'   centred. One recording per file.
+#' * `"ukb"`: the UK Biobank pipeline's `-summary.json`, keys
+#'   `calibration-xOffset(g)`, `calibration-xSlope`, `calibration-xSlopeTemp`
+#'   (and `y`, `z`), `file-name`, `quality-goodCalibration`: the same
+#'   uncentred model as actipy's (since its pull request #184, which explains
+#'   why: centring moves the offsets with the recording's mean temperature).
+#'   Read also: the older summaries (`calibration-xSlope(g)`,
+#'   `calibration-xTemp(C)`, `calibration-meanDeviceTemp(C)`, temperature
+#'   centred on the mean device temperature) and the pipeline's `files.csv`
+#'   (`fileName,calOffset,calSlope,calTemp[,meanTemp]`, each triple separated
+#'   by spaces: the values it gives to `accProcess --calOffset --calSlope
+#'   --calTemp [--meanTemp]`). Written: the current summary keys, one
+#'   recording per file.
+#' * `"omconvert"`: the `Calibration:` line of omconvert's `-info` file,
+#'   `scale x,y,z, offset x,y,z, tempOffset x,y,z, referenceTemperature`
+#'   (the same ten values, comma-separated, are what its `-calibration`
+#'   option takes), with `Calibration-Result:` (0: calibrated); its model is
+#'   GGIR's, centred on the mean temperature of its stationary points. One
+#'   recording per file.
+#' * `"skdh"`: scikit-digital-health's `CalibrateAccelerometer` results,
+#'   `offset`, `scale` and `temperature scale` (saved as json); its model is
+#'   GGIR's, but its results do not hold the mean temperature it centred on:
+#'   gravcal writes it under the key `temperature mean`, and a file without
+#'   it needs `meantemp` when its temperature scale is not zero.
+#'
+#' omconvert prints its coefficients with 10 decimals, actipy and the UK
+#' Biobank pipeline with Python's shortest exact representation; gravcal
+#' writes 17 significant digits (GGIR's csv: 15, as R's `write.csv()`), so
+#' that coefficients written and read back calibrate to within 1e-12 g.
+#'
+#' @param file For `read_coefs()`, the paths of coefficient files (a
+#'   multi-recording file or one file per recording). For `write_coefs()`,
+#'   the path of the file to write: one path for `"ggir"`, one per recording
+#'   for the other formats (they hold one recording each; actipy's,
+#'   omconvert's and skdh's hold no recording name, so name each file after
+#'   its recording: `read_coefs()` takes the name from it).
+#' @param format The tool whose form the file has; `"auto"` (for reading)
+#'   tells it from the file's content.
+#' @param meantemp For `"skdh"` files without a `temperature mean`: the mean
+#'   temperature (degree C) the temperature scale is centred on. An error for
+#'   other formats, which hold their own.
+#' @return `read_coefs()`: a data frame, one row per recording: `file` (the
+#'   recording: GGIR's `filename`, the UK Biobank's `file-name`, else the
+#'   coefficient file's name without extension), `tool`, `status` (`"ok"`,
+#'   `"failed"` where the tool says it did not calibrate, or `NA`),
+#'   `scale.x`, `scale.y`, `scale.z`, `offset.x`, `offset.y`, `offset.z`
+#'   (g, added before the scale, as GGIR's), `temperature.offset.x`,
+#'   `temperature.offset.y`, `temperature.offset.z` (g per degree C),
+#'   `meantemp` (degree C; 0 for the uncentred tools, `NA` when there is no
+#'   temperature term) and `source` (the file read). `write_coefs()`: that
+#'   data frame for what was written, invisibly.
+#' @seealso [compare_coefs()], [write_ggir_coefs()].
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 30, sf = 10, seed = 4,
+#'                           tempoffset = c(0.002, -0.001, 0.001))
+#' fit <- calibrate(rec, sf = 10, method = "ggir")
+#' out <- file.path(tempdir(), "p01.json")  # named after the recording
+#' write_coefs(list(p01 = fit), out, format = "actipy")
+#' cf <- read_coefs(out)
+#' cf
+#' cal <- apply_calibration(rec, cf)
+#' max(abs(cal$x - apply_calibration(rec, fit)$x))
+read_coefs <- function(file, format = c("auto", "ggir", "actipy", "ukb",
+                                        "omconvert", "skdh"),
+                       meantemp = NULL) {
+  format <- match_choice(format, "format")
+  if (!is.character(file) || !length(file) || anyNA(file) ||
+      any(!nzchar(file))) {
+    abort("`file` must be paths of coefficient files, not ", describe(file),
+          ".")
+  }
+  if (!is.null(meantemp)) check_number(meantemp, "meantemp")
+  absent <- !file.exists(file) | dir.exists(file)
+  if (any(absent)) {
+    abort("`file`: \"", file[absent][1], "\" is not a file.")
+  }
+  for (f in file) check_regular_file(f, "file")
+  rows <- lapply(file, function(f) {
+    text <- read_text(f)
+    fmt <- if (format == "auto") detect_coef_format(text, f) else format
+    if (!is.null(meantemp) && fmt != "skdh") {
+      abort("`meantemp` is only for \"skdh\" files (whose results do not ",
+            "hold it); \"", f, "\" is a ", fmt, " file, which holds its own.")
+    }
+    out <- switch(fmt,
+                  ggir = read_ggir_file(f),
+                  actipy = read_actipy(text, f),
+                  ukb = read_ukb(text, f),
+                  omconvert = read_omconvert(text, f),
+                  skdh = read_skdh(text, f, meantemp))
+    out$source <- f
+    out
+  })
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  out
+}
+
+#' @rdname read_coefs
+#' @param fits What to write: a `gravcal_fit` of GGIR's model (from
+#'   `calibrate(..., method = "ggir")` or [fit_icp()]; a fit with cross-axis
+#'   terms cannot be written, as no other tool applies them), a named list of
+#'   them (names: the recordings), a `g.calibrate()` result, or a data frame
+#'   of coefficients (from `read_coefs()` or [calibrate_files()]).
+#' @export
+write_coefs <- function(fits, file, format = c("ggir", "actipy", "ukb",
+                                               "omconvert", "skdh")) {
+  format <- match_choice(format, "format")
+  if (!is.character(file) || !length(file) || anyNA(file) ||
+      any(!nzchar(file))) {
+    abort("`file` must be file paths, not ", describe(file), ".")
+  }
+  cf <- as_coefs(fits, "fits")
+  if (format == "ggir") {
+    if (length(file) != 1) {
+      abort("`file` must be one path for format \"ggir\" (one csv file for ",
+            "all recordings), not ", length(file), ".")
+    }
+    if (inherits(fits, "gravcal_fit") || is_ggir_result(fits) ||
+        (is.list(fits) && !is.data.frame(fits))) {
+      write_ggir_coefs(fits, file)
+    } else {
+      write_ggir_coefs(stats::setNames(lapply(seq_len(nrow(cf)), function(i) {
+        r <- cf[i, ]
+        to <- unlist(r[coef_names()[7:9]])
+        list(scale = unlist(r[coef_names()[1:3]]),
+             offset = unlist(r[coef_names()[4:6]]), tempoffset = to,
+             QCmessage = "", meantempcal = r$meantemp,
+             use.temp = any(to != 0), cal.error.start = NA_real_,
+             cal.error.end = NA_real_, npoints = NA_real_,
+             nhoursused = NA_real_)
+      }), cf$file), file)
+    }
+    return(invisible(cf))
+  }
+  if (length(file) != nrow(cf)) {
+    abort("`file` must give one path per recording for format \"", format,
+          "\" (one recording per file): ", nrow(cf), " recordings, ",
+          length(file), " paths.")
+  }
+  for (i in seq_along(file)) {
+    f <- file[i]
+    if (dir.exists(f)) {
+      abort("`file`: \"", f, "\" is a directory, not a file path.")
+    }
+    if (!dir.exists(dirname(f))) {
+      abort("`file`: the folder \"", dirname(f), "\" does not exist.")
+    }
+    check_regular_file(f, "file", missing_ok = TRUE)
+    r <- cf[i, ]
+    text <- switch(format,
+                   actipy = actipy_text(r),
+                   ukb = ukb_text(r),
+                   omconvert = omconvert_text(r),
+                   skdh = skdh_text(r))
+    write_bytes_atomic(charToRaw(text), f)
+  }
+  invisible(cf)
+}
+
+# ---- one row of coefficients ----------------------------------------------
+
+coefs_row <- function(file, tool, scale, offset, tempoffset, meantemp,
+                      status = NA_character_, se = NULL) {
+  v <- c(scale, offset, tempoffset)
+  if (length(scale) != 3 || length(offset) != 3 || length(tempoffset) != 3 ||
+      !is.numeric(v) || !all(is.finite(v))) {
+    abort("The coefficients of \"", file, "\" (", tool, ") are not 3 finite ",
+          "values each for scale, offset and temperature offset.")
+  }
+  if (any(scale == 0)) {
+    abort("The coefficients of \"", file, "\" (", tool, ") have a zero ",
+          "scale.")
+  }
+  if (any(tempoffset != 0) && !isTRUE(is.finite(meantemp))) {
+    abort("The coefficients of \"", file, "\" (", tool, ") have a ",
+          "temperature term but no finite mean temperature.")
+  }
+  out <- data.frame(file = file, tool = tool, status = status,
+                    stringsAsFactors = FALSE)
+  out[coef_names()] <- as.list(as.double(v))
+  out$meantemp <- as.double(meantemp)
+  if (!is.null(se)) out[paste0(coef_names(), ".se")] <- as.list(as.double(se))
+  out
+}
+
+# intercept + slope v + slopeT (T - m) in gravcal's form.
+from_intercept <- function(file, tool, intercept, slope, slope_t, m = 0,
+                           status = NA_character_) {
+  if (!all(is.finite(c(intercept, slope, slope_t, m))) ||
+      length(intercept) != 3 || length(slope) != 3 || length(slope_t) != 3) {
+    abort("The coefficients of \"", file, "\" (", tool, ") are not 3 finite ",
+          "values each for intercept, slope and temperature slope.")
+  }
+  if (any(slope == 0)) {
+    abort("The coefficients of \"", file, "\" (", tool, ") have a zero ",
+          "slope.")
+  }
+  coefs_row(file, tool, slope, intercept / slope, slope_t,
+            if (any(slope_t != 0)) m else NA_real_, status)
+}
+
+# gravcal's form to intercept + slope v + slopeT T (uncentred).
+to_intercept <- function(r) {
+  s <- unlist(r[coef_names()[1:3]])
+  o <- unlist(r[coef_names()[4:6]])
+  t <- unlist(r[coef_names()[7:9]])
+  m <- if (any(t != 0)) r$meantemp else 0
+  list(intercept = unname(s * o - t * m), slope = unname(s),
+       slope_t = unname(t))
+}
+
+# Any of the inputs the functions take, as rows of coefficients (with their
+# standard errors where there are some).
+as_coefs <- function(x, arg) {
+  if (inherits(x, "gravcal_fit") || is_ggir_result(x)) {
+    nm <- if (is.null(x$file)) "recording" else basename(x$file)
+    x <- stats::setNames(list(x), nm)
+  }
+  if (is.data.frame(x)) return(coefs_from_frame(x, arg))
+  if (!is.list(x) || !length(x)) {
+    abort("`", arg, "` must be a gravcal_fit, a g.calibrate() result, a ",
+          "named list of them or a data frame of coefficients, not ",
+          describe(x), ".")
+  }
+  nms <- names(x)
+  if (is.null(nms)) nms <- rep("", length(x))
+  for (i in seq_along(x)) {
+    if ((is.na(nms[i]) || !nzchar(nms[i])) && is.list(x[[i]]) &&
+        is.character(x[[i]]$file)) {
+      nms[i] <- basename(x[[i]]$file)
+    }
+  }
+  if (any(is.na(nms) | !nzchar(nms))) {
+    abort("`", arg, "` must be named by the recordings, e.g. ",
+          "list(p01 = fit).")
+  }
+  rows <- lapply(seq_along(x), function(i) {
+    f <- x[[i]]
+    if (inherits(f, "gravcal_fit")) {
+      check_fit(f, arg)
+      K <- f$K
+      if (any(K[row(K) != col(K)] != 0)) {
+        abort("`", arg, "`: the fit for \"", nms[i], "\" has cross-axis ",
+              "terms (method \"", f$method, "\"), which no other tool ",
+              "applies; use calibrate(..., method = \"ggir\").")
+      }
+      se <- if (!is.null(f$se)) {
+        unname(f$se[c("k_xx", "k_yy", "k_zz", "o_x", "o_y", "o_z", "t_x",
+                      "t_y", "t_z")])
+      }
+      uses <- any(f$tempoffset != 0)
+      coefs_row(nms[i], "gravcal", diag(K), f$offset, f$tempoffset,
+                if (uses) f$meantemp else NA_real_,
+                if (identical(f$status, "ok")) "ok" else f$status, se)
+    } else if (is_ggir_result(f)) {
+      to <- if (length(f$tempoffset)) f$tempoffset else c(0, 0, 0)
+      mt <- if (length(f$meantempcal)) f$meantempcal[1] else NA_real_
+      coefs_row(nms[i], "ggir", f$scale, f$offset, to,
+                if (any(to != 0)) mt else NA_real_)
+    } else {
+      abort("`", arg, "`: element \"", nms[i], "\" is not a gravcal_fit ",
+            "or a g.calibrate() result but ", describe(f), ".")
+    }
+  })
+  out <- rbind_fill(rows)
+  if (anyDuplicated(out$file)) {
+    abort("`", arg, "` holds two sets of coefficients for \"",
+          out$file[anyDuplicated(out$file)], "\".")
+  }
+  out
+}
+
+# A data frame of coefficients: read_coefs()'s, calibrate_files()'s, or
+# GGIR's columns.
+coefs_from_frame <- function(x, arg) {
+  nm <- names(x)
+  if (!"file" %in% nm && "filename" %in% nm) x$file <- x$filename
+  if (!"meantemp" %in% nm && "meantempcal" %in% nm) x$meantemp <- x$meantempcal
+  if (!all(coef_names()[7:9] %in% nm)) x[coef_names()[7:9]] <- 0
+  need <- c("file", coef_names()[1:6])
+  miss <- setdiff(need, names(x))
+  if (length(miss)) {
+    abort("`", arg, "` lacks the column(s) ", paste0("`", miss, "`",
+                                                     collapse = ", "),
+          " (a data frame of coefficients needs `file`, `scale.x` ... ",
+          "`offset.z`, and `temperature.offset.x` ... with `meantemp` ",
+          "where there is a temperature term).")
+  }
+  if (!nrow(x)) abort("`", arg, "` has no rows.")
+  cross <- intersect(c("cross.xy", "cross.xz", "cross.yz"), names(x))
+  if (length(cross) && any(as.matrix(x[cross]) != 0, na.rm = TRUE)) {
+    abort("`", arg, "` has cross-axis terms (`cross.*` columns of the ",
+          "lightweight method), which no other tool applies.")
+  }
+  if (!"meantemp" %in% names(x)) x$meantemp <- NA_real_
+  has_se <- all(paste0(coef_names(), ".se") %in% names(x))
+  rows <- lapply(seq_len(nrow(x)), function(i) {
+    v <- vapply(coef_names(), function(n) as.double(x[[n]][i]), 0)
+    if (!all(is.finite(v))) {
+      abort("`", arg, "`: the coefficients of \"", x$file[i], "\" (row ", i,
+            ") are not all finite numbers.")
+    }
+    to <- v[7:9]
+    coefs_row(as.character(x$file[i]),
+              if ("tool" %in% names(x)) as.character(x$tool[i]) else "gravcal",
+              v[1:3], v[4:6], to,
+              if (any(to != 0)) as.double(x$meantemp[i]) else NA_real_,
+              if ("status" %in% names(x)) as.character(x$status[i]) else
+                NA_character_,
+              if (has_se) vapply(paste0(coef_names(), ".se"),
+                                 function(n) as.double(x[[n]][i]), 0))
+  })
+  out <- rbind_fill(rows)
+  if ("source" %in% names(x)) out$source <- x$source
+  out
+}
+
+rbind_fill <- function(rows) {
+  cols <- unique(unlist(lapply(rows, names)))
+  rows <- lapply(rows, function(r) {
+    for (n in setdiff(cols, names(r))) r[[n]] <- NA_real_
+    r[cols]
+  })
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  out
+}
+
+# The fit apply_calibration() applies for one row of coefficients.
+coefs_fit <- function(x, arg = "fit") {
+  if (nrow(x) != 1) {
+    abort("`", arg, "` must be one row of coefficients (one recording), ",
+          "not ", nrow(x), " rows; take the recording's row, e.g. ",
+          "coefs[coefs$file == \"p01\", ].")
+  }
+  r <- as_coefs(x, arg)
+  v <- unlist(r[coef_names()])
+  to <- v[7:9]
+  fit <- new_fit(K = diag(v[1:3]), offset = v[4:6], tempoffset = to,
+                 meantemp = if (any(to != 0)) r$meantemp else NA_real_,
+                 method = "ggir", status = "ok",
+                 message = paste0("coefficients of ", r$tool, " for ", r$file))
+  fit
+}
+
+# ---- reading ----------------------------------------------------------------
+
+read_text <- function(f) {
+  bytes <- readBin(f, "raw", n = file.size(f))
+  if (any(bytes == as.raw(0))) {
+    abort("`file`: \"", f, "\" is not a text file of coefficients.")
+  }
+  text <- rawToChar(bytes)
+  Encoding(text) <- "UTF-8"
+  text
+}
+
+detect_coef_format <- function(text, f) {
+  if (grepl("^\\s*\\{", text)) {
+    if (grepl("\"Calib[xyz]Slope\"", text)) return("actipy")
+    if (grepl("\"calibration-[xyz]Offset\\(g\\)\"", text)) return("ukb")
+    if (grepl("\"scale\"", text) && grepl("\"offset\"", text)) return("skdh")
+  } else {
+    first <- sub("[\r\n].*$", "", text)
+    if (grepl("(^|,)\"?scale\\.x\"?(,|$)", first) &&
+        grepl("(^|,)\"?filename\"?(,|$)", first)) return("ggir")
+    if (grepl("^\"?fileName\"?,\"?calOffset\"?", first)) return("ukb")
+    if (grepl("(^|[\r\n])Calibration:", text)) return("omconvert")
+  }
+  abort("`format`: the coefficients in \"", f, "\" are of none of the ",
+        "forms read (GGIR csv, actipy / UK Biobank / skdh json, omconvert ",
+        "info); give `format` to have its error say what is missing.")
+}
+
+read_ggir_file <- function(f) {
+  d <- tryCatch(utils::read.csv(f, stringsAsFactors = FALSE,
+                                check.names = FALSE),
+                error = function(e) abort("`file`: \"", f, "\" cannot be ",
+                                          "read as csv (", conditionMessage(e),
+                                          ")."))
+  miss <- setdiff(c("filename", coef_names()), names(d))
+  if (length(miss)) {
+    abort("`file`: \"", f, "\" is not a GGIR coefficient file: it lacks the ",
+          "column(s) ", paste0("`", miss, "`", collapse = ", "), ".")
+  }
+  if (!nrow(d)) abort("`file`: \"", f, "\" holds no recordings.")
+  rows <- lapply(seq_len(nrow(d)), function(i) {
+    v <- suppressWarnings(vapply(coef_names(),
+                                 function(n) as.double(d[[n]][i]), 0))
+    if (!all(is.finite(v))) {
+      abort("`file`: in \"", f, "\", the coefficients of \"", d$filename[i],
+            "\" are not all finite numbers.")
+    }
+    mt <- if ("meantempcal" %in% names(d)) as.double(d$meantempcal[i]) else
+      NA_real_
+    coefs_row(as.character(d$filename[i]), "ggir", v[1:3], v[4:6], v[7:9],
+              if (any(v[7:9] != 0)) mt else NA_real_, NA_character_)
+  })
+  do.call(rbind, rows)
+}
+
+# The value of "key" in json text: numbers (a number or an array, flattened),
+# NULL when the key is absent.
+json_numbers <- function(text, key, f) {
+  pat <- paste0("\"", gsub("([][{}()+*^$|\\\\?.])", "\\\\\\1", key),
+                "\"\\s*:\\s*")
+  m <- regexpr(pat, text, perl = TRUE)
+  if (m < 0) return(NULL)
+  rest <- substring(text, m + attr(m, "match.length"))
+  val <- regmatches(rest, regexpr(
+    "^(\\[[^]]*\\]+|\"[^\"]*\"|[^,}\\s]+)", rest, perl = TRUE))
+  if (!length(val)) {
+    abort("`file`: in \"", f, "\", the value of \"", key, "\" cannot be read.")
+  }
+  toks <- regmatches(val, gregexpr("[^][,\\s]+", val, perl = TRUE))[[1]]
+  toks <- gsub("\"", "", toks)
+  toks[toks == "null"] <- NA
+  out <- suppressWarnings(as.double(toks))
+  bad <- is.na(out) & !is.na(toks) & toks != "NaN"
+  if (any(bad)) {
+    abort("`file`: in \"", f, "\", the value of \"", key, "\" is not a ",
+          "number: ", val, ".")
+  }
+  out
+}
+
+json_string <- function(text, key) {
+  pat <- paste0("\"", gsub("([][{}()+*^$|\\\\?.])", "\\\\\\1", key),
+                "\"\\s*:\\s*\"([^\"]*)\"")
+  m <- regmatches(text, regexec(pat, text, perl = TRUE))[[1]]
+  if (length(m) < 2) NULL else m[2]
+}
+
+# Three values of keys named by axis, e.g. "Calib%sSlope".
+json_axes <- function(text, fmt, f, required = TRUE) {
+  v <- lapply(c("x", "y", "z"), function(a) json_numbers(text, sprintf(fmt, a), f))
+  present <- !vapply(v, is.null, TRUE)
+  if (!any(present) && !required) return(NULL)
+  if (!all(present)) {
+    abort("`file`: \"", f, "\" lacks the key \"",
+          sprintf(fmt, c("x", "y", "z")[!present][1]), "\".")
+  }
+  v <- unlist(v)
+  if (length(v) != 3 || !all(is.finite(v))) {
+    abort("`file`: in \"", f, "\", the values of \"", sprintf(fmt, "x"),
+          "\" ... are not 3 finite numbers (", paste(v, collapse = ", "),
+          ").")
+  }
+  v
+}
+
+file_id <- function(f) {
+  sub("[.](json|txt|csv|info)$", "", basename(f), ignore.case = TRUE)
+}
+
+flag_status <- function(v) {
+  if (is.null(v) || length(v) != 1 || is.na(v)) NA_character_ else
+    if (v == 1) "ok" else "failed"
+}
+
+read_actipy <- function(text, f) {
+  intercept <- json_axes(text, "Calib%sIntercept", f)
+  slope <- json_axes(text, "Calib%sSlope", f)
+  slope_t <- json_axes(text, "Calib%sSlopeT", f, required = FALSE)
+  if (is.null(slope_t)) slope_t <- c(0, 0, 0)
+  from_intercept(file_id(f), "actipy", intercept, slope, slope_t, 0,
+                 flag_status(json_numbers(text, "CalibOK", f)))
+}
+
+read_ukb <- function(text, f) {
+  if (!grepl("^\\s*\\{", text)) return(read_ukb_files_csv(f))
+  id <- json_string(text, "file-name")
+  id <- if (is.null(id)) file_id(f) else basename(id)
+  status <- flag_status(json_numbers(text, "quality-goodCalibration", f))
+  intercept <- json_axes(text, "calibration-%sOffset(g)", f)
+  if (!is.null(json_numbers(text, "calibration-xSlope", f))) {
+    # since pull request #184: temperature not centred
+    slope <- json_axes(text, "calibration-%sSlope", f)
+    slope_t <- json_axes(text, "calibration-%sSlopeTemp", f, required = FALSE)
+    if (is.null(slope_t)) slope_t <- c(0, 0, 0)
+    return(from_intercept(id, "ukb", intercept, slope, slope_t, 0, status))
+  }
+  # before it: centred on the mean device temperature
+  slope <- json_axes(text, "calibration-%sSlope(g)", f)
+  slope_t <- json_axes(text, "calibration-%sTemp(C)", f)
+  m <- json_numbers(text, "calibration-meanDeviceTemp(C)", f)
+  if (length(m) != 1 || !is.finite(m)) {
+    abort("`file`: \"", f, "\" has the UK Biobank pipeline's centred ",
+          "temperature coefficients but no finite ",
+          "\"calibration-meanDeviceTemp(C)\".")
+  }
+  from_intercept(id, "ukb", intercept, slope, slope_t, m, status)
+}
+
+read_ukb_files_csv <- function(f) {
+  d <- utils::read.csv(f, stringsAsFactors = FALSE, colClasses = "character")
+  miss <- setdiff(c("fileName", "calOffset", "calSlope", "calTemp"), names(d))
+  if (length(miss)) {
+    abort("`file`: \"", f, "\" is not a UK Biobank files.csv: it lacks the ",
+          "column(s) ", paste0("`", miss, "`", collapse = ", "), ".")
+  }
+  triple <- function(s, what, i) {
+    v <- suppressWarnings(as.double(strsplit(trimws(s), "\\s+")[[1]]))
+    if (length(v) != 3 || !all(is.finite(v))) {
+      abort("`file`: in \"", f, "\", `", what, "` of \"", d$fileName[i],
+            "\" is not 3 finite numbers separated by spaces: \"", s, "\".")
+    }
+    v
+  }
+  rows <- lapply(seq_len(nrow(d)), function(i) {
+    m <- if ("meanTemp" %in% names(d)) as.double(d$meanTemp[i]) else 0
+    from_intercept(basename(d$fileName[i]), "ukb",
+                   triple(d$calOffset[i], "calOffset", i),
+                   triple(d$calSlope[i], "calSlope", i),
+                   triple(d$calTemp[i], "calTemp", i), m)
+  })
+  do.call(rbind, rows)
+}
+
+read_omconvert <- function(text, f) {
+  lines <- strsplit(text, "\r?\n")[[1]]
+  cal <- grep("^Calibration:", lines, value = TRUE)
+  if (length(cal) != 1) {
+    abort("`file`: \"", f, "\" must have one \"Calibration:\" line ",
+          "(omconvert's -info file), not ", length(cal), ".")
+  }
+  v <- suppressWarnings(as.double(strsplit(sub("^Calibration:", "", cal),
+                                           ",")[[1]]))
+  if (length(v) != 10 || !all(is.finite(v))) {
+    abort("`file`: in \"", f, "\", the \"Calibration:\" line must hold 10 ",
+          "finite numbers (scale x,y,z, offset x,y,z, tempOffset x,y,z, ",
+          "referenceTemperature): \"", cal, "\".")
+  }
+  res <- grep("^Calibration-Result:", lines, value = TRUE)
+  status <- if (length(res) == 1) {
+    code <- suppressWarnings(as.integer(sub("^Calibration-Result:", "", res)))
+    if (is.na(code)) NA_character_ else if (code == 0) "ok" else "failed"
+  } else NA_character_
+  to <- v[7:9]
+  coefs_row(file_id(f), "omconvert", v[1:3], v[4:6], to,
+            if (any(to != 0)) v[10] else NA_real_, status)
+}
+
+read_skdh <- function(text, f, meantemp) {
+  get3 <- function(key, required = TRUE) {
+    v <- json_numbers(text, key, f)
+    if (is.null(v) && !required) return(NULL)
+    if (length(v) != 3 || !all(is.finite(v))) {
+      abort("`file`: in \"", f, "\", \"", key, "\" must be 3 finite numbers",
+            if (is.null(v)) " but is absent" else
+              paste0(", not ", paste(v, collapse = ", ")), ".")
+    }
+    v
+  }
+  scale <- get3("scale")
+  offset <- get3("offset")
+  ts <- get3("temperature scale", required = FALSE)
+  if (is.null(ts)) ts <- c(0, 0, 0)
+  m <- json_numbers(text, "temperature mean", f)
+  if (!is.null(m) && !is.null(meantemp)) {
+    abort("`meantemp`: \"", f, "\" holds its own \"temperature mean\" (",
+          format(m), ").")
+  }
+  if (is.null(m)) m <- meantemp
+  if (any(ts != 0) && (length(m) != 1 || !is.finite(m))) {
+    abort("`meantemp` is needed: \"", f, "\" has a temperature scale but ",
+          "scikit-digital-health's results do not hold the mean temperature ",
+          "it is centred on; give it as `meantemp`.")
+  }
+  coefs_row(file_id(f), "skdh", scale, offset, ts,
+            if (any(ts != 0)) m else NA_real_)
+}
+
+# ---- writing ----------------------------------------------------------------
+
+num17 <- function(v) {
+  ifelse(is.na(v), "NaN", sprintf("%.17g", v))
+}
+
+json_object <- function(keys, values) {
+  paste0("{\n", paste0("    \"", keys, "\": ", values, collapse = ",\n"),
+         "\n}\n")
+}
+
+status_flag <- function(s) {
+  if (is.na(s)) NULL else if (s == "ok") "1" else "0"
+}
+
+actipy_text <- function(r) {
+  u <- to_intercept(r)
+  keys <- c(sprintf("Calib%sIntercept", c("x", "y", "z")),
+            sprintf("Calib%sSlope", c("x", "y", "z")))
+  vals <- num17(c(u$intercept, u$slope))
+  if (any(u$slope_t != 0)) {
+    keys <- c(keys, sprintf("Calib%sSlopeT", c("x", "y", "z")))
+    vals <- c(vals, num17(u$slope_t))
+  }
+  ok <- status_flag(r$status)
+  if (!is.null(ok)) {
+    keys <- c("CalibOK", keys)
+    vals <- c(ok, vals)
+  }
+  json_object(keys, vals)
+}
+
+ukb_text <- function(r) {
+  u <- to_intercept(r)
+  keys <- c("file-name",
+            sprintf("calibration-%sOffset(g)", c("x", "y", "z")),
+            sprintf("calibration-%sSlope", c("x", "y", "z")),
+            sprintf("calibration-%sSlopeTemp", c("x", "y", "z")))
+  vals <- c(json_quote(r$file), num17(c(u$intercept, u$slope, u$slope_t)))
+  ok <- status_flag(r$status)
+  if (!is.null(ok)) {
+    keys <- c(keys, "quality-goodCalibration")
+    vals <- c(vals, ok)
+  }
+  json_object(keys, vals)
+}
+
+json_quote <- function(s) {
+  s <- gsub("\\\\", "\\\\\\\\", s)
+  paste0("\"", gsub("\"", "\\\\\"", s), "\"")
+}
+
+omconvert_text <- function(r) {
+  v <- unlist(r[coef_names()])
+  m <- if (any(v[7:9] != 0)) r$meantemp else 0
+  paste0(if (!is.na(r$status)) sprintf("Calibration-Result: %d\n",
+                                       if (r$status == "ok") 0L else -1L),
+         "Calibration: ", paste(num17(c(v, m)), collapse = ","), "\n")
+}
+
+skdh_text <- function(r) {
+  v <- unlist(r[coef_names()])
+  arr <- function(x) paste0("[", paste(num17(x), collapse = ", "), "]")
+  keys <- c("offset", "scale", "temperature scale")
+  vals <- c(arr(v[4:6]), arr(v[1:3]), paste0("[", arr(v[7:9]), "]"))
+  if (any(v[7:9] != 0)) {
+    keys <- c(keys, "temperature mean")
+    vals <- c(vals, num17(r$meantemp))
+  }
+  json_object(keys, vals)
+}
+
+# ---- comparing ---------------------------------------------------------------
+
+#' Compare two tools' coefficients for the same recordings
+#'
+#' Matches the recordings of `a` and `b` by file name (without folder and
+#' extension, and without the UK Biobank pipeline's `-summary` suffix), and
+#' gives for each the difference of every coefficient (`b - a`), the z value
+#' of that difference where standard errors exist (gravcal's fits and
+#' [calibrate_files()] tables have them: `z = (b - a) / sqrt(se_a^2 +
+#' se_b^2)`, with the standard errors there are), and the largest
+#' difference between the two calibrations over orientations: `max |a_A(u)
+#' - a_B(u)|` in mg over 2000 unit vectors `u` spread evenly over the
+#' sphere.
+#'
+#' Offsets depend on the temperature the model is centred on, so both sets
+#' are first expressed at one reference temperature (`a`'s mean
+#' temperature, else `b`'s; the offsets `o + t (T_ref - m) / s`), and the
+#' calibrations are compared at that temperature. A standard error of an
+#' offset is the one at its fit's own mean temperature.
+#'
+#' @param a,b Coefficients: data frames from [read_coefs()] or
+#'   [calibrate_files()], `gravcal_fit`s of GGIR's model, or named lists of
+#'   them.
+#' @return A data frame (class `gravcal_coef_comparison`), one row per
+#'   recording in both: `file`, `tool_a`, `tool_b`, `reference_temp`, the
+#'   differences `d_scale.x` ... `d_temperature.offset.z`, the z values
+#'   `z_scale.x` ... (NA without standard errors), `max_abs_z` and
+#'   `mapping_mg`. The recordings in only one of them are in
+#'   `attr(, "only_a")` and `attr(, "only_b")`.
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 30, sf = 10, seed = 4,
+#'                           tempoffset = c(0.002, -0.001, 0.001))
+#' fit <- calibrate(rec, sf = 10, method = "ggir")
+#' out <- file.path(tempdir(), "p01.txt")
+#' write_coefs(list(p01 = fit), out, format = "omconvert")
+#' compare_coefs(list(p01 = fit), read_coefs(out))
+compare_coefs <- function(a, b) {
+  ca <- as_coefs(a, "a")
+  cb <- as_coefs(b, "b")
+  ka <- coef_key(ca$file)
+  kb <- coef_key(cb$file)
+  for (k in list(list(ka, "a"), list(kb, "b"))) {
+    if (anyDuplicated(k[[1]])) {
+      abort("`", k[[2]], "` holds two recordings named \"",
+            k[[1]][anyDuplicated(k[[1]])], "\" (without folder and ",
+            "extension); they cannot be matched.")
+    }
+  }
+  both <- intersect(ka, kb)
+  if (!length(both)) {
+    abort("`a` and `b` have no recording in common (by file name without ",
+          "folder and extension): `a` has ", paste0("\"", utils::head(ka, 3),
+                                                   "\"", collapse = ", "),
+          ", `b` has ", paste0("\"", utils::head(kb, 3), "\"",
+                               collapse = ", "), ".")
+  }
+  u <- sphere_points(2000)
+  rows <- lapply(both, function(k) {
+    ra <- ca[match(k, ka), ]
+    rb <- cb[match(k, kb), ]
+    tref <- if (is.finite(ra$meantemp)) ra$meantemp else
+      if (is.finite(rb$meantemp)) rb$meantemp else 0
+    va <- at_temperature(ra, tref)
+    vb <- at_temperature(rb, tref)
+    d <- vb - va
+    sea <- se_of(ra)
+    seb <- se_of(rb)
+    se <- sqrt(ifelse(is.na(sea), 0, sea^2) + ifelse(is.na(seb), 0, seb^2))
+    se[is.na(sea) & is.na(seb)] <- NA
+    z <- d / se
+    # both calibrations at the reference temperature, measured v = u
+    map <- function(v) sweep(sweep(u, 2, v[4:6], "+"), 2, v[1:3], "*")
+    diff <- map(vb) - map(va)
+    out <- data.frame(file = ra$file, tool_a = ra$tool, tool_b = rb$tool,
+                      reference_temp = tref, stringsAsFactors = FALSE)
+    out[paste0("d_", coef_names())] <- as.list(unname(d))
+    out[paste0("z_", coef_names())] <- as.list(unname(z))
+    out$max_abs_z <- if (all(is.na(z))) NA_real_ else max(abs(z), na.rm = TRUE)
+    out$mapping_mg <- 1000 * max(sqrt(rowSums(diff^2)))
+    out
+  })
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  attr(out, "only_a") <- ca$file[!ka %in% both]
+  attr(out, "only_b") <- cb$file[!kb %in% both]
+  class(out) <- c("gravcal_coef_comparison", "data.frame")
+  out
+}
+
+coef_key <- function(f) {
+  b <- basename(as.character(f))
+  b <- sub("-summary[.]json$", "", b, ignore.case = TRUE)
+  sub("[.][^.]*$", "", b)
+}
+
+# The 9 coefficients with the offsets moved to reference temperature tref.
+at_temperature <- function(r, tref) {
+  v <- unlist(r[coef_names()])
+  if (any(v[7:9] != 0)) v[4:6] <- v[4:6] + v[7:9] * (tref - r$meantemp) / v[1:3]
+  v
+}
+
+se_of <- function(r) {
+  n <- paste0(coef_names(), ".se")
+  if (!all(n %in% names(r))) return(rep(NA_real_, 9))
+  unname(unlist(r[n]))
+}
+
+# n unit vectors spread evenly over the sphere (a Fibonacci lattice).
+sphere_points <- function(n) {
+  i <- seq_len(n) - 0.5
+  z <- 1 - 2 * i / n
+  r <- sqrt(1 - z^2)
+  phi <- i * pi * (3 - sqrt(5))
+  cbind(r * cos(phi), r * sin(phi), z)
+}
+
+#' @export
+print.gravcal_coef_comparison <- function(x, digits = 3, ...) {
+  cat("<gravcal_coef_comparison> ", nrow(x), " recording(s) in both",
+      sep = "")
+  oa <- attr(x, "only_a")
+  ob <- attr(x, "only_b")
+  if (length(oa) || length(ob)) {
+    cat(sprintf(" (%d only in `a`, %d only in `b`)", length(oa), length(ob)))
+  }
+  cat("\n")
+  if (!nrow(x)) return(invisible(x))
+  cat(sprintf("  largest mapping difference: %.*f mg (%s)\n", digits,
+              max(x$mapping_mg), x$file[which.max(x$mapping_mg)]))
+  if (any(is.finite(x$max_abs_z))) {
+    cat(sprintf("  largest |z| of a coefficient difference: %.*f\n", digits,
+                max(x$max_abs_z, na.rm = TRUE)))
+  }
+  show <- data.frame(file = x$file, tools = paste(x$tool_a, "vs", x$tool_b),
+                     mapping_mg = round(x$mapping_mg, digits),
+                     max_abs_z = round(x$max_abs_z, digits),
+                     d_scale = signif(apply(abs(as.matrix(
+                       x[paste0("d_", coef_names()[1:3])])), 1, max), digits),
+                     d_offset_g = signif(apply(abs(as.matrix(
+                       x[paste0("d_", coef_names()[4:6])])), 1, max), digits),
+                     stringsAsFactors = FALSE)
+  print(show, row.names = FALSE)
+  invisible(x)
+}

@@ -1,0 +1,344 @@
+# Coefficients that travel between tools (issue 31, item 3): read_coefs(),
+# write_coefs(), apply_calibration() with a row of coefficients and
+# compare_coefs(). The hand-written files below follow each tool's own
+# source (named at each test); the expected calibrated samples are computed
+# here with each tool's own formula, not with gravcal's conversion.
+
+# A recording with a temperature column and a temperature effect, and
+# gravcal's GGIR-method fit of it (which uses the temperature term).
+coef_fixture <- local({
+  cache <- NULL
+  function() {
+    if (is.null(cache)) {
+      rec <- simulate_recording(hours = 30, sf = 10, seed = 31,
+                                tempoffset = c(0.003, -0.002, 0.0015))
+      fit <- calibrate(rec, sf = 10, method = "ggir")
+      cache <<- list(rec = rec, fit = fit)
+    }
+    cache
+  }
+})
+
+# A fit of GGIR's model with coefficients far from the identity, so that a
+# slip in a conversion (offset before or after the scale, the temperature
+# centred or not) moves the calibrated samples by far more than 1e-12 g.
+far_fit <- function(fit) {
+  diag(fit$K) <- c(1.05, 0.96, 1.02)
+  fit$offset[] <- c(0.05, -0.03, 0.02)
+  fit$tempoffset[] <- c(0.004, -0.0025, 0.0015)
+  fit$meantemp <- 27.3
+  fit
+}
+
+xyz_max_diff <- function(a, b) {
+  max(abs(c(a$x - b$x, a$y - b$y, a$z - b$z)))
+}
+
+test_that("round trips through every format give the same calibrated samples to 1e-12 g", {
+  fx <- coef_fixture()
+  expect_identical(fx$fit$status, "ok")
+  expect_true(any(fx$fit$tempoffset != 0))
+  expect_true(is.finite(fx$fit$meantemp))
+  d <- snap_dir("coefs-1")
+  ext <- c(ggir = ".csv", actipy = ".json", ukb = "-summary.json",
+           omconvert = ".txt", skdh = ".json")
+  n <- 0
+  for (fit in list(fx$fit, far_fit(fx$fit))) {
+    direct <- apply_calibration(fx$rec, fit)
+    # the fit does change the samples, by more than the tolerance
+    expect_gt(xyz_max_diff(direct, fx$rec), 1e-3)
+    for (fmt in names(ext)) {
+      f <- file.path(d, paste0("p01", ext[[fmt]]))
+      write_coefs(list(p01 = fit), f, format = fmt)
+      for (how in c(fmt, "auto")) {
+        cf <- read_coefs(f, format = how)
+        expect_identical(nrow(cf), 1L)
+        expect_identical(cf$tool, fmt)
+        expect_identical(coef_key(cf$file), "p01")
+        back <- apply_calibration(fx$rec, cf)
+        expect_lt(xyz_max_diff(back, direct), 1e-12)
+        n <- n + 1
+      }
+      # the centred tools keep the mean temperature; the others are 0
+      cf <- read_coefs(f, format = fmt)
+      if (fmt %in% c("ggir", "omconvert", "skdh")) {
+        expect_equal(cf$meantemp, fit$meantemp, tolerance = 1e-14)
+      } else {
+        expect_identical(cf$meantemp, 0)
+      }
+      # and back out again, from the coefficients read (a data frame)
+      f2 <- file.path(d, paste0("again", ext[[fmt]]))
+      write_coefs(cf, f2, format = fmt)
+      expect_lt(xyz_max_diff(apply_calibration(fx$rec, read_coefs(f2)),
+                             direct), 1e-12)
+    }
+  }
+  expect_identical(n, 20)
+})
+
+test_that("a conversion slip would be caught: centring matters by far more than 1e-12 g", {
+  fx <- coef_fixture()
+  fit <- far_fit(fx$fit)
+  d <- snap_dir("coefs-2")
+  f <- file.path(d, "p01.json")
+  write_coefs(list(p01 = fit), f, format = "actipy")
+  cf <- read_coefs(f)
+  # reading actipy's uncentred intercept as if it were centred on the
+  # fit's mean temperature moves every sample by t * meantemp
+  wrong <- cf
+  wrong$meantemp <- fit$meantemp
+  expect_gt(xyz_max_diff(apply_calibration(fx$rec, wrong),
+                         apply_calibration(fx$rec, fit)), 0.01)
+})
+
+test_that("GGIR's backup.cal.coef written by hand is read to its coefficients", {
+  # columns as GGIR's g.calibrate() output / backup.cal.coef (the ones
+  # write_ggir_coefs() documents); GGIR applies (v + offset) * scale +
+  # (T - meantempcal) * temperature.offset
+  d <- snap_dir("coefs-3")
+  f <- file.path(d, "cal.csv")
+  writeLines(c(
+    "filename,scale.x,scale.y,scale.z,offset.x,offset.y,offset.z,temperature.offset.x,temperature.offset.y,temperature.offset.z,meantempcal",
+    "a.bin,1.01,0.98,1.002,0.012,-0.02,0.007,0.001,-0.0005,0.0002,24.5",
+    "b.bin,0.995,1.004,1,-0.004,0.003,0.001,0,0,0,0"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$file, c("a.bin", "b.bin"))
+  expect_identical(cf$tool, c("ggir", "ggir"))
+  expect_identical(unlist(cf[1, coef_names()], use.names = FALSE),
+                   c(1.01, 0.98, 1.002, 0.012, -0.02, 0.007, 0.001, -0.0005,
+                     0.0002))
+  expect_identical(cf$meantemp, c(24.5, NA))
+  v <- data.frame(x = 0.4, y = -0.7, z = 0.55, temperature = 31)
+  got <- apply_calibration(v, cf[1, ])
+  want <- (c(0.4, -0.7, 0.55) + c(0.012, -0.02, 0.007)) * c(1.01, 0.98, 1.002) +
+    (31 - 24.5) * c(0.001, -0.0005, 0.0002)
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+})
+
+test_that("actipy's calibration info written by hand is read to its coefficients", {
+  # keys of actipy.processing.calibrate_gravity()'s info dict; it applies
+  # intercept + slope * v + slopeT * T (temperature not centred)
+  d <- snap_dir("coefs-4")
+  f <- file.path(d, "p02.json")
+  writeLines(c("{", '  "CalibOK": 1,', '  "CalibErrorBefore(mg)": 12.5,',
+               '  "CalibErrorAfter(mg)": 2.1,',
+               '  "CalibxIntercept": 0.021, "CalibyIntercept": -0.013,',
+               '  "CalibzIntercept": 0.0045,',
+               '  "CalibxSlope": 1.012, "CalibySlope": 0.991, "CalibzSlope": 1.003,',
+               '  "CalibxSlopeT": 0.0011, "CalibySlopeT": -0.0007, "CalibzSlopeT": 0.0002',
+               "}"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$file, "p02")
+  expect_identical(cf$tool, "actipy")
+  expect_identical(cf$status, "ok")
+  expect_identical(unlist(cf[c("scale.x", "scale.y", "scale.z")],
+                          use.names = FALSE), c(1.012, 0.991, 1.003))
+  expect_equal(unlist(cf[c("offset.x", "offset.y", "offset.z")],
+                      use.names = FALSE),
+               c(0.021, -0.013, 0.0045) / c(1.012, 0.991, 1.003),
+               tolerance = 1e-15)
+  expect_identical(cf$meantemp, 0)
+  v <- data.frame(x = c(0.4, -0.9), y = c(-0.7, 0.1), z = c(0.55, 0.3),
+                  temperature = c(31, 18))
+  got <- apply_calibration(v, cf)
+  for (i in 1:2) {
+    want <- c(0.021, -0.013, 0.0045) +
+      c(1.012, 0.991, 1.003) * c(v$x[i], v$y[i], v$z[i]) +
+      c(0.0011, -0.0007, 0.0002) * v$temperature[i]
+    expect_equal(c(got$x[i], got$y[i], got$z[i]), want, tolerance = 1e-14)
+  }
+  # without temperature slopes (actipy on data without temperature)
+  writeLines('{"CalibxIntercept": 0.01, "CalibyIntercept": 0, "CalibzIntercept": 0, "CalibxSlope": 1.1, "CalibySlope": 1, "CalibzSlope": 1}', f)
+  cf <- read_coefs(f, "actipy")
+  expect_identical(unlist(cf[coef_names()[7:9]], use.names = FALSE), c(0, 0, 0))
+  expect_identical(cf$meantemp, NA_real_)
+  expect_identical(cf$status, NA_character_)
+})
+
+test_that("the UK Biobank pipeline's summaries and files.csv written by hand are read", {
+  d <- snap_dir("coefs-5")
+  v <- data.frame(x = 0.4, y = -0.7, z = 0.55, temperature = 29)
+  # since biobankAccelerometerAnalysis #184 (device.py,
+  # store_calibration_params): uncentred, intercept + slope v + slopeT T
+  f <- file.path(d, "p03-summary.json")
+  writeLines(c("{", '    "file-name": "/data/raw/p03.cwa",',
+               '    "file-deviceID": 41234,',
+               '    "calibration-xOffset(g)": -0.0123,',
+               '    "calibration-yOffset(g)": 0.0204,',
+               '    "calibration-zOffset(g)": 0.0066,',
+               '    "calibration-xSlope": 1.0078,',
+               '    "calibration-ySlope": 0.9952,',
+               '    "calibration-zSlope": 1.0011,',
+               '    "calibration-xSlopeTemp": 0.00081,',
+               '    "calibration-ySlopeTemp": -0.00042,',
+               '    "calibration-zSlopeTemp": 0.00013,',
+               '    "calibration-errsBefore(mg)": 9.8,',
+               '    "quality-goodCalibration": 1', "}"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$file, "p03.cwa")
+  expect_identical(cf$tool, "ukb")
+  expect_identical(cf$status, "ok")
+  got <- apply_calibration(v, cf)
+  want <- c(-0.0123, 0.0204, 0.0066) + c(1.0078, 0.9952, 1.0011) *
+    c(0.4, -0.7, 0.55) + c(0.00081, -0.00042, 0.00013) * 29
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+  # before #184 (accelerometer/device.py, storeCalibrationParams): the
+  # temperature centred on calibration-meanDeviceTemp(C)
+  f <- file.path(d, "p04-summary.json")
+  writeLines(c("{", '"file-name": "p04.cwa",',
+               '"calibration-xOffset(g)": -0.0123, "calibration-yOffset(g)": 0.0204,',
+               '"calibration-zOffset(g)": 0.0066,',
+               '"calibration-xSlope(g)": 1.0078, "calibration-ySlope(g)": 0.9952,',
+               '"calibration-zSlope(g)": 1.0011,',
+               '"calibration-xTemp(C)": 0.00081, "calibration-yTemp(C)": -0.00042,',
+               '"calibration-zTemp(C)": 0.00013,',
+               '"calibration-meanDeviceTemp(C)": 26.4,',
+               '"quality-goodCalibration": 0', "}"), f)
+  cf <- read_coefs(f, "ukb")
+  expect_identical(cf$status, "failed")
+  expect_identical(cf$meantemp, 26.4)
+  got <- apply_calibration(v, cf)
+  want <- c(-0.0123, 0.0204, 0.0066) + c(1.0078, 0.9952, 1.0011) *
+    c(0.4, -0.7, 0.55) + c(0.00081, -0.00042, 0.00013) * (29 - 26.4)
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+  # files.csv (utils.py, writeFilesWithCalibrationCoefs): the values it
+  # passes to accProcess --calOffset --calSlope --calTemp --meanTemp
+  f <- file.path(d, "files.csv")
+  writeLines(c("fileName,calOffset,calSlope,calTemp,meanTemp",
+               "p05.cwa,-0.0123 0.0204 0.0066,1.0078 0.9952 1.0011,0.00081 -0.00042 0.00013,26.4",
+               "p06.cwa,0.01 0 0,1 1 1,0 0 0,20"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$file, c("p05.cwa", "p06.cwa"))
+  got <- apply_calibration(v, cf[1, ])
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+  expect_identical(cf$meantemp[2], NA_real_)
+})
+
+test_that("omconvert's -info file written by hand is read to its coefficients", {
+  # omconvert.c writes "Calibration: %.10f,..." (scale x3, offset x3,
+  # tempOffset x3, referenceTemperature) and "Calibration-Result: %d";
+  # omcalibrate.c applies (v + offset) * scale + (T - referenceTemperature)
+  # * tempOffset
+  d <- snap_dir("coefs-6")
+  f <- file.path(d, "p07.txt")
+  writeLines(c("Calibration-Result: 0",
+               "Calibration: 1.0123456789,0.9876543210,1.0011111111,0.0150000000,-0.0220000000,0.0030000000,0.0012000000,-0.0006000000,0.0001000000,25.7500000000",
+               "Calibration-Stationary-Count: 812",
+               "Calibration-Stationary-Error-Pre: 0.0134000000",
+               "Calibration-Stationary-Error-Post: 0.0031000000"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$tool, "omconvert")
+  expect_identical(cf$status, "ok")
+  expect_identical(cf$meantemp, 25.75)
+  v <- data.frame(x = 0.4, y = -0.7, z = 0.55, temperature = 22)
+  got <- apply_calibration(v, cf)
+  want <- (c(0.4, -0.7, 0.55) + c(0.015, -0.022, 0.003)) *
+    c(1.0123456789, 0.9876543210, 1.0011111111) +
+    (22 - 25.75) * c(0.0012, -0.0006, 0.0001)
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+})
+
+test_that("scikit-digital-health's results written by hand are read, with the mean temperature given", {
+  # CalibrateAccelerometer.predict() returns "offset", "scale" and
+  # "temperature scale" (shape (1, 3)) and applies (y + d) s + (T - mean T) m,
+  # the mean temperature not returned
+  d <- snap_dir("coefs-7")
+  f <- file.path(d, "p08.json")
+  writeLines('{"offset": [0.011, -0.004, 0.02], "scale": [1.004, 0.997, 1.01], "temperature scale": [[0.0009, -0.0003, 0.0002]]}', f)
+  expect_error(read_coefs(f), "`meantemp` is needed")
+  cf <- read_coefs(f, meantemp = 23.1)
+  expect_identical(cf$tool, "skdh")
+  expect_identical(cf$meantemp, 23.1)
+  v <- data.frame(x = 0.4, y = -0.7, z = 0.55, temperature = 30)
+  got <- apply_calibration(v, cf)
+  want <- (c(0.4, -0.7, 0.55) + c(0.011, -0.004, 0.02)) * c(1.004, 0.997, 1.01) +
+    (30 - 23.1) * c(0.0009, -0.0003, 0.0002)
+  expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
+})
+
+test_that("bad input is an error naming the argument", {
+  fx <- coef_fixture()
+  d <- snap_dir("coefs-8")
+  f <- file.path(d, "p.json")
+  expect_error(read_coefs(f), "`file`")
+  expect_error(read_coefs(1), "`file` must be paths")
+  writeLines('{"CalibxIntercept": 0.01}', f)
+  expect_error(read_coefs(f, format = "nope"), "`format`")
+  expect_error(read_coefs(f, "actipy"), "lacks the key \"CalibyIntercept\"")
+  writeLines('{"CalibxIntercept": NaN, "CalibyIntercept": 0, "CalibzIntercept": 0, "CalibxSlope": 1, "CalibySlope": 1, "CalibzSlope": 1}', f)
+  expect_error(read_coefs(f), "`file`.*not 3 finite")
+  writeLines('{"something": 1}', f)
+  expect_error(read_coefs(f), "`format`")
+  g <- file.path(d, "g.csv")
+  writeLines(c("filename,scale.x,scale.y,scale.z,offset.x,offset.y,offset.z,temperature.offset.x,temperature.offset.y,temperature.offset.z,meantempcal",
+               "a.bin,1,1,Inf,0,0,0,0,0,0,0"), g)
+  expect_error(read_coefs(g), "`file`.*not all finite")
+  writeLines(c("filename,scale.x,scale.y,offset.x", "a.bin,1,1,0"), g)
+  expect_error(read_coefs(g, "ggir"), "lacks the column\\(s\\) `scale.z`")
+  o <- file.path(d, "o.txt")
+  writeLines("Calibration: 1,1,1,0,0,0", o)
+  expect_error(read_coefs(o), "10 finite numbers")
+  writeLines('{"offset": [0, 0, 0], "scale": [1, 1, 1]}', f)
+  expect_error(read_coefs(f, "skdh", meantemp = NA), "`meantemp`")
+  expect_error(read_coefs(g, "ggir", meantemp = 20), "`meantemp` is only")
+  # writing
+  expect_error(write_coefs(list(p = fx$fit), file.path(d, "a.json"),
+                           format = "csv"), "`format`")
+  expect_error(write_coefs(list(p = fx$fit, q = fx$fit),
+                           file.path(d, "a.json"), format = "actipy"),
+               "one path per recording")
+  expect_error(write_coefs(list(fx$fit), file.path(d, "a.json"), "actipy"),
+               "`fits` must be named")
+  lw <- calibrate(fx$rec, sf = 10)
+  if (any(lw$K[row(lw$K) != col(lw$K)] != 0)) {
+    expect_error(write_coefs(list(p = lw), file.path(d, "a.json"), "actipy"),
+                 "`fits`.*cross-axis")
+  }
+  expect_error(write_coefs(data.frame(file = "a", scale.x = 1), f, "actipy"),
+               "`fits` lacks the column\\(s\\) `scale.y`")
+  bad <- read_coefs(g <- {
+    writeLines(c("filename,scale.x,scale.y,scale.z,offset.x,offset.y,offset.z,temperature.offset.x,temperature.offset.y,temperature.offset.z,meantempcal",
+                 "a.bin,1,1,1,0,0,0,0,0,0,0", "b.bin,1,1,1,0,0,0,0,0,0,0"), g)
+    g
+  })
+  expect_error(apply_calibration(fx$rec, bad), "`fit` must be one row")
+  bad$offset.x[1] <- NA
+  expect_error(apply_calibration(fx$rec, bad[1, ]), "`fit`.*not all finite")
+  expect_error(write_coefs(list(p = fx$fit), file.path(d, "no", "a.json"),
+                           "actipy"), "`file`: the folder")
+})
+
+test_that("compare_coefs() gives the differences, z values and mapping difference", {
+  fx <- coef_fixture()
+  fit <- fx$fit
+  d <- snap_dir("coefs-9")
+  f <- file.path(d, "p01.json")
+  write_coefs(list(p01 = fit), f, format = "actipy")
+  cmp <- compare_coefs(list(p01.bin = fit), read_coefs(f))
+  expect_s3_class(cmp, "gravcal_coef_comparison")
+  expect_identical(nrow(cmp), 1L)
+  expect_identical(c(cmp$tool_a, cmp$tool_b), c("gravcal", "actipy"))
+  # the same calibration in two conventions: no difference once both are
+  # at the same reference temperature
+  expect_lt(cmp$mapping_mg, 1e-9)
+  expect_lt(max(abs(unlist(cmp[paste0("d_", coef_names())]))), 1e-12)
+  expect_identical(cmp$reference_temp, fit$meantemp)
+  # a known change: offset.x by 0.01 g moves the mapping by scale.x * 10 mg
+  # in every orientation; its z is the change over the fit's standard error
+  moved <- read_coefs(f)
+  moved$offset.x <- moved$offset.x + 0.01
+  cmp <- compare_coefs(list(p01 = fit), moved)
+  expect_equal(cmp$mapping_mg, 10 * fit$K[1, 1], tolerance = 1e-9)
+  expect_equal(cmp$d_offset.x, 0.01, tolerance = 1e-9)
+  expect_true(is.finite(fit$se[["o_x"]]))
+  expect_equal(cmp$z_offset.x, 0.01 / fit$se[["o_x"]], tolerance = 1e-9)
+  expect_equal(cmp$max_abs_z, max(abs(unlist(cmp[paste0("z_", coef_names())])),
+                                  na.rm = TRUE))
+  expect_output(print(cmp), "largest mapping difference: 1[0-9][.][0-9]+ mg")
+  # unmatched recordings are reported, not dropped silently
+  two <- rbind(moved, transform(moved, file = "p09"))
+  cmp <- compare_coefs(list(p01 = fit), two)
+  expect_identical(attr(cmp, "only_b"), "p09")
+  expect_output(print(cmp), "1 only in `b`")
+  expect_error(compare_coefs(list(p02 = fit), moved), "no recording in common")
+})
