@@ -393,9 +393,62 @@ coefs_fit <- function(x, arg = "fit") {
   to <- v[7:9]
   fit <- new_fit(K = diag(v[1:3]), offset = v[4:6], tempoffset = to,
                  meantemp = if (any(to != 0)) r$meantemp else NA_real_,
-                 method = "ggir", status = "ok",
-                 message = paste0("coefficients of ", r$tool, " for ", r$file))
+                 method = "ggir", status = "given",
+                 message = paste0("coefficients of ", r$tool, " for ", r$file,
+                                  ", given, not fitted"))
+  fit$use_temp <- any(to != 0)
   fit
+}
+
+# calibrate_files(coefs = ): the given coefficients, one row per recording
+# (matched by file name without folder and extension), checked before any
+# work.
+given_coefs <- function(coefs, ids) {
+  cf <- as_coefs(coefs, "coefs")
+  key <- coef_key(cf$file)
+  if (anyDuplicated(key)) {
+    abort("`coefs` holds two rows for the recording \"",
+          key[anyDuplicated(key)], "\" (file names are matched without ",
+          "folder and extension).")
+  }
+  idk <- coef_key(ids)
+  miss <- !idk %in% key
+  if (any(miss)) {
+    abort("`coefs` has no coefficients for ", sum(miss), " recording(s): ",
+          paste0("\"", utils::head(ids[miss], 3), "\"", collapse = ", "),
+          if (sum(miss) > 3) ", ...", " (matched by file name without ",
+          "folder and extension).")
+  }
+  cf[match(idk, key), , drop = FALSE]
+}
+
+# A recording's fit with the given coefficients in place of its own: the
+# same rest points, the errors on them with the given coefficients, no
+# standard errors (nothing was fitted), status "given".
+with_given <- function(fit, r) {
+  g <- coefs_fit(r, "coefs")
+  fit$K <- g$K
+  fit$offset <- g$offset
+  fit$tempoffset <- g$tempoffset
+  fit$meantemp <- g$meantemp
+  fit$use_temp <- g$use_temp
+  if (!is.null(fit$params)) {
+    fit$params[] <- c(diag(g$K), 0, 0, 0, g$offset)
+  }
+  own <- fit$status
+  fit <- clear_uncertainty(fit)
+  fit[c("segments", "segment_settings", "ggir")] <- list(NULL)
+  fit$error_heldout_before <- NA_real_
+  fit$error_heldout_after <- NA_real_
+  fit$status <- "given"
+  fit$message <- paste0("coefficients of ", r$tool, " given (", r$file,
+                        "), not fitted; the recording's own fit: ", own)
+  if (any(fit$tempoffset != 0) && NROW(fit$points) &&
+      is.null(fit$points$temperature)) {
+    fit$message <- paste0(fit$message, "; the recording has no temperature, ",
+                          "so the errors leave the temperature term out")
+  }
+  refresh_errors(fit)
 }
 
 # ---- reading ----------------------------------------------------------------

@@ -42,8 +42,8 @@
 #' Written to `outdir`: `calibration.csv` (the table below) and, for
 #' `method = "ggir"`, `calibration_ggir_coefs.csv`, the coefficients in
 #' GGIR's `backup.cal.coef` format ([write_ggir_coefs()]) of exactly the
-#' recordings of this table that were calibrated (status `"ok"` or
-#' `"high_error"`; only the header when there are none). A run with the
+#' recordings of this table that were calibrated (status `"ok"`,
+#' `"high_error"` or `"given"`; only the header when there are none). A run with the
 #' lightweight method removes a `calibration_ggir_coefs.csv` an earlier run
 #' wrote, since it no longer matches the table.
 #'
@@ -90,8 +90,21 @@
 #'   last step: at least 10 windows, every axis beyond `-+spherecrit`, the
 #'   fit, GGIR's errors and QC message (`minloadcrit` against the hours
 #'   pooled), the temperature term when every recording pooled used it.
+#' @param coefs `NULL` (default), or coefficients to apply instead of each
+#'   recording's own: a data frame from [read_coefs()] (another tool's,
+#'   converted to gravcal's model), a [calibrate_files()] table or a named
+#'   list of fits of GGIR's model, with a row for every recording (matched
+#'   by file name without folder and extension; rows for other recordings
+#'   are not used). Each recording is still read and calibrated as without
+#'   `coefs` (its saved result is the same, so `resume` reuses it), then its
+#'   row and fit take the given coefficients: status `"given"`, a message
+#'   naming the tool and the recording's own status, `error_before_mg` and
+#'   `error_after_mg` on its own rest points with the given coefficients, no
+#'   standard errors, `parameters` 0; `calibration_ggir_coefs.csv` holds
+#'   them. Not with `pool = "device"`.
 #' @return A data frame, one row per recording, in the order of `files`:
-#'   `file` (the recording's identity, see above), `status` (see [calibrate()], or `"failed"`),
+#'   `file` (the recording's identity, see above), `status` (see [calibrate()], `"given"` (see
+#'   `coefs`), or `"failed"`),
 #'   `message` (why, for a recording that failed or was not calibrated;
 #'   also notes such as a damaged saved result that was recomputed); the
 #'   coefficients named as in GGIR's coefficient file: `scale.x`,
@@ -132,9 +145,14 @@
 calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
                             pattern = format_file_pattern(),
-                            pool = c("none", "device"), recursive = FALSE) {
+                            pool = c("none", "device"), recursive = FALSE,
+                            coefs = NULL) {
   method <- match_choice(method, "method")
   pool <- match_choice(pool, "pool")
+  if (!is.null(coefs) && pool == "device") {
+    abort("`pool = \"device\"` cannot be used with `coefs`: the given ",
+          "coefficients replace every recording's own.")
+  }
   if (missing(outdir) || !is.character(outdir) || length(outdir) != 1 ||
       is.na(outdir) || !nzchar(outdir)) {
     abort("`outdir` must be a directory path for the results.")
@@ -145,6 +163,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   ids <- cohort$id
   # GGIR's coefficient file keys its rows by file name
   if (method == "ggir") check_ggir_names(paths, ids)
+  given <- if (!is.null(coefs)) given_coefs(coefs, ids)
   check_flag(resume, "resume")
   args <- list(...)
   if (length(args) && (is.null(names(args)) || any(!nzchar(names(args))))) {
@@ -200,9 +219,20 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
     tab <- pooled$tab
     fits <- pooled$fits
   }
+  if (!is.null(given)) {
+    for (i in seq_along(ids)) {
+      if (is.null(fits[[i]])) next  # failed: nothing to apply them to
+      g <- with_given(fits[[i]], given[i, , drop = FALSE])
+      row <- cohort_row(paths[i], ids[i], g, NULL, character(0),
+                        tab$seconds[i], method)
+      row$warnings <- tab$warnings[i]
+      tab[i, ] <- row
+      fits[[i]] <- g
+    }
+  }
   write_owned(csv_bytes(tab), outputs[1], store)
   if (method == "ggir") {
-    ok <- tab$status %in% c("ok", "high_error") &
+    ok <- tab$status %in% c("ok", "high_error", "given") &
       !vapply(fits, is.null, TRUE)
     coefs <- if (any(ok)) {
       ggir_coef_table(stats::setNames(fits[ok], basename(paths[ok])))

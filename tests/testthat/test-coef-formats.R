@@ -342,3 +342,64 @@ test_that("compare_coefs() gives the differences, z values and mapping differenc
   expect_output(print(cmp), "1 only in `b`")
   expect_error(compare_coefs(list(p02 = fit), moved), "no recording in common")
 })
+
+test_that("calibrate_files(coefs = ) applies another tool's coefficients to each recording", {
+  d <- snap_dir("coefs-cohort")
+  raw <- file.path(d, "raw")
+  dir.create(raw)
+  for (i in 1:2) {
+    rec <- simulate_recording(hours = 30, sf = 10, seed = 40 + i,
+                              tempoffset = c(0.002, -0.001, 0.001))
+    saveRDS(rec, file.path(raw, sprintf("p%02d.rds", i)))
+  }
+  own <- calibrate_files(raw, method = "ggir", outdir = file.path(d, "own"),
+                         sf = 10)
+  expect_true(all(own$status %in% c("ok", "high_error")))
+  # another tool's coefficients for both: p01's own fit through actipy's
+  # form, and for p02 a hand-made set (files named after the recordings)
+  fits <- attr(own, "fits")
+  write_coefs(list(p01 = fits[[1]]), file.path(d, "p01.json"), "actipy")
+  writeLines('{"CalibxIntercept": 0.02, "CalibyIntercept": -0.01, "CalibzIntercept": 0.005, "CalibxSlope": 1.01, "CalibySlope": 0.99, "CalibzSlope": 1.002}',
+             file.path(d, "p02.json"))
+  cf <- read_coefs(file.path(d, c("p01.json", "p02.json")))
+  res <- calibrate_files(raw, method = "ggir", outdir = file.path(d, "given"),
+                         sf = 10, coefs = cf)
+  expect_identical(res$status, c("given", "given"))
+  expect_identical(res$message, paste0(
+    "coefficients of actipy given (p0", 1:2, "), not fitted; the ",
+    "recording's own fit: ", own$status))
+  g <- attr(res, "fits")
+  for (i in 1:2) {
+    rec <- readRDS(file.path(raw, sprintf("p%02d.rds", i)))
+    expect_lt(xyz_max_diff(apply_calibration(rec, g[[i]]),
+                           apply_calibration(rec, cf[i, ])), 1e-12)
+  }
+  # p01: the same calibration as its own, so the same error on its points
+  expect_equal(res$error_after_mg[1], own$error_after_mg[1], tolerance = 1e-9)
+  expect_equal(res$error_before_mg, own$error_before_mg, tolerance = 1e-12)
+  # p02: the error of the hand-made coefficients on p02's own rest points,
+  # restated here from the points and actipy's formula
+  pts <- g[[2]]$points
+  expect_gt(NROW(pts), 10)
+  a <- cbind(0.02 + 1.01 * pts$mean_x, -0.01 + 0.99 * pts$mean_y,
+             0.005 + 1.002 * pts$mean_z)
+  expect_equal(res$error_after_mg[2], err_mg(a), tolerance = 1e-9)
+  expect_identical(res$parameters, c(0L, 0L))
+  expect_true(all(is.na(res$scale.x.se)))
+  expect_equal(res$scale.x, cf$scale.x, tolerance = 1e-15)
+  # GGIR's file holds the given coefficients
+  gg <- read_coefs(file.path(d, "given", "calibration_ggir_coefs.csv"))
+  expect_equal(gg$offset.x, cf$offset.x, tolerance = 1e-14)
+  # bad input
+  expect_error(calibrate_files(raw, method = "ggir",
+                               outdir = file.path(d, "x"), sf = 10,
+                               coefs = cf[1, ]),
+               "`coefs` has no coefficients for 1 recording\\(s\\): \"p02.rds\"")
+  expect_error(calibrate_files(raw, method = "ggir",
+                               outdir = file.path(d, "x"), sf = 10,
+                               coefs = cf, pool = "device"), "`pool")
+  expect_error(calibrate_files(raw, method = "ggir",
+                               outdir = file.path(d, "x"), sf = 10,
+                               coefs = data.frame(file = "p01")),
+               "`coefs` lacks the column")
+})
