@@ -214,20 +214,24 @@ write_coefs <- function(fits, file, format = c("ggir", "actipy", "ukb",
 
 # ---- one row of coefficients ----------------------------------------------
 
+# The start of a message about one recording's coefficients.
+coef_what <- function(arg, file, tool) {
+  paste0("`", arg, "`: the coefficients of \"", file, "\" (", tool, ")")
+}
+
 coefs_row <- function(file, tool, scale, offset, tempoffset, meantemp,
-                      status = NA_character_, se = NULL) {
+                      status = NA_character_, se = NULL, arg = "file") {
   v <- c(scale, offset, tempoffset)
   if (length(scale) != 3 || length(offset) != 3 || length(tempoffset) != 3 ||
       !is.numeric(v) || !all(is.finite(v))) {
-    abort("The coefficients of \"", file, "\" (", tool, ") are not 3 finite ",
+    abort(coef_what(arg, file, tool), " are not 3 finite ",
           "values each for scale, offset and temperature offset.")
   }
   if (any(scale == 0)) {
-    abort("The coefficients of \"", file, "\" (", tool, ") have a zero ",
-          "scale.")
+    abort(coef_what(arg, file, tool), " have a zero scale.")
   }
   if (any(tempoffset != 0) && !isTRUE(is.finite(meantemp))) {
-    abort("The coefficients of \"", file, "\" (", tool, ") have a ",
+    abort(coef_what(arg, file, tool), " have a ",
           "temperature term but no finite mean temperature.")
   }
   out <- data.frame(file = file, tool = tool, status = status,
@@ -240,18 +244,17 @@ coefs_row <- function(file, tool, scale, offset, tempoffset, meantemp,
 
 # intercept + slope v + slopeT (T - m) in gravcal's form.
 from_intercept <- function(file, tool, intercept, slope, slope_t, m = 0,
-                           status = NA_character_) {
+                           status = NA_character_, arg = "file") {
   if (!all(is.finite(c(intercept, slope, slope_t, m))) ||
       length(intercept) != 3 || length(slope) != 3 || length(slope_t) != 3) {
-    abort("The coefficients of \"", file, "\" (", tool, ") are not 3 finite ",
+    abort(coef_what(arg, file, tool), " are not 3 finite ",
           "values each for intercept, slope and temperature slope.")
   }
   if (any(slope == 0)) {
-    abort("The coefficients of \"", file, "\" (", tool, ") have a zero ",
-          "slope.")
+    abort(coef_what(arg, file, tool), " have a zero slope.")
   }
   coefs_row(file, tool, slope, intercept / slope, slope_t,
-            if (any(slope_t != 0)) m else NA_real_, status)
+            if (any(slope_t != 0)) m else NA_real_, status, arg = arg)
 }
 
 # gravcal's form to intercept + slope v + slopeT T (uncentred).
@@ -306,12 +309,13 @@ as_coefs <- function(x, arg) {
       uses <- any(f$tempoffset != 0)
       coefs_row(nms[i], "gravcal", diag(K), f$offset, f$tempoffset,
                 if (uses) f$meantemp else NA_real_,
-                if (identical(f$status, "ok")) "ok" else f$status, se)
+                if (identical(f$status, "ok")) "ok" else f$status, se,
+                arg = arg)
     } else if (is_ggir_result(f)) {
       to <- if (length(f$tempoffset)) f$tempoffset else c(0, 0, 0)
       mt <- if (length(f$meantempcal)) f$meantempcal[1] else NA_real_
       coefs_row(nms[i], "ggir", f$scale, f$offset, to,
-                if (any(to != 0)) mt else NA_real_)
+                if (any(to != 0)) mt else NA_real_, arg = arg)
     } else {
       abort("`", arg, "`: element \"", nms[i], "\" is not a gravcal_fit ",
             "or a g.calibrate() result but ", describe(f), ".")
@@ -353,6 +357,8 @@ coefs_from_frame <- function(x, arg) {
     v <- vapply(coef_names(), function(n) as.double(x[[n]][i]), 0)
     if (!all(is.finite(v))) {
       abort("`", arg, "`: the coefficients of \"", x$file[i], "\" (row ", i,
+            if ("status" %in% names(x)) paste0(", status \"", x$status[i],
+                                               "\""),
             ") are not all finite numbers.")
     }
     to <- v[7:9]
@@ -363,7 +369,8 @@ coefs_from_frame <- function(x, arg) {
               if ("status" %in% names(x)) as.character(x$status[i]) else
                 NA_character_,
               if (has_se) vapply(paste0(coef_names(), ".se"),
-                                 function(n) as.double(x[[n]][i]), 0))
+                                 function(n) as.double(x[[n]][i]), 0),
+              arg = arg)
   })
   out <- rbind_fill(rows)
   if ("source" %in% names(x)) out$source <- x$source
@@ -541,7 +548,8 @@ json_string <- function(text, key) {
 
 # Three values of keys named by axis, e.g. "Calib%sSlope".
 json_axes <- function(text, fmt, f, required = TRUE) {
-  v <- lapply(c("x", "y", "z"), function(a) json_numbers(text, sprintf(fmt, a), f))
+  v <- lapply(c("x", "y", "z"),
+              function(a) json_numbers(text, sprintf(fmt, a), f))
   present <- !vapply(v, is.null, TRUE)
   if (!any(present) && !required) return(NULL)
   if (!all(present)) {
