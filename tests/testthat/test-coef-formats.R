@@ -13,7 +13,9 @@ coef_fixture <- local({
       rec <- simulate_recording(hours = 30, sf = 10, seed = 31,
                                 tempoffset = c(0.003, -0.002, 0.0015))
       fit <- calibrate(rec, sf = 10, method = "ggir")
-      cache <<- list(rec = rec, fit = fit)
+      # and without the temperature term
+      fit_nt <- calibrate(rec, sf = 10, method = "ggir", use_temp = FALSE)
+      cache <<- list(rec = rec, fit = fit, fit_nt = fit_nt)
     }
     cache
   }
@@ -43,7 +45,8 @@ test_that("round trips through every format give the same calibrated samples to 
   ext <- c(ggir = ".csv", actipy = ".json", ukb = "-summary.json",
            omconvert = ".txt", skdh = ".json")
   n <- 0
-  for (fit in list(fx$fit, far_fit(fx$fit))) {
+  expect_true(all(fx$fit_nt$tempoffset == 0))
+  for (fit in list(fx$fit, far_fit(fx$fit), fx$fit_nt)) {
     direct <- apply_calibration(fx$rec, fit)
     # the fit does change the samples, by more than the tolerance
     expect_gt(xyz_max_diff(direct, fx$rec), 1e-3)
@@ -61,7 +64,9 @@ test_that("round trips through every format give the same calibrated samples to 
       }
       # the centred tools keep the mean temperature; the others are 0
       cf <- read_coefs(f, format = fmt)
-      if (fmt %in% c("ggir", "omconvert", "skdh")) {
+      if (all(fit$tempoffset == 0)) {
+        expect_identical(cf$meantemp, NA_real_)
+      } else if (fmt %in% c("ggir", "omconvert", "skdh")) {
         expect_equal(cf$meantemp, fit$meantemp, tolerance = 1e-14)
       } else {
         expect_identical(cf$meantemp, 0)
@@ -73,7 +78,7 @@ test_that("round trips through every format give the same calibrated samples to 
                              direct), 1e-12)
     }
   }
-  expect_identical(n, 20)
+  expect_identical(n, 30)
 })
 
 test_that("a conversion slip would be caught: centring matters by far more than 1e-12 g", {
@@ -387,6 +392,14 @@ test_that("calibrate_files(coefs = ) applies another tool's coefficients to each
   expect_identical(res$parameters, c(0L, 0L))
   expect_true(all(is.na(res$scale.x.se)))
   expect_equal(res$scale.x, cf$scale.x, tolerance = 1e-15)
+  # the cohort's own table against the given coefficients: p01 the same
+  # calibration, p02 another
+  cmp <- compare_coefs(own, cf)
+  expect_identical(cmp$file, c("p01.rds", "p02.rds"))
+  expect_lt(cmp$mapping_mg[1], 1e-9)
+  expect_gt(cmp$mapping_mg[2], 1)
+  expect_lt(cmp$max_abs_z[1], 1e-6)
+  expect_true(is.finite(cmp$max_abs_z[2]))
   # GGIR's file holds the given coefficients
   gg <- read_coefs(file.path(d, "given", "calibration_ggir_coefs.csv"))
   expect_equal(gg$offset.x, cf$offset.x, tolerance = 1e-14)
