@@ -234,10 +234,10 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   if (method == "ggir") {
     ok <- tab$status %in% c("ok", "high_error", "given") &
       !vapply(fits, is.null, TRUE)
-    coefs <- if (any(ok)) {
+    ggir_rows <- if (any(ok)) {
       ggir_coef_table(stats::setNames(fits[ok], basename(paths[ok])))
     } else empty_ggir_coefs()
-    write_owned(csv_bytes(coefs), outputs[2], store)
+    write_owned(csv_bytes(ggir_rows), outputs[2], store)
   } else {
     remove_owned(outputs[2], store)
   }
