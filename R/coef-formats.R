@@ -462,6 +462,11 @@ with_given <- function(fit, r) {
 
 read_text <- function(f) {
   bytes <- readBin(f, "raw", n = file.size(f))
+  # a byte order mark (files saved by some Windows editors)
+  bom <- as.raw(c(0xef, 0xbb, 0xbf))
+  if (length(bytes) >= 3 && identical(bytes[1:3], bom)) {
+    bytes <- bytes[-(1:3)]
+  }
   if (any(bytes == as.raw(0))) {
     abort("`file`: \"", f, "\" is not a text file of coefficients.")
   }
@@ -489,7 +494,8 @@ detect_coef_format <- function(text, f) {
 
 read_ggir_file <- function(f) {
   d <- tryCatch(utils::read.csv(f, stringsAsFactors = FALSE,
-                                check.names = FALSE),
+                                check.names = FALSE,
+                                fileEncoding = "UTF-8-BOM"),
                 error = function(e) abort("`file`: \"", f, "\" cannot be ",
                                           "read as csv (", conditionMessage(e),
                                           ")."))
@@ -609,7 +615,8 @@ read_ukb <- function(text, f) {
 }
 
 read_ukb_files_csv <- function(f) {
-  d <- utils::read.csv(f, stringsAsFactors = FALSE, colClasses = "character")
+  d <- utils::read.csv(f, stringsAsFactors = FALSE, colClasses = "character",
+                       fileEncoding = "UTF-8-BOM")
   miss <- setdiff(c("fileName", "calOffset", "calSlope", "calTemp"), names(d))
   if (length(miss)) {
     abort("`file`: \"", f, "\" is not a UK Biobank files.csv: it lacks the ",

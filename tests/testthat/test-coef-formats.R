@@ -261,6 +261,20 @@ test_that("scikit-digital-health's results written by hand are read, with the me
   expect_equal(c(got$x, got$y, got$z), want, tolerance = 1e-14)
 })
 
+test_that("files saved with a byte order mark are read", {
+  d <- snap_dir("coefs-bom")
+  bom <- as.raw(c(0xef, 0xbb, 0xbf))
+  f <- file.path(d, "p.json")
+  writeBin(c(bom, charToRaw('{"CalibxIntercept": 0.01, "CalibyIntercept": 0, "CalibzIntercept": 0, "CalibxSlope": 1.1, "CalibySlope": 1, "CalibzSlope": 1}')), f)
+  expect_identical(read_coefs(f)$scale.x, 1.1)
+  g <- file.path(d, "g.csv")
+  writeBin(c(bom, charToRaw(paste0(
+    "filename,scale.x,scale.y,scale.z,offset.x,offset.y,offset.z,",
+    "temperature.offset.x,temperature.offset.y,temperature.offset.z,",
+    "meantempcal\na.bin,1.1,1,1,0,0,0,0,0,0,0\n"))), g)
+  expect_identical(read_coefs(g)$scale.x, 1.1)
+})
+
 test_that("bad input is an error naming the argument", {
   fx <- coef_fixture()
   d <- snap_dir("coefs-8")
