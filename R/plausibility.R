@@ -233,9 +233,9 @@ cohort_plausibility <- function(tab) {
       check.names = FALSE)
     refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g",
                        serial[idx[1]], length(use),
-                       paste(format(round(ref[scales], 4), nsmall = 4), collapse = " "),
-                       paste(format(round(ref[paste0("offset.", c("x", "y", "z"))], 4),
-                                    nsmall = 4), collapse = " "))
+                       paste(sprintf("%.4f", ref[scales]), collapse = " "),
+                       paste(sprintf("%.4f", ref[paste0("offset.", c("x", "y", "z"))]),
+                             collapse = " "))
     for (j in seq_along(hist)) {
       i <- hist[j]
       # relative to the device's reference where it has a history of its
