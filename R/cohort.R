@@ -63,7 +63,10 @@
 #' reference: the median of each coefficient over its recordings (those
 #' without a firmware-style attenuation when at least 3 remain), with a
 #' robust spread (the median absolute deviation, scaled to a standard
-#' deviation). A recording's coefficient disagrees with the reference when
+#' deviation; the median of all devices' spreads in the cohort when that
+#' is larger, so that a device whose few recordings happen to agree is not
+#' held to a tighter rule than the cohort's fits show). A recording's
+#' coefficient disagrees with the reference when
 #' it differs by more than 4 times the combined uncertainty (its standard
 #' error, the reference's and the spread). Column `plausibility` says
 #' `"attenuated"` (all three scales changed by one common factor, at least

@@ -33,7 +33,7 @@
 #' left out, to have a history), `z` (a coefficient disagrees with its
 #' device's reference when it differs by more than `z` times the combined
 #' uncertainty: the recording's standard error, the reference's and the
-#' device's robust spread), `attenuation` (the smallest common change of
+#' device's robust spread, or the cohort's when larger), `attenuation` (the smallest common change of
 #' the three scales called a firmware-style attenuation, relative to the
 #' device's reference), `attenuation_absolute` (the same, relative to 1, for
 #' a device without history or whose history shows it) and `agreement` (the
@@ -194,6 +194,8 @@ cohort_plausibility <- function(tab) {
   devices <- list()
   att <- rep(FALSE, n)
   outlier <- rep(FALSE, n)
+  # first, each device's reference; then every recording judged against it
+  hists <- list()
   for (k in unique(key[applied])) {
     idx <- which(key == k & applied)
     hist <- idx[!pooled[idx]]
@@ -203,6 +205,7 @@ cohort_plausibility <- function(tab) {
                             c(0, 0, 0), rules$attenuation_absolute)
     })
     abs_att <- !vapply(abs_note, is.null, NA)
+    if (any(pooled[idx])) add(idx[pooled[idx]], "pooled: not judged against the device's history")
     if (length(hist) < rules$min_recordings) {
       for (j in which(abs_att)) add(hist[j], abs_note[[j]])
       att[hist[abs_att]] <- TRUE
@@ -211,28 +214,45 @@ cohort_plausibility <- function(tab) {
                                  "recording(s) of device %s, %d needed)"),
                           length(hist), serial[idx[1]], rules$min_recordings))
       }
-      if (any(pooled[idx])) add(idx[pooled[idx]], "pooled: not judged against the device's history")
       next
     }
     # the reference: the device's recordings without the attenuation
     # signature when there are enough of them, else all (the whole device
     # shows it)
     use <- if (sum(!abs_att) >= rules$min_recordings) hist[!abs_att] else hist
-    ref <- apply(co[use, , drop = FALSE], 2, stats::median)
-    spread <- apply(co[use, , drop = FALSE], 2, stats::mad)
-    # uncertainty of the median: 1.2533 times that of the mean
-    u_ref <- 1.2533 * apply(se[use, , drop = FALSE], 2, function(v) {
-      v <- v[is.finite(v)]
-      if (length(v)) stats::median(v) else NA_real_
-    }) / sqrt(length(use))
+    hists[[length(hists) + 1]] <- list(
+      serial = serial[idx[1]], hist = hist, use = use, abs_att = abs_att,
+      abs_note = abs_note,
+      ref = apply(co[use, , drop = FALSE], 2, stats::median),
+      spread = apply(co[use, , drop = FALSE], 2, stats::mad),
+      # uncertainty of the median: 1.2533 times that of the mean
+      u_ref = 1.2533 * apply(se[use, , drop = FALSE], 2, function(v) {
+        v <- v[is.finite(v)]
+        if (length(v)) stats::median(v) else NA_real_
+      }) / sqrt(length(use)))
+  }
+  # the spread between a device's recordings: its own, or the median of
+  # all devices' when larger (a device whose few recordings happen to agree
+  # does not set a tighter rule than the cohort shows)
+  cohort_spread <- if (length(hists)) {
+    apply(do.call(rbind, lapply(hists, `[[`, "spread")), 2, stats::median,
+          na.rm = TRUE)
+  }
+  for (h in hists) {
+    ref <- h$ref
+    spread <- pmax(h$spread, cohort_spread, na.rm = TRUE)
+    u_ref <- h$u_ref
+    hist <- h$hist
+    use <- h$use
+    abs_att <- h$abs_att
     devices[[length(devices) + 1]] <- data.frame(
-      serial = serial[idx[1]], recordings = length(hist),
+      serial = h$serial, recordings = length(hist),
       reference_recordings = length(use),
       t(stats::setNames(ref, paste0("ref.", cols))),
       t(stats::setNames(spread, paste0("spread.", cols))),
       check.names = FALSE)
     refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g",
-                       serial[idx[1]], length(use),
+                       h$serial, length(use),
                        paste(sprintf("%.4f", ref[scales]), collapse = " "),
                        paste(sprintf("%.4f", ref[paste0("offset.", c("x", "y", "z"))]),
                              collapse = " "))
@@ -246,7 +266,7 @@ cohort_plausibility <- function(tab) {
                               rules$attenuation)
       }
       if (!is.null(a)) a <- paste0(a, " (", refnote, ")")
-      if (is.null(a) && abs_att[j]) a <- abs_note[[j]]
+      if (is.null(a) && abs_att[j]) a <- h$abs_note[[j]]
       if (!is.null(a)) {
         att[i] <- TRUE
         add(i, a)
@@ -264,7 +284,6 @@ cohort_plausibility <- function(tab) {
                                      z[worst]), collapse = ", "), refnote))
       }
     }
-    if (any(pooled[idx])) add(idx[pooled[idx]], "pooled: not judged against the device's history")
   }
   for (i in which(applied)) {
     if (length(bounds[[i]])) {

@@ -126,6 +126,26 @@ test_that("a clean cohort is not flagged", {
   expect_match(j$tab$plausibility_note[3], "no device history")
 })
 
+test_that("a device's spread is at least the cohort's", {
+  # fits that vary between recordings ten times more than their standard
+  # errors say (as fits of short free-living recordings do): a device whose
+  # first two recordings happen to agree holds its third, as far from them
+  # as the cohort's recordings typically are, to the cohort's spread
+  set.seed(14)
+  rows <- lapply(1:12, function(d) {
+    device_rows(c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02)), 3, 0.005)
+  })
+  p <- c(1.01, 0.99, 1, 0.01, 0.02, -0.01)
+  rows[[1]] <- rbind(p, p + 1e-5, p + c(0, 0, 0, 0.008, 0, 0))
+  tab <- cohort_tab(do.call(rbind, rows), 0.0005, rep(sprintf("S%02d", 1:12), each = 3))
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility[1:3], rep("ok", 3))
+  expect_gt(j$devices$spread.offset.x[1], 0.002)
+  # alone, its own spread (1e-5) would flag it
+  j1 <- gravcal:::cohort_plausibility(tab[1:3, ])
+  expect_identical(j1$tab$plausibility[1:3], c("ok", "ok", "device_outlier"))
+})
+
 test_that("calibrate_files() flags a firmware-style attenuation; print() shows it", {
   dir <- tempfile("plaus")
   dir.create(dir)
