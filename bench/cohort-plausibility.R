@@ -141,6 +141,42 @@ utils::write.csv(recs[setdiff(names(recs), "note")],
                  file.path(out_dir, "cohort-plausibility.csv"), row.names = FALSE)
 
 fmt <- function(x, d = 2) formatC(x, format = "f", digits = d)
+
+# How much fits of one real device vary between recordings: the agcounts
+# recording (../shared/data; ActiGraph, 30 Hz, 20.7 h free-living) cut
+# into three parts of 6.9 h, each calibrated alone as a "recording" of one
+# device, and judged as calibrate_files() judges a device's history.
+real_split <- function() {
+  dir <- Sys.getenv("GRAVCAL_SHARED_DATA", "../shared/data")
+  f <- file.path(dir, "agcounts", sprintf("calibration%saxis.RData", c("X", "Y", "Z")))
+  if (!all(file.exists(f))) return("(skipped: ../shared/data/agcounts is absent)")
+  e <- new.env()
+  for (x in f) load(x, envir = e)
+  n <- length(e$X)
+  out <- character(0)
+  for (method in c("lightweight", "ggir")) {
+    rows <- lapply(1:3, function(j) {
+      idx <- floor((j - 1) * n / 3) + seq_len(floor(n / 3))
+      fit <- calibrate(data.frame(x = e$X[idx], y = e$Y[idx], z = e$Z[idx]),
+                       sf = 30, method = method)
+      r <- gravcal:::cohort_row("agcounts", sprintf("part%d", j), fit, NULL, "", 0, method)
+      r$serial <- "agcounts"
+      r
+    })
+    j <- gravcal:::cohort_plausibility(do.call(rbind, rows))$tab
+    out <- c(out, sprintf("- %s, part %d: status %s, scales %s %s %s (se %s), offsets %s %s %s g (se %s), plausibility %s",
+                          method, 1:3, j$status, fmt(j$scale.x, 4), fmt(j$scale.y, 4), fmt(j$scale.z, 4),
+                          fmt(j$scale.x.se, 4), fmt(j$offset.x, 4), fmt(j$offset.y, 4),
+                          fmt(j$offset.z, 4), fmt(j$offset.x.se, 4), j$plausibility))
+  }
+  c(paste0("The agcounts recording (ActiGraph, 30 Hz, 20.7 h free-living, ../shared/data) cut ",
+           "into three parts of 6.9 h, each calibrated alone and judged as three recordings ",
+           "of one device (one device: no cohort spread to lean on):"), "", out, "",
+          paste0("Fits of short real recordings of one device differ by more than their ",
+                 "standard errors say; a device with only such recordings can be flagged ",
+                 "`device_outlier` without a fault (in a cohort, the median of the devices' ",
+                 "spreads guards against this when its fits vary alike)."))
+}
 md <- c(
   "# Plausibility of every fit in a simulated cohort",
   "",
@@ -230,6 +266,10 @@ md <- c(
       if (any(!fl & faulty)) paste0("Faulty, not flagged: ", paste(sprintf(
         "%s (%s)", recs$file[!fl & faulty], pl[!fl & faulty]), collapse = "; "), "."))
   }),
+  "",
+  "## A real recording split in three",
+  "",
+  real_split(),
   "",
   "## Device references (GGIR method)",
   "",
