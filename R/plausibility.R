@@ -170,7 +170,6 @@ cohort_plausibility <- function(tab) {
   flag <- rep(NA_character_, n)
   note <- rep("", n)
   add <- function(i, s) note[i] <<- ifelse(nzchar(note[i]), paste0(note[i], "; ", s), s)
-  groups <- c("scale", "cross", "offset", "temperature.offset")
   cols <- c(paste0("scale.", c("x", "y", "z")), paste0("cross.", c("xy", "xz", "yz")),
             paste0("offset.", c("x", "y", "z")),
             paste0("temperature.offset.", c("x", "y", "z")))
