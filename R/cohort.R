@@ -56,6 +56,33 @@
 #' name alone, so `method = "ggir"` refuses, before any work, two
 #' recordings with the same file name in different folders.
 #'
+#' **Plausibility.** Every calibrated recording is judged against the
+#' bounds of [plausible_bounds()] and against its device's other recordings
+#' (by the `serial` column; pooled rows are not part of a device's
+#' history). A device with at least 3 calibrated recordings has a
+#' reference: the median of each coefficient over its recordings (those
+#' without a firmware-style attenuation when at least 3 remain), with a
+#' robust spread (the median absolute deviation, scaled to a standard
+#' deviation; the median of all devices' spreads in the cohort when that
+#' is larger, so that a device whose few recordings happen to agree is not
+#' held to a tighter rule than the cohort's fits show). A recording's
+#' coefficient disagrees with the reference when
+#' it differs by more than 4 times the combined uncertainty (its standard
+#' error, the reference's and the spread). Column `plausibility` says
+#' `"attenuated"` (all three scales changed by one common factor, at least
+#' 0.02 from the device's reference or 0.03 from 1, beyond their uncertainty:
+#' what a firmware fault that attenuates the raw signal does, as in
+#' ActiGraph's notice 16CPAN03), `"out_of_bounds"` (beyond omconvert's
+#' bounds, or not applied because beyond gravcal's), `"device_outlier"`
+#' (disagrees with its device's reference) or `"ok"`, in that order of
+#' precedence; `NA` for a recording not calibrated. `plausibility_note`
+#' says why, with the device's reference values. The devices' references
+#' are in `attr(, "devices")` (one row per device with a history: `serial`,
+#' `recordings`, `reference_recordings`, `ref.<coefficient>`,
+#' `spread.<coefficient>`), and each fit in `attr(, "fits")` carries its
+#' flag (`fit$plausibility`), which `print()` shows. GGIR's coefficient file
+#' is unchanged.
+#'
 #' @param files Paths of recordings (formats as [calibrate()] reads), or
 #'   one directory, whose recordings are all taken.
 #' @param method `"ggir"` (default) or `"lightweight"`; see [calibrate()].
@@ -120,7 +147,8 @@
 #'   calibrated) and `points` (calibration points used); `meantempcal`;
 #'   `error_before_mg`, `error_after_mg` (on the rest points used); `format`,
 #'   `serial` (the device's serial number from the file's header, NA
-#'   where there is none), `pooled` (see `pool`), `hours` (of samples read), `windows`,
+#'   where there is none), `pooled` (see `pool`), `plausibility` and
+#'   `plausibility_note` (see Plausibility above), `hours` (of samples read), `windows`,
 #'   `rest_windows`; what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
 #'   not use: damaged blocks, pages, records or lines), `gaps` and
@@ -230,6 +258,15 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
       fits[[i]] <- g
     }
   }
+  # each fit judged against the bounds and its device's other recordings
+  judged <- cohort_plausibility(tab)
+  tab <- place_plausibility(judged$tab)
+  for (i in seq_along(fits)) {
+    if (!is.null(fits[[i]])) {
+      fits[[i]]$plausibility <- list(flag = tab$plausibility[i],
+                                     note = tab$plausibility_note[i])
+    }
+  }
   write_owned(csv_bytes(tab), outputs[1], store)
   if (method == "ggir") {
     ok <- tab$status %in% c("ok", "high_error", "given") &
@@ -242,7 +279,16 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
     remove_owned(outputs[2], store)
   }
   attr(tab, "fits") <- fits
+  attr(tab, "devices") <- judged$devices
   tab
+}
+
+# The plausibility columns right after `pooled`.
+place_plausibility <- function(tab) {
+  pl <- c("plausibility", "plausibility_note")
+  rest <- setdiff(names(tab), pl)
+  at <- match("pooled", rest)
+  tab[c(rest[seq_len(at)], pl, rest[-seq_len(at)])]
 }
 
 # The recordings of a cohort: list(path, id). `path`: absolute, so that

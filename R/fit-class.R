@@ -2,13 +2,8 @@
 # constructor, the guards every fit passes, and its methods (coef, print,
 # summary).
 
-# Plausible coefficient ranges, far wider than the correction factors van
-# Hees et al. (2014, Table 2; vignette("vanhees2014")) report for the
-# devices of four cohorts (mean gain 0.990-1.005 with SD up to 0.014, mean
-# offset -0.012 to 0.105 g with SD up to 0.037 g, mean temperature offset
-# up to 0.004 g per degree C), so that only coefficients no real sensor
-# needs are refused.
-plausible <- list(scale = c(0.7, 1.3), cross = 0.2, offset = 0.6, temp = 0.05)
+# The plausible coefficient ranges (`plausible`, the refusal bounds of
+# plausible_bounds()) are in plausibility.R.
 
 # A fit that does not lower the error or whose coefficients are implausible
 # is not applied: identity coefficients and a status that says why.
@@ -129,6 +124,14 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
   cat("<gravcal_fit> ", x$method, " method, status: ", x$status, "\n",
       sep = "")
   if (nzchar(x$message)) cat("  ", x$message, "\n", sep = "")
+  # the plausibility flag (calibrate_files()'s, with the device's history,
+  # or the bounds of plausible_bounds() alone), when it is not "ok"
+  pl <- if (is.null(x$plausibility)) fit_plausibility(x) else x$plausibility
+  if (!is.null(pl) && !is.na(pl$flag) && pl$flag != "ok" &&
+      x$status %in% c("ok", "high_error")) {
+    cat("  plausibility: ", pl$flag, if (nzchar(pl$note)) paste0(" - ", pl$note),
+        "\n", sep = "")
+  }
   inp <- format_input(x$input)
   if (!is.null(inp)) cat("  input: ", inp, "\n", sep = "")
   np <- if (is.null(x$points)) 0L else nrow(x$points)

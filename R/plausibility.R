@@ -1,0 +1,300 @@
+# Plausibility of fits: the one table of coefficient bounds (used by every
+# place that judges plausibility: guard_fit(), the GGIR method's own mode,
+# print() and calibrate_files()), and each device's history in a cohort.
+
+#' Plausible calibration coefficients: the bounds gravcal judges fits by
+#'
+#' One table, used everywhere gravcal judges whether coefficients are
+#' plausible. Two levels per coefficient:
+#'
+#' * `refuse_lower`, `refuse_upper`: beyond these no real sensor needs
+#'   correcting, and gravcal's own modes do not apply the fit (status
+#'   `"implausible"`, identity coefficients; GGIR-compatible mode applies
+#'   whatever GGIR applies). They are far wider than the correction factors
+#'   van Hees et al. (2014, Table 2; `vignette("vanhees2014")`) report for
+#'   the devices of four cohorts (mean gain 0.990-1.005 with SD up to
+#'   0.014, mean offset -0.012 to 0.105 g with SD up to 0.037 g, mean
+#'   temperature offset up to 0.004 g per degree C). The GGIR method's
+#'   own mode checks scale, offset and temperature offset; the lightweight
+#'   method scale, cross-axis terms and offset.
+#' * `flag_lower`, `flag_upper`: the range check of omconvert (Open
+#'   Movement, `omcalibrate.c`: at most 0.2 from 1 for scale, 0.41 g for
+#'   offset, 0.02 g per degree C for temperature offset); a fit beyond them
+#'   is applied but flagged `"out_of_bounds"` in [calibrate_files()]'s
+#'   `plausibility` column and by `print()`. omconvert has no cross-axis
+#'   terms; their flag bound, 0.1, is twice the half-width of the
+#'   non-orthogonalities Farago et al. (2024) simulate ([random_params()]).
+#'   GGIR and actipy check no coefficient, only the error after
+#'   calibration (below 10 mg) and the spread of the rest points.
+#'
+#' The rules [calibrate_files()] uses to judge a recording against its
+#' device's other recordings are in the attribute `"history"`: `min_recordings`
+#' (a device needs at least this many calibrated recordings, pooled ones
+#' left out, to have a history), `z` (a coefficient disagrees with its
+#' device's reference when it differs by more than `z` times the combined
+#' uncertainty: the recording's standard error, the reference's and the
+#' device's robust spread, or the cohort's when larger), `attenuation` (the smallest common change of
+#' the three scales called a firmware-style attenuation, relative to the
+#' device's reference), `attenuation_absolute` (the same, relative to 1, for
+#' a device without history or whose history shows it) and `agreement` (the
+#' three scales changed by the same factor: the smallest change at least
+#' this fraction of the largest, all in one direction).
+#'
+#' @return A data frame, one row per coefficient group (`scale`, `cross`,
+#'   `offset`, `temperature_offset`), with columns `coefficient`, `unit`,
+#'   `flag_lower`, `flag_upper`, `refuse_lower`, `refuse_upper` and
+#'   `source`; attribute `history` (a list, see above).
+#' @references
+#' van Hees VT et al. (2014). Autocalibration of accelerometer data for
+#' free-living physical activity assessment using local gravity and
+#' temperature. J Appl Physiol 117(7), 738-744.
+#'
+#' Open Movement omconvert, `omcalibrate.c`, `OmCalibrateConfigInit()`:
+#' <https://github.com/openmovementproject/omconvert>.
+#' @seealso [calibrate_files()] (the `plausibility` column).
+#' @export
+#' @examples
+#' plausible_bounds()
+#' attr(plausible_bounds(), "history")
+plausible_bounds <- function() {
+  b <- data.frame(
+    coefficient = c("scale", "cross", "offset", "temperature_offset"),
+    unit = c("", "", "g", "g per degree C"),
+    flag_lower = c(0.8, -0.1, -0.41, -0.02),
+    flag_upper = c(1.2, 0.1, 0.41, 0.02),
+    refuse_lower = c(0.7, -0.2, -0.6, -0.05),
+    refuse_upper = c(1.3, 0.2, 0.6, 0.05),
+    source = c(
+      "flag: omconvert (|scale - 1| <= 0.2); refuse: gravcal, far beyond van Hees et al. (2014) Table 2",
+      "flag: gravcal, twice Farago et al. (2024)'s simulated range; refuse: gravcal",
+      "flag: omconvert (0.41 g); refuse: gravcal, far beyond van Hees et al. (2014) Table 2",
+      "flag: omconvert (0.02 g per degree C); refuse: gravcal, far beyond van Hees et al. (2014) Table 2"),
+    stringsAsFactors = FALSE)
+  attr(b, "history") <- history_rules
+  b
+}
+
+# The device-history rules (documented in ?plausible_bounds).
+history_rules <- list(min_recordings = 3L, z = 4, attenuation = 0.02,
+                      attenuation_absolute = 0.03, agreement = 0.5)
+
+# The refusal bounds as guard_fit() and the GGIR method's own mode read them.
+plausible <- local({
+  b <- plausible_bounds()
+  r <- function(k) b[b$coefficient == k, c("refuse_lower", "refuse_upper")]
+  list(scale = unlist(r("scale"), use.names = FALSE),
+       cross = r("cross")$refuse_upper, offset = r("offset")$refuse_upper,
+       temp = r("temperature_offset")$refuse_upper)
+})
+
+# Which coefficients (named as in the cohort table) lie beyond the flag
+# bounds: a character vector of "name = value" (empty when none). `co`: a
+# named numeric vector with any of scale.*, cross.*, offset.*,
+# temperature.offset.*.
+beyond_flag_bounds <- function(co) {
+  b <- plausible_bounds()
+  group <- ifelse(startsWith(names(co), "scale."), "scale",
+           ifelse(startsWith(names(co), "cross."), "cross",
+           ifelse(startsWith(names(co), "offset."), "offset",
+                  "temperature_offset")))
+  i <- match(group, b$coefficient)
+  out <- is.finite(co) & (co < b$flag_lower[i] | co > b$flag_upper[i])
+  if (!any(out)) return(character(0))
+  sprintf("%s = %s (bounds %s to %s)", names(co)[out],
+          vapply(signif(co[out], 4), format, ""),
+          b$flag_lower[i][out], b$flag_upper[i][out])
+}
+
+# A fit's coefficients named as in the cohort table (those it applies).
+fit_table_coefs <- function(fit) {
+  cf <- stats::coef(fit)
+  stats::setNames(cf[c(1:3, 4:6, 7:9, 10:12)], c(
+    "scale.x", "scale.y", "scale.z", "cross.xy", "cross.xz", "cross.yz",
+    "offset.x", "offset.y", "offset.z", "temperature.offset.x",
+    "temperature.offset.y", "temperature.offset.z"))
+}
+
+# A fit's plausibility without a device history (print() of a fit that
+# calibrate_files() did not judge): list(flag, note) or NULL when the fit
+# applies no coefficients.
+fit_plausibility <- function(fit) {
+  if (identical(fit$status, "implausible")) {
+    return(list(flag = "out_of_bounds", note = paste0(
+      "coefficients beyond the bounds at which gravcal refuses them ",
+      "(plausible_bounds()); not applied")))
+  }
+  if (!fit$status %in% c("ok", "high_error")) return(NULL)
+  out <- beyond_flag_bounds(fit_table_coefs(fit))
+  if (length(out)) {
+    return(list(flag = "out_of_bounds", note = paste0(
+      "beyond omconvert's bounds (plausible_bounds()): ",
+      paste(out, collapse = ", "))))
+  }
+  a <- attenuation_signature(fit_table_coefs(fit)[1:3], rep(NA_real_, 3),
+                             c(1, 1, 1), c(0, 0, 0),
+                             history_rules$attenuation_absolute)
+  if (!is.null(a)) {
+    return(list(flag = "attenuated", note = a))
+  }
+  list(flag = "ok", note = "")
+}
+
+# Do three scales `s` (standard errors `se`) differ from the reference
+# `ref` (its uncertainty `u_ref`, per axis) by one common factor, as a
+# firmware attenuation of the raw signal would make them (a signal
+# attenuated by a needs scales 1/a)? NULL when not, else a note.
+attenuation_signature <- function(s, se, ref, u_ref, min_change) {
+  if (!all(is.finite(s)) || !all(is.finite(ref))) return(NULL)
+  r <- unname(s / ref)
+  d <- r - 1
+  if (!(all(d > 0) || all(d < 0))) return(NULL)
+  f <- mean(r)
+  if (abs(f - 1) < min_change) return(NULL)
+  if (min(abs(d)) < history_rules$agreement * max(abs(d))) return(NULL)
+  se[!is.finite(se)] <- 0
+  u <- sqrt(unname(se)^2 + unname(u_ref)^2) / unname(ref)
+  if (any(abs(d) <= history_rules$z * u)) return(NULL)
+  sprintf(paste0("all three scales x%.3f (%.3f, %.3f, %.3f) relative to %s: ",
+                 "a raw signal %s by %.1f %%"), f, r[1], r[2], r[3],
+          if (all(ref == 1)) "1" else "the device's reference",
+          if (f > 1) "attenuated" else "amplified", 100 * abs(1 - 1 / f))
+}
+
+# The device-history judgement of a cohort table (calibrate_files()):
+# the table with columns `plausibility` and `plausibility_note`, and the
+# devices' reference values (attribute "devices" of the result). See
+# calibrate_files()'s documentation.
+cohort_plausibility <- function(tab) {
+  rules <- history_rules
+  n <- nrow(tab)
+  flag <- rep(NA_character_, n)
+  note <- rep("", n)
+  add <- function(i, s) note[i] <<- ifelse(nzchar(note[i]), paste0(note[i], "; ", s), s)
+  cols <- c(paste0("scale.", c("x", "y", "z")), paste0("cross.", c("xy", "xz", "yz")),
+            paste0("offset.", c("x", "y", "z")),
+            paste0("temperature.offset.", c("x", "y", "z")))
+  cols <- cols[cols %in% names(tab)]
+  co <- as.matrix(tab[, cols, drop = FALSE])
+  se <- as.matrix(tab[, paste0(cols, ".se"), drop = FALSE])
+  colnames(se) <- cols
+  applied <- tab$status %in% c("ok", "high_error")
+  refused <- tab$status == "implausible"
+  flag[applied] <- "ok"
+  flag[refused] <- "out_of_bounds"
+  note[refused] <- paste0("coefficients beyond the bounds at which gravcal ",
+                          "refuses them (plausible_bounds()); not applied")
+  bounds <- lapply(seq_len(n), function(i) {
+    if (applied[i]) beyond_flag_bounds(co[i, ]) else character(0)
+  })
+  pooled <- applied & tab$pooled %in% TRUE
+  scales <- cols[1:3]
+  serial <- tab$serial
+  key <- ifelse(is.na(serial), paste0("\r", seq_len(n)), serial)
+  devices <- list()
+  att <- rep(FALSE, n)
+  outlier <- rep(FALSE, n)
+  # first, each device's reference; then every recording judged against it
+  hists <- list()
+  for (k in unique(key[applied])) {
+    idx <- which(key == k & applied)
+    hist <- idx[!pooled[idx]]
+    # firmware-style attenuation relative to 1 (no device history needed)
+    abs_note <- lapply(hist, function(i) {
+      attenuation_signature(co[i, scales], se[i, scales], c(1, 1, 1),
+                            c(0, 0, 0), rules$attenuation_absolute)
+    })
+    abs_att <- !vapply(abs_note, is.null, NA)
+    if (any(pooled[idx])) add(idx[pooled[idx]], "pooled: not judged against the device's history")
+    if (length(hist) < rules$min_recordings) {
+      for (j in which(abs_att)) add(hist[j], abs_note[[j]])
+      att[hist[abs_att]] <- TRUE
+      if (!is.na(serial[idx[1]])) {
+        add(hist, sprintf(paste0("no device history (%d calibrated ",
+                                 "recording(s) of device %s, %d needed)"),
+                          length(hist), serial[idx[1]], rules$min_recordings))
+      }
+      next
+    }
+    # the reference: the device's recordings without the attenuation
+    # signature when there are enough of them, else all (the whole device
+    # shows it)
+    use <- if (sum(!abs_att) >= rules$min_recordings) hist[!abs_att] else hist
+    hists[[length(hists) + 1]] <- list(
+      serial = serial[idx[1]], hist = hist, use = use, abs_att = abs_att,
+      abs_note = abs_note,
+      ref = apply(co[use, , drop = FALSE], 2, stats::median),
+      spread = apply(co[use, , drop = FALSE], 2, stats::mad),
+      # uncertainty of the median: 1.2533 times that of the mean
+      u_ref = 1.2533 * apply(se[use, , drop = FALSE], 2, function(v) {
+        v <- v[is.finite(v)]
+        if (length(v)) stats::median(v) else NA_real_
+      }) / sqrt(length(use)))
+  }
+  # the spread between a device's recordings: its own, or the median of
+  # all devices' when larger (a device whose few recordings happen to agree
+  # does not set a tighter rule than the cohort shows)
+  cohort_spread <- if (length(hists)) {
+    apply(do.call(rbind, lapply(hists, `[[`, "spread")), 2, stats::median,
+          na.rm = TRUE)
+  }
+  for (h in hists) {
+    ref <- h$ref
+    spread <- pmax(h$spread, cohort_spread, na.rm = TRUE)
+    u_ref <- h$u_ref
+    hist <- h$hist
+    use <- h$use
+    abs_att <- h$abs_att
+    devices[[length(devices) + 1]] <- data.frame(
+      serial = h$serial, recordings = length(hist),
+      reference_recordings = length(use),
+      t(stats::setNames(ref, paste0("ref.", cols))),
+      t(stats::setNames(spread, paste0("spread.", cols))),
+      check.names = FALSE)
+    refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g",
+                       h$serial, length(use),
+                       paste(sprintf("%.4f", ref[scales]), collapse = " "),
+                       paste(sprintf("%.4f", ref[paste0("offset.", c("x", "y", "z"))]),
+                             collapse = " "))
+    for (j in seq_along(hist)) {
+      i <- hist[j]
+      # relative to the device's reference where it has a history of its
+      # own, else (the whole device shows it) relative to 1
+      a <- if (length(use) < length(hist) || !any(abs_att)) {
+        attenuation_signature(co[i, scales], se[i, scales], ref[scales],
+                              sqrt(u_ref[scales]^2 + spread[scales]^2),
+                              rules$attenuation)
+      }
+      if (!is.null(a)) a <- paste0(a, " (", refnote, ")")
+      if (is.null(a) && abs_att[j]) a <- h$abs_note[[j]]
+      if (!is.null(a)) {
+        att[i] <- TRUE
+        add(i, a)
+        next
+      }
+      u <- sqrt(se[i, ]^2 + u_ref^2 + spread^2)
+      z <- (co[i, ] - ref) / u
+      z <- z[is.finite(z)]
+      if (any(abs(z) > rules$z)) {
+        outlier[i] <- TRUE
+        worst <- order(-abs(z))[seq_len(min(3, sum(abs(z) > rules$z)))]
+        add(i, sprintf("disagrees with its device's other recordings: %s (%s)",
+                       paste(sprintf("%s %s (z = %.1f)", names(z)[worst],
+                                     format(signif(co[i, names(z)[worst]], 4)),
+                                     z[worst]), collapse = ", "), refnote))
+      }
+    }
+  }
+  for (i in which(applied)) {
+    if (length(bounds[[i]])) {
+      add(i, paste0("beyond omconvert's bounds (plausible_bounds()): ",
+                    paste(bounds[[i]], collapse = ", ")))
+    }
+  }
+  flag[outlier] <- "device_outlier"
+  flag[applied & lengths(bounds) > 0] <- "out_of_bounds"
+  flag[att] <- "attenuated"
+  tab$plausibility <- flag
+  tab$plausibility_note <- note
+  devs <- if (length(devices)) do.call(rbind, devices) else NULL
+  list(tab = tab, devices = devs)
+}

@@ -1,0 +1,187 @@
+# Plausibility of every fit (issue 31, item 1): the bounds table, and each
+# device's history in calibrate_files().
+
+# A cohort table as calibrate_files() makes it (the columns the judgement
+# reads): `co` a matrix of scale.x..offset.z (one row per recording), `se`
+# the standard errors (one number or a matrix).
+cohort_tab <- function(co, se, serial, status = "ok", pooled = FALSE) {
+  cols <- c("scale.x", "scale.y", "scale.z", "offset.x", "offset.y", "offset.z")
+  co <- matrix(co, ncol = 6, dimnames = list(NULL, cols))
+  se <- matrix(se, nrow(co), 6, dimnames = list(NULL, paste0(cols, ".se")))
+  data.frame(file = sprintf("r%02d.cwa", seq_len(nrow(co))),
+             status = rep_len(status, nrow(co)), co, se,
+             serial = serial, pooled = rep_len(pooled, nrow(co)),
+             stringsAsFactors = FALSE, check.names = FALSE)
+}
+
+# n recordings of a device with true coefficients p (6), each estimated
+# with standard error se.
+device_rows <- function(p, n, se) {
+  t(replicate(n, p + stats::rnorm(6, sd = se)))
+}
+
+test_that("plausible_bounds() is the one table the guards read", {
+  b <- plausible_bounds()
+  expect_identical(b$coefficient, c("scale", "cross", "offset", "temperature_offset"))
+  # omconvert's range check (omcalibrate.c): |scale - 1| <= 0.2,
+  # offset <= 0.41 g, temperature offset <= 0.02 g per degree C
+  expect_equal(b$flag_upper[c(1, 3, 4)], c(1.2, 0.41, 0.02))
+  expect_true(all(b$flag_lower <= b$flag_upper & b$refuse_lower <= b$flag_lower &
+                    b$flag_upper <= b$refuse_upper))
+  # the refusal bounds guard_fit() and the GGIR method's own mode apply
+  expect_equal(gravcal:::plausible$scale, unlist(b[1, c("refuse_lower", "refuse_upper")],
+                                                  use.names = FALSE))
+  expect_equal(gravcal:::plausible$offset, b$refuse_upper[3])
+  expect_equal(gravcal:::plausible$temp, b$refuse_upper[4])
+  expect_true(gravcal:::ggir_plausible(c(b$refuse_upper[1] - 0.01, 1, 1), c(0, 0, 0), NULL))
+  expect_false(gravcal:::ggir_plausible(c(b$refuse_upper[1] + 0.01, 1, 1), c(0, 0, 0), NULL))
+  # between the two levels: applied, but flagged
+  co <- c(scale.x = 1.25, scale.y = 1, scale.z = 1, offset.x = 0, offset.y = -0.45,
+          offset.z = 0.1)
+  out <- gravcal:::beyond_flag_bounds(co)
+  expect_length(out, 2)
+  expect_match(out[1], "^scale.x = 1.25")
+  expect_match(out[2], "^offset.y = -0.45")
+  expect_length(gravcal:::beyond_flag_bounds(c(scale.x = 1.19, offset.z = 0.4)), 0)
+  h <- attr(b, "history")
+  expect_true(all(c("min_recordings", "z", "attenuation", "attenuation_absolute",
+                    "agreement") %in% names(h)))
+})
+
+test_that("a recording that disagrees with its device's others is a device outlier", {
+  set.seed(11)
+  p <- c(1.01, 0.99, 1.005, 0.02, -0.01, 0.015)
+  co <- device_rows(p, 5, 0.001)
+  co[3, 4] <- co[3, 4] + 0.02  # offset.x moved by 20 SE
+  j <- gravcal:::cohort_plausibility(cohort_tab(co, 0.001, "1234"))
+  expect_identical(j$tab$plausibility, c("ok", "ok", "device_outlier", "ok", "ok"))
+  expect_match(j$tab$plausibility_note[3], "offset.x")
+  expect_match(j$tab$plausibility_note[3], "device 1234 reference")
+  # the device's reference: the median, which the outlier does not move
+  expect_identical(j$devices$serial, "1234")
+  expect_equal(j$devices$recordings, 5)
+  expect_equal(j$devices$ref.offset.x, stats::median(co[, 4]))
+  expect_lt(abs(j$devices$ref.offset.x - p[4]), 0.003)
+  # within its uncertainty it is not: the same shift with standard errors
+  # of 0.01
+  co2 <- device_rows(p, 5, 0.001)
+  co2[3, 4] <- co2[3, 4] + 0.02
+  j2 <- gravcal:::cohort_plausibility(cohort_tab(co2, 0.01, "1234"))
+  expect_identical(j2$tab$plausibility, rep("ok", 5))
+})
+
+test_that("scales changed by one common factor are an attenuation", {
+  set.seed(12)
+  p <- c(0.985, 1.01, 0.995, 0.02, -0.01, 0.015)
+  co <- device_rows(p, 4, 0.001)
+  # the raw signal attenuated by 5 % on one recording: scales / 0.95
+  co[2, 1:3] <- co[2, 1:3] / 0.95
+  j <- gravcal:::cohort_plausibility(cohort_tab(co, 0.001, "77"))
+  expect_identical(j$tab$plausibility, c("ok", "attenuated", "ok", "ok"))
+  expect_match(j$tab$plausibility_note[2], "relative to the device's reference")
+  expect_match(j$tab$plausibility_note[2], "attenuated by (4[.]9|5[.]0|5[.]1) %")
+  # one axis alone moved by as much is not an attenuation, but an outlier
+  co3 <- device_rows(p, 4, 0.001)
+  co3[2, 1] <- co3[2, 1] / 0.95
+  j3 <- gravcal:::cohort_plausibility(cohort_tab(co3, 0.001, "77"))
+  expect_identical(j3$tab$plausibility, c("ok", "device_outlier", "ok", "ok"))
+  # a whole device attenuated, without a history (two recordings) or with
+  # one (three): relative to 1
+  for (n in 2:3) {
+    co4 <- device_rows(c(1, 1, 1, 0.01, 0, -0.01), n, 0.001)
+    co4[, 1:3] <- co4[, 1:3] / 0.93
+    j4 <- gravcal:::cohort_plausibility(cohort_tab(co4, 0.001, "88"))
+    expect_identical(j4$tab$plausibility, rep("attenuated", n))
+    expect_match(j4$tab$plausibility_note, "relative to 1")
+  }
+  # a device without a serial number: judged alone, relative to 1
+  co5 <- rbind(c(1.08, 1.07, 1.075, 0, 0, 0), c(1.01, 0.99, 1, 0, 0, 0))
+  j5 <- gravcal:::cohort_plausibility(cohort_tab(co5, 0.001, NA_character_))
+  expect_identical(j5$tab$plausibility, c("attenuated", "ok"))
+  expect_null(j5$devices)
+})
+
+test_that("a clean cohort is not flagged", {
+  set.seed(13)
+  # 30 devices, 3 to 5 recordings each, gains and offsets as van Hees et al.
+  # (2014, Table 2) report across devices (SD 0.01 and 0.02 g)
+  rows <- lapply(1:30, function(d) {
+    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02))
+    n <- 3 + d %% 3
+    list(co = device_rows(p, n, 0.002), serial = rep(sprintf("S%02d", d), n))
+  })
+  tab <- cohort_tab(do.call(rbind, lapply(rows, `[[`, "co")), 0.002,
+                    unlist(lapply(rows, `[[`, "serial")))
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(unique(j$tab$plausibility), "ok")
+  expect_equal(nrow(j$devices), 30)
+  # recordings not calibrated are not judged; pooled ones are not part of
+  # the history
+  tab$status[1] <- "no_rest"
+  tab$status[2] <- "implausible"
+  tab$pooled[4] <- TRUE
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility[1:4], c(NA, "out_of_bounds", "ok", "ok"))
+  expect_match(j$tab$plausibility_note[4], "pooled")
+  expect_match(j$tab$plausibility_note[3], "no device history")
+})
+
+test_that("a device's spread is at least the cohort's", {
+  # fits that vary between recordings ten times more than their standard
+  # errors say (as fits of short free-living recordings do): a device whose
+  # first two recordings happen to agree holds its third, as far from them
+  # as the cohort's recordings typically are, to the cohort's spread
+  set.seed(14)
+  rows <- lapply(1:12, function(d) {
+    device_rows(c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02)), 3, 0.005)
+  })
+  p <- c(1.01, 0.99, 1, 0.01, 0.02, -0.01)
+  rows[[1]] <- rbind(p, p + 1e-5, p + c(0, 0, 0, 0.008, 0, 0))
+  tab <- cohort_tab(do.call(rbind, rows), 0.0005, rep(sprintf("S%02d", 1:12), each = 3))
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility[1:3], rep("ok", 3))
+  expect_gt(j$devices$spread.offset.x[1], 0.002)
+  # alone, its own spread (1e-5) would flag it
+  j1 <- gravcal:::cohort_plausibility(tab[1:3, ])
+  expect_identical(j1$tab$plausibility[1:3], c("ok", "ok", "device_outlier"))
+})
+
+test_that("calibrate_files() flags a firmware-style attenuation; print() shows it", {
+  dir <- tempfile("plaus")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  p <- c(1.01, 0.99, 1.005, 0, 0, 0, 0.02, -0.015, 0.01)
+  for (k in 1:3) {
+    rec <- simulate_recording(hours = 12, sf = 12.5, params = p, seed = k)
+    v <- as.matrix(rec[, c("x", "y", "z")])
+    if (k == 2) v <- round(v * 0.93 * 256) / 256  # the raw signal attenuated by 7 %
+    gravcal:::write_cwa(v, file.path(dir, sprintf("r%d.cwa", k)), sf = 12.5,
+                        packed = FALSE, temperature = rec$temperature,
+                        device_id = 4321)
+  }
+  res <- calibrate_files(dir, method = "lightweight", outdir = file.path(dir, "out"))
+  expect_identical(res$serial, rep("4321", 3))
+  expect_identical(res$status, rep("ok", 3))
+  expect_identical(res$plausibility, c("ok", "attenuated", "ok"))
+  expect_identical(names(res)[match("pooled", names(res)) + 1:2],
+                   c("plausibility", "plausibility_note"))
+  expect_equal(attr(res, "devices")$serial, "4321")
+  # the attenuated recording's scales: 1 / 0.93 times the others'
+  expect_equal(res$scale.x[2] / res$scale.x[1], 1 / 0.93, tolerance = 0.01)
+  fit <- attr(res, "fits")[[2]]
+  expect_identical(fit$plausibility$flag, "attenuated")
+  expect_output(print(fit), "plausibility: attenuated")
+  expect_false(any(grepl("plausibility", capture.output(print(attr(res, "fits")[[1]])))))
+  # the table written holds the flags
+  csv <- utils::read.csv(file.path(dir, "out", "calibration.csv"), stringsAsFactors = FALSE)
+  expect_identical(csv$plausibility, res$plausibility)
+})
+
+test_that("print() of a fit beyond omconvert's bounds says so", {
+  set.seed(5)
+  p <- c(1.24, 1.0, 0.98, 0, 0, 0, 0.02, 0.01, -0.01)
+  rec <- simulate_recording(hours = 12, sf = 10, params = p, seed = 3)
+  fit <- calibrate(rec, sf = 10, method = "lightweight")
+  expect_identical(fit$status, "ok")
+  expect_output(print(fit), "plausibility: out_of_bounds - beyond omconvert's bounds")
+})
