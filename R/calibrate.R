@@ -212,9 +212,12 @@
 #'    after every block once it has `minloadcrit` hours, so a recording that
 #'    never reaches the error target costs time that grows with its square.
 #'    gravcal decides whether to read on with a fit that stops as GGIR's
-#'    does (a few iterations), refits only once the window table has grown
-#'    by a quarter, and fits to convergence for the result it returns; it
-#'    may therefore read up to a quarter more than GGIR before it stops.
+#'    does (a few iterations, started from the previous decision's
+#'    coefficients), refits only once the window table has grown by a
+#'    quarter, and fits to convergence (accelerated, see [fit_icp()]) for
+#'    the result it returns; it may therefore read up to a quarter more
+#'    than GGIR before it stops. Twice the recording takes about twice the
+#'    time (`bench/results/ggir-own-scaling.md`).
 #'
 #' Window statistics in compatible mode are computed in GGIR's arithmetic
 #' (R's `cumsum()` and `sd()`, bit for bit) so that its exact-equality rules

@@ -16,7 +16,10 @@
 #' relative to it), `--rmc LIST` (ad hoc
 #' csv files: GGIR's `rmc.*` parameters as R arguments, `'rmc.firstrow.acc
 #' = 2, rmc.sf = 50'`, or an `.rds` file of their list; see
-#' [rest_windows()]), `--no-resume` (redo
+#' [rest_windows()]), `--coefs FILE[,FILE...]` (apply the coefficients in
+#' these files, another tool's or an earlier run's, instead of fitting each
+#' recording's own; read by [read_coefs()], whose format is recognised; see
+#' `coefs` in [calibrate_files()]), `--no-resume` (redo
 #' recordings already done), `--help`. The other arguments are the
 #' recordings (or one directory).
 #'
@@ -74,6 +77,9 @@ cli_help <- function() {
     "  --rmc LIST       ad hoc csv files: GGIR's rmc.* parameters, as R arguments",
     "                   ('rmc.firstrow.acc = 2, rmc.unit.acc = \"mg\", rmc.sf = 50')",
     "                   or an .rds file holding their list",
+    "  --coefs FILES    apply the coefficients in these files (comma-separated;",
+    "                   GGIR, actipy, UK Biobank, omconvert or skdh: see read_coefs())",
+    "                   instead of fitting each recording's own",
     "  --no-resume      redo recordings already done in DIR",
     "  --help           this text",
     "",
@@ -106,10 +112,16 @@ cli_run <- function(args) {
     on.exit(future::plan(old), add = TRUE)
   }
   if (opt$recursive) extra$recursive <- TRUE
+  if (!is.null(opt$coefs)) {
+    paths <- trimws(strsplit(opt$coefs, ",", fixed = TRUE)[[1]])
+    extra$coefs <- tryCatch(read_coefs(paths[nzchar(paths)]), error = function(e) {
+      abort("`--coefs`: ", conditionMessage(e))
+    })
+  }
   tab <- do.call(calibrate_files, c(list(files = opt$files, method = opt$method,
                                          outdir = opt$out, resume = opt$resume),
                                     extra))
-  done <- tab$status %in% c("ok", "high_error")
+  done <- tab$status %in% c("ok", "high_error", "given")
   failed <- tab$status == "failed"
   message(sprintf(paste0("gravcal: %d recording(s): %d calibrated, %d not ",
                          "calibrated, %d failed; results in %s"),
@@ -138,7 +150,8 @@ cli_parse <- function(args) {
   opt <- list(method = "ggir", resume = TRUE, recursive = FALSE)
   files <- character(0)
   given <- character(0)
-  takes <- c("--method", "--out", "--workers", "--sf", "--pattern", "--rmc")
+  takes <- c("--method", "--out", "--workers", "--sf", "--pattern", "--rmc",
+             "--coefs")
   i <- 1
   while (i <= length(args)) {
     a <- args[i]

@@ -15,7 +15,14 @@
 #' * `ggir_compat = FALSE` (default): convergence. It stops when no
 #'   parameter moves by more than `tol` in an iteration (the temperature
 #'   offset is measured over the range of temperatures), which typically
-#'   removes about 1 mg of offset error that GGIR's rule leaves.
+#'   removes about 1 mg of offset error that GGIR's rule leaves. The
+#'   fixed point is GGIR's, reached faster: each iteration takes its
+#'   weights at the current coefficients (GGIR takes those of the iteration
+#'   before; the fixed points are the same, the minima of a Huber loss of
+#'   the distance to the sphere), and the iterations are accelerated by
+#'   SQUAREM (Varadhan and Roland 2008) with that loss as the check of each
+#'   step, so a fit needs tens of passes over the windows where GGIR's
+#'   iteration needs hundreds. `iterations` counts those passes.
 #'
 #' When the windows' temperature does not vary (or is missing) the
 #' temperature term is left out and `tempoffset` is 0, with a message in the

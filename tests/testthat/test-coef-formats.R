@@ -417,6 +417,17 @@ test_that("calibrate_files(coefs = ) applies another tool's coefficients to each
   # GGIR's file holds the given coefficients
   gg <- read_coefs(file.path(d, "given", "calibration_ggir_coefs.csv"))
   expect_equal(gg$offset.x, cf$offset.x, tolerance = 1e-14)
+  # the command line takes the same files: the same table
+  cli <- suppressMessages(calibrate_cli(c(
+    "--method", "ggir", "--out", file.path(d, "cli"), "--sf", "10", "--coefs",
+    paste(file.path(d, c("p01.json", "p02.json")), collapse = ","), raw),
+    quit = FALSE))
+  expect_identical(cli$status, res$status)
+  expect_identical(cli[c("scale.x", "offset.y", "error_after_mg")],
+                   res[c("scale.x", "offset.y", "error_after_mg")])
+  expect_error(calibrate_cli(c("--out", file.path(d, "cli2"), "--coefs",
+                               file.path(d, "none.json"), raw), quit = FALSE),
+               "`--coefs`: `file`: .*none.json.* is not a file")
   # bad input
   expect_error(calibrate_files(raw, method = "ggir",
                                outdir = file.path(d, "x"), sf = 10,

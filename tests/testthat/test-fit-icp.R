@@ -37,6 +37,48 @@ test_that("gravcal's own stopping rule converges past GGIR's", {
   expect_equal(nrow(own$trace), own$iterations)
 })
 
+test_that("the accelerated converged fit reaches the fixed point of GGIR's own iteration", {
+  # GGIR's iteration written out here in R (weights of the iteration before,
+  # as GGIR's g.calibrate() takes them), run until it no longer moves, on
+  # windows with cross-axis errors that its model cannot remove, so that it
+  # converges slowly; gravcal's accelerated fit must land on its fixed point
+  set.seed(11)
+  p <- random_params(scale = 0.05, misalignment = 0.25, offset = 0.05)
+  rec <- simulate_recording(hours = 40, sf = 2, params = p, seed = 11,
+                            noise = 0.01, tempoffset = c(0.002, -0.001, 0.001))
+  w <- rest_windows(rec, sf = 2, method = "ggir")
+  w <- w[w$rest, ]
+  v <- as.matrix(w[c("mean_x", "mean_y", "mean_z")])
+  tt <- w$temperature - mean(w$temperature)
+  o <- c(0, 0, 0); s <- c(1, 1, 1); to <- c(0, 0, 0); wt <- rep(1, nrow(v))
+  for (it in 1:20000) {
+    cur <- sweep(sweep(v, 2, o, "+"), 2, s, "*") + outer(tt, to)
+    cp <- cur / sqrt(rowSums(cur^2))
+    fitted <- cur
+    o_new <- o; s_new <- s; to_new <- to
+    for (k in 1:3) {
+      b <- stats::lm.wfit(cbind(1, cur[, k], tt), cp[, k], wt)$coefficients
+      fitted[, k] <- b[1] + b[2] * cur[, k] + b[3] * tt
+      o_new[k] <- o[k] + b[1] / (s[k] * b[2])
+      s_new[k] <- s[k] * b[2]
+      to_new[k] <- to[k] * b[2] + b[3]
+    }
+    moved <- max(abs(c(o_new - o, s_new - s, (to_new - to) * diff(range(tt)))))
+    o <- o_new; s <- s_new; to <- to_new
+    wt <- pmin(1 / sqrt(rowSums((fitted - cp)^2)), 100)
+    if (moved < 1e-13) break
+  }
+  expect_lt(moved, 1e-13)
+  expect_gt(it, 200)  # slow for GGIR's iteration ...
+  own <- fit_icp(w)
+  expect_true(own$converged)
+  expect_lt(own$iterations, it / 4)  # ... fast for the accelerated one
+  expect_lt(max(abs(diag(own$K) - s)), 1e-8)
+  expect_lt(max(abs(own$offset - o)), 1e-8)
+  expect_lt(max(abs(own$tempoffset - to)), 1e-9)
+  expect_equal(own$meantemp, mean(w$temperature))
+})
+
 test_that("fit_icp handles missing or constant temperature", {
   rec <- simulate_recording(hours = 24, sf = 10, seed = 6)
   w <- rest_windows(rec, sf = 10, method = "ggir")

@@ -369,8 +369,11 @@ class GgirProcedure {
       return false;
     }
     // [5] compatible mode fits as GGIR does; gravcal's own mode decides
-    // whether to read on with GGIR's cheap early stop, and fits to
-    // convergence only for a result it keeps
+    // whether to read on with GGIR's cheap early stop, started from the
+    // previous decision's coefficients (so that each decision costs a few
+    // passes over the table, and the decisions together stay a small share
+    // of the time however the refits fall), and fits to convergence, from
+    // the identity, only for a result it keeps
     IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r : last ? Rule::converge : Rule::ggir);
     if (!cfg_.compat && !last && judge(o, r)) r = icp(o, Rule::converge);
     o.has_icp = true;
@@ -410,6 +413,15 @@ class GgirProcedure {
     c.use_temp = o.use_temp;
     c.stop = rule == Rule::converge ? StopRule::parameters : StopRule::ggir;
     c.r_arithmetic = rule == Rule::ggir_r;
+    if (rule == Rule::ggir && has_warm_) {
+      c.warm = true;
+      for (int k = 0; k < 3; ++k) {
+        c.start_offset[k] = warm_.offset[k];
+        c.start_scale[k] = warm_.scale[k];
+        c.start_tempoffset[k] = warm_.tempoffset[k];
+      }
+      c.start_meantemp = warm_.meantemp;
+    }
     HostSolver solve{&host_};
     IcpResult r = fit_icp(
         &o.table[1 * n], &o.table[2 * n], &o.table[3 * n], t, n, c,
@@ -418,6 +430,10 @@ class GgirProcedure {
         },
         solve);
     if (!o.use_temp) r.meantemp = 0;
+    if (rule == Rule::ggir) {
+      has_warm_ = r.finite && r.temp_used == o.use_temp;
+      warm_ = r;
+    }
     const double* m[3] = {&o.table[1 * n], &o.table[2 * n], &o.table[3 * n]};
     error_ = ggir_error(m, n, r.scale, r.offset, r.tempoffset, t, r.meantemp);
     return r;
@@ -493,6 +509,8 @@ class GgirProcedure {
 
   GgirConfig cfg_;
   GgirHost& host_;
+  IcpResult warm_;         // own mode: the last decision's fit, and
+  bool has_warm_ = false;  // whether the next decision may start from it
   double L_;
   std::vector<double> buffer_, held_;
   LazySd lazy_;

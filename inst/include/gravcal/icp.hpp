@@ -20,8 +20,8 @@
 //
 // The arithmetic follows GGIR's R code where that decides a bit: the
 // calibrated value is (v + o) / (1 / s) + t / (1 / to), as R's scale()
-// computes it. The per-axis least squares use a Householder QR of the
-// weighted design (R's lm.wfit uses a Householder QR too). With
+// computes it. gravcal's own fit solves each axis's weighted least squares
+// from its normal equations (below); with
 // IcpConfig::r_arithmetic every other step is done as GGIR's R code does it
 // too (row sums and means in long double, fitted values from the weighted
 // residuals, the statistic element by element), so that a solver computing
@@ -33,6 +33,7 @@
 #define GRAVCAL_ICP_HPP
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -52,6 +53,14 @@ struct IcpConfig {
   bool use_temp = true;
   StopRule stop = StopRule::ggir;
   bool r_arithmetic = false;  // GGIR's R arithmetic, step by step (above)
+  // gravcal's own fit only: start from these coefficients (a fit on part of
+  // the same windows, whose temperature was centred on start_meantemp)
+  // rather than from the identity
+  bool warm = false;
+  double start_offset[3] = {0.0, 0.0, 0.0};
+  double start_scale[3] = {1.0, 1.0, 1.0};
+  double start_tempoffset[3] = {0.0, 0.0, 0.0};
+  double start_meantemp = 0.0;
 };
 
 struct IcpResult {
@@ -102,48 +111,117 @@ struct EigenLeastSquares {
   }
 };
 
-// The loops of gravcal's own fit (fit_icp()), element by element. (SSE2
-// versions saved less than 5 % of a week's calibrate(method = "ggir"):
-// bench/results/ab-kernels.md.)
+// gravcal's own fit streams through the points twice per iteration and
+// keeps no per-point matrices: each axis's weighted least squares of the
+// closest point p on [1, c, t] is solved from its normal equations, whose
+// sums one pass gathers (IcpSums), and a second pass computes GGIR's
+// statistic and the next weights. Its memory traffic is five columns per
+// pass whatever the number of points, so its time per iteration grows
+// linearly (a Householder QR of each axis's n x 3 design made some ten
+// passes over 14 columns, and slowed down per point once those left the
+// cache). The columns are centred (t on the mean temperature, c near the
+// unit sphere), so the 3 x 3 equations are well conditioned.
 
-// out[i] = apply_model_ggir(v[i], o, s, t ? t[i] : 0, to)
-inline void icp_apply_column(const double* v, const double* t, std::size_t n, double o, double s,
-                             double to, double* out) {
-  for (std::size_t i = 0; i < n; ++i) out[i] = apply_model_ggir(v[i], o, s, t != nullptr ? t[i] : 0.0, to);
-}
+// Sums are gathered per block of points and the block sums added, so that
+// rounding grows with the block length and the number of blocks, not n.
+constexpr std::size_t kIcpBlock = 1024;
 
-// p = c / |c|, |c| = sqrt(c0^2 + c1^2 + c2^2)
-inline void icp_project(const double* c0, const double* c1, const double* c2, std::size_t n,
-                        double* p0, double* p1, double* p2) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r = std::sqrt(c0[i] * c0[i] + c1[i] * c1[i] + c2[i] * c2[i]);
-    p0[i] = c0[i] / r;
-    p1[i] = c1[i] / r;
-    p2[i] = c2[i] / r;
+// The sums of one axis: w, w c, w t, w c c, w c t, w t t, w p, w c p, w t p.
+struct IcpSums {
+  double s[3][9] = {};
+  void add(const IcpSums& o) {
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 9; ++j) s[k][j] += o.s[k][j];
   }
+};
+
+// The current calibrated point c and its closest point p on the sphere.
+inline void icp_point(const double* const* in, const double* t, std::size_t i,
+                      const double* o, const double* s, const double* to, double* c,
+                      double* p) {
+  const double ti = t != nullptr ? t[i] : 0.0;
+  for (int k = 0; k < 3; ++k) c[k] = apply_model_ggir(in[k][i], o[k], s[k], ti, t != nullptr ? to[k] : 0.0);
+  const double r = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+  for (int k = 0; k < 3; ++k) p[k] = c[k] / r;
 }
 
-// c = b0 + b1 c (+ b2 t when t is not null)
-inline void icp_fitted(double b0, double b1, double b2, const double* t, std::size_t n,
-                       double* c) {
-  for (std::size_t i = 0; i < n; ++i) {
-    double f = b0 + b1 * c[i];
-    if (t != nullptr) f += b2 * t[i];
-    c[i] = f;
+// Pass 1: the normal equations' sums at the parameters (o, s, to), with
+// weights w; false when a closest point is not finite.
+inline bool icp_sums(const double* const* in, const double* t, std::size_t n, const double* o,
+                     const double* s, const double* to, const double* w, IcpSums& sums) {
+  bool finite = true;
+  for (std::size_t b = 0; b < n; b += kIcpBlock) {
+    const std::size_t e = std::min(n, b + kIcpBlock);
+    IcpSums blk;
+    for (std::size_t i = b; i < e; ++i) {
+      double c[3], p[3];
+      icp_point(in, t, i, o, s, to, c, p);
+      finite = finite && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+      const double wi = w[i], ti = t != nullptr ? t[i] : 0.0;
+      for (int k = 0; k < 3; ++k) {
+        double* a = blk.s[k];
+        const double wc = wi * c[k], wt = wi * ti;
+        a[0] += wi;
+        a[1] += wc;
+        a[2] += wt;
+        a[3] += wc * c[k];
+        a[4] += wc * ti;
+        a[5] += wt * ti;
+        a[6] += wi * p[k];
+        a[7] += wc * p[k];
+        a[8] += wt * p[k];
+      }
+    }
+    sums.add(blk);
   }
+  return finite;
 }
 
-// d2 = |c - p|^2; wd2 = w d2 (GGIR's statistic); next = min(1 / sqrt(d2),
-// max_weight)
-inline void icp_weights(const double* c0, const double* c1, const double* c2, const double* p0,
-                        const double* p1, const double* p2, std::size_t n, double max_weight,
-                        const double* w, double* next, double* wd2) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const double a = c0[i] - p0[i], b = c1[i] - p1[i], c = c2[i] - p2[i];
-    const double d2 = a * a + b * b + c * c;
-    wd2[i] = w[i] * d2;
-    const double wi = 1.0 / std::sqrt(d2);
-    next[i] = wi < max_weight ? wi : max_weight;
+// Solves one axis's normal equations for ncol (2 or 3) coefficients; false
+// when they do not determine them.
+inline bool icp_solve(const double* a, int ncol, double* beta) {
+  Eigen::Matrix3d M;
+  Eigen::Vector3d v;
+  M << a[0], a[1], a[2], a[1], a[3], a[4], a[2], a[4], a[5];
+  v << a[6], a[7], a[8];
+  const Eigen::Index m = ncol;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(M.topLeftCorner(m, m));
+  if (qr.rank() < m) return false;
+  const Eigen::VectorXd x = qr.solve(Eigen::VectorXd(v.head(m)));
+  beta[0] = x(0);
+  beta[1] = x(1);
+  beta[2] = m == 3 ? x(2) : 0.0;
+  return std::isfinite(beta[0]) && std::isfinite(beta[1]) && std::isfinite(beta[2]);
+}
+
+// Pass 2: at the same parameters, the fitted values f = b0 + b1 c + b2 t of
+// each axis against the closest points: GGIR's statistic's sums (w |f - p|^2
+// and w) and, in place, the next weights min(1 / |f - p|, max_weight).
+inline void icp_reweight(const double* const* in, const double* t, std::size_t n,
+                         const double* o, const double* s, const double* to,
+                         const double (*beta)[3], double max_weight, double* w, double& num,
+                         double& wsum) {
+  num = 0.0;
+  wsum = 0.0;
+  for (std::size_t b = 0; b < n; b += kIcpBlock) {
+    const std::size_t e = std::min(n, b + kIcpBlock);
+    double bn = 0.0, bw = 0.0;
+    for (std::size_t i = b; i < e; ++i) {
+      double c[3], p[3];
+      icp_point(in, t, i, o, s, to, c, p);
+      const double ti = t != nullptr ? t[i] : 0.0;
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = beta[k][0] + beta[k][1] * c[k] + beta[k][2] * ti - p[k];
+        d2 += d * d;
+      }
+      bn += w[i] * d2;
+      bw += w[i];
+      const double wi = 1.0 / std::sqrt(d2);
+      w[i] = wi < max_weight ? wi : max_weight;
+    }
+    num += bn;
+    wsum += bw;
   }
 }
 
@@ -260,6 +338,217 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
 // iteration as obs(iteration, result-so-far). obs may throw to abandon the
 // fit (the R glue does on Ctrl-C); the Eigen matrices the fit allocated are
 // freed by their destructors on the way out.
+// gravcal's converged fit (StopRule::parameters). GGIR's iteration weighs
+// each point by min(1 / |f - p|, max_weight), f its fitted value and p the
+// closest point of the iteration before; at a fixed point f = c and
+// |c - p| = | |c| - 1 |, so its fixed points are the coefficients where
+//   sum_i psi(|c_i| - 1) d|c_i| / d(coefficients) = 0,
+// psi(d) = min(1 / |d|, max_weight) d: the stationary points of
+//   sum_i rho(|c_i| - 1), rho(d) = max_weight d^2 / 2 for |d| < 1 / max_weight,
+//   |d| - 1 / (2 max_weight) beyond
+// (Huber's loss, of the distance to the sphere). The map F below takes the
+// weights at the current coefficients instead (iteratively reweighted least
+// squares for that loss: each step lowers it), which has the same fixed
+// points, and is accelerated by SQUAREM (Varadhan & Roland 2008, scheme S3)
+// with rho as its merit: a fixed point reached in tens of passes over the
+// windows where the plain iteration needs hundreds, so that the time of a
+// fit does not depend on how slowly the plain iteration would have
+// converged on a recording the model does not fit well.
+struct IcpCoefs {
+  double o[3] = {0.0, 0.0, 0.0}, s[3] = {1.0, 1.0, 1.0}, to[3] = {0.0, 0.0, 0.0};
+};
+
+// F(a) -> b, with the merit rho at a; false when not finite.
+inline bool icp_map(const double* const* in, const double* t, std::size_t n, int ncol,
+                    double max_weight, const IcpCoefs& a, IcpCoefs& b, double& merit) {
+  IcpSums sums;
+  const double half = 0.5 / max_weight;
+  merit = 0.0;
+  bool finite = true;
+  for (std::size_t b0 = 0; b0 < n; b0 += kIcpBlock) {
+    const std::size_t e = std::min(n, b0 + kIcpBlock);
+    IcpSums blk;
+    double bm = 0.0;
+    for (std::size_t i = b0; i < e; ++i) {
+      double c[3], p[3];
+      icp_point(in, t, i, a.o, a.s, a.to, c, p);
+      const double r = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+      const double d = std::fabs(r - 1.0);
+      const double wi = d * max_weight > 1.0 ? 1.0 / d : max_weight;
+      bm += d * max_weight > 1.0 ? d - half : 0.5 * max_weight * d * d;
+      finite = finite && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+      const double ti = t != nullptr ? t[i] : 0.0;
+      for (int k = 0; k < 3; ++k) {
+        double* q = blk.s[k];
+        const double wc = wi * c[k], wt = wi * ti;
+        q[0] += wi;
+        q[1] += wc;
+        q[2] += wt;
+        q[3] += wc * c[k];
+        q[4] += wc * ti;
+        q[5] += wt * ti;
+        q[6] += wi * p[k];
+        q[7] += wc * p[k];
+        q[8] += wt * p[k];
+      }
+    }
+    sums.add(blk);
+    merit += bm;
+  }
+  if (!finite || !std::isfinite(merit)) return false;
+  for (int k = 0; k < 3; ++k) {
+    double beta[3];
+    if (!icp_solve(sums.s[k], ncol, beta)) return false;
+    b.o[k] = a.o[k] + beta[0] / (a.s[k] * beta[1]);
+    b.s[k] = a.s[k] * beta[1];
+    b.to[k] = t != nullptr ? a.to[k] * beta[1] + beta[2] : 0.0;
+  }
+  return true;
+}
+
+// The coefficients as one vector for SQUAREM, the temperature terms
+// measured over the temperature range (as the stopping rule measures them).
+inline void icp_vec(const IcpCoefs& a, double trange, double* v) {
+  for (int k = 0; k < 3; ++k) {
+    v[k] = a.o[k];
+    v[3 + k] = a.s[k];
+    v[6 + k] = a.to[k] * trange;
+  }
+}
+inline IcpCoefs icp_unvec(const double* v, double trange) {
+  IcpCoefs a;
+  for (int k = 0; k < 3; ++k) {
+    a.o[k] = v[k];
+    a.s[k] = v[3 + k];
+    a.to[k] = trange > 0 ? v[6 + k] / trange : 0.0;
+  }
+  return a;
+}
+
+// GGIR's statistic at a fixed point: sum w d^2 / (n sum w), d = |c| - 1,
+// w = min(1 / |d|, max_weight).
+inline double icp_statistic(const double* const* in, const double* t, std::size_t n,
+                            double max_weight, const IcpCoefs& a) {
+  double num = 0.0, den = 0.0;
+  for (std::size_t b0 = 0; b0 < n; b0 += kIcpBlock) {
+    const std::size_t e = std::min(n, b0 + kIcpBlock);
+    double bn = 0.0, bd = 0.0;
+    for (std::size_t i = b0; i < e; ++i) {
+      double c[3], p[3];
+      icp_point(in, t, i, a.o, a.s, a.to, c, p);
+      const double d = std::fabs(std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - 1.0);
+      const double wi = d * max_weight > 1.0 ? 1.0 / d : max_weight;
+      bn += wi * d * d;
+      bd += wi;
+    }
+    num += bn;
+    den += bd;
+  }
+  return num / (static_cast<double>(n) * den);
+}
+
+// The converged fit from r's coefficients: SQUAREM on icp_map(); r.iterations
+// counts the passes (maps) made.
+template <class Observer>
+void icp_converge(const double* const* in, const double* t, std::size_t n, int ncol,
+                  double trange, const IcpConfig& cfg, Observer& obs, IcpResult& r) {
+  auto take = [&](const IcpCoefs& a) {
+    for (int k = 0; k < 3; ++k) {
+      r.offset[k] = a.o[k];
+      r.scale[k] = a.s[k];
+      r.tempoffset[k] = a.to[k];
+    }
+  };
+  auto change = [&](const IcpCoefs& a, const IcpCoefs& b) {
+    double c = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      c = std::fmax(c, std::fabs(b.o[k] - a.o[k]));
+      c = std::fmax(c, std::fabs(b.s[k] - a.s[k]));
+      c = std::fmax(c, std::fabs(b.to[k] - a.to[k]) * trange);
+    }
+    return c;
+  };
+  int evals = 0;
+  // one map, reported; false when it is not finite
+  auto step = [&](const IcpCoefs& a, IcpCoefs& b, double& merit) {
+    if (!icp_map(in, t, n, ncol, cfg.max_weight, a, b, merit)) return false;
+    ++evals;
+    take(b);
+    r.iterations = evals;
+    obs(evals, static_cast<const IcpResult&>(r));
+    return icp_finite(r, 0.0);
+  };
+  IcpCoefs x0, x1, x2, x3, xs;
+  for (int k = 0; k < 3; ++k) {
+    x0.o[k] = r.offset[k];
+    x0.s[k] = r.scale[k];
+    x0.to[k] = r.tempoffset[k];
+  }
+  double m0 = 0.0, m1 = 0.0, ms = 0.0;
+  while (evals < cfg.max_iter) {
+    if (!step(x0, x1, m0)) {
+      r.finite = false;
+      return;
+    }
+    if (change(x0, x1) < cfg.tol) {
+      r.converged = true;
+      x0 = x1;
+      break;
+    }
+    if (evals >= cfg.max_iter) {
+      x0 = x1;
+      break;
+    }
+    if (!step(x1, x2, m1)) {
+      r.finite = false;
+      return;
+    }
+    if (change(x1, x2) < cfg.tol) {
+      r.converged = true;
+      x0 = x2;
+      break;
+    }
+    // S3's step length, at least the plain two steps (alpha = -1 gives x2)
+    double v0[9], v1[9], v2[9], rr = 0.0, vv = 0.0;
+    icp_vec(x0, trange, v0);
+    icp_vec(x1, trange, v1);
+    icp_vec(x2, trange, v2);
+    for (int j = 0; j < 9; ++j) {
+      const double a = v1[j] - v0[j], b = v2[j] - 2.0 * v1[j] + v0[j];
+      rr += a * a;
+      vv += b * b;
+    }
+    const double alpha = vv > 0.0 ? -std::sqrt(rr / vv) : -1.0;
+    if (!(alpha < -1.0) || evals >= cfg.max_iter) {
+      x0 = x2;
+      continue;
+    }
+    double vs[9];
+    for (int j = 0; j < 9; ++j) {
+      const double a = v1[j] - v0[j], b = v2[j] - 2.0 * v1[j] + v0[j];
+      vs[j] = v0[j] - 2.0 * alpha * a + alpha * alpha * b;
+    }
+    xs = icp_unvec(vs, trange);
+    // the extrapolated point is kept, after one more map, only when its
+    // loss is no higher than that of x1 (each map lowers it: x2's is lower)
+    const int before = evals;
+    if (step(xs, x3, ms) && ms <= m1) {
+      if (change(xs, x3) < cfg.tol) {
+        r.converged = true;
+        x0 = x3;
+        break;
+      }
+      x0 = x3;
+    } else {
+      evals = before + 1;  // the pass was made, its result is not kept
+      x0 = x2;
+    }
+  }
+  take(x0);
+  r.iterations = evals;
+  r.statistic = icp_statistic(in, t, n, cfg.max_weight, x0);
+}
+
 template <class Observer, class Solver = EigenLeastSquares>
 IcpResult fit_icp(const double* x, const double* y, const double* z,
                   const double* temp, std::size_t n, const IcpConfig& cfg,
@@ -294,46 +583,44 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
     trange = tmax - tmin;
   }
 
-  const Eigen::Index N = static_cast<Eigen::Index>(n);
   const int ncol = use_temp ? 3 : 2;
-  Eigen::MatrixXd cur(N, 3), cp(N, 3);
-  Eigen::VectorXd w = Eigen::VectorXd::Ones(N);
-  Eigen::MatrixXd X(N, ncol);
-  Eigen::VectorXd b(N), sw(N);
-  // one QR for all the fits: compute() reuses its storage (the same
-  // arithmetic as a new X.householderQr() each time)
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(N, ncol);
-  double res_prev = std::numeric_limits<double>::infinity();
-
-  std::vector<double> wd2(n);  // w * d^2 of each point, for GGIR's statistic
-  Eigen::VectorXd w_next(N);   // the weights of the next iteration
-  const double* tp = use_temp ? t.data() : nullptr;
-  for (int it = 1; it <= cfg.max_iter; ++it) {
-    // the calibrated points (apply_model_ggir()), then their closest points
-    // on the sphere; column by column
+  if (cfg.warm) {
+    // the same mapping with the temperature centred on this table's mean:
+    // (v + o') s + (T - m') to = (v + o) s + (T - m) to
     for (int k = 0; k < 3; ++k) {
-      icp_apply_column(in[k], tp, n, r.offset[k], r.scale[k],
-                       use_temp ? r.tempoffset[k] : 0.0, cur.col(k).data());
+      r.scale[k] = cfg.start_scale[k];
+      r.tempoffset[k] = use_temp ? cfg.start_tempoffset[k] : 0.0;
+      r.offset[k] = cfg.start_offset[k] +
+                    (use_temp ? (r.meantemp - cfg.start_meantemp) * r.tempoffset[k] / r.scale[k] : 0.0);
     }
-    icp_project(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(), n,
-                cp.col(0).data(), cp.col(1).data(), cp.col(2).data());
-    if (!cp.allFinite()) {
+  }
+  const double* tp = use_temp ? t.data() : nullptr;
+  if (cfg.stop == StopRule::parameters) {
+    icp_converge(in, tp, n, ncol, trange, cfg, obs, r);
+    if (r.finite) r.finite = icp_finite(r, r.statistic);
+    return r;
+  }
+  std::vector<double> w(n, 1.0);
+  double res_prev = std::numeric_limits<double>::infinity();
+  for (int it = 1; it <= cfg.max_iter; ++it) {
+    // the calibrated points (apply_model_ggir()), their closest points on
+    // the sphere, and each axis's regression of the one on the other
+    const double o_old[3] = {r.offset[0], r.offset[1], r.offset[2]};
+    const double s_old[3] = {r.scale[0], r.scale[1], r.scale[2]};
+    const double t_old[3] = {r.tempoffset[0], r.tempoffset[1], r.tempoffset[2]};
+    IcpSums sums;
+    bool finite = icp_sums(in, tp, n, o_old, s_old, t_old, w.data(), sums);
+    double beta[3][3];
+    for (int k = 0; k < 3 && finite; ++k) finite = icp_solve(sums.s[k], ncol, beta[k]);
+    if (!finite) {
       r.finite = false;
       break;
     }
-    sw = w.cwiseSqrt();
-    double d_off[3], d_scale[3], d_temp[3] = {0.0, 0.0, 0.0};
+    double d_off[3], d_scale[3], d_temp[3];
     for (int k = 0; k < 3; ++k) {
-      X.col(0) = sw;
-      X.col(1) = sw.cwiseProduct(cur.col(k));
-      if (use_temp) X.col(2) = sw.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(tp, N));
-      b = sw.cwiseProduct(cp.col(k));
-      qr.compute(X);
-      const Eigen::VectorXd beta = qr.solve(b);
-      d_off[k] = beta(0);
-      d_scale[k] = beta(1);
-      if (use_temp) d_temp[k] = beta(2);
-      icp_fitted(beta(0), beta(1), use_temp ? beta(2) : 0.0, tp, n, cur.col(k).data());
+      d_off[k] = beta[k][0];
+      d_scale[k] = beta[k][1];
+      d_temp[k] = beta[k][2];
     }
     double change = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -348,21 +635,13 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
       r.tempoffset[k] = t_new;
     }
     // GGIR's statistic, with the weights of this iteration; then new weights.
-    icp_weights(cur.col(0).data(), cur.col(1).data(), cur.col(2).data(),
-                cp.col(0).data(), cp.col(1).data(), cp.col(2).data(), n,
-                cfg.max_weight, w.data(), w_next.data(), wd2.data());
-    long double num = 0.0L, wsum = 0.0L;
-    for (std::size_t i = 0; i < n; ++i) {  // two chains of long double sums
-      wsum += w(static_cast<Eigen::Index>(i));
-      num += wd2[i];
-    }
-    w.swap(w_next);
-    const double res = static_cast<double>(num / (static_cast<long double>(n) * wsum));
+    double num = 0.0, wsum = 0.0;
+    icp_reweight(in, tp, n, o_old, s_old, t_old, beta, cfg.max_weight, w.data(), num, wsum);
+    const double res = num / (static_cast<double>(n) * wsum);
     r.iterations = it;
     r.statistic = res;
     obs(it, static_cast<const IcpResult&>(r));
-    const bool finite = icp_finite(r, res);
-    if (!finite) {
+    if (!icp_finite(r, res)) {
       r.finite = false;
       break;
     }
