@@ -289,13 +289,13 @@ class GgirProcedure {
       for (int a = 0; a < 3; ++a) col_[4 + a].push_back(w.sd[a]);
       if (o.temp_available) col_[7].push_back(o.use_temp ? w.temperature : cfg_.temp_missing);
       rest_.push_back(r.rest);
-      why_.push_back(cfg_.compat || !r.rest ? why_none : guard(w));
+      why_.push_back(static_cast<unsigned char>(cfg_.compat || !r.rest ? why_none : guard(w)));
     }
   }
 
   // own mode's guards on a rest window (GgirConfig): identical samples
   // first, then clipping, then the norm (one reason per window)
-  unsigned char guard(const WindowStats& w) const {
+  GgirWhy guard(const WindowStats& w) const {
     const double valid = static_cast<double>(w.n) - static_cast<double>(w.n_invalid);
     if (valid > 1 && static_cast<double>(w.n_repeat) > cfg_.guard_repeat * (valid - 1)) {
       return why_identical;
