@@ -66,9 +66,11 @@
 #' iterations, typically 100-700). Give `max_iter = 50, tol = 0` for the
 #' paper's budget, exactly as a device would run it.
 #'
-#' Two guards keep unreliable rest windows out of the lightweight fit (the
-#' paper has none; [select_points()] and [fit_gradient()] called directly
-#' still take every point they are given):
+#' Three guards keep rest windows that are not a sensor at rest out of the
+#' lightweight fit, and out of the GGIR method's in gravcal's own mode (the
+#' paper and GGIR have none, and `ggir_compat = TRUE` keeps GGIR's rules;
+#' [select_points()] and [fit_gradient()] called directly still take every
+#' point they are given):
 #' * a window whose mean vector has a norm farther than `max_norm_error`
 #'   (default 0.3 g) from 1 g. Real sensors before calibration are 16-77 mg
 #'   from 1 g on average (van Hees et al. 2014, Table 3), and the
@@ -85,6 +87,21 @@
 #'   the full scale is taken from the file when its reader knows it
 #'   (Axivity, GENEActiv, ActiGraph); for samples in memory it is unknown
 #'   unless `range_g` is given, and then this guard is off.
+#' * a window made of identical samples: more than `max_identical`
+#'   (default 0.8) of its samples after the first equal the sample before
+#'   them in x, y and z (the window table's `n_repeat`, see
+#'   [rest_windows()]). ActiGraph devices in idle sleep mode repeat their
+#'   last sample, a stuck sensor gives a constant, a gap may be filled with
+#'   zeros: such windows have no noise, pass any rest rule, and are not a
+#'   measurement of gravity. A real still sensor is not left out: in the
+#'   rest windows of the real recordings the tests reach (ActiGraph,
+#'   Axivity AX3 and AX6), at most 0.36 of a still sensor's samples
+#'   repeat the one before (AX3 at 100 Hz; ActiGraph at 30 Hz: at most 0.26),
+#'   while idle sleep, a stuck sensor or zeros give nearly 1
+#'   (bench/results/rest-quality.md).
+#'   `max_identical = 1` turns this guard off.
+#' A window left out for several reasons counts once: identical first, then
+#' clipped, then norm.
 #'
 #' **Coefficients that change over time.** With `segments = "day"` (or a
 #' number of hours) the lightweight method also fits each day (segment) of
@@ -113,11 +130,13 @@
 #' whether it stopped early (`stopped`); `print()` shows it. GGIR's
 #' procedure keeps its own rule (`minloadcrit`).
 #'
-#' The fit records the windows left out: `excluded` (counts, named `norm`
-#' and `clipped`; a clipped window counts as clipped only),
-#' `excluded_windows` (those windows, with a column `why`) and `guards` (the
-#' limits used); `print()` shows the counts. Windows left out are neither
-#' points nor held-out windows.
+#' The fit records the windows left out: `excluded` (counts, named `norm`,
+#' `clipped` and `identical`), `excluded_windows` (those windows, with a
+#' column `why`; lightweight method only) and `guards` (the limits used);
+#' `print()` shows the counts. Windows left out are neither points nor
+#' held-out windows. In the GGIR method's own mode the counts are of the
+#' rest windows of the table before its duplicate filter (which also drops
+#' all but the last of a run of equal windows).
 #'
 #' The rest windows that were not selected as calibration points are a
 #' held-out set, as in the paper's Table 3: the fit reports the error on them
@@ -154,7 +173,7 @@
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
 #'   `chunk_size`, `progress`, `reader`, `rmc`), the guards (`max_norm_error`, in g,
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
-#'   file or unknown; see Details), the choice of points and model
+#'   file or unknown; `max_identical`, default 0.8; see Details), the choice of points and model
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
 #'   `max_se`, default 0.01; `model`, default `"auto"`; `use_temp`,
 #'   default TRUE; `segments`, default none, and `change_alpha`, default
@@ -170,7 +189,10 @@
 #'   `reader` (`"native"` or `"reference"`, see [rest_windows()]),
 #'   `rmc` (GGIR's `rmc.*` parameters of an ad hoc csv file, see
 #'   [rest_windows()]; the rest rule stays `max_sd`, where
-#'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`) and `verbose`.
+#'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`), `verbose` and, in
+#'   gravcal's own mode only, the guards `max_norm_error`, `range_g` and
+#'   `max_identical` (as for the lightweight method; an error with
+#'   `ggir_compat = TRUE`).
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
 #' [g.calibrate()] for the steps) and returns a `gravcal_fit` whose `K` is
@@ -245,7 +267,8 @@
 #'     with `t_x`, `t_y`, `t_z` when the temperature was used; empty when
 #'     the coefficients are the identity;
 #'   * for the lightweight method from [calibrate()]: `excluded`,
-#'     `excluded_windows` and `guards` (see Details).
+#'     `excluded_windows` and `guards`; for the GGIR method in gravcal's own
+#'     mode: `excluded` and `guards` (see Details).
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
 #' @export
 #' @examples
@@ -274,10 +297,11 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   choice <- la$choice
   max_norm_error <- la$max_norm_error
   range_g <- la$range_g
+  max_identical <- la$max_identical
   rargs <- args$rest_windows
   if (choice$budget == "adaptive") {
     rargs$stop <- budget_rule(args$fit_gradient, choice, max_norm_error,
-                              range_g)
+                              range_g, max_identical)
     rargs$stop_every <- choice$check_hours
     if (is.null(rargs$chunk_size) && !is.character(x)) {
       rargs$chunk_size <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
@@ -287,5 +311,6 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
                            file = if (is.character(x)) basename(x),
                            timed = !is.character(x) &&
-                             "time" %in% tolower(names(x)))
+                             "time" %in% tolower(names(x)),
+                           max_identical = max_identical)
 }

@@ -259,8 +259,18 @@ cwa_time_span <- function(file) {
 
 # calibrate(method = "ggir"): the procedure, then a gravcal_fit.
 calibrate_ggir <- function(x, sf, compat, dots, call) {
-  args <- split_dots(dots, list(ggir = ggir_param_names("own")))$ggir
+  d <- split_dots(dots, list(ggir = ggir_param_names("own"),
+                             guards = c("max_norm_error", "range_g",
+                                        "max_identical")))
+  args <- d$ggir
   a <- ggir_param_values("own", list(args))
+  # own mode's guards on rest windows; GGIR-compatible mode keeps GGIR's
+  # rules, so a guard given there is an error, not ignored
+  if (compat && length(d$guards)) {
+    abort("`", names(d$guards)[1], "` is for gravcal's own mode: with ",
+          "`ggir_compat = TRUE` the rest windows are GGIR's.")
+  }
+  guards <- if (!compat) guard_args(d$guards)
   if (compat) check_fp_build("`calibrate(method = \"ggir\", ggir_compat = TRUE)`")
   if (is.null(sf) && !is.character(x) && is.null(attr(x, "sf")) &&
       !("time" %in% tolower(colnames(x)))) {
@@ -274,10 +284,29 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
     src
   }
   src <- open()
+  if (!compat && is.null(guards$range_g) && is.numeric(src$info$range_g) &&
+      length(src$info$range_g) == 1) {
+    guards$range_g <- src$info$range_g
+  }
   res <- ggir_run_exact(src, open, compat = compat, spherecrit = a$spherecrit,
                         minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
-                        verbose = a$verbose, max_iter = a$max_iter, tol = a$tol)
+                        verbose = a$verbose, max_iter = a$max_iter, tol = a$tol,
+                        guards = guards)
+  ex <- attr(res, "gravcal")$excluded
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
+  if (!compat) {
+    fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
+                                    excluded_reasons)
+    fit$guards <- list(max_norm_error = guards$max_norm_error,
+                       range_g = if (is.null(guards$range_g)) NA_real_ else
+                         guards$range_g,
+                       max_identical = guards$max_identical)
+    if (fit$status == "no_rest" && sum(fit$excluded) > 0) {
+      fit$message <- paste0("all rest windows were left out (",
+                            format_excluded(fit$excluded, fit$guards), ") [GGIR: ",
+                            fit$QCmessage, "]")
+    }
+  }
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
   fit

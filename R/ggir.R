@@ -93,7 +93,8 @@ ggir_run <- function(src, compat = TRUE,
                      minloadcrit = ggir_constants$minloadcrit,
                      sdcriter = ggir_constants$max_sd, verbose = FALSE,
                      printsummary = FALSE, max_iter = ggir_constants$max_iter,
-                     tol = ggir_constants$tol, lazy = TRUE) {
+                     tol = ggir_constants$tol, lazy = TRUE,
+                     guards = NULL) {
   sf <- src$sf
   if (!(10 * sf >= 1 && 10 * sf < 1e7)) {
     abort("`sf` must give 1 to 1e7 samples in a 10 s window, not ",
@@ -104,7 +105,8 @@ ggir_run <- function(src, compat = TRUE,
   opts <- ggir_options(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter,
                        tol, verbose, block_units = src$units,
                        short_block_rows = src$short_rows %||% 0,
-                       temperature = isTRUE(src$temperature), lazy = lazy)
+                       temperature = isTRUE(src$temperature), lazy = lazy,
+                       guards = guards)
   # memory in use after each block (GGIR records R's heap from a full gc(),
   # which costs about as much as decoding the block)
   bsc <- list()
@@ -124,8 +126,12 @@ ggir_run <- function(src, compat = TRUE,
 # the user's, then GGIR's constants.
 ggir_options <- function(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter,
                          tol, verbose, block_units = 0, short_block_rows = 0,
-                         temperature = TRUE, lazy = TRUE) {
+                         temperature = TRUE, lazy = TRUE, guards = NULL) {
   k <- ggir_constants
+  # own mode's guards on rest windows (see guard_windows(), lightweight.R);
+  # none in compatible mode, nor when not given
+  g <- if (compat) NULL else guards
+  clip <- if (length(g$range_g) == 1 && is.finite(g$range_g)) clip_fraction * g$range_g else 0
   opts <- list(compat = compat, sf = sf, block_units = block_units,
                short_block_rows = short_block_rows, temperature = temperature,
                lazy = lazy, spherecrit = spherecrit, minloadcrit = minloadcrit,
@@ -136,7 +142,10 @@ ggir_options <- function(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter
                temp_min_sd = k$temp_min_sd, temp_missing = k$temp_missing,
                fill = k$fill, max_iter = max_iter, tol = tol,
                max_weight = k$max_weight, refit_growth = k$refit_growth,
-               verbose = verbose)
+               verbose = verbose,
+               guard_norm = if (is.null(g$max_norm_error)) Inf else g$max_norm_error,
+               guard_clip = clip,
+               guard_repeat = if (is.null(g$max_identical)) Inf else g$max_identical)
   lapply(opts, as.numeric)
 }
 
@@ -167,7 +176,7 @@ ggir_result <- function(r, bsc_qc, input, verbose = FALSE, printsummary = FALSE)
   attr(out, "gravcal") <- list(icp = icp, meantemp = r$meantemp,
                                blocks = r$blocks, input = input,
                                temp.available = r$temp.available,
-                               windows = r$windows)
+                               windows = r$windows, excluded = r$excluded)
   out
 }
 

@@ -2,12 +2,13 @@
 # a fit: its arguments, the guards on its windows, the fit.
 
 # The lightweight method's arguments from calibrate()'s `...`, routed and
-# checked: list(args (by destination), choice, max_norm_error, range_g).
+# checked: list(args (by destination), choice, max_norm_error, range_g,
+# max_identical).
 lightweight_args <- function(dots) {
   args <- split_dots(dots, list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader", "rmc"),
-    guards = c("max_norm_error", "range_g"),
+    guards = c("max_norm_error", "range_g", "max_identical"),
     choice = c("selection", "cell", "max_se", "model", "use_temp",
                "segments", "change_alpha", "budget", "target_se",
                "check_hours"),
@@ -16,7 +17,14 @@ lightweight_args <- function(dots) {
                      "use_sqrt", "tol", "trace", "difference", "algorithm",
                      "se")))
   choice <- check_choice_args(args$choice, args$select_points)
-  gargs <- args$guards
+  g <- guard_args(args$guards)
+  list(args = args, choice = choice, max_norm_error = g$max_norm_error,
+       range_g = g$range_g, max_identical = g$max_identical)
+}
+
+# The guards' arguments (max_norm_error, range_g, max_identical), checked,
+# with their defaults; range_g NULL when not given (the file's, or unknown).
+guard_args <- function(gargs) {
   max_norm_error <- if (is.null(gargs$max_norm_error)) 0.3 else
     gargs$max_norm_error
   if (!identical(max_norm_error, Inf)) {
@@ -27,8 +35,11 @@ lightweight_args <- function(dots) {
   if (!is.null(range_g)) {
     check_number(range_g, "range_g", min = 0, min_inclusive = FALSE)
   }
-  list(args = args, choice = choice, max_norm_error = max_norm_error,
-       range_g = range_g)
+  max_identical <- if (is.null(gargs$max_identical)) default_max_identical else
+    gargs$max_identical
+  check_number(max_identical, "max_identical", min = 0, max = 1)
+  list(max_norm_error = max_norm_error, range_g = range_g,
+       max_identical = max_identical)
 }
 
 # The lightweight method from its windows (rest_windows()'s table, with its
@@ -36,19 +47,20 @@ lightweight_args <- function(dots) {
 # `file`: the file's name for the fit (NULL for samples in memory); `timed`:
 # whether the windows' start comes from a `time` column.
 lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
-                                     call, file = NULL, timed = FALSE) {
+                                     call, file = NULL, timed = FALSE,
+                                     max_identical = default_max_identical) {
   if (is.null(range_g)) range_g <- attr(w, "input")$range_g
   rest <- w[w$rest, , drop = FALSE]
-  why <- guard_windows(rest, max_norm_error, range_g)
-  excluded <- table(factor(why[!is.na(why)], levels = c("norm", "clipped")))
-  excluded <- stats::setNames(as.integer(excluded), names(excluded))
+  why <- guard_windows(rest, max_norm_error, range_g, max_identical)
+  excluded <- count_excluded(why)
   excluded_windows <- rest[!is.na(why), , drop = FALSE]
   excluded_windows$why <- why[!is.na(why)]
   rest <- rest[is.na(why), , drop = FALSE]
   rownames(rest) <- NULL
   attr(rest, "n_windows") <- nrow(w)
   guards <- list(max_norm_error = max_norm_error,
-                 range_g = if (is.null(range_g)) NA_real_ else range_g)
+                 range_g = if (is.null(range_g)) NA_real_ else range_g,
+                 max_identical = max_identical)
   hours <- attr(w, "samples") / attr(w, "sf") / 3600
   budget <- list(budget = choice$budget, target_se = choice$target_se,
                  check_hours = choice$check_hours,
@@ -126,12 +138,18 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
   finish_fit(fit, rest)
 }
 
-# The rest windows that are never calibration points, and why: "clipped"
-# when on some axis the largest |sample| the window can hold, |mean| +
-# (max - min), reaches 98 % of the sensor's full scale `range_g` (skipped
-# when the range is unknown); else "norm" when the mean vector's norm is
-# farther than `max_norm_error` g from 1 g. NA for the windows kept.
-guard_windows <- function(rest, max_norm_error, range_g) {
+# The rest windows that are never calibration points, and why: "identical"
+# when more than `max_identical` of the window's samples after its first
+# equal the one before them in x, y and z (`n_repeat`: a stuck sensor,
+# ActiGraph's idle sleep repeating its last sample, a run of zeros; see
+# default_max_identical); else "clipped" when on some axis the largest
+# |sample| the window can hold, |mean| + (max - min), reaches 98 % of the
+# sensor's full scale `range_g` (skipped when the range is unknown); else
+# "norm" when the mean vector's norm is farther than `max_norm_error` g
+# from 1 g. NA for the windows kept. GGIR's procedure in gravcal's own mode
+# applies the same rules in the core (GgirProcedure::guard()).
+guard_windows <- function(rest, max_norm_error, range_g,
+                          max_identical = default_max_identical) {
   why <- rep(NA_character_, nrow(rest))
   if (nrow(rest) == 0) return(why)
   m <- cbind(rest$mean_x, rest$mean_y, rest$mean_z)
@@ -144,8 +162,33 @@ guard_windows <- function(rest, max_norm_error, range_g) {
     reach <- rowSums(abs(m) + r >= clip_fraction * range_g) > 0
     why[reach] <- "clipped"
   }
+  if (!is.null(rest$n_repeat) && !is.null(rest$n)) {
+    valid <- rest$n - if (is.null(rest$n_invalid)) 0L else rest$n_invalid
+    same <- valid > 1 & rest$n_repeat > max_identical * (valid - 1)
+    why[!is.na(same) & same] <- "identical"
+  }
   why
 }
+
+# The reasons guard_windows() gives, counted (named integers).
+excluded_reasons <- c("norm", "clipped", "identical")
+count_excluded <- function(why) {
+  ex <- table(factor(why[!is.na(why)], levels = excluded_reasons))
+  stats::setNames(as.integer(ex), names(ex))
+}
+
+# A rest window is left out as "identical" when more than this fraction of
+# its samples (after the first) equal the sample before them in x, y and z.
+# Measured (bench/rest-quality.R, bench/results/rest-quality.md) on the
+# rest windows of the real recordings the tests reach: at most 0.36 of a
+# still sensor's samples repeat the one before (Axivity AX3 at 100 Hz,
+# GGIRread's ax3_testfile.cwa: median 0.35; ActiGraph at 30 Hz, agcounts'
+# 20.7 h: median 0.04, largest 0.24 of 8171 windows; ActiGraph .gt3x
+# 0.26; AX6 0). Idle sleep, a stuck sensor or zeros give (n - 2) / (n - 1)
+# or more (only a window's first samples can differ). 0.8 keeps twice the
+# largest measured fraction clear of the limit; a window that is 80 %
+# constant is no longer a measurement of the posture's gravity.
+default_max_identical <- 0.8
 
 # A window reaches the sensor's range when a sample may lie within 2 % of
 # full scale: the last counts of an ADC and a decoder's rounding.
@@ -159,11 +202,16 @@ add_guards <- function(fit, excluded, excluded_windows, guards) {
 }
 
 format_excluded <- function(excluded, guards) {
+  ident <- if ("identical" %in% names(excluded)) excluded[["identical"]] else 0L
+  mi <- if (is.null(guards$max_identical)) default_max_identical else
+    guards$max_identical
   paste0(excluded[["norm"]], " with | |v| - 1 | > ",
          format(guards$max_norm_error), " g, ", excluded[["clipped"]],
-         " clipped", if (is.finite(guards$range_g))
+         " clipped", if (isTRUE(is.finite(guards$range_g)))
            paste0(" (range +-", format(guards$range_g), " g)") else
-             " (sensor range unknown, not checked)")
+             " (sensor range unknown, not checked)",
+         ", ", ident, " with more than ", format(100 * mi),
+         " % of samples identical")
 }
 
 # Route `...` to the functions that take each argument; unknown names fail.

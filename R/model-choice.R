@@ -60,11 +60,13 @@ default_target_se <- 0.001
 # is at most target_se and the coefficients moved by less than two
 # standard errors of their difference since the previous check (the same
 # model both times).
-budget_rule <- function(fargs, choice, max_norm_error, range_g) {
+budget_rule <- function(fargs, choice, max_norm_error, range_g,
+                        max_identical = default_max_identical) {
   prev <- NULL
   function(w) {
     rest <- w[!is.na(w$rest) & w$rest, , drop = FALSE]
-    rest <- rest[is.na(guard_windows(rest, max_norm_error, range_g)), ,
+    rest <- rest[is.na(guard_windows(rest, max_norm_error, range_g,
+                                     max_identical)), ,
                  drop = FALSE]
     if (nrow(rest) == 0) return(FALSE)
     pts <- select_points(rest, selection = "cells", cell = choice$cell)

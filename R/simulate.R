@@ -130,9 +130,20 @@ check_params <- function(params) {
 #' @param rest_fraction Fraction of daytime spent in rest bouts.
 #' @param start Start time (POSIXct).
 #' @param seed Optional seed; the caller's RNG state is restored afterwards.
+#' @param idle_sleep,stuck Hours of the recording (default 0) replaced by
+#'   stretches of samples that are not a sensor at rest, in 30-minute
+#'   stretches at random, non-overlapping places (the last stretch may be
+#'   shorter): `idle_sleep` repeats the sample before the stretch, as
+#'   ActiGraph devices in idle sleep mode do; `stuck` holds a constant vector
+#'   that is not gravity: the sample before the stretch moved by a random
+#'   0.05-0.2 g on each axis (either sign), as a stuck sensor gives. With
+#'   both 0 the recording (and the random numbers drawn) are those without
+#'   the arguments.
 #' @return A data frame with columns `time`, `x`, `y`, `z` and (optionally)
 #'   `temperature`, and an attribute `truth`: a list with `params`, `K`,
-#'   `offset`, `tempoffset`, `meantemp` and `sf`.
+#'   `offset`, `tempoffset`, `meantemp` and `sf`, and, with `idle_sleep` or
+#'   `stuck`, `contaminated`: a data frame of the stretches (`kind`,
+#'   `from`, `to`: sample numbers).
 #' @export
 #' @examples
 #' rec <- simulate_recording(hours = 1, sf = 10, seed = 1)
@@ -144,8 +155,14 @@ simulate_recording <- function(hours = 72, sf = 30, params = NULL,
                                tempoffset = c(0, 0, 0), rest_fraction = 0.4,
                                start = as.POSIXct("2024-01-01 00:00:00",
                                                   tz = "UTC"),
-                               seed = NULL) {
+                               seed = NULL, idle_sleep = 0, stuck = 0) {
   check_number(hours, "hours", min = 0, min_inclusive = FALSE)
+  check_number(idle_sleep, "idle_sleep", min = 0)
+  check_number(stuck, "stuck", min = 0)
+  if (idle_sleep + stuck > hours) {
+    abort("`idle_sleep` + `stuck` must be at most `hours` (", format(hours),
+          "), not ", format(idle_sleep + stuck), ".")
+  }
   check_sf(sf)
   check_number(noise, "noise", min = 0)
   check_number(resolution, "resolution", min = 0)
@@ -226,13 +243,54 @@ simulate_recording <- function(hours = 72, sf = 30, params = NULL,
   }
   v <- distort(a, params) + matrix(stats::rnorm(3 * n, sd = noise), ncol = 3)
   if (resolution > 0) v <- round(v / resolution) * resolution
+  bad <- NULL
+  if (idle_sleep + stuck > 0) {
+    cont <- contaminate(v, sf, idle_sleep, stuck)
+    v <- cont$v
+    bad <- cont$stretches
+  }
   out <- data.frame(time = start + tsec, x = v[, 1], y = v[, 2], z = v[, 3])
   if (temperature) out$temperature <- round(temp, 2)
   attr(out, "truth") <- list(
     params = stats::setNames(unname(params), param_names()),
     K = params_to_K(params), offset = unname(params[7:9]),
     tempoffset = tempoffset, meantemp = meantemp, sf = sf)
+  if (!is.null(bad)) attr(out, "truth")$contaminated <- bad
   out
+}
+
+# Samples v (n x 3) with `idle_sleep` and `stuck` hours replaced by
+# 30-minute stretches (see simulate_recording()) at random 30-minute slots;
+# list(v, stretches).
+contaminate <- function(v, sf, idle_sleep, stuck) {
+  n <- nrow(v)
+  slot <- max(1L, as.integer(round(1800 * sf)))
+  slots <- n %/% slot
+  len <- function(h) {
+    k <- as.integer(round(h * 3600 * sf))
+    if (k == 0) return(integer(0))
+    c(rep(slot, k %/% slot), if (k %% slot) k %% slot)
+  }
+  lens <- c(len(idle_sleep), len(stuck))
+  kind <- rep(c("idle_sleep", "stuck"), c(length(len(idle_sleep)),
+                                          length(len(stuck))))
+  if (length(lens) > slots) {
+    abort("`idle_sleep` + `stuck` need ", length(lens), " 30-minute ",
+          "stretches, more than the recording's ", slots, ".")
+  }
+  at <- sample.int(slots, length(lens)) - 1L
+  from <- at * slot + 2L  # keep a sample before each stretch
+  to <- pmin(from + lens - 1L, n)
+  for (i in seq_along(lens)) {
+    val <- v[from[i] - 1L, ]
+    if (kind[i] == "stuck") {
+      val <- val + sample(c(-1, 1), 3, replace = TRUE) *
+        stats::runif(3, 0.05, 0.2)
+    }
+    v[from[i]:to[i], ] <- rep(val, each = to[i] - from[i] + 1L)
+  }
+  list(v = v, stretches = data.frame(kind = kind, from = from, to = to,
+                                     stringsAsFactors = FALSE))
 }
 
 # Unit vectors of typical postures (lying, sitting, arm hanging, ...) with

@@ -65,8 +65,9 @@
 #'   first sample, from `time` when given, else seconds from the start), `n`
 #'   (samples), `mean_x`, `mean_y`, `mean_z`, `sd_x`, `sd_y`, `sd_z`,
 #'   `range_x`, `range_y`, `range_z`, `mean_norm`, `temperature` (NA without
-#'   a temperature column), `n_invalid` (non-finite samples) and `rest`
-#'   (logical). Attributes record `sf`, `method`, `window`, the criterion and
+#'   a temperature column), `n_invalid` (non-finite samples), `n_repeat`
+#'   (samples equal in x, y and z to the sample before them in the window:
+#'   a stuck sensor, ActiGraph's idle sleep, zeros) and `rest` (logical). Attributes record `sf`, `method`, `window`, the criterion and
 #'   `input`: what was read and, for a file, what its reader skipped and why.
 #' @references
 #' Farago D, Maczak B, Gingl Z (2024). Enhancing accuracy in actigraphic
@@ -234,6 +235,7 @@ windows_frame <- function(table, s, sf) {
     mean_norm = col("mean_norm"),
     temperature = col("temperature"),
     n_invalid = as.integer(col("n_invalid")),
+    n_repeat = as.integer(col("n_repeat")),
     rest = as.logical(col("rest"))
   )
   if (!length(first)) w$rest <- logical(0)

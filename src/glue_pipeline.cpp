@@ -200,7 +200,9 @@ gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
       {"min_hours", &c.min_hours}, {"max_error", &c.max_error},
       {"temp_max_first", &c.temp_max_first}, {"temp_min_sd", &c.temp_min_sd},
       {"temp_missing", &c.temp_missing}, {"fill", &c.fill}, {"tol", &c.tol},
-      {"max_weight", &c.max_weight}, {"refit_growth", &c.refit_growth}};
+      {"max_weight", &c.max_weight}, {"refit_growth", &c.refit_growth},
+      {"guard_norm", &c.guard_norm}, {"guard_clip", &c.guard_clip},
+      {"guard_repeat", &c.guard_repeat}};
   for (const auto& f : numbers) *f.field = num(o, f.name);
   if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
   return c;
@@ -249,6 +251,10 @@ Rcpp::List outcome_list(const gravcal::GgirOutcome& r, const RHost& host) {
   out["samples"] = static_cast<double>(r.samples);
   out["warnings"] = Rcpp::wrap(host.warnings);
   out["stopped"] = r.stopped;
+  out["excluded"] = Rcpp::NumericVector::create(
+      Rcpp::Named("norm") = static_cast<double>(r.excluded[0]),
+      Rcpp::Named("clipped") = static_cast<double>(r.excluded[1]),
+      Rcpp::Named("identical") = static_cast<double>(r.excluded[2]));
   return out;
 }
 

@@ -18,6 +18,7 @@ namespace gravcal_glue {
 struct WindowTable {
   std::vector<double> start, mean[3], sd[3], min[3], max[3], norm, temp;
   std::vector<int> n, n_invalid;
+  std::vector<double> n_repeat;
   std::vector<double> index;
   std::vector<int> rest;
 
@@ -35,6 +36,7 @@ struct WindowTable {
     temp.reserve(windows);
     n.reserve(windows);
     n_invalid.reserve(windows);
+    n_repeat.reserve(windows);
     index.reserve(windows);
     rest.reserve(windows);
   }
@@ -44,6 +46,7 @@ struct WindowTable {
     start.push_back(static_cast<double>(s.first));
     n.push_back(s.n);
     n_invalid.push_back(s.n_invalid);
+    n_repeat.push_back(static_cast<double>(s.n_repeat));
     for (int a = 0; a < 3; ++a) {
       mean[a].push_back(s.mean[a]);
       sd[a].push_back(s.sd[a]);
@@ -76,6 +79,7 @@ struct WindowTable {
         Rcpp::Named("max_z") = Rcpp::wrap(max[2]),
         Rcpp::Named("mean_norm") = Rcpp::wrap(norm),
         Rcpp::Named("temperature") = Rcpp::wrap(temp),
+        Rcpp::Named("n_repeat") = Rcpp::wrap(n_repeat),
         Rcpp::Named("rest") = r);
   }
 };

@@ -210,20 +210,22 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
   clean <- calibrate(rec, sf = 10, selection = "paper")
   # the first 5 s window held still at a norm of 0.07 g (a glitch): it lies
   # in the x0, y0 and z0 bands and comes first, so the selector takes it
+  # (constant, so the guard against identical samples is turned off:
+  # this test is of the norm guard; test-rest-quality.R has that one)
   bad <- rec
   bad$x[1:50] <- 0.05
   bad$y[1:50] <- 0.04
   bad$z[1:50] <- 0.03
-  off <- calibrate(bad, sf = 10, selection = "paper", max_norm_error = Inf)
+  off <- calibrate(bad, sf = 10, selection = "paper", max_norm_error = Inf, max_identical = 1)
   expect_equal(off$status, "ok")
   expect_equal(off$points$row[1], 1L)
   expect_equal(off$points$mean_norm[1], sqrt(0.05^2 + 0.04^2 + 0.03^2))
-  expect_equal(off$excluded, c(norm = 0L, clipped = 0L))
+  expect_equal(off$excluded, c(norm = 0L, clipped = 0L, identical = 0L))
   # one such point among 18 shifts the fit: the held-out error is several
   # times the clean fit's (3.5 against 0.46 mg)
   expect_gt(off$error_heldout_after, 4 * clean$error_heldout_after)
-  on <- calibrate(bad, sf = 10, selection = "paper")
-  expect_equal(on$excluded, c(norm = 1L, clipped = 0L))
+  on <- calibrate(bad, sf = 10, selection = "paper", max_identical = 1)
+  expect_equal(on$excluded, c(norm = 1L, clipped = 0L, identical = 0L))
   expect_equal(nrow(on$excluded_windows), 1L)
   expect_equal(on$excluded_windows$why, "norm")
   expect_equal(on$excluded_windows$mean_x, 0.05)
@@ -232,9 +234,9 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
   expect_lt(on$error_heldout_after, 1.1 * clean$error_heldout_after)
   expect_output(print(on), "left out: 1 with \\| \\|v\\| - 1 \\| > 0.3 g")
   # the limit is an argument, checked
-  expect_equal(calibrate(bad, sf = 10, selection = "paper", max_norm_error = 0.95)$excluded,
-               c(norm = 0L, clipped = 0L))
-  expect_error(calibrate(bad, sf = 10, selection = "paper", max_norm_error = -1),
+  expect_equal(calibrate(bad, sf = 10, selection = "paper", max_norm_error = 0.95, max_identical = 1)$excluded,
+               c(norm = 0L, clipped = 0L, identical = 0L))
+  expect_error(calibrate(bad, sf = 10, selection = "paper", max_norm_error = -1, max_identical = 1),
                "`max_norm_error` must be a number > 0")
   # select_points() and fit_gradient() called directly keep the paper's
   # procedure: no guard
@@ -247,27 +249,29 @@ test_that("a rest window that reaches the sensor's range is never a point", {
   clean <- calibrate(rec, sf = 10, selection = "paper")
   # x stuck at the full scale of a +-2 g sensor for the first 5 s: flat, so
   # rest by the range criterion, and in the y0 and z0 bands
+  # (constant, so the guard against identical samples, which would take it
+  # first, is turned off: this test is of the clipping guard)
   clip <- rec
   clip$x[1:50] <- 2
   clip$y[1:50] <- 0.2
   clip$z[1:50] <- 0.1
   # norm guard off, range unknown: taken as a point, and the fit is wrecked
-  off <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf)
-  expect_equal(off$excluded, c(norm = 0L, clipped = 0L))
+  off <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf, max_identical = 1)
+  expect_equal(off$excluded, c(norm = 0L, clipped = 0L, identical = 0L))
   expect_equal(off$status, "implausible")
   # the clipping guard alone excludes it
-  on <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf, range_g = 2)
-  expect_equal(on$excluded, c(norm = 0L, clipped = 1L))
+  on <- calibrate(clip, sf = 10, selection = "paper", max_norm_error = Inf, range_g = 2, max_identical = 1)
+  expect_equal(on$excluded, c(norm = 0L, clipped = 1L, identical = 0L))
   expect_equal(on$excluded_windows$why, "clipped")
   expect_equal(on$status, "ok")
   expect_equal(unname(coef(on)), unname(coef(clean)), tolerance = 1e-6)
   expect_output(print(on), "1 clipped \\(range \\+-2 g\\)")
   # with both guards it counts once, as clipped
-  both <- calibrate(clip, sf = 10, selection = "paper", range_g = 2)
-  expect_equal(both$excluded, c(norm = 0L, clipped = 1L))
+  both <- calibrate(clip, sf = 10, selection = "paper", range_g = 2, max_identical = 1)
+  expect_equal(both$excluded, c(norm = 0L, clipped = 1L, identical = 0L))
   # gravcal's default selection applies the same guards
-  dflt <- calibrate(clip, sf = 10, range_g = 2)
-  expect_equal(dflt$excluded, c(norm = 0L, clipped = 1L))
+  dflt <- calibrate(clip, sf = 10, range_g = 2, max_identical = 1)
+  expect_equal(dflt$excluded, c(norm = 0L, clipped = 1L, identical = 0L))
   expect_equal(dflt$status, "ok")
   expect_false(1L %in% dflt$points$row)
   # a window whose samples come within 2 % of the range is clipped; an
@@ -276,7 +280,7 @@ test_that("a rest window that reaches the sensor's range is never a point", {
                   range_x = c(0.07, 0.01), range_y = 0, range_z = 0)
   expect_equal(gravcal:::guard_windows(w, Inf, 2), c("clipped", NA))
   expect_equal(gravcal:::guard_windows(w, Inf, 8), c(NA_character_, NA))
-  expect_error(calibrate(clip, sf = 10, selection = "paper", range_g = 0), "`range_g` must be")
+  expect_error(calibrate(clip, sf = 10, selection = "paper", range_g = 0, max_identical = 1), "`range_g` must be")
 })
 
 test_that("all rest windows left out is the status no_rest", {
@@ -286,7 +290,7 @@ test_that("all rest windows left out is the status no_rest", {
                       z = rnorm(n, sd = 0.002))
   f <- calibrate(zeros, sf = 10)
   expect_equal(f$status, "no_rest")
-  expect_equal(f$excluded, c(norm = 60L, clipped = 0L))
+  expect_equal(f$excluded, c(norm = 60L, clipped = 0L, identical = 0L))
   expect_match(f$message, "60 windows met the rest criterion but all")
 })
 
@@ -300,15 +304,15 @@ test_that("the clipping guard takes the full scale from a device file", {
   f <- tempfile(fileext = ".cwa")
   on.exit(unlink(f))
   gravcal:::write_cwa(v, f, sf = 25, range = 2)
-  fit <- calibrate(f, max_norm_error = Inf)
+  fit <- calibrate(f, max_norm_error = Inf, max_identical = 1)
   expect_equal(fit$input$range_g, 2)
   expect_equal(fit$guards$range_g, 2)
-  expect_equal(fit$excluded, c(norm = 0L, clipped = 1L))
+  expect_equal(fit$excluded, c(norm = 0L, clipped = 1L, identical = 0L))
   expect_equal(fit$status, "ok")
   # a range given by the user wins: at +-16 g the window is not clipped,
   # is taken as a point and wrecks the fit
   wide <- calibrate(f, max_norm_error = Inf, range_g = 16,
-                    selection = "paper")
-  expect_equal(wide$excluded, c(norm = 0L, clipped = 0L))
+                    selection = "paper", max_identical = 1)
+  expect_equal(wide$excluded, c(norm = 0L, clipped = 0L, identical = 0L))
   expect_equal(wide$status, "implausible")
 })

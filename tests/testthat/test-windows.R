@@ -111,7 +111,8 @@ test_that("bad input gets errors that name the argument", {
   expect_equal(nrow(w), 0)
   expect_named(w, c("start", "n", "mean_x", "mean_y", "mean_z", "sd_x",
                     "sd_y", "sd_z", "range_x", "range_y", "range_z",
-                    "mean_norm", "temperature", "n_invalid", "rest"))
+                    "mean_norm", "temperature", "n_invalid", "n_repeat",
+                    "rest"))
 })
 
 test_that("rest_windows() does not change the caller's data", {

@@ -67,6 +67,15 @@ struct GgirConfig {
   double tol = 1e-10;
   double max_weight = 100.0;
   double refit_growth = 1.25;  // own mode: refit once the table grew by this
+  // own mode's guards on rest windows (compatible mode has none; R's
+  // calibrate() documents them): a window whose mean vector's norm is
+  // farther than guard_norm g from 1 g; one that reaches guard_clip g on
+  // some axis (|mean| + max - min; not positive or NaN: not checked); one
+  // with more than guard_repeat of its samples after the first equal to the
+  // one before (WindowStats::n_repeat). Inf: the guard is off.
+  double guard_norm = INFINITY;
+  double guard_clip = 0.0;
+  double guard_repeat = INFINITY;
 };
 
 // The QC outcome (R maps each to GGIR's message).
@@ -113,7 +122,13 @@ struct GgirOutcome {
   std::int64_t windows = 0;   // windows in the table
   std::int64_t samples = 0;   // samples read
   bool stopped = false;       // interrupted
+  // own mode: rest windows of the last table left out by the guards, by
+  // reason (GgirWhy: norm, clipped, identical)
+  std::int64_t excluded[3] = {0, 0, 0};
 };
+
+// Why own mode's guards leave a rest window out (none: kept).
+enum GgirWhy : unsigned char { why_none = 0, why_norm = 1, why_clipped = 2, why_identical = 3 };
 
 class GgirProcedure {
  public:
@@ -274,7 +289,26 @@ class GgirProcedure {
       for (int a = 0; a < 3; ++a) col_[4 + a].push_back(w.sd[a]);
       if (o.temp_available) col_[7].push_back(o.use_temp ? w.temperature : cfg_.temp_missing);
       rest_.push_back(r.rest);
+      why_.push_back(static_cast<unsigned char>(cfg_.compat || !r.rest ? why_none : guard(w)));
     }
+  }
+
+  // own mode's guards on a rest window (GgirConfig): identical samples
+  // first, then clipping, then the norm (one reason per window)
+  GgirWhy guard(const WindowStats& w) const {
+    const double valid = static_cast<double>(w.n) - static_cast<double>(w.n_invalid);
+    if (valid > 1 && static_cast<double>(w.n_repeat) > cfg_.guard_repeat * (valid - 1)) {
+      return why_identical;
+    }
+    if (cfg_.guard_clip > 0) {
+      for (int a = 0; a < 3; ++a) {
+        if (std::fabs(w.mean[a]) + (w.max[a] - w.min[a]) >= cfg_.guard_clip) return why_clipped;
+      }
+    }
+    const double nm = std::sqrt(w.mean[0] * w.mean[0] + w.mean[1] * w.mean[1] +
+                                w.mean[2] * w.mean[2]);
+    if (std::fabs(nm - 1.0) > cfg_.guard_norm) return why_norm;
+    return why_none;
   }
 
   // GGIR's calibration error: mean | |a| - 1 | over the rows' means after
@@ -313,6 +347,13 @@ class GgirProcedure {
       if (cfg_.compat && col_[0][r] == cfg_.fill) continue;
       idx.push_back(r);
     }
+    // own mode: the rest windows its guards leave out, by reason, counted
+    // before the duplicate filter (which also drops all but the last window
+    // of a run of equal windows, as a stuck sensor's)
+    for (int k = 0; k < 3; ++k) o.excluded[k] = 0;
+    for (const std::size_t r : idx) {
+      if (rest_[r] && why_[r] != why_none) ++o.excluded[why_[r] - 1];
+    }
     if (idx.size() > 1) {
       // consecutive windows equal in 3 (GGIR) or all 6 of means and sds
       const double* cols[7];
@@ -323,6 +364,12 @@ class GgirProcedure {
     }
     o.has_table = false;
     o.nhoursused = 0;
+    // the first window is left out, then the windows at rest, then (own
+    // mode) those its guards leave out
+    std::vector<std::size_t> keep;
+    for (std::size_t j = 1; j < idx.size(); ++j) {
+      if (rest_[idx[j]] && why_[idx[j]] == why_none) keep.push_back(idx[j]);
+    }
     const double n = static_cast<double>(idx.size());
     const bool enough = cfg_.compat ? n > (cfg_.minloadcrit - cfg_.enough_offset)
                                     : !too_short_ && n * 10 >= cfg_.min_hours * 3600;
@@ -332,11 +379,6 @@ class GgirProcedure {
       return false;
     }
     o.nhoursused = (n * 10) / 3600;
-    // the first window is left out, then the windows at rest
-    std::vector<std::size_t> keep;
-    for (std::size_t j = 1; j < idx.size(); ++j) {
-      if (rest_[idx[j]]) keep.push_back(idx[j]);
-    }
     if (keep.size() < static_cast<std::size_t>(cfg_.min_rest)) {
       o.qc = GgirQc::no_rest;
       return false;
@@ -519,6 +561,7 @@ class GgirProcedure {
   std::vector<Row> block_;
   std::vector<double> col_[8];
   std::vector<bool> rest_;
+  std::vector<unsigned char> why_;  // own mode's guard on each rest row (GgirWhy)
   bool pending_ = false;
   bool too_short_ = false;  // own mode: the recording holds under two hours
   double next_fit_ = 0.0;

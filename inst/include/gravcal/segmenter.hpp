@@ -4,7 +4,8 @@
 // The segmenter cuts a sample stream into consecutive, non-overlapping
 // windows of a fixed duration and gives, per window, the mean, standard
 // deviation (n - 1), min, max and range of each axis, the mean of the
-// per-sample vector norm and the mean temperature (WindowStats). The cutting
+// per-sample vector norm, the mean temperature and the number of samples
+// equal in x, y and z to the one before them (WindowStats). The cutting
 // is the window cutter's (window_cutter.hpp); the statistics are one of
 // three policies:
 // - streaming (the default; stats_streaming.hpp): sums about the first

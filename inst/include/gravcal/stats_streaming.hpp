@@ -180,7 +180,7 @@ class StreamingStatsT {
         (t != nullptr && !std::isfinite(lane_total(a.st)))) {
       return false;
     }
-    c_.set_whole(m, t != nullptr, a.lo, a.hi);
+    c_.set_whole(m, t != nullptr, a.lo, a.hi, count_repeats(x, y, z, m));
     for (int k = 0; k < 3; ++k) {
       shift_[k] = k == 0 ? x[0] : k == 1 ? y[0] : z[0];
       for (int l = 0; l < 4; ++l) {

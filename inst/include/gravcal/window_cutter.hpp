@@ -69,6 +69,8 @@ struct WindowCounts {
   std::int64_t n_invalid = 0;  // samples with a non-finite x, y or z
   std::int64_t n_valid = 0;
   std::int64_t n_temp = 0;     // finite temperatures
+  std::int64_t n_repeat = 0;   // valid samples equal to the valid one before
+  double prev[3] = {0.0, 0.0, 0.0};  // the last valid sample
   double min[3] = {INFINITY, INFINITY, INFINITY};
   double max[3] = {-INFINITY, -INFINITY, -INFINITY};
 
@@ -78,16 +80,21 @@ struct WindowCounts {
 
   // A valid sample's min and max; returns its lane (position & 3).
   int add_valid(const double* v) {
+    if (n_valid > 0 && v[0] == prev[0] && v[1] == prev[1] && v[2] == prev[2]) ++n_repeat;
     for (int a = 0; a < 3; ++a) {
+      prev[a] = v[a];
       if (v[a] < min[a]) min[a] = v[a];
       if (v[a] > max[a]) max[a] = v[a];
     }
     return static_cast<int>(n_valid++ & 3);
   }
 
-  // A whole window of m valid samples with min lo and max hi.
-  void set_whole(std::size_t m, bool temperature, const double* lo, const double* hi) {
+  // A whole window of m valid samples with min lo and max hi, `repeats` of
+  // them equal to the one before (count_repeats()).
+  void set_whole(std::size_t m, bool temperature, const double* lo, const double* hi,
+                 std::int64_t repeats) {
     n_invalid = 0;
+    n_repeat = repeats;
     n_valid = static_cast<std::int64_t>(m);
     n_temp = temperature ? n_valid : 0;
     for (int a = 0; a < 3; ++a) {
@@ -98,6 +105,7 @@ struct WindowCounts {
 
   void fill(WindowStats& s) const {
     s.n_invalid = static_cast<std::int32_t>(n_invalid);
+    s.n_repeat = n_repeat;
     for (int a = 0; a < 3; ++a) {
       s.min[a] = n_valid > 0 ? min[a] : NAN;
       s.max[a] = n_valid > 0 ? max[a] : NAN;

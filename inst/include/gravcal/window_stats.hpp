@@ -11,6 +11,7 @@
 #include "fp_contract.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 namespace gravcal {
@@ -28,7 +29,23 @@ struct WindowStats {
   double max[3];
   double mean_norm;    // mean of sqrt(x^2 + y^2 + z^2)
   double temperature;  // mean of finite temperatures, NaN if none
+  std::int64_t n_repeat;  // valid samples equal in x, y and z to the valid
+                          // sample before them in the window: a stuck
+                          // sensor, ActiGraph's idle sleep (the last sample
+                          // repeated), a run of zeros. Last, so that the
+                          // fields before it keep their bytes.
 };
+
+// Of m samples, how many equal the one before them in x, y and z (the
+// whole-window twin of WindowCounts::add_valid()'s count, window_cutter.hpp).
+inline std::int64_t count_repeats(const double* x, const double* y, const double* z,
+                                  std::size_t m) {
+  std::int64_t r = 0;
+  for (std::size_t k = 1; k < m; ++k) {
+    r += (x[k] == x[k - 1]) & (y[k] == y[k - 1]) & (z[k] == z[k - 1]);
+  }
+  return r;
+}
 
 // A sum kept in four lanes by the sample's position in the window (k & 3),
 // joined as (0 + 1) + (2 + 3): the rule every streaming sum follows, so that
