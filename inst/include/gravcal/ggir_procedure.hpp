@@ -67,6 +67,8 @@ struct GgirConfig {
   double tol = 1e-10;
   double max_weight = 100.0;
   double refit_growth = 1.25;  // own mode: refit once the table grew by this
+  std::size_t decide_windows = 10000;  // own mode: most windows (evenly
+                                       // spaced) a decision to read on fits
   // own mode's guards on rest windows (compatible mode has none; R's
   // calibrate() documents them): a window whose mean vector's norm is
   // farther than guard_norm g from 1 g; one that reaches guard_clip g on
@@ -248,7 +250,9 @@ class GgirProcedure {
         pending_ = true;
         due = false;
       }
-      if (last && pending_) due = true;
+      // own mode: the result is always a converged fit on the whole table,
+      // also when the last block added nothing after a decision
+      if (last && (pending_ || decided_)) due = true;
       if (due) stop_loading = fit(o, last);  // [4] - [6]
       if (last || stop_loading) break;
     }
@@ -337,6 +341,7 @@ class GgirProcedure {
   // stop
   bool fit(GgirOutcome& o, bool last) {
     pending_ = false;
+    decided_ = false;
     next_fit_ = static_cast<double>(n_feat()) * cfg_.refit_growth;
     const std::size_t N = col_[0].size();
     std::vector<std::size_t> idx;
@@ -417,7 +422,13 @@ class GgirProcedure {
     // of the time however the refits fall), and fits to convergence, from
     // the identity, only for a result it keeps
     IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r : last ? Rule::converge : Rule::ggir);
-    if (!cfg_.compat && !last && judge(o, r)) r = icp(o, Rule::converge);
+    if (!cfg_.compat && !last) {
+      if (judge(o, r)) {
+        r = icp(o, Rule::converge);
+      } else {
+        decided_ = true;
+      }
+    }
     o.has_icp = true;
     o.icp = r;
     for (int k = 0; k < 3; ++k) {
@@ -444,10 +455,30 @@ class GgirProcedure {
 
   enum class Rule { ggir_r, ggir, converge };
 
-  // the fit on the last table, with GGIR's error after it (error_)
+  // the fit on the last table, with GGIR's error after it (error_). Own
+  // mode's decisions to read on fit at most cfg_.decide_windows evenly
+  // spaced windows of it (their error estimates the table's to well under
+  // a mg), so that the decisions, whose number grows with the log of the
+  // recording's length, cost a fixed time each: the converged fit on the
+  // whole table, when the reading stops, decides the result.
   IcpResult icp(const GgirOutcome& o, Rule rule) {
-    const std::size_t n = o.table_rows.size();
-    const double* t = o.use_temp ? &o.table[7 * n] : nullptr;
+    std::size_t n = o.table_rows.size();
+    const double* col[4] = {&o.table[1 * n], &o.table[2 * n], &o.table[3 * n],
+                            o.use_temp ? &o.table[7 * n] : nullptr};
+    std::vector<double> sub;
+    if (rule == Rule::ggir && n > cfg_.decide_windows && cfg_.decide_windows >= 3) {
+      const std::size_t m = cfg_.decide_windows;
+      sub.resize(4 * m);
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t i = j * n / m;  // evenly spaced, first row first
+        for (int c = 0; c < 4; ++c) sub[c * m + j] = col[c] != nullptr ? col[c][i] : 0.0;
+      }
+      for (int c = 0; c < 4; ++c) {
+        if (col[c] != nullptr) col[c] = &sub[c * m];
+      }
+      n = m;
+    }
+    const double* t = col[3];
     IcpConfig c;
     c.max_iter = cfg_.max_iter;
     c.tol = cfg_.tol;
@@ -466,7 +497,7 @@ class GgirProcedure {
     }
     HostSolver solve{&host_};
     IcpResult r = fit_icp(
-        &o.table[1 * n], &o.table[2 * n], &o.table[3 * n], t, n, c,
+        col[0], col[1], col[2], t, n, c,
         [&](int it, const IcpResult&) {
           if ((it & 15) == 0 && host_.interrupted()) throw Interrupted();
         },
@@ -476,8 +507,7 @@ class GgirProcedure {
       has_warm_ = r.finite && r.temp_used == o.use_temp;
       warm_ = r;
     }
-    const double* m[3] = {&o.table[1 * n], &o.table[2 * n], &o.table[3 * n]};
-    error_ = ggir_error(m, n, r.scale, r.offset, r.tempoffset, t, r.meantemp);
+    error_ = ggir_error(col, n, r.scale, r.offset, r.tempoffset, t, r.meantemp);
     return r;
   }
 
@@ -563,6 +593,7 @@ class GgirProcedure {
   std::vector<bool> rest_;
   std::vector<unsigned char> why_;  // own mode's guard on each rest row (GgirWhy)
   bool pending_ = false;
+  bool decided_ = false;    // own mode: the last fit was a decision's
   bool too_short_ = false;  // own mode: the recording holds under two hours
   double next_fit_ = 0.0;
   double error_ = 0.0;

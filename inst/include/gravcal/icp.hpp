@@ -485,6 +485,11 @@ void icp_converge(const double* const* in, const double* t, std::size_t n, int n
     x0.to[k] = r.tempoffset[k];
   }
   double m0 = 0.0, m1 = 0.0, ms = 0.0;
+  // the longest step tried: grows fourfold after a step of that length is
+  // kept, shrinks to a quarter of a step that is refused (SQUAREM's
+  // adaptive step bound), so that a refused extrapolation is not tried
+  // again at the same length
+  double step_max = 4.0;
   while (evals < cfg.max_iter) {
     if (!step(x0, x1, m0)) {
       r.finite = false;
@@ -518,7 +523,7 @@ void icp_converge(const double* const* in, const double* t, std::size_t n, int n
       rr += a * a;
       vv += b * b;
     }
-    const double alpha = vv > 0.0 ? -std::sqrt(rr / vv) : -1.0;
+    const double alpha = vv > 0.0 ? std::fmax(-std::sqrt(rr / vv), -step_max) : -1.0;
     if (!(alpha < -1.0) || evals >= cfg.max_iter) {
       x0 = x2;
       continue;
@@ -533,6 +538,7 @@ void icp_converge(const double* const* in, const double* t, std::size_t n, int n
     // loss is no higher than that of x1 (each map lowers it: x2's is lower)
     const int before = evals;
     if (step(xs, x3, ms) && ms <= m1) {
+      if (-alpha >= step_max) step_max *= 4.0;
       if (change(xs, x3) < cfg.tol) {
         r.converged = true;
         x0 = x3;
@@ -541,6 +547,7 @@ void icp_converge(const double* const* in, const double* t, std::size_t n, int n
       x0 = x3;
     } else {
       evals = before + 1;  // the pass was made, its result is not kept
+      step_max = std::fmax(1.0, -alpha / 4.0);
       x0 = x2;
     }
   }
