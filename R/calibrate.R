@@ -257,8 +257,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   method <- match_choice(method, "method")
   check_flag(ggir_compat, "ggir_compat")
   if (method == "ggir") {
+    # segments and the adaptive budget (gravcal's own mode only)
+    dots <- list(...)
+    over <- ggir_over_time(dots, ggir_compat)
+    if (!is.null(over)) dots <- dots[!names(dots) %in% ggir_over_time_names]
     return(calibrate_ggir(x, if (missing(sf)) NULL else sf, ggir_compat,
-                          list(...), call))
+                          dots, call, over))
   }
   if (is.character(x)) {
     # a file: read block by block by rest_windows()

@@ -67,11 +67,21 @@ struct GgirConfig {
   double tol = 1e-10;
   double max_weight = 100.0;
   double refit_growth = 1.25;  // own mode: refit once the table grew by this
+  // own mode only: when to stop reading. 0: GGIR's rule (the error target
+  // met after minloadcrit hours); 1: read the whole recording (coefficients
+  // per segment of time need every part of it); 2: the adaptive budget: a
+  // converged fit every check_hours of windows (or once the table grew by
+  // refit_growth, whichever is later), and stop once GGIR's error target
+  // is met and the host's enough() says the coefficients are determined
+  int reading = 0;
+  double check_hours = 6.0;
 };
 
 // The QC outcome (R maps each to GGIR's message).
 enum class GgirQc { none, done, done_no_temp, attempted, no_decrease, no_sphere,
                     no_rest, no_data, not_finite };
+
+struct GgirOutcome;
 
 class GgirHost {
  public:
@@ -87,6 +97,10 @@ class GgirHost {
   virtual void block_added(int i) { (void)i; }
   // true: abandon the run (an interrupt); may also throw
   virtual bool interrupted() { return false; }
+  // the adaptive budget's stop rule (GgirConfig::reading == 2): after a
+  // converged fit that meets GGIR's error target, true stops the reading
+  // (o holds the fit and its table)
+  virtual bool enough(const GgirOutcome& o) { (void)o; return false; }
 };
 
 struct GgirOutcome {
@@ -113,6 +127,7 @@ struct GgirOutcome {
   std::int64_t windows = 0;   // windows in the table
   std::int64_t samples = 0;   // samples read
   bool stopped = false;       // interrupted
+  bool early = false;         // the reading stopped before the recording's end
 };
 
 class GgirProcedure {
@@ -227,15 +242,17 @@ class GgirProcedure {
       // refits before the last block only once the table has grown by a
       // quarter, so that time stays linear when the target is never met.
       bool due = added || i == 1;
-      if (due && !last &&
-          (static_cast<double>(n_feat()) * 10 / 3600 <= cfg_.minloadcrit ||
-           (!cfg_.compat && static_cast<double>(n_feat()) < next_fit_))) {
+      if (due && !last && defer()) {
         pending_ = true;
         due = false;
       }
       if (last && pending_) due = true;
       if (due) stop_loading = fit(o, last);  // [4] - [6]
-      if (last || stop_loading) break;
+      if (last) break;
+      if (stop_loading) {
+        o.early = true;
+        break;
+      }
     }
     finish(o);  // [7]
   }
@@ -246,6 +263,21 @@ class GgirProcedure {
   };
 
   std::int64_t n_feat() const { return static_cast<std::int64_t>(col_[0].size()); }
+
+  int reading() const { return cfg_.compat ? 0 : cfg_.reading; }
+
+  // whether the fit after a block that is not the last can wait
+  bool defer() const {
+    const double n = static_cast<double>(n_feat());
+    switch (reading()) {
+      case 1:
+        return true;
+      case 2:
+        return n < next_fit_ || n < next_check_;
+      default:
+        return n * 10 / 3600 <= cfg_.minloadcrit || (!cfg_.compat && n < next_fit_);
+    }
+  }
 
   // [2] GGIR's temperature checks on a block's used samples: false, with a
   // warning, when the temperature cannot be used.
@@ -304,6 +336,7 @@ class GgirProcedure {
   bool fit(GgirOutcome& o, bool last) {
     pending_ = false;
     next_fit_ = static_cast<double>(n_feat()) * cfg_.refit_growth;
+    next_check_ = static_cast<double>(n_feat()) + cfg_.check_hours * 3600 / 10;
     const std::size_t N = col_[0].size();
     std::vector<std::size_t> idx;
     idx.reserve(N);
@@ -371,8 +404,11 @@ class GgirProcedure {
     // [5] compatible mode fits as GGIR does; gravcal's own mode decides
     // whether to read on with GGIR's cheap early stop, and fits to
     // convergence only for a result it keeps
-    IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r : last ? Rule::converge : Rule::ggir);
-    if (!cfg_.compat && !last && judge(o, r)) r = icp(o, Rule::converge);
+    // (the adaptive budget judges converged fits only)
+    const bool adaptive = reading() == 2;
+    IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r
+                         : (last || adaptive) ? Rule::converge : Rule::ggir);
+    if (!cfg_.compat && !last && !adaptive && judge(o, r, last)) r = icp(o, Rule::converge);
     o.has_icp = true;
     o.icp = r;
     for (int k = 0; k < 3; ++k) {
@@ -385,9 +421,9 @@ class GgirProcedure {
     o.error_end = error_;
     o.has_error_end = true;
     // [6]
-    if (judge(o, r)) {
+    if (judge(o, r, last)) {
       o.qc = o.use_temp == o.temp_available ? GgirQc::done : GgirQc::done_no_temp;
-      return true;
+      return reading() != 1;
     }
     if (o.nhoursused > cfg_.minloadcrit) {
       host_.print("\nnew calibration error: " + r_number(o.error_end) + " g");
@@ -423,10 +459,16 @@ class GgirProcedure {
     return r;
   }
 
-  bool judge(const GgirOutcome& o, const IcpResult&) const {
+  bool judge(const GgirOutcome& o, const IcpResult& r, bool last) {
     // NaN compares false, as R's isTRUE() of NA
-    return error_ < o.error_start && error_ < cfg_.max_error &&
-           o.nhoursused > cfg_.minloadcrit;
+    const bool good = error_ < o.error_start && error_ < cfg_.max_error;
+    if (reading() == 2 && !last) {
+      // the adaptive budget: the host's rule in place of minloadcrit, on a
+      // finite fit (at the last block, GGIR's rule says whether it is done)
+      // (o already holds this fit's coefficients and error)
+      return good && r.finite && host_.enough(o);
+    }
+    return good && o.nhoursused > cfg_.minloadcrit;
   }
 
   // [7]
@@ -504,6 +546,7 @@ class GgirProcedure {
   bool pending_ = false;
   bool too_short_ = false;  // own mode: the recording holds under two hours
   double next_fit_ = 0.0;
+  double next_check_ = 0.0;  // adaptive budget: the next check, in windows
   double error_ = 0.0;
 };
 
