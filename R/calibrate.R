@@ -100,7 +100,8 @@
 #' `.se` suffix); [apply_calibration()] applies each segment's
 #' coefficients to its samples, and `plot(fit, type = "segments")` draws
 #' them over time. A recording without drift comes out as one segment.
-#' `K`, `offset` and `tempoffset` stay those of the whole recording.
+#' `K`, `offset` and `tempoffset` stay those of the whole recording. The
+#' GGIR method takes `segments` too (see "The GGIR method").
 #'
 #' **An adaptive data budget.** With `budget = "adaptive"` the lightweight
 #' method reads the recording block by block and, every `check_hours` (6)
@@ -110,8 +111,8 @@
 #' coefficients moved by less than two standard errors of their
 #' difference since the previous check. `fit$budget` says how much was
 #' read (`hours_read`, and `hours_total` for samples in memory) and
-#' whether it stopped early (`stopped`); `print()` shows it. GGIR's
-#' procedure keeps its own rule (`minloadcrit`).
+#' whether it stopped early (`stopped`); `print()` shows it. The GGIR
+#' method takes `budget` too (see "The GGIR method").
 #'
 #' The fit records the windows left out: `excluded` (counts, named `norm`
 #' and `clipped`; a clipped window counts as clipped only),
@@ -170,7 +171,9 @@
 #'   `reader` (`"native"` or `"reference"`, see [rest_windows()]),
 #'   `rmc` (GGIR's `rmc.*` parameters of an ad hoc csv file, see
 #'   [rest_windows()]; the rest rule stays `max_sd`, where
-#'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`) and `verbose`.
+#'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`), `verbose`, and in
+#'   gravcal's own mode (`ggir_compat = FALSE`) `segments`, `change_alpha`,
+#'   `budget`, `target_se` and `check_hours` (see "The GGIR method").
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
 #' [g.calibrate()] for the steps) and returns a `gravcal_fit` whose `K` is
@@ -215,6 +218,29 @@
 #'    does (a few iterations), refits only once the window table has grown
 #'    by a quarter, and fits to convergence for the result it returns; it
 #'    may therefore read up to a quarter more than GGIR before it stops.
+#'
+#' **Beyond one fit** (gravcal's own mode; GGIR has no such parameters, so
+#' `ggir_compat = TRUE` and [g.calibrate()] refuse them with an error naming
+#' them). With `segments = "day"` (or a number of hours) the procedure
+#' reads the whole recording (`minloadcrit` no longer stops it), then fits
+#' GGIR's model (scale, offset and, when the whole fit used it, temperature
+#' offset) to the rest windows of each segment of time (window i of the
+#' procedure starts (i - 1) * 10 s after the first sample) and merges
+#' neighbours as the lightweight method does (a Wald test at
+#' `change_alpha`; a segment that does not cover the sphere or whose scale
+#' or offset has a standard error above 0.01 joins a neighbour). Each
+#' segment's offsets are referred to the whole recording's `meantemp`, so
+#' that its temperature term applies as the whole fit's does. `fit$segments`
+#' and [apply_calibration()] are as for the lightweight method, with times
+#' in seconds from the first sample. With `budget = "adaptive"` the
+#' procedure fits to convergence every `check_hours` hours of windows (at
+#' the end of a block, and not before the table has grown by a quarter)
+#' and, in place of `minloadcrit`, stops reading once GGIR's error target
+#' is met (error below 10 mg and below the error before) and every
+#' standard error is at most `target_se`, with the coefficients (at the
+#' same reference temperature) stable since the previous check.
+#' `fit$budget` is as for the lightweight method. The two cannot be
+#' combined (segments need the whole recording).
 #'
 #' Window statistics in compatible mode are computed in GGIR's arithmetic
 #' (R's `cumsum()` and `sd()`, bit for bit) so that its exact-equality rules
