@@ -295,7 +295,9 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
   ggir_over_time_fit(fit, over, a, src$sf, early,
-                     hours_total = if (!is.character(x)) NROW(x) / src$sf / 3600)
+                     hours_total = if (!is.character(x)) {
+                       NROW(x) / src$sf / 3600
+                     })
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.

@@ -266,8 +266,8 @@ ggir_budget_rule <- function(target_se, minloadcrit) {
       return(FALSE)
     }
     # the previous check's offsets at this fit's reference temperature
-    done <- budget_met(f, if (!is.null(prev)) ggir_rereference(prev, f$meantemp),
-                       target_se)
+    if (!is.null(prev)) prev <- ggir_rereference(prev, f$meantemp)
+    done <- budget_met(f, prev, target_se)
     prev <<- f
     done
   }

@@ -5,16 +5,16 @@
 # Each segment's rest windows are fitted with the model the whole recording
 # chose (same parameters, same reference temperature, so that their
 # coefficients are comparable): the lightweight model (segment_fitter_lw())
-# or GGIR's scale, offset and temperature offset (segment_fitter_ggir()). Then, repeatedly: a segment that cannot be
-# fitted alone (too few distinct postures for the model) is merged with a
-# neighbour; otherwise the pair of neighbours least different is merged
-# when a Wald test of their difference (wald_test(): d' (V1 + V2)^-1 d
-# against chi-squared with as many degrees of freedom as coefficients) has a
-# p-value above `change_alpha` divided by the number of pairs left (a
-# Bonferroni bound over the pairs, so that a recording without drift comes
-# out as one segment in at least 1 - change_alpha of cases when the
-# standard errors are right). A merged segment is refitted on the union of
-# its windows.
+# or GGIR's scale, offset and temperature offset (segment_fitter_ggir()).
+# Then, repeatedly: a segment that cannot be fitted alone (too few distinct
+# postures for the model) is merged with a neighbour; otherwise the pair of
+# neighbours least different is merged when a Wald test of their
+# difference (wald_test(): d' (V1 + V2)^-1 d against chi-squared with as
+# many degrees of freedom as coefficients) has a p-value above
+# `change_alpha` divided by the number of pairs left (a Bonferroni bound
+# over the pairs, so that a recording without drift comes out as one
+# segment in at least 1 - change_alpha of cases when the standard errors
+# are right). A merged segment is refitted on the union of its windows.
 
 # Seconds per segment from `segments`: "day" or a number of hours.
 segment_seconds <- function(segments) {

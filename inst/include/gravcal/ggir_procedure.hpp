@@ -14,7 +14,8 @@
 //   [5] fit scale, offset and temperature offset by weighted iterative
 //       closest point (icp.hpp) and compute GGIR's error;
 //   [6] stop once the error is small enough after minloadcrit hours, else
-//       read on;
+//       read on (gravcal's own mode may instead read the whole recording,
+//       or stop when the host's enough() says so: GgirConfig::reading);
 //   [7] after the last block, the QC outcome.
 // GGIR-compatible mode keeps every rule as GGIR has it; gravcal's own mode
 // departs where GGIR's behaviour is an accident (see R/ggir.R's header).
