@@ -117,7 +117,8 @@
 #' `.se` suffix); [apply_calibration()] applies each segment's
 #' coefficients to its samples, and `plot(fit, type = "segments")` draws
 #' them over time. A recording without drift comes out as one segment.
-#' `K`, `offset` and `tempoffset` stay those of the whole recording.
+#' `K`, `offset` and `tempoffset` stay those of the whole recording. The
+#' GGIR method takes `segments` too (see "The GGIR method").
 #'
 #' **An adaptive data budget.** With `budget = "adaptive"` the lightweight
 #' method reads the recording block by block and, every `check_hours` (6)
@@ -127,8 +128,8 @@
 #' coefficients moved by less than two standard errors of their
 #' difference since the previous check. `fit$budget` says how much was
 #' read (`hours_read`, and `hours_total` for samples in memory) and
-#' whether it stopped early (`stopped`); `print()` shows it. GGIR's
-#' procedure keeps its own rule (`minloadcrit`).
+#' whether it stopped early (`stopped`); `print()` shows it. The GGIR
+#' method takes `budget` too (see "The GGIR method").
 #'
 #' The fit records the windows left out: `excluded` (counts, named `norm`,
 #' `clipped` and `identical`), `excluded_windows` (those windows, with a
@@ -190,9 +191,10 @@
 #'   `rmc` (GGIR's `rmc.*` parameters of an ad hoc csv file, see
 #'   [rest_windows()]; the rest rule stays `max_sd`, where
 #'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`), `verbose` and, in
-#'   gravcal's own mode only, the guards `max_norm_error`, `range_g` and
-#'   `max_identical` (as for the lightweight method; an error with
-#'   `ggir_compat = TRUE`).
+#'   gravcal's own mode only (an error with `ggir_compat = TRUE`), the
+#'   guards `max_norm_error`, `range_g` and `max_identical` (as for the
+#'   lightweight method), `segments`, `change_alpha`, `budget`, `target_se`
+#'   and `check_hours` (see "The GGIR method").
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
 #' [g.calibrate()] for the steps) and returns a `gravcal_fit` whose `K` is
@@ -241,6 +243,29 @@
 #'    than GGIR before it stops. Twice the recording takes about twice the
 #'    time (`bench/results/ggir-own-scaling.md`).
 #'
+#' **Beyond one fit** (gravcal's own mode; GGIR has no such parameters, so
+#' `ggir_compat = TRUE` and [g.calibrate()] refuse them with an error naming
+#' them). With `segments = "day"` (or a number of hours) the procedure
+#' reads the whole recording (`minloadcrit` no longer stops it), then fits
+#' GGIR's model (scale, offset and, when the whole fit used it, temperature
+#' offset) to the rest windows of each segment of time (window i of the
+#' procedure starts (i - 1) * 10 s after the first sample) and merges
+#' neighbours as the lightweight method does (a Wald test at
+#' `change_alpha`; a segment that does not cover the sphere or whose scale
+#' or offset has a standard error above 0.01 joins a neighbour). Each
+#' segment's offsets are referred to the whole recording's `meantemp`, so
+#' that its temperature term applies as the whole fit's does. `fit$segments`
+#' and [apply_calibration()] are as for the lightweight method, with times
+#' in seconds from the first sample. With `budget = "adaptive"` the
+#' procedure fits to convergence every `check_hours` hours of windows (at
+#' the end of a block, and not before the table has grown by a quarter)
+#' and, in place of `minloadcrit`, stops reading once GGIR's error target
+#' is met (error below 10 mg and below the error before) and every
+#' standard error is at most `target_se`, with the coefficients (at the
+#' same reference temperature) stable since the previous check.
+#' `fit$budget` is as for the lightweight method. The two cannot be
+#' combined (segments need the whole recording).
+#'
 #' Window statistics in compatible mode are computed in GGIR's arithmetic
 #' (R's `cumsum()` and `sd()`, bit for bit) so that its exact-equality rules
 #' decide the same way; gravcal's own mode uses the streaming arithmetic.
@@ -283,8 +308,12 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
   method <- match_choice(method, "method")
   check_flag(ggir_compat, "ggir_compat")
   if (method == "ggir") {
+    # segments and the adaptive budget (gravcal's own mode only)
+    dots <- list(...)
+    over <- ggir_over_time(dots, ggir_compat)
+    if (!is.null(over)) dots <- dots[!names(dots) %in% ggir_over_time_names]
     return(calibrate_ggir(x, if (missing(sf)) NULL else sf, ggir_compat,
-                          list(...), call))
+                          dots, call, over))
   }
   if (is.character(x)) {
     # a file: read block by block by rest_windows()

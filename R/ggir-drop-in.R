@@ -196,6 +196,13 @@ ggir_params <- function(params_rawdata, params_general, dots) {
   }
   known <- c(ggir_param_known(), "sf", "use.temp", "outputdir", "studyname")
   extra <- setdiff(names(dots), known)
+  over <- intersect(extra, ggir_over_time_names)
+  if (length(over)) {
+    abort("g.calibrate(): ", paste0("`", over, "`", collapse = ", "),
+          ": GGIR's g.calibrate() has no such parameter (coefficients per ",
+          "segment of time and the adaptive budget are gravcal's own mode's: ",
+          "calibrate(method = \"ggir\"), ggir_compat = FALSE).")
+  }
   if (length(extra)) {
     warning("g.calibrate(): ignored argument", if (length(extra) > 1) "s",
             " ", paste0("`", extra, "`", collapse = ", "), call. = FALSE)
@@ -257,8 +264,9 @@ cwa_time_span <- function(file) {
   range(t)
 }
 
-# calibrate(method = "ggir"): the procedure, then a gravcal_fit.
-calibrate_ggir <- function(x, sf, compat, dots, call) {
+# calibrate(method = "ggir"): the procedure, then a gravcal_fit. `over`:
+# the choices beyond one fit (ggir_over_time(); NULL: none).
+calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   d <- split_dots(dots, list(ggir = ggir_param_names("own"),
                              guards = c("max_norm_error", "range_g",
                                         "max_identical")))
@@ -291,8 +299,14 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   res <- ggir_run_exact(src, open, compat = compat, spherecrit = a$spherecrit,
                         minloadcrit = a$minloadcrit, sdcriter = a$max_sd,
                         verbose = a$verbose, max_iter = a$max_iter, tol = a$tol,
-                        guards = guards)
+                        guards = guards,
+                        reading = ggir_reading(over),
+                        check_hours = over$check_hours %||% 6,
+                        on_fit = if (identical(over$budget, "adaptive")) {
+                          ggir_budget_rule(over$target_se, a$minloadcrit)
+                        })
   ex <- attr(res, "gravcal")$excluded
+  early <- isTRUE(attr(res, "gravcal")$early)
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!compat) {
     fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
@@ -309,7 +323,10 @@ calibrate_ggir <- function(x, sf, compat, dots, call) {
   }
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
-  fit
+  ggir_over_time_fit(fit, over, a, src$sf, early,
+                     hours_total = if (!is.character(x)) {
+                       NROW(x) / src$sf / 3600
+                     })
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.

@@ -94,7 +94,8 @@ ggir_run <- function(src, compat = TRUE,
                      sdcriter = ggir_constants$max_sd, verbose = FALSE,
                      printsummary = FALSE, max_iter = ggir_constants$max_iter,
                      tol = ggir_constants$tol, lazy = TRUE,
-                     guards = NULL) {
+                     guards = NULL, reading = "ggir", check_hours = 6,
+                     on_fit = NULL) {
   sf <- src$sf
   if (!(10 * sf >= 1 && 10 * sf < 1e7)) {
     abort("`sf` must give 1 to 1e7 samples in a 10 s window, not ",
@@ -106,7 +107,11 @@ ggir_run <- function(src, compat = TRUE,
                        tol, verbose, block_units = src$units,
                        short_block_rows = src$short_rows %||% 0,
                        temperature = isTRUE(src$temperature), lazy = lazy,
-                       guards = guards)
+                       guards = guards, reading = reading,
+                       check_hours = check_hours)
+  # the adaptive budget's rule, called by the core after a converged fit
+  # that meets GGIR's error target (GgirHost::enough())
+  if (!is.null(on_fit)) opts$on_fit <- on_fit
   # memory in use after each block (GGIR records R's heap from a full gc(),
   # which costs about as much as decoding the block)
   bsc <- list()
@@ -124,9 +129,14 @@ ggir_run <- function(src, compat = TRUE,
 
 # The procedure's settings for the core (GgirConfig in ggir_procedure.hpp):
 # the user's, then GGIR's constants.
+# `reading` (own mode only): when to stop reading: "ggir" (GGIR's rule,
+# minloadcrit), "all" (the whole recording, for coefficients per segment of
+# time) or "adaptive" (the adaptive budget: a check every `check_hours`
+# hours of windows, or once the table grew by a quarter, whichever is later).
 ggir_options <- function(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter,
                          tol, verbose, block_units = 0, short_block_rows = 0,
-                         temperature = TRUE, lazy = TRUE, guards = NULL) {
+                         temperature = TRUE, lazy = TRUE, guards = NULL,
+                         reading = "ggir", check_hours = 6) {
   k <- ggir_constants
   # own mode's guards on rest windows (see guard_windows(), lightweight.R);
   # none in compatible mode, nor when not given
@@ -145,7 +155,9 @@ ggir_options <- function(compat, sf, spherecrit, minloadcrit, sdcriter, max_iter
                verbose = verbose,
                guard_norm = if (is.null(g$max_norm_error)) Inf else g$max_norm_error,
                guard_clip = clip,
-               guard_repeat = if (is.null(g$max_identical)) Inf else g$max_identical)
+               guard_repeat = if (is.null(g$max_identical)) Inf else g$max_identical,
+               reading = match(reading, c("ggir", "all", "adaptive")) - 1,
+               check_hours = check_hours)
   lapply(opts, as.numeric)
 }
 
@@ -176,7 +188,8 @@ ggir_result <- function(r, bsc_qc, input, verbose = FALSE, printsummary = FALSE)
   attr(out, "gravcal") <- list(icp = icp, meantemp = r$meantemp,
                                blocks = r$blocks, input = input,
                                temp.available = r$temp.available,
-                               windows = r$windows, excluded = r$excluded)
+                               windows = r$windows, excluded = r$excluded,
+                               early = isTRUE(r$early))
   out
 }
 
@@ -208,4 +221,83 @@ ggir_run_exact <- function(src, open, compat, ...) {
     out <- ggir_run(open(), compat = compat, ..., lazy = FALSE)
   }
   out
+}
+
+# gravcal's own mode beyond one fit: coefficients per segment of time
+# (`segments`, `change_alpha`) and the adaptive budget (`budget`,
+# `target_se`, `check_hours`), as for the lightweight method. GGIR's
+# g.calibrate() has no such parameters, so compatible mode refuses them.
+ggir_over_time_names <- c("segments", "change_alpha", "budget", "target_se",
+                          "check_hours")
+
+# These arguments from calibrate()'s `...`, checked (check_choice_args());
+# NULL when none is given.
+ggir_over_time <- function(dots, compat) {
+  given <- intersect(names(dots), ggir_over_time_names)
+  if (!length(given)) return(NULL)
+  if (compat) {
+    abort(paste0("`", given, "`", collapse = ", "), " cannot be used with ",
+          "`ggir_compat = TRUE`: GGIR's g.calibrate() has no such ",
+          "parameter (coefficients per segment of time and the adaptive ",
+          "budget are gravcal's own mode's; give `ggir_compat = FALSE`).")
+  }
+  ch <- check_choice_args(dots[given], list())
+  if (!is.null(ch$segments) && ch$budget == "adaptive") {
+    abort("`segments` and `budget = \"adaptive\"` cannot be combined for ",
+          "`method = \"ggir\"`: coefficients per segment of time need the ",
+          "whole recording read.")
+  }
+  ch
+}
+
+# How the procedure reads for these choices (ggir_options()'s `reading`).
+ggir_reading <- function(over) {
+  if (is.null(over)) return("ggir")
+  if (!is.null(over$segments)) return("all")
+  if (identical(over$budget, "adaptive")) return("adaptive")
+  "ggir"
+}
+
+# The adaptive budget's stop rule for GGIR's procedure: the core calls it
+# (GgirHost::enough()) with its outcome after a converged fit that meets
+# GGIR's error target; TRUE stops the reading once the fit's standard
+# errors (those of ggir_fit(): the Jacobian at the solution with GGIR's
+# weights) are at most target_se and the coefficients are stable since the
+# previous check (budget_met(), as for the lightweight method).
+ggir_budget_rule <- function(target_se, minloadcrit) {
+  prev <- NULL
+  function(r) {
+    r$warnings <- character(0)  # the run reports them once, at its end
+    r$qc <- "done"              # the core called: GGIR's error target met
+    f <- ggir_fit(ggir_result(r, data.frame(), list()), FALSE, call = NULL,
+                  minloadcrit)
+    if (!identical(f$status, "ok")) {
+      prev <<- NULL
+      return(FALSE)
+    }
+    # the previous check's offsets at this fit's reference temperature
+    if (!is.null(prev)) prev <- ggir_rereference(prev, f$meantemp)
+    done <- budget_met(f, prev, target_se)
+    prev <<- f
+    done
+  }
+}
+
+# A fit of GGIR's model with its temperature term referred to `meantemp`
+# instead of the mean temperature of its points, where GGIR's ICP centres
+# it: the same model, (v + o) s + (T - m') t = (v + o + (m - m') t / s) s +
+# (T - m) t, so only the offsets move; the covariance is taken again there
+# (add_uncertainty(), GGIR's weights), so that fits of different stretches
+# of a recording compare (segments, the adaptive budget's checks).
+ggir_rereference <- function(f, meantemp) {
+  if (!isTRUE(f$use_temp) || !any(f$tempoffset != 0) ||
+      !isTRUE(is.finite(meantemp)) || identical(f$meantemp, meantemp)) {
+    return(f)
+  }
+  f$offset <- f$offset + (meantemp - f$meantemp) * f$tempoffset / diag(f$K)
+  f$meantemp <- meantemp
+  pts <- f$points
+  add_uncertainty(f, cbind(pts$mean_x, pts$mean_y, pts$mean_z),
+                  pts$temperature, weights = "ggir",
+                  max_weight = ggir_constants$max_weight)
 }

@@ -100,8 +100,9 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
     fit$selection <- choice
     fit <- guard_fit(fit)
     if (!is.null(choice$segments) && fit$status == "ok") {
-      fit <- fit_segments(fit, rest, origin = w$start[1], args$fit_gradient,
-                          choice)
+      fit <- fit_segments(fit, rest$start, origin = w$start[1],
+                          segment_fitter_lw(fit, rest, args$fit_gradient,
+                                            choice), choice)
       fit$segment_settings$time <- if (timed) "time" else "seconds"
       fit$segment_settings$sf <- attr(w, "sf")
     }

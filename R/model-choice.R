@@ -78,15 +78,24 @@ budget_rule <- function(fargs, choice, max_norm_error, range_g,
       prev <<- NULL
       return(FALSE)
     }
-    nm <- f$model
-    se <- f$se[nm]
-    done <- all(is.finite(se)) && all(se <= choice$target_se) &&
-      !is.null(prev) && identical(prev$model, nm) &&
-      all(abs(stats::coef(f)[nm] - stats::coef(prev)[nm]) <=
-            2 * sqrt(se^2 + prev$se[nm]^2))
+    done <- budget_met(f, prev, choice$target_se)
     prev <<- f
     done
   }
+}
+
+# The adaptive budget's test on a fit `f` and the previous check's `prev`
+# (NULL: none): every standard error of f's coefficients at most
+# `target_se`, and each moved by less than two standard errors of the
+# difference since `prev`, which fitted the same coefficients. Shared by
+# both methods (budget_rule(), ggir_budget_rule()).
+budget_met <- function(f, prev, target_se) {
+  nm <- f$model
+  se <- f$se[nm]
+  length(nm) > 0 && all(is.finite(se)) && all(se <= target_se) &&
+    !is.null(prev) && identical(prev$model, nm) &&
+    all(abs(stats::coef(f)[nm] - stats::coef(prev)[nm]) <=
+          2 * sqrt(se^2 + prev$se[nm]^2))
 }
 
 # The largest standard error (HC3) a fitted parameter may have for its

@@ -127,11 +127,15 @@ Rcpp::List run_samples(gravcal::Source& src, const Rcpp::List& o) {
   return out;
 }
 
+class RHost;
+Rcpp::List outcome_list(const gravcal::GgirOutcome& r, const RHost& host);
+
 // What GGIR's procedure borrows from R.
 class RHost : public gravcal::GgirHost {
  public:
-  RHost(bool verbose, Rcpp::Nullable<Rcpp::Function> on_block)
-      : verbose_(verbose), on_block_(on_block) {}
+  RHost(bool verbose, Rcpp::Nullable<Rcpp::Function> on_block,
+        Rcpp::Nullable<Rcpp::Function> on_fit = R_NilValue)
+      : verbose_(verbose), on_block_(on_block), on_fit_(on_fit) {}
   double round_digits(double x, int digits) override {
     return R::fround(x, static_cast<double>(digits));
   }
@@ -147,11 +151,14 @@ class RHost : public gravcal::GgirHost {
     if (on_block_.isNotNull()) Rcpp::Function(on_block_.get())(i);
   }
   bool interrupted() override { return interrupt_tick(); }
+  // the adaptive budget's rule: R's on_fit(outcome) (see ggir_run())
+  bool enough(const gravcal::GgirOutcome& o) override;
   std::vector<std::string> warnings;
 
  private:
   bool verbose_;
   Rcpp::Nullable<Rcpp::Function> on_block_;
+  Rcpp::Nullable<Rcpp::Function> on_fit_;
   gravcal_glue::RLeastSquares ls_;
 };
 
@@ -189,6 +196,8 @@ gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
   c.min_rest = static_cast<int>(num(o, "min_rest"));
   c.error_digits = static_cast<int>(num(o, "error_digits"));
   c.max_iter = static_cast<int>(num(o, "max_iter"));
+  c.reading = static_cast<int>(num(o, "reading"));
+  if (c.reading < 0 || c.reading > 2) Rcpp::stop("reading must be 0, 1 or 2");
   const struct {
     const char* name;
     double* field;
@@ -202,7 +211,7 @@ gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
       {"temp_missing", &c.temp_missing}, {"fill", &c.fill}, {"tol", &c.tol},
       {"max_weight", &c.max_weight}, {"refit_growth", &c.refit_growth},
       {"guard_norm", &c.guard_norm}, {"guard_clip", &c.guard_clip},
-      {"guard_repeat", &c.guard_repeat}};
+      {"guard_repeat", &c.guard_repeat}, {"check_hours", &c.check_hours}};
   for (const auto& f : numbers) *f.field = num(o, f.name);
   if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
   return c;
@@ -255,13 +264,28 @@ Rcpp::List outcome_list(const gravcal::GgirOutcome& r, const RHost& host) {
       Rcpp::Named("norm") = static_cast<double>(r.excluded[0]),
       Rcpp::Named("clipped") = static_cast<double>(r.excluded[1]),
       Rcpp::Named("identical") = static_cast<double>(r.excluded[2]));
+  out["early"] = r.early;
   return out;
+}
+
+bool RHost::enough(const gravcal::GgirOutcome& o) {
+  if (on_fit_.isNull()) return false;
+  Rcpp::LogicalVector v = Rcpp::Function(on_fit_.get())(outcome_list(o, *this));
+  return v.size() == 1 && v[0] == TRUE;
+}
+
+// the R function in opts$on_fit, if any
+Rcpp::Nullable<Rcpp::Function> on_fit(const Rcpp::List& o) {
+  if (!o.containsElementNamed("on_fit")) return R_NilValue;
+  SEXP f = o["on_fit"];
+  if (Rf_isNull(f)) return R_NilValue;
+  return Rcpp::Function(f);
 }
 
 // GGIR's procedure over the source (ggir_procedure.hpp).
 Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
                     Rcpp::Nullable<Rcpp::Function> on_block) {
-  RHost host(num(o, "verbose") != 0, on_block);
+  RHost host(num(o, "verbose") != 0, on_block, on_fit(o));
   gravcal::GgirProcedure proc(ggir_config(o), host);
   return outcome_list(proc.run(src), host);
 }

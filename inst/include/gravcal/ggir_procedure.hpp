@@ -14,7 +14,8 @@
 //   [5] fit scale, offset and temperature offset by weighted iterative
 //       closest point (icp.hpp) and compute GGIR's error;
 //   [6] stop once the error is small enough after minloadcrit hours, else
-//       read on;
+//       read on (gravcal's own mode may instead read the whole recording,
+//       or stop when the host's enough() says so: GgirConfig::reading);
 //   [7] after the last block, the QC outcome.
 // GGIR-compatible mode keeps every rule as GGIR has it; gravcal's own mode
 // departs where GGIR's behaviour is an accident (see R/ggir.R's header).
@@ -78,11 +79,21 @@ struct GgirConfig {
   double guard_norm = INFINITY;
   double guard_clip = 0.0;
   double guard_repeat = INFINITY;
+  // own mode only: when to stop reading. 0: GGIR's rule (the error target
+  // met after minloadcrit hours); 1: read the whole recording (coefficients
+  // per segment of time need every part of it); 2: the adaptive budget: a
+  // converged fit every check_hours of windows (or once the table grew by
+  // refit_growth, whichever is later), and stop once GGIR's error target
+  // is met and the host's enough() says the coefficients are determined
+  int reading = 0;
+  double check_hours = 6.0;
 };
 
 // The QC outcome (R maps each to GGIR's message).
 enum class GgirQc { none, done, done_no_temp, attempted, no_decrease, no_sphere,
                     no_rest, no_data, not_finite };
+
+struct GgirOutcome;
 
 class GgirHost {
  public:
@@ -98,6 +109,10 @@ class GgirHost {
   virtual void block_added(int i) { (void)i; }
   // true: abandon the run (an interrupt); may also throw
   virtual bool interrupted() { return false; }
+  // the adaptive budget's stop rule (GgirConfig::reading == 2): after a
+  // converged fit that meets GGIR's error target, true stops the reading
+  // (o holds the fit and its table)
+  virtual bool enough(const GgirOutcome& o) { (void)o; return false; }
 };
 
 struct GgirOutcome {
@@ -127,6 +142,7 @@ struct GgirOutcome {
   // own mode: rest windows of the last table left out by the guards, by
   // reason (GgirWhy: norm, clipped, identical)
   std::int64_t excluded[3] = {0, 0, 0};
+  bool early = false;         // the reading stopped before the recording's end
 };
 
 // Why own mode's guards leave a rest window out (none: kept).
@@ -244,9 +260,7 @@ class GgirProcedure {
       // refits before the last block only once the table has grown by a
       // quarter, so that time stays linear when the target is never met.
       bool due = added || i == 1;
-      if (due && !last &&
-          (static_cast<double>(n_feat()) * 10 / 3600 <= cfg_.minloadcrit ||
-           (!cfg_.compat && static_cast<double>(n_feat()) < next_fit_))) {
+      if (due && !last && defer()) {
         pending_ = true;
         due = false;
       }
@@ -254,7 +268,11 @@ class GgirProcedure {
       // also when the last block added nothing after a decision
       if (last && (pending_ || decided_)) due = true;
       if (due) stop_loading = fit(o, last);  // [4] - [6]
-      if (last || stop_loading) break;
+      if (last) break;
+      if (stop_loading) {
+        o.early = true;
+        break;
+      }
     }
     finish(o);  // [7]
   }
@@ -265,6 +283,21 @@ class GgirProcedure {
   };
 
   std::int64_t n_feat() const { return static_cast<std::int64_t>(col_[0].size()); }
+
+  int reading() const { return cfg_.compat ? 0 : cfg_.reading; }
+
+  // whether the fit after a block that is not the last can wait
+  bool defer() const {
+    const double n = static_cast<double>(n_feat());
+    switch (reading()) {
+      case 1:
+        return true;
+      case 2:
+        return n < next_fit_ || n < next_check_;
+      default:
+        return n * 10 / 3600 <= cfg_.minloadcrit || (!cfg_.compat && n < next_fit_);
+    }
+  }
 
   // [2] GGIR's temperature checks on a block's used samples: false, with a
   // warning, when the temperature cannot be used.
@@ -343,6 +376,7 @@ class GgirProcedure {
     pending_ = false;
     decided_ = false;
     next_fit_ = static_cast<double>(n_feat()) * cfg_.refit_growth;
+    next_check_ = static_cast<double>(n_feat()) + cfg_.check_hours * 3600 / 10;
     const std::size_t N = col_[0].size();
     std::vector<std::size_t> idx;
     idx.reserve(N);
@@ -418,12 +452,15 @@ class GgirProcedure {
     // [5] compatible mode fits as GGIR does; gravcal's own mode decides
     // whether to read on with GGIR's cheap early stop, started from the
     // previous decision's coefficients (so that each decision costs a few
-    // passes over the table, and the decisions together stay a small share
-    // of the time however the refits fall), and fits to convergence, from
-    // the identity, only for a result it keeps
-    IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r : last ? Rule::converge : Rule::ggir);
-    if (!cfg_.compat && !last) {
-      if (judge(o, r)) {
+    // passes over at most cfg_.decide_windows windows, and the decisions
+    // together stay a small share of the time however the refits fall), and
+    // fits to convergence, from the identity, only for a result it keeps
+    // (the adaptive budget judges converged fits only)
+    const bool adaptive = reading() == 2;
+    IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r
+                         : (last || adaptive) ? Rule::converge : Rule::ggir);
+    if (!cfg_.compat && !last && !adaptive) {
+      if (judge(o, r, last)) {
         r = icp(o, Rule::converge);
       } else {
         decided_ = true;
@@ -441,9 +478,9 @@ class GgirProcedure {
     o.error_end = error_;
     o.has_error_end = true;
     // [6]
-    if (judge(o, r)) {
+    if (judge(o, r, last)) {
       o.qc = o.use_temp == o.temp_available ? GgirQc::done : GgirQc::done_no_temp;
-      return true;
+      return reading() != 1;
     }
     if (o.nhoursused > cfg_.minloadcrit) {
       host_.print("\nnew calibration error: " + r_number(o.error_end) + " g");
@@ -511,10 +548,16 @@ class GgirProcedure {
     return r;
   }
 
-  bool judge(const GgirOutcome& o, const IcpResult&) const {
+  bool judge(const GgirOutcome& o, const IcpResult& r, bool last) {
     // NaN compares false, as R's isTRUE() of NA
-    return error_ < o.error_start && error_ < cfg_.max_error &&
-           o.nhoursused > cfg_.minloadcrit;
+    const bool good = error_ < o.error_start && error_ < cfg_.max_error;
+    if (reading() == 2 && !last) {
+      // the adaptive budget: the host's rule in place of minloadcrit, on a
+      // finite fit (at the last block, GGIR's rule says whether it is done)
+      // (o already holds this fit's coefficients and error)
+      return good && r.finite && host_.enough(o);
+    }
+    return good && o.nhoursused > cfg_.minloadcrit;
   }
 
   // [7]
@@ -596,6 +639,7 @@ class GgirProcedure {
   bool decided_ = false;    // own mode: the last fit was a decision's
   bool too_short_ = false;  // own mode: the recording holds under two hours
   double next_fit_ = 0.0;
+  double next_check_ = 0.0;  // adaptive budget: the next check, in windows
   double error_ = 0.0;
 };
 
