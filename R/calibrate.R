@@ -235,10 +235,10 @@
 #' 5. Time grows linearly with the recording. GGIR refits on all windows
 #'    after every block once it has `minloadcrit` hours, so a recording that
 #'    never reaches the error target costs time that grows with its square.
-#'    gravcal decides whether to read on with a fit that stops as GGIR's
-#'    does (a few iterations, started from the previous decision's
-#'    coefficients), refits only once the window table has grown by a
-#'    quarter, and fits to convergence (accelerated, see [fit_icp()]) for
+#'    gravcal decides whether to read on with a fit converged to 1e-6 on
+#'    at most 10,000 evenly spaced windows of the table, started from the
+#'    previous decision's coefficients, refits only once the window table
+#'    has grown by a quarter, and fits to convergence on the whole table (accelerated, see [fit_icp()]) for
 #'    the result it returns; it may therefore read up to a quarter more
 #'    than GGIR before it stops. Twice the recording takes about twice the
 #'    time (`bench/results/ggir-own-scaling.md`).

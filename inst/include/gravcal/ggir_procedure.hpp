@@ -69,7 +69,8 @@ struct GgirConfig {
   double max_weight = 100.0;
   double refit_growth = 1.25;  // own mode: refit once the table grew by this
   std::size_t decide_windows = 10000;  // own mode: most windows (evenly
-                                       // spaced) a decision to read on fits
+                                       // spaced) a decision to read on fits,
+  double decide_tol = 1e-6;            // and to what tolerance
   // own mode's guards on rest windows (compatible mode has none; R's
   // calibrate() documents them): a window whose mean vector's norm is
   // farther than guard_norm g from 1 g; one that reaches guard_clip g on
@@ -450,15 +451,16 @@ class GgirProcedure {
       return false;
     }
     // [5] compatible mode fits as GGIR does; gravcal's own mode decides
-    // whether to read on with GGIR's cheap early stop, started from the
-    // previous decision's coefficients (so that each decision costs a few
-    // passes over at most cfg_.decide_windows windows, and the decisions
-    // together stay a small share of the time however the refits fall), and
+    // whether to read on with a fit converged to cfg_.decide_tol, started
+    // from the previous decision's coefficients (so that each decision
+    // costs a few passes over at most cfg_.decide_windows windows, and the
+    // decisions together stay a small share of the time however the refits
+    // fall), and
     // fits to convergence, from the identity, only for a result it keeps
     // (the adaptive budget judges converged fits only)
     const bool adaptive = reading() == 2;
     IcpResult r = icp(o, cfg_.compat ? Rule::ggir_r
-                         : (last || adaptive) ? Rule::converge : Rule::ggir);
+                         : (last || adaptive) ? Rule::converge : Rule::decide);
     if (!cfg_.compat && !last && !adaptive) {
       if (judge(o, r, last)) {
         r = icp(o, Rule::converge);
@@ -490,7 +492,7 @@ class GgirProcedure {
     return false;
   }
 
-  enum class Rule { ggir_r, ggir, converge };
+  enum class Rule { ggir_r, decide, converge };  // GGIR's fit; own mode's decision; its result
 
   // the fit on the last table, with GGIR's error after it (error_). Own
   // mode's decisions to read on fit at most cfg_.decide_windows evenly
@@ -503,7 +505,7 @@ class GgirProcedure {
     const double* col[4] = {&o.table[1 * n], &o.table[2 * n], &o.table[3 * n],
                             o.use_temp ? &o.table[7 * n] : nullptr};
     std::vector<double> sub;
-    if (rule == Rule::ggir && n > cfg_.decide_windows && cfg_.decide_windows >= 3) {
+    if (rule == Rule::decide && n > cfg_.decide_windows && cfg_.decide_windows >= 3) {
       const std::size_t m = cfg_.decide_windows;
       sub.resize(4 * m);
       for (std::size_t j = 0; j < m; ++j) {
@@ -521,9 +523,12 @@ class GgirProcedure {
     c.tol = cfg_.tol;
     c.max_weight = cfg_.max_weight;
     c.use_temp = o.use_temp;
-    c.stop = rule == Rule::converge ? StopRule::parameters : StopRule::ggir;
+    c.stop = rule == Rule::ggir_r ? StopRule::ggir : StopRule::parameters;
     c.r_arithmetic = rule == Rule::ggir_r;
-    if (rule == Rule::ggir && has_warm_) {
+    // a decision (own mode) needs the error to a fraction of a mg, not the
+    // coefficients to 1e-10: converged to decide_tol
+    if (rule == Rule::decide) c.tol = cfg_.decide_tol;
+    if (rule == Rule::decide && has_warm_) {
       c.warm = true;
       for (int k = 0; k < 3; ++k) {
         c.start_offset[k] = warm_.offset[k];
@@ -540,7 +545,7 @@ class GgirProcedure {
         },
         solve);
     if (!o.use_temp) r.meantemp = 0;
-    if (rule == Rule::ggir) {
+    if (rule == Rule::decide) {
       has_warm_ = r.finite && r.temp_used == o.use_temp;
       warm_ = r;
     }
