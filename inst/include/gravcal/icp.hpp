@@ -129,6 +129,22 @@ constexpr std::size_t kIcpBlock = 1024;
 // The sums of one axis: w, w c, w t, w c c, w c t, w t t, w p, w c p, w t p.
 struct IcpSums {
   double s[3][9] = {};
+  // one point: weight wi, current point c, closest point p, temperature ti
+  void add_point(double wi, const double* c, const double* p, double ti) {
+    for (int k = 0; k < 3; ++k) {
+      double* a = s[k];
+      const double wc = wi * c[k], wt = wi * ti;
+      a[0] += wi;
+      a[1] += wc;
+      a[2] += wt;
+      a[3] += wc * c[k];
+      a[4] += wc * ti;
+      a[5] += wt * ti;
+      a[6] += wi * p[k];
+      a[7] += wc * p[k];
+      a[8] += wt * p[k];
+    }
+  }
   void add(const IcpSums& o) {
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < 9; ++j) s[k][j] += o.s[k][j];
@@ -158,19 +174,7 @@ inline bool icp_sums(const double* const* in, const double* t, std::size_t n, co
       icp_point(in, t, i, o, s, to, c, p);
       finite = finite && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
       const double wi = w[i], ti = t != nullptr ? t[i] : 0.0;
-      for (int k = 0; k < 3; ++k) {
-        double* a = blk.s[k];
-        const double wc = wi * c[k], wt = wi * ti;
-        a[0] += wi;
-        a[1] += wc;
-        a[2] += wt;
-        a[3] += wc * c[k];
-        a[4] += wc * ti;
-        a[5] += wt * ti;
-        a[6] += wi * p[k];
-        a[7] += wc * p[k];
-        a[8] += wt * p[k];
-      }
+      blk.add_point(wi, c, p, ti);
     }
     sums.add(blk);
   }
@@ -378,19 +382,7 @@ inline bool icp_map(const double* const* in, const double* t, std::size_t n, int
       bm += d * max_weight > 1.0 ? d - half : 0.5 * max_weight * d * d;
       finite = finite && std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
       const double ti = t != nullptr ? t[i] : 0.0;
-      for (int k = 0; k < 3; ++k) {
-        double* q = blk.s[k];
-        const double wc = wi * c[k], wt = wi * ti;
-        q[0] += wi;
-        q[1] += wc;
-        q[2] += wt;
-        q[3] += wc * c[k];
-        q[4] += wc * ti;
-        q[5] += wt * ti;
-        q[6] += wi * p[k];
-        q[7] += wc * p[k];
-        q[8] += wt * p[k];
-      }
+      blk.add_point(wi, c, p, ti);
     }
     sums.add(blk);
     merit += bm;
