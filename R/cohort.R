@@ -65,8 +65,11 @@
 #' robust spread (the median absolute deviation, scaled to a standard
 #' deviation; the median of all devices' spreads in the cohort when that
 #' is larger, so that a device whose few recordings happen to agree is not
-#' held to a tighter rule than the cohort's fits show). A recording's
-#' coefficient disagrees with the reference when
+#' held to a tighter rule than the cohort's fits show). Offsets depend on
+#' the temperature a fit's temperature term is centred on (its recording's
+#' mean temperature), so a device's offsets are first restated at one
+#' temperature, the median of its recordings' (`o + (T_ref - m) K^-1 t`).
+#' A recording's coefficient disagrees with the reference when
 #' it differs by more than 4 times the combined uncertainty (its standard
 #' error, the reference's and the spread). Column `plausibility` says
 #' `"attenuated"` (all three scales changed by one common factor, at least
@@ -78,7 +81,7 @@
 #' precedence; `NA` for a recording not calibrated. `plausibility_note`
 #' says why, with the device's reference values. The devices' references
 #' are in `attr(, "devices")` (one row per device with a history: `serial`,
-#' `recordings`, `reference_recordings`, `ref.<coefficient>`,
+#' `recordings`, `reference_recordings`, `reference_temp`, `ref.<coefficient>`,
 #' `spread.<coefficient>`), and each fit in `attr(, "fits")` carries its
 #' flag (`fit$plausibility`), which `print()` shows. GGIR's coefficient file
 #' is unchanged.

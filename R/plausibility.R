@@ -139,6 +139,50 @@ fit_plausibility <- function(fit) {
   list(flag = "ok", note = "")
 }
 
+# The temperature at which a device's recordings (rows `rows` of a cohort
+# table) are compared: the median of the mean temperatures their
+# temperature terms are centred on (NA when none has a temperature term).
+device_reference_temp <- function(tab, rows) {
+  if (!"meantempcal" %in% names(tab)) return(NA_real_)
+  tc <- paste0("temperature.offset.", c("x", "y", "z"))
+  if (!all(tc %in% names(tab))) return(NA_real_)
+  t <- as.matrix(tab[rows, tc, drop = FALSE])
+  m <- tab$meantempcal[rows]
+  use <- is.finite(m) & rowSums(abs(t) > 0 & is.finite(t)) > 0
+  if (!any(use)) return(NA_real_)
+  stats::median(m[use])
+}
+
+# A cohort table row's coefficients `co` (named as its columns) and their
+# standard errors `se`, with the offsets restated at temperature `tref`
+# instead of the recording's mean temperature `m`: the model K (v + o) +
+# (T - m) t is K (v + o + (tref - m) K^-1 t) + (T - tref) t, the same
+# calibration. The offsets' standard errors take the temperature
+# offsets' part, (tref - m) K^-1 se_t, as independent of theirs (the
+# offset and the slope of a model centred on its points' mean temperature
+# are nearly uncorrelated).
+offsets_at_temperature <- function(co, se, m, tref) {
+  oc <- paste0("offset.", c("x", "y", "z"))
+  tc <- paste0("temperature.offset.", c("x", "y", "z"))
+  if (!is.finite(tref) || !isTRUE(is.finite(m)) || !all(tc %in% names(co)) ||
+      !all(is.finite(co[tc])) || !any(co[tc] != 0)) {
+    return(list(co = co, se = se))
+  }
+  sc <- co[paste0("scale.", c("x", "y", "z"))]
+  if (!all(is.finite(sc)) || any(sc == 0)) return(list(co = co, se = se))
+  cr <- paste0("cross.", c("xy", "xz", "yz"))
+  cross <- if (all(cr %in% names(co))) co[cr] else c(0, 0, 0)
+  cross[!is.finite(cross)] <- 0
+  K <- params_to_K(c(sc, cross))
+  Ki <- solve(K)
+  d <- tref - m
+  co[oc] <- co[oc] + d * drop(Ki %*% co[tc])
+  st <- se[tc]
+  st[!is.finite(st)] <- 0
+  se[oc] <- sqrt(se[oc]^2 + d^2 * drop(Ki^2 %*% st^2))
+  list(co = co, se = se)
+}
+
 # Do three scales `s` (standard errors `se`) differ from the reference
 # `ref` (its uncertainty `u_ref`, per axis) by one common factor, as a
 # firmware attenuation of the raw signal would make them (a signal
@@ -177,6 +221,7 @@ cohort_plausibility <- function(tab) {
   co <- as.matrix(tab[, cols, drop = FALSE])
   se <- as.matrix(tab[, paste0(cols, ".se"), drop = FALSE])
   colnames(se) <- cols
+  raw <- co
   applied <- tab$status %in% c("ok", "high_error")
   refused <- tab$status == "implausible"
   flag[applied] <- "ok"
@@ -184,7 +229,7 @@ cohort_plausibility <- function(tab) {
   note[refused] <- paste0("coefficients beyond the bounds at which gravcal ",
                           "refuses them (plausible_bounds()); not applied")
   bounds <- lapply(seq_len(n), function(i) {
-    if (applied[i]) beyond_flag_bounds(co[i, ]) else character(0)
+    if (applied[i]) beyond_flag_bounds(raw[i, ]) else character(0)
   })
   pooled <- applied & tab$pooled %in% TRUE
   scales <- cols[1:3]
@@ -198,6 +243,15 @@ cohort_plausibility <- function(tab) {
   for (k in unique(key[applied])) {
     idx <- which(key == k & applied)
     hist <- idx[!pooled[idx]]
+    # offsets depend on the temperature the model is centred on (each
+    # recording's own mean temperature): the device's recordings are
+    # compared at one, the median of theirs
+    tref <- device_reference_temp(tab, hist)
+    for (i in hist) {
+      r <- offsets_at_temperature(co[i, ], se[i, ], tab$meantempcal[i], tref)
+      co[i, ] <- r$co
+      se[i, ] <- r$se
+    }
     # firmware-style attenuation relative to 1 (no device history needed)
     abs_note <- lapply(hist, function(i) {
       attenuation_signature(co[i, scales], se[i, scales], c(1, 1, 1),
@@ -221,6 +275,7 @@ cohort_plausibility <- function(tab) {
     use <- if (sum(!abs_att) >= rules$min_recordings) hist[!abs_att] else hist
     hists[[length(hists) + 1]] <- list(
       serial = serial[idx[1]], hist = hist, use = use, abs_att = abs_att,
+      tref = tref,
       abs_note = abs_note,
       ref = apply(co[use, , drop = FALSE], 2, stats::median),
       spread = apply(co[use, , drop = FALSE], 2, stats::mad),
@@ -247,14 +302,16 @@ cohort_plausibility <- function(tab) {
     devices[[length(devices) + 1]] <- data.frame(
       serial = h$serial, recordings = length(hist),
       reference_recordings = length(use),
+      reference_temp = h$tref,
       t(stats::setNames(ref, paste0("ref.", cols))),
       t(stats::setNames(spread, paste0("spread.", cols))),
       check.names = FALSE)
-    refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g",
+    refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g%s",
                        h$serial, length(use),
                        paste(sprintf("%.4f", ref[scales]), collapse = " "),
                        paste(sprintf("%.4f", ref[paste0("offset.", c("x", "y", "z"))]),
-                             collapse = " "))
+                             collapse = " "),
+                       if (is.finite(h$tref)) sprintf(" at %.1f degrees C", h$tref) else "")
     for (j in seq_along(hist)) {
       i <- hist[j]
       # relative to the device's reference where it has a history of its

@@ -70,6 +70,56 @@ test_that("a recording that disagrees with its device's others is a device outli
   expect_identical(j2$tab$plausibility, rep("ok", 5))
 })
 
+test_that("a device's offsets are compared at one temperature", {
+  # one device (true offsets p, temperature offsets t per degree C) whose
+  # five recordings had mean temperatures 22 to 34 degrees C: each fit
+  # states its offsets at its own mean temperature, o + (T - m) K^-1 t
+  # apart, 12 mg apart at the extremes on x with t_x = 1 mg per degree C
+  set.seed(12)
+  p <- c(1.01, 0.99, 1.005, 0.02, -0.01, 0.015)
+  t <- c(0.001, -0.0008, 0.0005)
+  m <- c(22, 25, 28, 31, 34)
+  co <- device_rows(p, 5, 0.0002)
+  co[, 4:6] <- co[, 4:6] + outer(m - 28, t / p[1:3])
+  tab <- cohort_tab(co, 0.0002, "555")
+  tab[paste0("temperature.offset.", c("x", "y", "z"))] <- as.list(t)
+  tab[paste0("temperature.offset.", c("x", "y", "z"), ".se")] <- 2e-5
+  tab$meantempcal <- m
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility, rep("ok", 5))
+  expect_equal(j$devices$reference_temp, 28)
+  expect_lt(abs(j$devices$ref.offset.x - p[4]), 0.001)
+  # a recording whose offset moved by 4 mg is found at one temperature;
+  # as each fit states them, the temperature's spread of the offsets
+  # (5 mg on y between 22 and 34 degrees C) hides it
+  tab$offset.y[3] <- tab$offset.y[3] + 0.004
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility, c("ok", "ok", "device_outlier", "ok", "ok"))
+  expect_match(j$tab$plausibility_note[3], "offset.y", fixed = TRUE)
+  expect_match(j$tab$plausibility_note[3], "at 28.0 degrees C", fixed = TRUE)
+  tab0 <- tab
+  tab0$meantempcal <- NA_real_
+  j0 <- gravcal:::cohort_plausibility(tab0)
+  expect_identical(j0$tab$plausibility, rep("ok", 5))
+  # the restatement is the same calibration: equal calibrated samples at
+  # any temperature, for a model with cross-axis terms too
+  cf <- c(scale.x = 1.02, scale.y = 0.97, scale.z = 1.01, cross.xy = 0.01,
+          cross.xz = -0.02, cross.yz = 0.015, offset.x = 0.03, offset.y = -0.02,
+          offset.z = 0.01, temperature.offset.x = 0.002,
+          temperature.offset.y = -0.001, temperature.offset.z = 0.0015)
+  se <- stats::setNames(rep(1e-4, 12), names(cf))
+  r <- gravcal:::offsets_at_temperature(cf, se, 26.3, 31)
+  K <- gravcal:::params_to_K(cf[1:6])
+  v <- matrix(stats::rnorm(30), 10)
+  temp <- stats::runif(10, 15, 40)
+  cal <- function(c, mt) {
+    t(K %*% (t(v) + c[7:9])) + outer(temp - mt, c[10:12])
+  }
+  expect_equal(cal(r$co, 31), cal(cf, 26.3), tolerance = 1e-14)
+  expect_true(all(r$se[7:9] > se[7:9]))
+  expect_identical(r$se[c(1:6, 10:12)], se[c(1:6, 10:12)])
+})
+
 test_that("scales changed by one common factor are an attenuation", {
   set.seed(12)
   p <- c(0.985, 1.01, 0.995, 0.02, -0.01, 0.015)
