@@ -152,7 +152,9 @@
 #'   `serial` (the device's serial number from the file's header, NA
 #'   where there is none), `pooled` (see `pool`), `plausibility` and
 #'   `plausibility_note` (see Plausibility above), `hours` (of samples read), `windows`,
-#'   `rest_windows`; what the file's reader did: `reader` (`"native"` or
+#'   `rest_windows`, `excluded_norm`, `excluded_clipped` and
+#'   `excluded_identical` (rest windows the guards left out, by reason; NA
+#'   where they do not run: GGIR-compatible mode); what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
 #'   not use: damaged blocks, pages, records or lines), `gaps` and
 #'   `gap_seconds` (jumps in time), `truncated` and `read_notes` (the first
@@ -522,6 +524,13 @@ calibrate_one <- function(file, id, method, args) {
        fit = fit)
 }
 
+# A fit's count of rest windows left out for `reason` (NA when its guards
+# did not run).
+excluded_count <- function(fit, reason) {
+  ex <- if (!is.null(fit)) fit$excluded
+  if (is.null(ex) || !reason %in% names(ex)) NA_integer_ else as.integer(ex[[reason]])
+}
+
 # `file`: the recording's path; `id`: its identity in the cohort.
 cohort_row <- function(file, id, fit, error, warnings, seconds, method) {
   na <- is.null(fit)
@@ -562,6 +571,11 @@ cohort_row <- function(file, id, fit, error, warnings, seconds, method) {
     hours = if (na) NA_real_ else fit_hours(fit),
     windows = if (na) NA_real_ else num(fit$n_windows),
     rest_windows = rest,
+    # rest windows the guards left out, by reason (gravcal's own modes;
+    # NA where no guard ran: GGIR-compatible mode, given coefficients)
+    excluded_norm = excluded_count(fit, "norm"),
+    excluded_clipped = excluded_count(fit, "clipped"),
+    excluded_identical = excluded_count(fit, "identical"),
     # what the reader read and skipped (native decoders)
     reader = if (is.null(inp$reader)) NA_character_ else inp$reader,
     samples = num(inp$samples),

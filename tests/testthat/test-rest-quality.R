@@ -162,3 +162,28 @@ test_that("constant and all-zero recordings count as identical: no rest", {
                nrow(rest_windows(rec, sf = 10, skip_zero = FALSE)))
   expect_equal(f0$excluded[["norm"]], 0L)
 })
+
+test_that("calibrate_files() reports the windows each guard left out", {
+  # (a .cwa file's rate is 3200 / 2^k Hz)
+  rec <- simulate_recording(hours = 24, sf = 12.5, seed = 11, params = sim_params,
+                            idle_sleep = 4)
+  dir <- tempfile("rest-quality")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE), add = TRUE)
+  v <- as.matrix(rec[, c("x", "y", "z")])
+  gravcal:::write_cwa(round(v * 256) / 256, file.path(dir, "sleepy.cwa"),
+                      sf = 12.5, packed = FALSE, temperature = rec$temperature)
+  for (method in c("lightweight", "ggir")) {
+    tab <- calibrate_files(dir, method = method,
+                           outdir = file.path(dir, paste0("out-", method)))
+    fit <- attr(tab, "fits")[[1]]
+    expect_identical(tab$excluded_identical, fit$excluded[["identical"]])
+    expect_identical(tab$excluded_norm, fit$excluded[["norm"]])
+    expect_identical(tab$excluded_clipped, fit$excluded[["clipped"]])
+    expect_gte(tab$excluded_identical, if (method == "ggir") 1440 - 8 else 2880 - 8)
+  }
+  # GGIR-compatible mode runs no guard: NA, not 0
+  tab <- calibrate_files(dir, method = "ggir", ggir_compat = TRUE,
+                         outdir = file.path(dir, "out-compat"))
+  expect_identical(tab$excluded_identical, NA_integer_)
+})
