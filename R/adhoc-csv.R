@@ -21,7 +21,9 @@
 # * the rest threshold is rmc.noise * 1.2 (R/ggir-drop-in.R).
 # Time stamps do not enter the calibration; they give read_recording() its
 # time column (UNIXsec, UNIXmsec and ActivPAL read per sample, POSIX and
-# character text from the first stamp on, start + i / sf).
+# character text from the first stamp on, start + i / sf), except with
+# rmc.doresample and a UNIX time column: GGIR then resamples every block
+# onto sf from its time stamps (see rmc_layout()).
 
 # The rmc.* parameters (their values from the parameter table,
 # ggir-params.R) as the decoder's layout for `file`: list(opts = decoder
@@ -39,8 +41,10 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
           "); GGIR::g.calibrate() reads such files.")
   }
   if (isTRUE(p$rmc.check4timegaps)) refuse("rmc.check4timegaps", "time gaps in ad hoc csv files are not imputed")
-  if (isTRUE(p$rmc.doresample) && length(p$rmc.col.time)) {
-    refuse("rmc.doresample", "ad hoc csv files are not resampled")
+  resample <- isTRUE(p$rmc.doresample) && length(p$rmc.col.time) > 0
+  if (resample && !p$rmc.unit.time %in% c("UNIXsec", "UNIXmsec")) {
+    refuse("rmc.doresample", paste0("resampled with a time column in UNIX seconds or ",
+                                    "milliseconds, not rmc.unit.time = \"", p$rmc.unit.time, "\""))
   }
   header <- rmc_header(p, file)
   sf <- rmc_sf(p, header, file)
@@ -110,6 +114,10 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
       opts$start_time <- as.numeric(t0)
     }
   }
+  # rmc.doresample: GGIR resamples each block linearly (interpolationType
+  # 2: nearest neighbour) from its first time stamp to its last, at sf
+  # (decode_ggir_resample.hpp; GGIR-compatible reads only)
+  if (resample) opts$grid_sf <- as.numeric(sf)
   list(opts = opts, sf = sf, skip = skip, header = header,
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
@@ -189,6 +197,10 @@ source_adhoc <- function(file, sf, chunksize, arg, layout) {
   }
   o <- layout$opts
   sf <- layout$sf
+  if (!is.null(o$grid_sf)) {
+    abort("`rmc.doresample` = TRUE is taken by gravcal's own csv decoder only ",
+          "(reader = \"native\"), not with reader = \"reference\".")
+  }
   B <- format_block_units("adhoc_csv", sf, chunksize)
   acc <- function(a) {
     if (!is.null(o$acc_div)) a <- a / o$acc_div

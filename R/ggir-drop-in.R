@@ -65,7 +65,7 @@
 #' |---|---|---|
 #' | `chunksize`, `spherecrit`, `minloadcrit` | every format | honoured |
 #' | `printsummary` | (prints only) | honoured |
-#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole | honoured (an error with `reader = "reference"` unless 1) |
+#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
@@ -87,7 +87,8 @@
 #' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
 #' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
 #' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration |
-#' | `rmc.check4timegaps = TRUE`; `rmc.doresample = TRUE` with a time column | refused with an error |
+#' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds (`rmc.unit.time`): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; other time units refused with an error |
+#' | `rmc.check4timegaps = TRUE` | refused with an error |
 #'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
@@ -152,12 +153,6 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   }
   src <- open()
   ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
-  # GGIR resamples Axivity csv exports as interpolationType says; gravcal
-  # linearly only (GGIR's default, 1)
-  if (identical(src$format, "axivity_csv") && !identical(as.numeric(pr$interpolationType), 1)) {
-    abort("`interpolationType` = ", deparse(pr$interpolationType), " is not supported for ",
-          "Axivity csv exports (gravcal resamples them linearly, interpolationType = 1).")
-  }
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
   # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike

@@ -83,7 +83,7 @@ ggir_param_table <- function() {
         }
       }, effect = paste0(".cwa (readAxivity's resampling), GENEActiv .bin at a ",
                          "rate that is not whole (g.readaccfile's resampling); ",
-                         "ad hoc csv with rmc.doresample (refused there)")),
+                         "Axivity csv, ad hoc csv with rmc.doresample")),
       row("frequency_tol", NA, 0.1, at_least_0,
           effect = ".cwa: readAxivity's tolerance on a block's rate before it imputes"),
       row("desiredtz", NA, "", tz_check, list = "general",
@@ -140,7 +140,7 @@ ggir_param_table <- function() {
       list("rmc.headername.recordingid", NULL, rmc_string, "the header's recording id (not used)"),
       list("rmc.header.structure", NULL, rmc_string, "how header names and values are separated"),
       list("rmc.check4timegaps", FALSE, check_flag, "TRUE refused: not implemented"),
-      list("rmc.doresample", FALSE, check_flag, "TRUE with a time column refused: not implemented"),
+      list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX time column: honoured (block by block resampling); other time units refused"),
       # a wear column: g.calibrate() does not use it
       list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),
       list("rmc.dec", ".", rmc_choice(c(".", ",")), "the decimal mark"),

@@ -176,7 +176,7 @@ check_reference_opts <- function(read_opts, format) {
   defaults <- list(interpolation = c(interpolationType = 1),
                    frequency_tol = c(frequency_tol = 0.1))
   used <- switch(format, cwa = c("interpolation", "frequency_tol"),
-                 geneactiv = "interpolation", character(0))
+                 geneactiv = , axivity_csv = "interpolation", character(0))
   for (nm in intersect(intersect(names(read_opts), names(defaults)), used)) {
     d <- defaults[[nm]]
     if (!identical(as.numeric(read_opts[[nm]]), unname(d))) {

@@ -59,7 +59,20 @@ inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Op
   std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
   if (opts.num("compat", 1) == 0) return d;
   return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), opts.num("grid_sf", opts.num("sf", 0))));
+      std::move(d), opts.num("grid_sf", opts.num("sf", 0)),
+      static_cast<int>(opts.num("interpolation", 1))));
+}
+
+// GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
+// rmc.doresample and a UNIX time column (option grid_sf > 0; compat = 1),
+// resampled block by block onto that rate, the grid's last point kept.
+inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                                 const std::string& name) {
+  std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
+  const double grid = opts.num("grid_sf", 0);
+  if (opts.num("compat", 1) == 0 || !(grid > 0)) return d;
+  return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
+      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true));
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating
@@ -74,7 +87,7 @@ inline const DecoderKind* find_decoder(const std::string& format) {
   static const DecoderKind kinds[] = {
       {"actigraph_csv", true, make_csv},
       {"csv", true, make_csv},
-      {"adhoc_csv", true, make_csv},
+      {"adhoc_csv", true, make_adhoc_csv},
       {"axivity_csv", true, make_axivity_csv},
       {"gt3x", false, make_gt3x},
       {"cwa", false, make_cwa},

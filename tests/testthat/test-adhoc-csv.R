@@ -88,6 +88,84 @@ test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
   expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
 })
 
+test_that("rmc.doresample: every block resampled from its time stamps, as GGIR does", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # a device whose clock ran at 10.3 Hz for a nominal 10 Hz: time stamps
+  # (written to the millisecond) 1 / 10.3 s apart, rmc.sf = 10; GGIR's
+  # read.myacc.csv resamples each block of lines onto 10 Hz from its first
+  # time stamp to its last (its last included)
+  rec <- adhoc_rec(hours = 30, sf = 10, seed = 17)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  noise <- list(rmc.noise = 0.013 / 1.2)
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10.3, unit = "g", time = "UNIXsec")
+  pr$rmc.sf <- 10
+  pr$rmc.doresample <- TRUE
+  b <- expect_adhoc_same(f, c(pr, noise))
+  expect_gt(b$ggir$npoints, 100)
+  # the resampling moved GGIR's windows: without it, other numbers
+  b0 <- run_both(f, c(utils::modifyList(pr, list(rmc.doresample = FALSE)), noise))
+  expect_false(identical(b0$ggir$spheredata, b$ggir$spheredata))
+  # nearest neighbour (interpolationType = 2)
+  b2 <- expect_adhoc_same(f, c(pr, noise, list(interpolationType = 2)))
+  expect_false(identical(b2$ggir$spheredata, b$ggir$spheredata))
+  # UNIX milliseconds, in blocks of half the size
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10.3, unit = "mg", time = "UNIXmsec")
+  pr$rmc.sf <- 10
+  pr$rmc.doresample <- TRUE
+  expect_adhoc_same(f, c(pr, noise, list(chunksize = 0.5)))
+  # GGIR's own reader through data.table (reader = "reference") does not
+  # resample: an error naming the parameter
+  expect_error(suppressWarnings(gravcal::g.calibrate(
+    f, params_rawdata = pr, verbose = FALSE, reader = "reference")),
+    "`rmc.doresample` = TRUE is taken by gravcal's own csv decoder only")
+})
+
+test_that("rmc.doresample: samples equal read.myacc.csv's, block by block, grid ends included", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # time stamps 0.1 s apart as text, from UNIX time 0: a block's (t_n -
+  # t_1) / 0.1 lands within 1e-10 of a whole number, so GGIR's grid (R's
+  # seq()) sometimes ends past the last time stamp and is clamped to it;
+  # blocks of 37 lines
+  set.seed(5)
+  n <- 3700
+  d <- data.frame(time = sprintf("%.1f", (seq_len(n) - 1) * 0.1),
+                  x = round(stats::rnorm(n), 4), y = round(stats::rnorm(n), 4),
+                  z = round(stats::rnorm(n), 4), temperature = round(stats::runif(n, 20, 30), 2))
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  pr <- list(rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.temp = 5, rmc.col.time = 1,
+             rmc.unit.time = "UNIXsec", rmc.sf = 10, rmc.doresample = TRUE)
+  B <- 37
+  for (type in 1:2) {
+    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f)
+    h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = type), lay$opts))
+    clamped <- 0
+    for (i in seq_len(n / B)) {
+      G <- GGIR:::read.myacc.csv(rmc.file = f, rmc.nrow = B, rmc.skip = (i - 1) * B,
+                                 rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.temp = 5,
+                                 rmc.col.time = 1, rmc.unit.time = "UNIXsec", rmc.sf = 10,
+                                 rmc.doresample = TRUE, interpolationType = type,
+                                 desiredtz = "UTC")$data
+      g <- gravcal:::native_block(h, max_units = B, time = TRUE)
+      got <- g$cols
+      for (v in c("x", "y", "z", "temperature", "time")) {
+        expect_identical(got[[v]][seq_len(g$to)], G[[v]], label = paste(type, i, v))
+      }
+      tt <- as.numeric(d$time[(i - 1) * B + c(1, B)])
+      if (G$time[nrow(G)] == tt[2] && tt[1] + (nrow(G) - 1) * 0.1 > tt[2]) {
+        clamped <- clamped + 1
+      }
+    }
+    gravcal:::gc_decoder_close(h$ptr)
+    # some blocks' grids were clamped to their last time stamp
+    expect_gt(clamped, 0)
+  }
+})
+
 test_that("ad hoc csv samples equal GGIR's read.myacc.csv, sample for sample", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
@@ -174,7 +252,10 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
   gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
                                   verbose = FALSE)
   expect_error(gc(rmc.check4timegaps = TRUE), "`rmc.check4timegaps` = TRUE is not supported")
+  # rmc.doresample with a text time column: refused (UNIX times are
+  # resampled, see below)
   expect_error(gc(rmc.doresample = TRUE), "`rmc.doresample` = TRUE is not supported")
+  expect_error(gc(rmc.doresample = TRUE), "not rmc.unit.time = \"POSIX\"", fixed = TRUE)
   expect_error(gc(rmc.unit.acc = "kg"), "`rmc.unit.acc` must be one of \"g\", \"mg\", \"bit\"")
   expect_error(gc(rmc.unit.acc = "bit"), "`rmc.unit.acc` = \"bit\" needs `rmc.bitrate`")
   expect_error(gc(rmc.col.acc = c(2, 2, 3)), "`rmc.col.acc` must be 3 different column numbers")

@@ -30,11 +30,18 @@ test_that("g.calibrate() on an Axivity csv export is GGIR's, both readers", {
   utils::capture.output(G <- gravcal::g.calibrate(f, params_rawdata = pr, verbose = FALSE,
                                                   reader = "reference"))
   for (nm in setdiff(names(b$ggir), "bsc_qc")) expect_identical(G[[nm]], b$ggir[[nm]], label = nm)
-  # GGIR's nearest-neighbour resampling is not implemented: refused
+  # GGIR's nearest-neighbour resampling (interpolationType = 2): gravcal's
+  # decoder; GGIR's reader as gravcal calls it takes only 1
+  b2 <- run_both(f, list(interpolationType = 2))
+  expect_same_as_ggir(b2)
+  for (nm in setdiff(names(b2$ggir), "bsc_qc")) {
+    expect_identical(b2$gravcal[[nm]], b2$ggir[[nm]], label = paste("nearest", nm))
+  }
+  expect_false(identical(b2$ggir$spheredata, b$ggir$spheredata))
   expect_error(gravcal::g.calibrate(f, params_rawdata = c(pr[names(pr) != "interpolationType"],
                                                           list(interpolationType = 2)),
-                                    verbose = FALSE),
-               "`interpolationType` = 2 is not supported for Axivity csv")
+                                    verbose = FALSE, reader = "reference"),
+               "`interpolationType` = 2 is taken by gravcal's own decoders only")
 })
 
 test_that("an Axivity csv export read whole keeps its samples and times; other csv files are not one", {

@@ -26,6 +26,11 @@
 // `grid_rate` (> 0: always resample, at that rate). The inner decoder
 // gives its time stamps and has continue_call() (one reader call in
 // several reads; a no-op for csv).
+//
+// And for GGIR's ad hoc csv files read with rmc.doresample = TRUE and a
+// UNIX time column (GGIR's read.myacc.csv): the same per block, but the
+// grid keeps its last point, which R's seq() clamps to the block's last
+// time stamp (pmin(x, to)): `keep_last`.
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 
@@ -47,8 +52,9 @@ class GgirResamplerOf : public Decoder {
   // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
   // linear, 2 nearest neighbour (GGIR's interpolationType)
   explicit GgirResamplerOf(std::unique_ptr<Inner> inner, double grid_rate = 0,
-                           int interpolation = 1)
-      : inner_(std::move(inner)), grid_rate_(grid_rate), nearest_(interpolation == 2) {}
+                           int interpolation = 1, bool keep_last = false)
+      : inner_(std::move(inner)), grid_rate_(grid_rate), nearest_(interpolation == 2),
+        keep_last_(keep_last) {}
 
   bool open() override {
     const bool ok = inner_->open();
@@ -120,6 +126,7 @@ class GgirResamplerOf : public Decoder {
     left_ = max_units;
     first_read_ = true;
     have_prev_ = false;
+    have_interval_ = false;
     k_ = 0;
     pending_.clear();
   }
@@ -167,24 +174,46 @@ class GgirResamplerOf : public Decoder {
       p.v[4] = g;
       pending_.push_back(p);
     }
-    for (int c = 0; c < 5; ++c) prev_[c] = cur[c];
+    for (int c = 0; c < 5; ++c) {
+      prev2_[c] = prev_[c];
+      prev_[c] = cur[c];
+    }
+    have_interval_ = true;
     last_ = cur[4];
     // a point is not the grid's last once the grid reaches the next one
+    // (with keep_last: a point the grid reaches is in it)
     const double reach = (last_ - from_) / by_ + 1e-10;
+    const std::int64_t ahead = keep_last_ ? 0 : 1;
     std::size_t m = 0;
-    while (m < pending_.size() && static_cast<double>(pending_[m].k + 1) <= reach) ++m;
+    while (m < pending_.size() && static_cast<double>(pending_[m].k + ahead) <= reach) ++m;
     confirm(m);
   }
 
   // The call ended: the grid runs to as.integer((tn - t1) / by + 1e-10); its
   // last point is dropped, as GGIR drops it.
+  // With keep_last the grid's last point stays; where it lies beyond the
+  // last time stamp (the 1e-10), R's seq() puts it at that time stamp, so
+  // it is interpolated there, from the block's last interval.
   void end_call() {
     in_call_ = false;
     if (have_prev_) {
       const double n = std::floor((last_ - from_) / by_ + 1e-10);
       std::size_t m = 0;
-      while (m < pending_.size() && static_cast<double>(pending_[m].k) < n) ++m;
+      if (keep_last_) {
+        while (m < pending_.size() && static_cast<double>(pending_[m].k) <= n) ++m;
+      } else {
+        while (m < pending_.size() && static_cast<double>(pending_[m].k) < n) ++m;
+      }
       confirm(m);
+      if (keep_last_ && have_interval_ && static_cast<double>(k_) == n) {
+        Point p;
+        p.k = k_++;
+        double u = (last_ - prev2_[4]) / (prev_[4] - prev2_[4]);
+        if (nearest_) u = ggir_nearest_weight(u);
+        for (int c = 0; c < 4; ++c) p.v[c] = u * (prev_[c] - prev2_[c]) + prev2_[c];
+        p.v[4] = last_;
+        ready_.push_back(p);
+      }
     }
     pending_.clear();
   }
@@ -205,16 +234,18 @@ class GgirResamplerOf : public Decoder {
   std::unique_ptr<Inner> inner_;
   double grid_rate_ = 0.0;
   bool nearest_ = false;
+  bool keep_last_ = false;
   bool active_ = false;
   double by_ = 0.0;
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
-  bool in_call_ = false, first_read_ = true, have_prev_ = false;
+  bool in_call_ = false, first_read_ = true, have_prev_ = false, have_interval_ = false;
   std::int64_t left_ = -1;
   std::int64_t call_units_ = 0;
   std::int64_t k_ = 0;
   double from_ = 0.0, last_ = 0.0;
   double prev_[5] = {0, 0, 0, 0, 0};
+  double prev2_[5] = {0, 0, 0, 0, 0};  // the sample before prev_
   std::vector<Point> pending_;  // computed, maybe the grid's last
   std::vector<Point> ready_;    // confirmed, not yet given
   std::size_t head_ = 0;
