@@ -166,6 +166,43 @@ test_that("rmc.doresample: samples equal read.myacc.csv's, block by block, grid 
   }
 })
 
+test_that("rmc.doresample: a gap in the time stamps is filled as GGIR fills it, a huge one not", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # 300 lines at 10 Hz with a 1,000 s gap after line 150: GGIR interpolates
+  # 10,000 grid points across it (more than the resampler makes at once)
+  t <- c((0:149) * 0.1, 1000 + (150:299) * 0.1)
+  set.seed(6)
+  d <- data.frame(time = sprintf("%.1f", t), x = round(stats::rnorm(300), 4),
+                  y = round(stats::rnorm(300), 4), z = round(stats::rnorm(300), 4))
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  pr <- list(rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.time = 1,
+             rmc.unit.time = "UNIXsec", rmc.sf = 10, rmc.doresample = TRUE)
+  G <- GGIR:::read.myacc.csv(rmc.file = f, rmc.nrow = 300, rmc.firstrow.acc = 2,
+                             rmc.col.acc = 2:4, rmc.col.time = 1, rmc.unit.time = "UNIXsec",
+                             rmc.sf = 10, rmc.doresample = TRUE, desiredtz = "UTC")$data
+  lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f)
+  h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1), lay$opts))
+  g <- gravcal:::native_block(h, max_units = 300, time = TRUE, capacity = 20000)
+  gravcal:::gc_decoder_close(h$ptr)
+  expect_gt(nrow(G), 10000)
+  expect_equal(g$to, nrow(G))
+  for (v in c("x", "y", "z", "time")) {
+    expect_identical(g$cols[[v]][seq_len(g$to)], G[[v]], label = v)
+  }
+  # a gap of 2e7 s (2e8 grid points at 10 Hz: GGIR would need gigabytes)
+  # is not filled, and the report says so
+  d$time <- sprintf("%.1f", c((0:149) * 0.1, 2e7 + (150:299) * 0.1))
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  r <- gravcal:::native_read_all(f, "adhoc_csv", c(list(compat = 1), lay$opts))
+  rep <- attr(r, "report")
+  expect_lt(nrow(r), 400)
+  expect_identical(rep$counters[["resample_gaps_not_filled"]], 1)
+  expect_true(any(grepl("time stamps jump by 20000000", rep$notes, fixed = TRUE)))
+})
+
 test_that("ad hoc csv samples equal GGIR's read.myacc.csv, sample for sample", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")

@@ -31,6 +31,13 @@
 // UNIX time column (GGIR's read.myacc.csv): the same per block, but the
 // grid keeps its last point, which R's seq() clamps to the block's last
 // time stamp (pmin(x, to)): `keep_last`.
+//
+// Grid points are made at most kGenBatch at a time, so that a long gap in
+// the time stamps (which GGIR fills by interpolation) costs time, not
+// memory; a gap of more than kMaxGapPoints grid points (about 11.6 days at
+// 100 Hz, where GGIR would need gigabytes) is not filled but counted and
+// noted ("resample_gaps_not_filled"), and a time stamp that is not a finite
+// number is left out with its sample ("resample_bad_time").
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 
@@ -38,6 +45,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "decode.hpp"
@@ -87,6 +95,10 @@ class GgirResamplerOf : public Decoder {
       ready_.clear();
       head_ = 0;
       if (!in_call_) break;
+      if (gen_active_) {
+        generate();
+        continue;
+      }
       if (raw_at_ < raw_n_) {
         take(raw_at_++);
         continue;
@@ -96,6 +108,7 @@ class GgirResamplerOf : public Decoder {
       if (inner_->done() || !refill()) end_call();
     }
     report_ = inner_->report();
+    add_own(report_);
     report_.samples = given_;
     // the call's units count once all its samples are given, so that a
     // caller reading a block of units gets the whole block
@@ -106,7 +119,8 @@ class GgirResamplerOf : public Decoder {
   }
 
   bool done() const override {
-    return inner_->done() && !in_call_ && head_ == ready_.size() && raw_at_ >= raw_n_;
+    return inner_->done() && !in_call_ && !gen_active_ && head_ == ready_.size() &&
+           raw_at_ >= raw_n_;
   }
 
   std::size_t max_samples_per_unit() const override {
@@ -115,6 +129,8 @@ class GgirResamplerOf : public Decoder {
 
  private:
   static constexpr std::size_t kRawChunk = 4096;
+  static constexpr std::size_t kGenBatch = 4096;
+  static constexpr double kMaxGapPoints = 1e8;
   static constexpr std::size_t kRawCols = 5;  // x, y, z, t, time
   struct Point {
     std::int64_t k;
@@ -127,6 +143,7 @@ class GgirResamplerOf : public Decoder {
     first_read_ = true;
     have_prev_ = false;
     have_interval_ = false;
+    gen_active_ = false;
     k_ = 0;
     pending_.clear();
   }
@@ -155,38 +172,81 @@ class GgirResamplerOf : public Decoder {
   // One raw sample: the grid points up to its time, interpolated from the
   // interval that ends at it.
   void take(std::size_t i) {
-    double cur[5];
-    for (std::size_t c = 0; c < kRawCols; ++c) cur[c] = raw_[c * kRawChunk + i];
+    for (std::size_t c = 0; c < kRawCols; ++c) cur_[c] = raw_[c * kRawChunk + i];
+    if (!std::isfinite(cur_[4])) {
+      ++bad_time_;
+      return;
+    }
     if (!have_prev_) {
-      for (int c = 0; c < 5; ++c) prev_[c] = cur[c];
-      from_ = cur[4];
+      for (int c = 0; c < 5; ++c) prev_[c] = cur_[c];
+      from_ = cur_[4];
       have_prev_ = true;
       return;
     }
-    for (;;) {
+    if ((cur_[4] - prev_[4]) / by_ > kMaxGapPoints) {
+      // not filled: the grid goes on after the gap
+      ++gaps_not_filled_;
+      if (gap_notes_.size() < 5) {
+        gap_notes_.push_back("time stamps jump by " + std::to_string(cur_[4] - prev_[4]) +
+                             " s within a block; the gap is not filled by resampling");
+      }
+      double k = std::floor((cur_[4] - from_) / by_);
+      while (k > 0 && from_ + k * by_ > cur_[4]) k -= 1;
+      while (from_ + k * by_ <= cur_[4]) k += 1;
+      k_ = static_cast<std::int64_t>(k);
+      end_interval();
+      return;
+    }
+    gen_active_ = true;
+    generate();
+  }
+
+  // Grid points up to cur_'s time, interpolated from the interval (prev_,
+  // cur_], at most kGenBatch of them per call.
+  void generate() {
+    for (std::size_t made = 0; made < kGenBatch; ++made) {
       const double g = from_ + static_cast<double>(k_) * by_;
-      if (!(g <= cur[4])) break;
+      if (!(g <= cur_[4])) {
+        gen_active_ = false;
+        end_interval();
+        return;
+      }
       Point p;
       p.k = k_++;
-      double u = (g - prev_[4]) / (cur[4] - prev_[4]);
+      double u = (g - prev_[4]) / (cur_[4] - prev_[4]);
       if (nearest_) u = ggir_nearest_weight(u);
-      for (int c = 0; c < 4; ++c) p.v[c] = u * (cur[c] - prev_[c]) + prev_[c];
+      for (int c = 0; c < 4; ++c) p.v[c] = u * (cur_[c] - prev_[c]) + prev_[c];
       p.v[4] = g;
       pending_.push_back(p);
     }
+    confirm_upto(cur_[4]);
+  }
+
+  void end_interval() {
     for (int c = 0; c < 5; ++c) {
       prev2_[c] = prev_[c];
-      prev_[c] = cur[c];
+      prev_[c] = cur_[c];
     }
     have_interval_ = true;
-    last_ = cur[4];
-    // a point is not the grid's last once the grid reaches the next one
-    // (with keep_last: a point the grid reaches is in it)
-    const double reach = (last_ - from_) / by_ + 1e-10;
+    last_ = cur_[4];
+    confirm_upto(last_);
+  }
+
+  // A point is not the grid's last once the grid reaches the next one
+  // (with keep_last: a point the grid reaches is in it), the grid reaching
+  // as far as time stamp t.
+  void confirm_upto(double t) {
+    const double reach = (t - from_) / by_ + 1e-10;
     const std::int64_t ahead = keep_last_ ? 0 : 1;
     std::size_t m = 0;
     while (m < pending_.size() && static_cast<double>(pending_[m].k + ahead) <= reach) ++m;
     confirm(m);
+  }
+
+  void add_own(Report& r) const {
+    if (bad_time_ > 0) r.count("resample_bad_time", bad_time_);
+    if (gaps_not_filled_ > 0) r.count("resample_gaps_not_filled", gaps_not_filled_);
+    for (const auto& n : gap_notes_) r.note(n);
   }
 
   // The call ended: the grid runs to as.integer((tn - t1) / by + 1e-10); its
@@ -240,6 +300,10 @@ class GgirResamplerOf : public Decoder {
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
   bool in_call_ = false, first_read_ = true, have_prev_ = false, have_interval_ = false;
+  bool gen_active_ = false;  // grid points of (prev_, cur_] still to make
+  double cur_[5] = {0, 0, 0, 0, 0};
+  std::int64_t bad_time_ = 0, gaps_not_filled_ = 0;
+  std::vector<std::string> gap_notes_;
   std::int64_t left_ = -1;
   std::int64_t call_units_ = 0;
   std::int64_t k_ = 0;
