@@ -95,7 +95,9 @@ grep -q 'R_init_gravcal' "$out/objdump.txt" ||
 
 # files over 2 GiB: the objects seek and tell in 64 bits (_fseeki64,
 # _ftelli64, imported from the C runtime: __imp_), never through
-# fseek/ftell (a 32-bit long on Windows)
+# fseek/ftell (a 32-bit long on Windows). mingw-w64's msvcrt library
+# supplies the two over fgetpos/fsetpos (a 64-bit fpos_t), hence those in
+# the DLL's imports; UCRT (Rtools) has them itself.
 narrow=$(grep -xE '(__imp_)?(fseek|ftell)' "$out/undefined.txt" || true)
 if [ -n "$narrow" ]; then
   echo "win-dll: the objects call $(echo "$narrow" | tr '\n' ' ')(32-bit positions on Windows)" >&2
