@@ -37,17 +37,24 @@ out=$(cd "$out" && pwd)
 pkg_cppflags=$(sed -n 's/^PKG_CPPFLAGS *= *//p' src/Makevars.win)
 pkg_libs=$(sed -n 's/^PKG_LIBS *= *//p' src/Makevars.win)
 # R's compile line on Windows (-DNDEBUG as R's Makeconf); -Wno-cast-function-type:
-# R's routine registration casts every entry to DL_FUNC
-cd src
-for f in *.cpp; do
-  b=$(basename "$f" .cpp)
+# R's routine registration casts every entry to DL_FUNC. WIN_JOBS (2)
+# files at a time; any failure fails the script.
+compile() {
   # shellcheck disable=SC2086
   "$cxx" -std=gnu++17 -O2 -DNDEBUG -Wall -Wextra -Wno-cast-function-type -Werror \
     -I"$r_inc" $pkg_cppflags -isystem "$rcpp_inc" -isystem "$eigen_inc" \
-    -c "$f" -o "$out/$b.o"
-  echo "mingw-w64: src/$f compiles (-O2 -Wall -Wextra -Werror)"
-done
+    -c "$1" -o "$out/${1%.cpp}.o" &&
+    echo "mingw-w64: src/$1 compiles (-O2 -Wall -Wextra -Werror)"
+}
+export -f compile
+export cxx r_inc pkg_cppflags rcpp_inc eigen_inc out
+cd src
+printf '%s\n' *.cpp | xargs -P "${WIN_JOBS:-2}" -I{} bash -c 'compile "$1"' _ {} ||
+  { echo "win-dll: src/*.cpp do not all compile for Windows (above)" >&2; exit 1; }
 cd ..
+n_src=$(ls src/*.cpp | wc -l)
+n_obj=$(ls "$out"/*.o | wc -l)
+[ "$n_obj" -eq "$n_src" ] || { echo "win-dll: $n_obj objects for $n_src sources" >&2; exit 1; }
 
 # the symbols the objects take from R
 "$host-nm" -u "$out"/*.o | awk 'NF == 2 && $1 == "U" { print $2 }' | sort -u > "$out/undefined.txt"
