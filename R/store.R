@@ -213,9 +213,11 @@ lock_describe <- function(owner) {
          owner["started"])
 }
 
-# Stale: taken on this host by a process that no longer exists. `os` and
-# `run` (system2()) are arguments for the tests of the Windows branch.
-lock_stale <- function(owner, host, os = .Platform$OS.type, run = system2) {
+# Stale: taken on this host by a process that no longer exists. `os`,
+# `run` (system2()) and `signal` (tools::pskill()) are arguments for the
+# tests of the Windows branch, which must never signal.
+lock_stale <- function(owner, host, os = .Platform$OS.type, run = system2,
+                       signal = tools::pskill) {
   pid <- suppressWarnings(as.integer(owner["pid"]))
   if (is.na(pid) || !identical(unname(owner["host"]), host) ||
       pid == Sys.getpid()) {
@@ -236,7 +238,7 @@ lock_stale <- function(owner, host, os = .Platform$OS.type, run = system2) {
     state <- sub("^.*\\) ([A-Za-z]).*$", "\\1", stat)
     return(length(state) == 1L && state %in% c("Z", "X"))
   }
-  !isTRUE(suppressWarnings(tools::pskill(pid, 0)))
+  !isTRUE(suppressWarnings(signal(pid, 0L)))
 }
 
 # Whether process `pid` runs, on Windows, from tasklist's table (one

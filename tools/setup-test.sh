@@ -3,7 +3,8 @@
 # when it is missing: first what it needs to be built and run
 # (tools/setup.sh), then the Suggests, the tools of the test targets
 # (Chromium, pandoc, qpdf, tidy, valgrind, clang with libFuzzer and libc++,
-# the Cortex-M and mingw-w64 cross compilers, qemu, 32-bit multilib) and
+# the Cortex-M and mingw-w64 cross compilers, wine64 to run the Windows
+# build of the core tests, qemu, 32-bit multilib) and
 # GGIR. Debian's prebuilt r-cran-* packages when we are root on Debian
 # (fast), then anything still missing from CRAN. Safe to run again: it
 # skips what is there.
@@ -17,7 +18,7 @@ deb_pkgs="r-cran-testthat r-cran-knitr
 r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
 r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
 libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev
-libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev"
+libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev wine64"
 
 . "$(dirname "$0")/apt-missing.sh"
 # shellcheck disable=SC2086

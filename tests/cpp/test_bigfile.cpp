@@ -3,7 +3,8 @@
 // std::fseek take a long, 32 bits on Windows and on 32-bit Linux, where
 // such a file would lose its size and could not be seeked; `make` runs this
 // built for the host and for 32-bit x86 (-m32, with 64-bit off_t), whose
-// long is 32 bits as Windows' is. The file is sparse (written only at its
+// long is 32 bits as Windows' is; make cross-check builds it for Windows
+// (mingw-w64) and runs it under wine. The file is sparse (written only at its
 // start and at the two marks), so it takes a few kB of disk.
 //   make -C tests/cpp test_bigfile && ./test_bigfile [directory]
 #include <cstdint>
@@ -13,6 +14,12 @@
 #include <string>
 
 #include "gravcal/decode.hpp"
+
+// Windows' long is 32 bits (LLP64): the build for Windows proves it here,
+// so its run (under wine, make cross-check) is a run with a 32-bit long
+#if defined(_WIN32)
+static_assert(sizeof(long) == 4, "Windows' long is 32 bits");
+#endif
 
 static int failures = 0;
 #define CHECK(cond)                                                   \

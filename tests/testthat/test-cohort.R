@@ -168,7 +168,16 @@ test_that("on Windows a lock's process is looked up in tasklist, never signalled
       out
     }
   }
-  stale <- function(pid, run) lock_stale(owner(pid), host, os = "windows", run = run)
+  # tools::pskill() terminates a process on Windows whatever the signal:
+  # the Windows branch must never call it
+  signalled <- 0L
+  signal <- function(pid, sig) {
+    signalled <<- signalled + 1L
+    TRUE
+  }
+  stale <- function(pid, run) {
+    lock_stale(owner(pid), host, os = "windows", run = run, signal = signal)
+  }
   row <- function(pid) sprintf('"Rterm.exe","%d","Console","1","102,400 K"', pid)
   # running: the lock is kept
   expect_false(stale(4242L, answer(row(4242L))))
@@ -188,8 +197,10 @@ test_that("on Windows a lock's process is looked up in tasklist, never signalled
   n <- length(calls)
   expect_false(lock_stale(c(pid = "4242", host = "elsewhere"), host, os = "windows",
                           run = answer(character(0))))
-  expect_false(lock_stale(owner(Sys.getpid()), host, os = "windows", run = answer(character(0))))
+  expect_false(lock_stale(owner(Sys.getpid()), host, os = "windows", run = answer(character(0)),
+                          signal = signal))
   expect_identical(length(calls), n)
+  expect_identical(signalled, 0L)
 })
 
 test_that("calibrate_files() and calibrate_cli() reject bad input clearly", {
