@@ -70,8 +70,12 @@ if [ "$ld" != "FALSE" ]; then
 fi
 
 # packages, into this R's own library (R_LIBS unset: nothing from the
-# system R's libraries)
+# system R's libraries); testthat's dependency fs needs libuv's headers
 unset R_LIBS R_LIBS_USER R_LIBS_SITE
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && ! dpkg -s libuv1-dev >/dev/null 2>&1; then
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get install -y -qq -o DPkg::Lock::Timeout=600 --no-install-recommends libuv1-dev >/dev/null
+fi
 start=$(date +%s)
 "$rbin/Rscript" --vanilla -e '
 pk <- c("Rcpp", "RcppEigen", "testthat")
