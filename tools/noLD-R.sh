@@ -87,6 +87,18 @@ if (length(miss)) {
 still <- setdiff(pk, rownames(installed.packages()))
 if (length(still)) stop("noLD-R: could not install ", paste(still, collapse = ", "))
 ' "$cran"
+# testthat as Debian 12 has it (GRAVCAL_NOLD_TESTTHAT, default 3.1.6): the
+# snapshots of error messages were recorded with it, and testthat 3.2
+# prints conditions otherwise
+"$rbin/Rscript" --vanilla -e '
+a <- commandArgs(TRUE)
+if (as.character(utils::packageVersion("testthat")) != a[1]) {
+  install.packages("ellipsis", repos = a[2], quiet = TRUE)  # a dependency of 3.1
+  install.packages(sprintf("%s/src/contrib/Archive/testthat/testthat_%s.tar.gz", a[2], a[1]),
+                   repos = NULL, type = "source", quiet = TRUE)
+}
+if (as.character(utils::packageVersion("testthat")) != a[1]) stop("noLD-R: testthat ", a[1], " not installed")
+' "${GRAVCAL_NOLD_TESTTHAT:-3.1.6}" "$cran"
 PATH="$rbin:$PATH" GRAVCAL_CRAN="$cran" nice -n 10 bash "$here/install-ggir.sh" </dev/null
 echo "noLD-R: packages ready in $(( $(date +%s) - start )) s"
 echo "$rbin"
