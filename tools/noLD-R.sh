@@ -99,6 +99,17 @@ if (as.character(utils::packageVersion("testthat")) != a[1]) {
 }
 if (as.character(utils::packageVersion("testthat")) != a[1]) stop("noLD-R: testthat ", a[1], " not installed")
 ' "${GRAVCAL_NOLD_TESTTHAT:-3.1.6}" "$cran"
+# MASS (signal's dependency, so GGIR's): R's recommended packages are not
+# built here, and CRAN's current MASS needs R >= 4.4: the version for R 4.2
+# from CRAN's archive (GRAVCAL_NOLD_MASS, default 7.3-58.3)
+"$rbin/Rscript" --vanilla -e '
+a <- commandArgs(TRUE)
+if (!requireNamespace("MASS", quietly = TRUE)) {
+  install.packages(sprintf("%s/src/contrib/Archive/MASS/MASS_%s.tar.gz", a[2], a[1]),
+                   repos = NULL, type = "source", quiet = TRUE)
+}
+if (!requireNamespace("MASS", quietly = TRUE)) stop("noLD-R: MASS ", a[1], " not installed")
+' "${GRAVCAL_NOLD_MASS:-7.3-58.3}" "$cran"
 PATH="$rbin:$PATH" GRAVCAL_CRAN="$cran" nice -n 10 bash "$here/install-ggir.sh" </dev/null
 echo "noLD-R: packages ready in $(( $(date +%s) - start )) s"
 echo "$rbin"
