@@ -8,6 +8,8 @@
 #               user's aggressive compiler flags (flags-check)
 #   make site   the pkgdown documentation site (_build/site), checked in
 #               headless Chromium
+#   make test-noLD  (not part of make test) the tests that compare with
+#               R's and GGIR's numbers, on an R built without long double
 R ?= R
 RSCRIPT ?= Rscript
 BUILD := _build
@@ -26,7 +28,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-noLD test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -176,6 +178,23 @@ site: install setup-test
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png
+
+# GGIR's numbers on an R without long double (configure
+# --disable-long-double, CRAN's "noLD" check; not part of make test): builds
+# that R once (tools/noLD-R.sh, into GRAVCAL_NOLD_PREFIX, default
+# ~/.cache/gravcal/R-noLD: about 25 minutes on 2 cores, then GGIR and the
+# test packages from CRAN into its library, about 20 more) or reuses it,
+# installs gravcal into it and runs the test files that compare with R's or
+# GGIR's own numbers (NOLD_TESTS, tools/run-tests.R's filter)
+NOLD_TESTS ?= ggir|ggir-params|ggir-interpolation|ggir-stress|fit-icp|decode-.*|windows|adhoc-csv|axivity-csv|read|simd|fp-build|noLD
+test-noLD:
+	@bin=$$(bash tools/noLD-R.sh | tail -1) && \
+	mkdir -p $(BUILD)/lib-noLD && \
+	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-noLD . > $(BUILD)/install-noLD.log 2>&1 || \
+	  { cat $(BUILD)/install-noLD.log; exit 1; }; } && \
+	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-noLD)" R_LIBS_USER="$(abspath $(BUILD)/lib-noLD)" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true GRAVCAL_TEST_FILTER='^($(NOLD_TESTS))$$' \
+	  $$bin/Rscript ../../tools/run-tests.R
 
 # calibrate_files() through future.batchtools on a real Slurm: starts a
 # single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort

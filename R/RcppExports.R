@@ -5,6 +5,14 @@ gc_fp_probe <- function(a, b, c) {
     .Call(`_gravcal_gc_fp_probe`, a, b, c)
 }
 
+gc_set_r_long_double <- function(on) {
+    .Call(`_gravcal_gc_set_r_long_double`, on)
+}
+
+gc_r_mean_sd <- function(x, long_double) {
+    .Call(`_gravcal_gc_r_mean_sd`, x, long_double)
+}
+
 gc_file_kind <- function(path) {
     .Call(`_gravcal_gc_file_kind`, path)
 }

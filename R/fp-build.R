@@ -22,6 +22,47 @@ fp_probe <- function() {
 .onLoad <- function(libname, pkgname) {
   # never fails: an error here leaves the probe to the first use
   build_state$fp <- tryCatch(fp_probe(), error = function(e) NULL)
+  build_state$r_long_double <- tryCatch(r_accumulator_probe(), error = function(e) TRUE)
+  try(gc_set_r_long_double(build_state$r_long_double), silent = TRUE)
+}
+
+# R's accumulator. R sums (mean(), sum(), cumsum(), var(), rowSums()) in its
+# LDOUBLE type: long double, or double when R was configured with
+# --disable-long-double (CRAN's "noLD" check). GGIR computes in R, so the
+# compiled replays of R's arithmetic must accumulate as this R does. Read
+# from the R it runs in: capabilities("long.double"), checked against R's
+# own mean() and sd() of an input whose sums differ between the two
+# accumulators (probe_values()); where the two replays agree on it (where
+# long double is double anyway: macOS arm64) capabilities() decides.
+# TRUE: long double.
+r_accumulator_probe <- function() {
+  cap <- isTRUE(capabilities("long.double"))
+  x <- probe_values()
+  r <- c(mean(x), stats::sd(x))
+  ld <- gc_r_mean_sd(x, TRUE)
+  d <- gc_r_mean_sd(x, FALSE)
+  if (identical(ld, d)) return(cap)
+  if (identical(r, ld)) return(TRUE)
+  if (identical(r, d)) return(FALSE)
+  cap
+}
+
+# An input whose mean and sd differ between sums in long double and in
+# double: 1 followed by values of about 2^-40 (lost in part when added to 1
+# in double, kept in the 64 bits of x87's long double), then the same
+# values after -1.
+probe_values <- function() {
+  small <- (1 + (1:64) / 128) * 2^-40
+  c(1, small, -1, rev(small) * 3)
+}
+
+# Runs `code` with R's accumulator taken as long double (TRUE) or double
+# (FALSE), whatever this R has: for the tests of the replay of an R without
+# long double on an R with it.
+with_r_accumulator <- function(long_double, code) {
+  old <- gc_set_r_long_double(long_double)
+  on.exit(gc_set_r_long_double(old), add = TRUE)
+  force(code)
 }
 
 # Stops when the build cannot give GGIR's bits; `what` names the caller.

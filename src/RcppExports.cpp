@@ -23,6 +23,27 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_set_r_long_double
+bool gc_set_r_long_double(bool on);
+RcppExport SEXP _gravcal_gc_set_r_long_double(SEXP onSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< bool >::type on(onSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_set_r_long_double(on));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_r_mean_sd
+Rcpp::NumericVector gc_r_mean_sd(Rcpp::NumericVector x, bool long_double);
+RcppExport SEXP _gravcal_gc_r_mean_sd(SEXP xSEXP, SEXP long_doubleSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type x(xSEXP);
+    Rcpp::traits::input_parameter< bool >::type long_double(long_doubleSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_r_mean_sd(x, long_double));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_file_kind
 std::string gc_file_kind(std::string path);
 RcppExport SEXP _gravcal_gc_file_kind(SEXP pathSEXP) {
@@ -278,6 +299,8 @@ END_RCPP
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
+    {"_gravcal_gc_set_r_long_double", (DL_FUNC) &_gravcal_gc_set_r_long_double, 1},
+    {"_gravcal_gc_r_mean_sd", (DL_FUNC) &_gravcal_gc_r_mean_sd, 2},
     {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},

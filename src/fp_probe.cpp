@@ -7,6 +7,9 @@
 
 #include <Rcpp.h>
 
+#include "gravcal/r_arith.hpp"
+#include "r_services.h"
+
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_fp_probe(double a, double b, double c) {
 #if defined(__FAST_MATH__)
@@ -16,4 +19,28 @@ Rcpp::List gc_fp_probe(double a, double b, double c) {
 #endif
   return Rcpp::List::create(Rcpp::Named("value") = a * b + c,
                             Rcpp::Named("fast_math") = fast_math);
+}
+
+// R's accumulator for the replays of R's arithmetic (r_services.h): set by
+// R when the package loads, from capabilities("long.double"); returns the
+// previous setting.
+// [[Rcpp::export(rng = false)]]
+bool gc_set_r_long_double(bool on) {
+  bool& cur = gravcal_glue::r_long_double();
+  const bool old = cur;
+  cur = on;
+  return old;
+}
+
+// R's mean(x) and sd(x) (na.rm = TRUE) as the core replays them, with R's
+// accumulator long double (long_double) or double: for the load-time probe
+// of R's own arithmetic (R/fp-build.R) and the tests.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector gc_r_mean_sd(Rcpp::NumericVector x, bool long_double) {
+  const gravcal::RMeanSd r = gravcal::with_r_acc(long_double, [&](auto acc) {
+    return gravcal::r_mean_sd<decltype(acc)>([&](auto&& f) {
+      for (double v : x) f(v);
+    });
+  });
+  return Rcpp::NumericVector::create(r.mean, r.sd);
 }

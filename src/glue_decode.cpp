@@ -13,12 +13,15 @@
 
 #include "gravcal/decode.hpp"
 #include "decoders.h"
+#include "r_services.h"
 #include "sources_glue.h"
 
 namespace {
 
 gravcal::Options to_options(const Rcpp::List& opts) {
   gravcal::Options o;
+  // R's accumulator, for the decoders that replay R's sums (.cwa)
+  o.set("r_long_double", gravcal_glue::r_long_double() ? 1.0 : 0.0);
   if (opts.size() == 0) return o;
   const Rcpp::CharacterVector nm = opts.names();
   for (R_xlen_t i = 0; i < opts.size(); ++i) {

@@ -42,6 +42,7 @@ Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y
     Rcpp::stop("rule must be \"ggir_r\", \"ggir\" or \"converge\"");
   cfg.stop = rule == "converge" ? gravcal::StopRule::parameters : gravcal::StopRule::ggir;
   cfg.r_arithmetic = rule == "ggir_r";
+  cfg.r_long_double = gravcal_glue::r_long_double();
   std::vector<double> tr;
   const gravcal::IcpResult r = gravcal::fit_icp(
       x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), cfg,

@@ -88,7 +88,8 @@ Rcpp::List run_blocks(gravcal::Source& src, const Rcpp::List& o) {
   const bool compat = num(o, "compat") != 0;
   gravcal_glue::SegmenterBox box(10 * sf, false, compat);
   const bool temp = num(o, "temperature") != 0 && src.has_temperature();
-  gravcal::GgirBlocks blocks(box.seg, num(o, "per_hour"), compat, temp, num(o, "temp_min_sd"));
+  gravcal::GgirBlocks blocks(box.seg, num(o, "per_hour"), compat, temp, num(o, "temp_min_sd"),
+                             gravcal_glue::r_long_double());
   gravcal::BlocksStage stage(blocks, temp);
   Rcpp::NumericVector par = o["par"];
   const gravcal_glue::RestRule is_rest(1, par);
@@ -193,6 +194,7 @@ gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
   c.compat = num(o, "compat") != 0;
   c.temperature = num(o, "temperature") != 0;
   c.lazy = num(o, "lazy") != 0;
+  c.r_long_double = gravcal_glue::r_long_double();
   c.min_rest = static_cast<int>(num(o, "min_rest"));
   c.error_digits = static_cast<int>(num(o, "error_digits"));
   c.max_iter = static_cast<int>(num(o, "max_iter"));

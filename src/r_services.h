@@ -11,6 +11,16 @@
 
 namespace gravcal_glue {
 
+// R's accumulator (its LDOUBLE, in mean(), sum(), cumsum(), var(),
+// rowSums()): long double (true), or double in an R built without long
+// double (capabilities("long.double") FALSE). Set from R when the package
+// loads (R/fp-build.R, gc_set_r_long_double()); each call that replays R's
+// arithmetic reads it once and passes it to the core.
+inline bool& r_long_double() {
+  static bool on = true;
+  return on;
+}
+
 // Weighted least squares by R's own LINPACK routine dqrls, with lm.wfit's
 // tolerance and its handling of aliased columns: the numbers GGIR's lm.wfit
 // calls get, to the last bit (see icp.hpp, IcpConfig::r_arithmetic).

@@ -12,6 +12,7 @@
 #include "gravcal/gravcal.hpp"
 #include "gravcal/segmenter.hpp"
 #include "gravcal/ggir_blocks.hpp"
+#include "r_services.h"
 
 namespace gravcal_glue {
 
@@ -91,7 +92,7 @@ struct SegmenterBox {
       : seg(samples_per_window, skip_zero) {
     if (r_arithmetic) {
       buffer.assign(3 * (static_cast<std::size_t>(std::ceil(samples_per_window)) + 1), 0.0);
-      if (!seg.use_r_arithmetic(buffer.data(), buffer.size()))
+      if (!seg.use_r_arithmetic(buffer.data(), buffer.size(), r_long_double()))
         Rcpp::stop("could not set up the window buffer");
     }
   }

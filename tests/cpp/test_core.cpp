@@ -429,49 +429,51 @@ static void test_r_sd_below() {
   CHECK(same.sd == 0 && gravcal::r_sd_below(same, thr) == 1);
 }
 
-// add_repeated() (r_arith.hpp): k additions of x to a long double in a few
+// add_repeated() (r_arith.hpp): k additions of x to an accumulator Acc (R's:
+// long double, or double in an R without long double) in a few
 // steps, to the bit as the loop: sums growing and shrinking across
 // binades, through zero, x below half a step, ties (x half-way between
 // multiples of the grid of s), huge values.
-static void test_add_repeated() {
+template <class Acc>
+static void test_add_repeated_acc() {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> U(-1.0, 1.0);
   int bad = 0;
   for (int t = 0; t < 40000; ++t) {
-    long double s = 0;
+    Acc s = 0;
     double x = 0;
     switch (t % 7) {
-      case 0: s = 25.0L * (1 + U(rng)); x = 25 + U(rng); break;
-      case 1: s = 1e8L * U(rng); x = 30 * U(rng); break;
-      case 2: s = 0x1p20L - 50 * std::fabs(U(rng)); x = 0.7 + 0.1 * U(rng); break;
-      case 3: s = 0x1p20L + 50 * std::fabs(U(rng)); x = -0.7 - 0.1 * U(rng); break;
-      case 4: s = 3.0L * U(rng); x = static_cast<double>(-s / 7 * (1 + 1e-3 * U(rng))); break;
+      case 0: s = Acc(25.0) * (1 + U(rng)); x = 25 + U(rng); break;
+      case 1: s = Acc(1e8) * U(rng); x = 30 * U(rng); break;
+      case 2: s = Acc(0x1p20) - 50 * std::fabs(U(rng)); x = 0.7 + 0.1 * U(rng); break;
+      case 3: s = Acc(0x1p20) + 50 * std::fabs(U(rng)); x = -0.7 - 0.1 * U(rng); break;
+      case 4: s = Acc(3.0) * U(rng); x = static_cast<double>(-s / 7 * (1 + 1e-3 * U(rng))); break;
       case 5: {  // x half-way between multiples of the grid of s
-        s = 1027.0L;
-        const long double q = std::ldexp(1.0L, 11 - std::numeric_limits<long double>::digits);
-        x = static_cast<double>(q * (std::floor(1000 * U(rng)) + 0.5L));
+        s = Acc(1027.0);
+        const Acc q = std::ldexp(Acc(1.0), 11 - std::numeric_limits<Acc>::digits);
+        x = static_cast<double>(q * (std::floor(1000 * U(rng)) + Acc(0.5)));
         break;
       }
-      default: s = 1e300L * U(rng); x = 1e290 * U(rng); break;
+      default: s = Acc(1e300) * U(rng); x = 1e290 * U(rng); break;
     }
     if (t % 97 == 0) s = 0;
     const std::uint64_t k = 1 + rng() % (t % 3 == 0 ? 5000 : 50);
-    long double a = s, b = s;
+    Acc a = s, b = s;
     for (std::uint64_t i = 0; i < k; ++i) a += x;
     gravcal::add_repeated(b, x, k);
     bad += !(a == b || (std::isnan(a) && std::isnan(b)));
   }
   // at a binade's edges: the last additions before 2^20 (from above) or
   // 2^21 (from below) round on the next binade's grid
-  const int digits = std::numeric_limits<long double>::digits;
-  const long double q = std::ldexp(1.0L, 21 - digits);  // the grid of [2^20, 2^21)
+  const int digits = std::numeric_limits<Acc>::digits;
+  const Acc q = std::ldexp(Acc(1.0), 21 - digits);  // the grid of [2^20, 2^21)
   for (int m = 1; m <= 12; ++m) {
     for (int r = 1; r <= 3; ++r) {
       for (int f = 1; f <= 4; ++f) {
         for (int up = 0; up < 2; ++up) {
-          const long double s0 = up ? 0x1p21L - m * q : 0x1p20L + m * q;
-          const double x = static_cast<double>((up ? 1 : -1) * (r + f / 10.0L) * q);
-          long double a = s0, b = s0;
+          const Acc s0 = up ? Acc(0x1p21) - m * q : Acc(0x1p20) + m * q;
+          const double x = static_cast<double>((up ? 1 : -1) * (r + f / Acc(10.0)) * q);
+          Acc a = s0, b = s0;
           for (int i = 0; i < 20; ++i) a += x;
           gravcal::add_repeated(b, x, 20);
           bad += a != b;
@@ -483,12 +485,17 @@ static void test_add_repeated() {
   // by runs, with the grid kept between calls
   std::vector<double> v(20000);
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = 25.3 + 0.29 * static_cast<double>((i / 120) % 37);
-  long double a = 0, b = 0;
+  Acc a = 0, b = 0;
   for (double e : v) a += e;
-  gravcal::Binade g;
+  gravcal::Binade<Acc> g;
   gravcal::add_in_order(b, v.data(), 7000, g);
   gravcal::add_in_order(b, v.data() + 7000, v.size() - 7000, g);
   CHECK_LD(a == b);
+}
+
+static void test_add_repeated() {
+  test_add_repeated_acc<long double>();
+  test_add_repeated_acc<double>();
 }
 
 // Segmenter::lazy_r_sd() against R's sds everywhere, through GGIR's block

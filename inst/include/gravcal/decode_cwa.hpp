@@ -9,7 +9,9 @@
 //
 // Options: "compat" (default 1); with compat = 1 also "interpolation" (1,
 // the default: linear; 2: nearest neighbour, readAxivity's
-// interpolationType) and "frequency_tol" (default 0.1, readAxivity's).
+// interpolationType), "frequency_tol" (default 0.1, readAxivity's) and
+// "r_long_double" (default 1: R's sum() accumulates in long double; 0: in
+// double, an R without long double; see r_arith.hpp).
 //  compat = 0: the samples at their own times, no resampling. Sample i of a
 //    block is at start + i / f, start = T + frac / 65536 - offset / f (T the
 //    packed RTC time, frac the block's fraction of a second, offset the
@@ -72,6 +74,7 @@
 
 #include "gravcal/decode.hpp"
 #include "gravcal/kernels.hpp"
+#include "gravcal/r_arith.hpp"
 
 namespace gravcal {
 
@@ -242,7 +245,8 @@ class CwaDecoder : public Decoder {
       : src_(src),
         compat_(opts.num("compat", 1) != 0),
         nearest_(opts.num("interpolation", 1) == 2),
-        frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)) {}
+        frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)),
+        r_long_double_(opts.num("r_long_double", 1) != 0) {}
 
   bool open() override;
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
@@ -280,6 +284,7 @@ class CwaDecoder : public Decoder {
   bool compat_;
   bool nearest_;                   // interpolationType = 2
   double frequency_tol_;
+  bool r_long_double_;  // R's accumulator: long double, else double
   bool done_ = false;
   std::int64_t n_blocks_ = -1;     // complete data blocks in the file; -1 unknown
   double header_f_ = 0;            // rate in the header (GGIR's grid rate)
@@ -793,13 +798,15 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   imputed_[2] = 1;
   if (impute_) {
     report_.count("imputed_spans");
-    // R: sqrt(sum(v^2)), v^2 in double, sum() in long double
-    long double s = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double q = anchor_[a] * anchor_[a];
-      s += q;
-    }
-    const double norm = std::sqrt(static_cast<double>(s));
+    // R: sqrt(sum(v^2)), v^2 in double, sum() in R's accumulator
+    const double norm = with_r_acc(r_long_double_, [&](auto acc) {
+      decltype(acc) s = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double q = anchor_[a] * anchor_[a];
+        s += q;
+      }
+      return std::sqrt(static_cast<double>(s));
+    });
     if (norm > 0.8 && norm < 1.2) {
       for (int a = 0; a < 3; ++a) imputed_[a] = anchor_[a] / norm;
     }

@@ -92,15 +92,17 @@ class GgirBlocks {
  public:
   // per_hour: samples per hour (3600 sf); compat: GGIR's accidents;
   // temperature: the stream has a temperature column; temp_min_sd: the
-  // threshold the temperature's sd is compared with (GGIR: 0.01).
+  // threshold the temperature's sd is compared with (GGIR: 0.01);
+  // r_long_double: R's accumulator (r_arith.hpp) is long double, else double.
   GgirBlocks(Segmenter& seg, double per_hour, bool compat, bool temperature,
-             double temp_min_sd = 0.01)
+             double temp_min_sd = 0.01, bool r_long_double = true)
       : seg_(seg),
         Hd_(per_hour),
         H_(static_cast<std::int64_t>(per_hour + kRColonFuzz)),
         compat_(compat),
         temp_(temperature),
-        temp_min_sd_(temp_min_sd) {
+        temp_min_sd_(temp_min_sd),
+        r_long_double_(r_long_double) {
     if (H_ < 1) H_ = 1;
     // 3600 sf just below a whole number in double (33.3 Hz: 119879.99...):
     // R's `1:use` still takes the whole number of rows (H_), and GGIR's
@@ -399,11 +401,16 @@ class GgirBlocks {
   // value, so that a block at the threshold goes GGIR's way.
   void temperature_stats(std::int64_t use) {
     if (!temp_) return;
+    with_r_acc(r_long_double_, [&](auto acc) { temperature_stats_in<decltype(acc)>(use); });
+  }
+
+  template <class Acc>
+  void temperature_stats_in(std::int64_t use) {
     // gravcal's own mode leaves non-finite temperatures out (as the
     // windows' temperatures do); GGIR's R arithmetic keeps an Inf, whose sd
     // is NaN, and so drops the temperature of the whole recording
     const bool keep_all = compat_;
-    info_.first_mean = r_mean_sd([&](auto&& f) {
+    info_.first_mean = r_mean_sd<Acc>([&](auto&& f) {
       for (double v : first_) {
         if (keep_all || std::isfinite(v)) f(v);
       }
@@ -417,12 +424,12 @@ class GgirBlocks {
       info_.temp_sd = fast.sd;
       return;
     }
-    const int below = r_sd_below(fast, temp_min_sd_);
+    const int below = r_sd_below<Acc>(fast, temp_min_sd_);
     if (below >= 0 && (fast.sd < temp_min_sd_) == (below == 1)) {
       info_.temp_sd = fast.sd;
       return;
     }
-    info_.temp_sd = r_mean_sd([&](auto&& f) {
+    info_.temp_sd = r_mean_sd<Acc>([&](auto&& f) {
       each_run(use, [&](double v, std::uint64_t c) {
         for (std::uint64_t i = 0; i < c; ++i) f(v);
       });
@@ -445,6 +452,7 @@ class GgirBlocks {
   bool compat_;
   bool temp_;
   double temp_min_sd_;
+  bool r_long_double_;
   GgirBlockInfo info_;
   std::int64_t pushed_ = 0;    // the block's samples given to the segmenter
   bool started_ = false;

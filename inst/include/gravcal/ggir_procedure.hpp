@@ -51,6 +51,9 @@ struct GgirConfig {
   double short_block_rows = 0.0;  // a block with fewer rows is the last (0: none)
   bool temperature = true;     // use the source's temperature if it has one
   bool lazy = true;            // compatible mode: R's sds only where seen
+  bool r_long_double = true;   // R's accumulator (its LDOUBLE) is long
+                               // double; false: double (an R without long
+                               // double, capabilities("long.double") FALSE)
   double spherecrit = 0.3;     // g
   double minloadcrit = 168.0;  // h
   double max_sd = 0.013;       // g, rest: sd of every axis below
@@ -158,7 +161,7 @@ class GgirProcedure {
     // filter): see Segmenter::lazy_r_sd()
     if (cfg_.compat) {
       buffer_.assign(3 * (static_cast<std::size_t>(std::ceil(L_)) + 1), 0.0);
-      seg_.use_r_arithmetic(buffer_.data(), buffer_.size());
+      seg_.use_r_arithmetic(buffer_.data(), buffer_.size(), cfg_.r_long_double);
     }
     if (cfg_.compat && cfg_.lazy) {
       held_.assign(buffer_.size(), 0.0);
@@ -368,7 +371,10 @@ class GgirProcedure {
       const double e = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
       d[i] = std::fabs(e - 1.0);
     }
-    return host_.round_digits(r_mean(d.data(), n), cfg_.error_digits);
+    const double mean = with_r_acc(cfg_.r_long_double, [&](auto acc) {
+      return r_mean<decltype(acc)>(d.data(), n);
+    });
+    return host_.round_digits(mean, cfg_.error_digits);
   }
 
   // [4] - [6] filter the table, check it, fit; true when the reading may
@@ -525,6 +531,7 @@ class GgirProcedure {
     c.use_temp = o.use_temp;
     c.stop = rule == Rule::ggir_r ? StopRule::ggir : StopRule::parameters;
     c.r_arithmetic = rule == Rule::ggir_r;
+    c.r_long_double = cfg_.r_long_double;
     // a decision (own mode) needs the error to a fraction of a mg, not the
     // coefficients to 1e-10: converged to decide_tol
     if (rule == Rule::decide) c.tol = cfg_.decide_tol;

@@ -53,6 +53,8 @@ struct IcpConfig {
   bool use_temp = true;
   StopRule stop = StopRule::ggir;
   bool r_arithmetic = false;  // GGIR's R arithmetic, step by step (above)
+  bool r_long_double = true;  // ... with R's accumulator long double (R's
+                              // default), else double (R without long double)
   // gravcal's own fit only: start from these coefficients (a fit on part of
   // the same windows, whose temperature was centred on start_meantemp)
   // rather than from the identity
@@ -234,7 +236,8 @@ inline void icp_reweight(const double* const* in, const double* t, std::size_t n
 // temperature that does not vary gives NA coefficients (reported as not
 // finite), the statistic is 3 * mean(w * (a - p)^2 / sum(w)) over all 3n
 // elements, the weights min(1 / sqrt(rowSums((a - p)^2)), max_weight).
-template <class Observer, class Solver>
+// Acc: R's accumulator (IcpConfig::r_long_double).
+template <class Acc, class Observer, class Solver>
 IcpResult fit_icp_r(const double* x, const double* y, const double* z,
                     const double* temp, std::size_t n, const IcpConfig& cfg,
                     Observer& obs, const Solver& solve) {
@@ -247,7 +250,7 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
   const bool use_temp = cfg.use_temp && temp != nullptr;
   std::vector<double> t(n, 0.0);
   if (use_temp) {
-    r.meantemp = r_mean(temp, n);
+    r.meantemp = r_mean<Acc>(temp, n);
     for (std::size_t i = 0; i < n; ++i) t[i] = temp[i] - r.meantemp;
     r.temp_used = true;
   }
@@ -263,7 +266,7 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
     }
     // closest points: curr / sqrt(rowSums(curr^2))
     for (std::size_t i = 0; i < n; ++i) {
-      long double ss = 0.0L;
+      Acc ss = 0.0;
       for (int k = 0; k < 3; ++k) {
         const double c = cur[k * n + i];
         ss += c * c;
@@ -301,7 +304,7 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
       if (use_temp) r.tempoffset[k] = r.tempoffset[k] * d_scale[k] + d_temp[k];
       r.scale[k] = r.scale[k] * d_scale[k];
     }
-    long double wsum_l = 0.0L;
+    Acc wsum_l = 0.0;
     for (std::size_t i = 0; i < n; ++i) wsum_l += w[i];
     const double wsum = static_cast<double>(wsum_l);
     for (int k = 0; k < 3; ++k) {
@@ -310,9 +313,9 @@ IcpResult fit_icp_r(const double* x, const double* y, const double* z,
         e[k * n + i] = w[i] * (d * d) / wsum;
       }
     }
-    const double res = 3.0 * r_mean(e.data(), 3 * n);
+    const double res = 3.0 * r_mean<Acc>(e.data(), 3 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      long double ss = 0.0L;
+      Acc ss = 0.0;
       for (int k = 0; k < 3; ++k) {
         const double d = cur[k * n + i] - cp[k * n + i];
         ss += d * d;
@@ -553,7 +556,11 @@ IcpResult fit_icp(const double* x, const double* y, const double* z,
                   const double* temp, std::size_t n, const IcpConfig& cfg,
                   Observer&& obs, const Solver& solve = Solver()) {
   IcpResult r;
-  if (cfg.r_arithmetic) return fit_icp_r(x, y, z, temp, n, cfg, obs, solve);
+  if (cfg.r_arithmetic) {
+    return with_r_acc(cfg.r_long_double, [&](auto acc) {
+      return fit_icp_r<decltype(acc)>(x, y, z, temp, n, cfg, obs, solve);
+    });
+  }
   if (n < 3) {
     r.finite = false;
     return r;

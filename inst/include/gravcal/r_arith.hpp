@@ -14,6 +14,14 @@
 // long double additions in closed form (add_repeated()), so that R's
 // arithmetic runs only where its bits can matter.
 //
+// R's accumulators. R sums in its LDOUBLE type: long double, or double in
+// an R configured with --disable-long-double (CRAN's "noLD" check; and on
+// macOS arm64, where long double is double anyway). Every function here
+// that replays R's sums takes the accumulator as a template parameter Acc
+// (long double by default; double for an R without long double), which the
+// R glue chooses once per call from capabilities("long.double") of the R it
+// runs in (R/fp-build.R).
+//
 // Header-only, standard headers only.
 #ifndef GRAVCAL_R_ARITH_HPP
 #define GRAVCAL_R_ARITH_HPP
@@ -28,17 +36,27 @@
 
 namespace gravcal {
 
+// f(Acc()) with R's accumulator: long double when r_long_double (R's
+// default), else double; the one place a run-time choice of R's arithmetic
+// becomes a type.
+template <class F>
+decltype(auto) with_r_acc(bool r_long_double, F&& f) {
+  if (r_long_double) return f(static_cast<long double>(0));
+  return f(0.0);
+}
+
 struct RMeanSd {
   double mean = std::numeric_limits<double>::quiet_NaN();
   double sd = std::numeric_limits<double>::quiet_NaN();  // NaN with n < 2
   std::size_t n = 0;  // values that are not NaN
 };
 
-// mean(v, na.rm = TRUE) and sd(v, na.rm = TRUE) as R computes them.
-template <class Each>
+// mean(v, na.rm = TRUE) and sd(v, na.rm = TRUE) as R computes them, with
+// R's accumulator Acc.
+template <class Acc = long double, class Each>
 RMeanSd r_mean_sd(Each&& each) {
   RMeanSd r;
-  long double s = 0.0L;
+  Acc s = 0.0;
   std::size_t n = 0;
   each([&](double a) {
     if (std::isnan(a)) return;
@@ -47,10 +65,10 @@ RMeanSd r_mean_sd(Each&& each) {
   });
   r.n = n;
   if (n == 0) return r;
-  const long double ln = static_cast<long double>(n);
-  long double m = s / ln;
+  const Acc ln = static_cast<Acc>(n);
+  Acc m = s / ln;
   if (std::isfinite(static_cast<double>(m))) {
-    long double c = 0.0L;
+    Acc c = 0.0;
     each([&](double a) {
       if (!std::isnan(a)) c += (a - m);
     });
@@ -58,12 +76,12 @@ RMeanSd r_mean_sd(Each&& each) {
   }
   r.mean = static_cast<double>(m);
   if (n > 1) {
-    long double ss = 0.0L;
-    const long double xm = r.mean;
+    Acc ss = 0.0;
+    const Acc xm = r.mean;
     each([&](double a) {
       if (!std::isnan(a)) ss += (a - xm) * (a - xm);
     });
-    r.sd = std::sqrt(static_cast<double>(ss / static_cast<long double>(n - 1)));
+    r.sd = std::sqrt(static_cast<double>(ss / static_cast<Acc>(n - 1)));
   }
   return r;
 }
@@ -109,12 +127,14 @@ RunsSd runs_sd(EachRun&& each) {
 
 // Whether R's sd() of the same values is below `thr` (1), not below (0), or
 // too close to tell (-1), from runs_sd()'s result alone. Only when this is
-// -1 need R's arithmetic be repeated (r_mean_sd()).
+// -1 need R's arithmetic be repeated (r_mean_sd()). Acc: R's accumulator,
+// whose unit roundoff is u below (runs_sd()'s own sums, in long double, are
+// at least as precise).
 //
 // Why the answer is R's. Let the n values a_i have true mean mu, true
 // variance s2 = sum (a_i - mu)^2 / (n - 1) and M = max |a_i|, all finite;
-// u = the unit roundoff of long double (2^-64 on x87; 2^-53 where long
-// double is double), v = 2^-53 (double); standard bounds for
+// u = the unit roundoff of R's accumulator (2^-64 for x87's long double;
+// 2^-53 where it is double), v = 2^-53 (double); standard bounds for
 // recursive summation (Higham, Accuracy and Stability of Numerical
 // Algorithms, 2nd ed., sec. 4.2; gamma_k = k u / (1 - k u)).
 // - R's mean (r_mean_sd()): the sum is off by at most gamma_(n-1) n M, so
@@ -141,14 +161,16 @@ RunsSd runs_sd(EachRun&& each) {
 // [1e-100, 1e100] (M = 0 too), and no infinite value; outside that, -1.
 // The margins are far wider than the errors seen in practice (about 1e-12
 // relative for 4e6 values), so -1 happens only within about 1e-12 of thr.
-inline int r_sd_below(const RunsSd& r, double thr) {
+template <class Acc = long double>
+int r_sd_below(const RunsSd& r, double thr) {
   if (r.n < 2 || !r.finite) return -1;
   if (!(thr >= 1e-100 && thr <= 1e100)) return -1;
   if (r.max_abs > 1e100 || (r.max_abs != 0.0 && r.max_abs < 1e-100)) return -1;
   if (r.n > (std::uint64_t(1) << 40) || r.runs > (std::uint64_t(1) << 40)) return -1;
-  // u: the unit roundoff of R's long double, 2^-64 where it is the x87's
-  // 80-bit format, 2^-53 where long double is double (MSVC, macOS arm64)
-  const long double u = std::numeric_limits<long double>::epsilon() / 2;
+  // u: the unit roundoff of R's accumulator, 2^-64 where it is the x87's
+  // 80-bit long double, 2^-53 where it is double (an R without long double;
+  // macOS arm64); runs_sd()'s u is never larger
+  const long double u = std::numeric_limits<Acc>::epsilon() / 2;
   const long double v = std::ldexp(1.0L, -53);
   const long double n = static_cast<long double>(r.n);
   const long double k = static_cast<long double>(r.runs);
@@ -164,56 +186,58 @@ inline int r_sd_below(const RunsSd& r, double thr) {
   return -1;
 }
 
-// The long double grid around a value: |s| in [bottom, top) = [2^(e-1),
-// 2^e) has spacing q = 2^(e - digits).
+// The grid of the accumulator Acc around a value: |s| in [bottom, top) =
+// [2^(e-1), 2^e) has spacing q = 2^(e - digits), digits Acc's.
+template <class Acc = long double>
 struct Binade {
-  long double q = 0, inv_q = 0, bottom = 0, top = 0;
-  bool holds(long double a) const { return a >= bottom && a < top; }
-  void set(long double s) {
-    constexpr int digits = std::numeric_limits<long double>::digits;
+  Acc q = 0, inv_q = 0, bottom = 0, top = 0;
+  bool holds(Acc a) const { return a >= bottom && a < top; }
+  void set(Acc s) {
+    constexpr int digits = std::numeric_limits<Acc>::digits;
     int e = 0;
     std::frexp(s, &e);
-    q = std::ldexp(1.0L, e - digits);
-    inv_q = std::ldexp(1.0L, digits - e);
-    bottom = std::ldexp(1.0L, e - 1);
-    top = std::ldexp(1.0L, e);
+    q = std::ldexp(Acc(1), e - digits);
+    inv_q = std::ldexp(Acc(1), digits - e);
+    bottom = std::ldexp(Acc(1), e - 1);
+    top = std::ldexp(Acc(1), e);
   }
 };
 
 // add_repeated()'s closed form (see there): adds x to s j times, 0 < j <=
 // k, as j additions would, and returns j; or returns 0 when the next
 // addition must be a plain one. b: the grid of s, kept between calls.
-inline std::uint64_t repeat_steps(long double& s, double x, std::uint64_t k, Binade& b) {
-  if (x == 0.0 || s == 0.0L || !std::isfinite(x) || !std::isfinite(s)) return 0;
-  const long double a = std::fabs(s);
+template <class Acc>
+std::uint64_t repeat_steps(Acc& s, double x, std::uint64_t k, Binade<Acc>& b) {
+  if (x == 0.0 || s == 0.0 || !std::isfinite(x) || !std::isfinite(s)) return 0;
+  const Acc a = std::fabs(s);
   if (!b.holds(a)) b.set(s);
-  const long double y = x * b.inv_q;  // exact: a power of 2
-  if (!(std::fabs(y) < 0x1p62L)) return 0;
-  const long double n = static_cast<long double>(std::llrint(y));
-  if (std::fabs(y - n) == 0.5L) return 0;  // a tie: the last bit of s decides
-  const long double r = n * b.q;              // x on the grid of s
+  const Acc y = x * b.inv_q;  // exact: a power of 2
+  if (!(std::fabs(y) < Acc(0x1p62))) return 0;
+  const Acc n = static_cast<Acc>(std::llrint(y));
+  if (std::fabs(y - n) == Acc(0.5)) return 0;  // a tie: the last bit of s decides
+  const Acc r = n * b.q;                       // x on the grid of s
   // |s| may go from lo to hi (q inside the binade), in steps of |r|
-  const long double lo = b.bottom + b.q, hi = b.top - b.q;
-  if (r == 0.0L) return a >= lo && a <= hi ? k : 0;  // s does not move
-  const long double room = (s > 0) == (r > 0) ? hi - a : a - lo;
+  const Acc lo = b.bottom + b.q, hi = b.top - b.q;
+  if (r == 0.0) return a >= lo && a <= hi ? k : 0;  // s does not move
+  const Acc room = (s > 0) == (r > 0) ? hi - a : a - lo;
   if (!(room > 0)) return 0;
-  const long double step = std::fabs(r);
+  const Acc step = std::fabs(r);
   std::uint64_t j = k;
-  if (static_cast<long double>(k) * step > room) {
+  if (static_cast<Acc>(k) * step > room) {
     j = static_cast<std::uint64_t>(std::floor(room / step));
   }
   // room / step rounded: step back until s + j r is inside (j r is exact:
   // |j n| < 2^digits)
   while (j > 0) {
-    const long double t = std::fabs(s + static_cast<long double>(j) * r);
+    const Acc t = std::fabs(s + static_cast<Acc>(j) * r);
     if (t >= lo && t <= hi) break;
     --j;
   }
-  if (j > 0) s += static_cast<long double>(j) * r;  // exact, see add_repeated()
+  if (j > 0) s += static_cast<Acc>(j) * r;  // exact, see add_repeated()
   return j;
 }
 
-// s += x, k times, in long double, to the bit (as a loop of k additions
+// s += x, k times, in Acc (R's accumulator), to the bit (as a loop of k additions
 // would give it), in a few steps. Each addition rounds the exact s + x to
 // the long double grid of s's binade: spacing q = 2^(e - digits) for |s| in
 // [2^(e-1), 2^e). s is on that grid, so while s + x stays inside the
@@ -225,7 +249,8 @@ inline std::uint64_t repeat_steps(long double& s, double x, std::uint64_t k, Bin
 // q, 2^e - q]: every exact sum on the way is then inside the binade
 // (|x - r| <= q / 2). At a tie, near the binade's edges, with s or x zero
 // or not finite, and for fewer than 4 additions: plain additions.
-inline void add_repeated(long double& s, double x, std::uint64_t k, Binade& b) {
+template <class Acc>
+void add_repeated(Acc& s, double x, std::uint64_t k, Binade<Acc>& b) {
   while (k > 0) {
     const std::uint64_t j = k < 4 ? 0 : repeat_steps(s, x, k, b);
     if (j == 0) {
@@ -237,21 +262,23 @@ inline void add_repeated(long double& s, double x, std::uint64_t k, Binade& b) {
   }
 }
 
-inline void add_repeated(long double& s, double x, std::uint64_t k) {
-  Binade b;
+template <class Acc>
+void add_repeated(Acc& s, double x, std::uint64_t k) {
+  Binade<Acc> b;
   add_repeated(s, x, k, b);
 }
 
 // R's mean() of n contiguous values (no NaN handling: R's mean without
-// na.rm gives NaN when any value is NaN, as this does).
-inline double r_mean(const double* v, std::size_t n) {
+// na.rm gives NaN when any value is NaN, as this does), R's accumulator Acc.
+template <class Acc = long double>
+double r_mean(const double* v, std::size_t n) {
   if (n == 0) return std::numeric_limits<double>::quiet_NaN();
-  const long double ln = static_cast<long double>(n);
-  long double s = 0.0L;
+  const Acc ln = static_cast<Acc>(n);
+  Acc s = 0.0;
   for (std::size_t i = 0; i < n; ++i) s += v[i];
-  long double m = s / ln;
+  Acc m = s / ln;
   if (std::isfinite(static_cast<double>(m))) {
-    long double t = 0.0L;
+    Acc t = 0.0;
     for (std::size_t i = 0; i < n; ++i) t += (v[i] - m);
     m += t / ln;
   }

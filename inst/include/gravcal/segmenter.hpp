@@ -17,6 +17,9 @@
 // - R's arithmetic for what GGIR's procedure sees of the sds (lazy_r_sd();
 //   stats_r.hpp, LazyRStats): R's sds only where a comparison could tell
 //   them from sds in double; windows reach the sink one window late.
+// R's arithmetic has two flavours, as R's accumulator (r_arith.hpp): long
+// double (R's default) or double (an R built without long double); the
+// segmenter holds a cutter of each (RExactStatsT<Acc>, LazyRStatsT<Acc>).
 //
 // Header-only, standard headers only, no heap.
 #ifndef GRAVCAL_SEGMENTER_HPP
@@ -41,7 +44,7 @@ struct TableStreamWindow {
 };
 
 class Segmenter {
-  enum class Mode { streaming, r, lazy };
+  enum class Mode { streaming, r, lazy, r_double, lazy_double };
 
   // f(the cutter of the arithmetic in use); visit() and cvisit() come
   // first: the methods below deduce their return types from them
@@ -49,12 +52,16 @@ class Segmenter {
   decltype(auto) visit(F&& f) {
     if (mode_ == Mode::r) return f(r_);
     if (mode_ == Mode::lazy) return f(lazy_);
+    if (mode_ == Mode::r_double) return f(r_d_);
+    if (mode_ == Mode::lazy_double) return f(lazy_d_);
     return f(stream_);
   }
   template <class F>
   decltype(auto) cvisit(F&& f) const {
     if (mode_ == Mode::r) return f(r_);
     if (mode_ == Mode::lazy) return f(lazy_);
+    if (mode_ == Mode::r_double) return f(r_d_);
+    if (mode_ == Mode::lazy_double) return f(lazy_d_);
     return f(stream_);
   }
 
@@ -64,16 +71,26 @@ class Segmenter {
   Segmenter(double samples_per_window, bool skip_zero)
       : stream_(samples_per_window, skip_zero),
         r_(samples_per_window, skip_zero),
-        lazy_(samples_per_window, skip_zero) {}
+        lazy_(samples_per_window, skip_zero),
+        r_d_(samples_per_window, skip_zero),
+        lazy_d_(samples_per_window, skip_zero) {}
 
-  // Switch to R's arithmetic. `buffer` must hold 3 * (ceil(L) + 1) doubles
-  // and outlive the segmenter; call before the first push. Returns false
-  // (and changes nothing) when it is too small.
-  bool use_r_arithmetic(double* buffer, std::size_t capacity) {
+  // Switch to R's arithmetic, with R's accumulator long double
+  // (r_long_double, R's default) or double (an R without long double).
+  // `buffer` must hold 3 * (ceil(L) + 1) doubles and outlive the segmenter;
+  // call before the first push. Returns false (and changes nothing) when it
+  // is too small.
+  bool use_r_arithmetic(double* buffer, std::size_t capacity, bool r_long_double = true) {
     const double L = r_.samples_per_window();
-    if (!r_.stats().lend(buffer, capacity, L)) return false;
-    lazy_.stats().lend(buffer, capacity, L);
-    mode_ = Mode::r;
+    if (r_long_double) {
+      if (!r_.stats().lend(buffer, capacity, L)) return false;
+      lazy_.stats().lend(buffer, capacity, L);
+      mode_ = Mode::r;
+    } else {
+      if (!r_d_.stats().lend(buffer, capacity, L)) return false;
+      lazy_d_.stats().lend(buffer, capacity, L);
+      mode_ = Mode::r_double;
+    }
     return true;
   }
   bool r_arithmetic() const { return mode_ != Mode::streaming; }
@@ -86,10 +103,14 @@ class Segmenter {
   // held back. Returns false (and changes nothing) when the buffer is too
   // small, the arithmetic is not R's, or max_sd is not positive and finite.
   bool lazy_r_sd(double max_sd, LazySd* state, double* buffer, std::size_t capacity) {
-    if (mode_ == Mode::streaming || !lazy_.stats().lazy(max_sd, state, buffer, capacity)) {
-      return false;
+    if (mode_ == Mode::streaming) return false;
+    if (mode_ == Mode::r_double || mode_ == Mode::lazy_double) {
+      if (!lazy_d_.stats().lazy(max_sd, state, buffer, capacity)) return false;
+      mode_ = Mode::lazy_double;
+    } else {
+      if (!lazy_.stats().lazy(max_sd, state, buffer, capacity)) return false;
+      mode_ = Mode::lazy;
     }
-    mode_ = Mode::lazy;
     return true;
   }
 
@@ -130,6 +151,8 @@ class Segmenter {
   WindowCutter<StreamingStatsT<TableStreamWindow>> stream_;
   WindowCutter<RExactStats> r_;
   WindowCutter<LazyRStats> lazy_;
+  WindowCutter<RExactStatsT<double>> r_d_;
+  WindowCutter<LazyRStatsT<double>> lazy_d_;
 };
 
 }  // namespace gravcal

@@ -20,6 +20,11 @@
 // could tell from an sd in double, with bounds on both (fast_sd()); windows
 // then reach the sink one window late (LazySd).
 //
+// R's accumulator: every policy and function here takes it as Acc, long
+// double (RExactStats, LazyRStats) or double (for an R without long double;
+// see r_arith.hpp). With Acc = double the kernels that replay long double
+// (r_scan's vector variants, r_var_means3()) give way to the portable loops.
+//
 // A new window statistic of this arithmetic: its running sum here (add(),
 // whole(), means()) and its field in WindowStats.
 //
@@ -33,6 +38,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "kernels.hpp"
 #include "r_arith.hpp"
@@ -41,10 +47,11 @@
 
 namespace gravcal {
 
-// for (k < n) s += v[k], in long double, to the bit, by runs of equal values
+// for (k < n) s += v[k], in Acc, to the bit, by runs of equal values
 // (add_repeated(), r_arith.hpp): a temperature repeats over a page or a
 // block of the file. b: the grid of s, kept between calls.
-inline void add_in_order(long double& s, const double* v, std::size_t n, Binade& b) {
+template <class Acc>
+void add_in_order(Acc& s, const double* v, std::size_t n, Binade<Acc>& b) {
   std::size_t i = 0;
   while (i < n) {
     const std::size_t j = kernels::active().run_end(v, i, n);
@@ -54,7 +61,7 @@ inline void add_in_order(long double& s, const double* v, std::size_t n, Binade&
 }
 
 // R's sd() of three columns of n (>= 2) values: the mean with R's
-// correction pass, then the sum of squared deviations, in long double. The
+// correction pass, then the sum of squared deviations, in Acc. The
 // three columns go through each pass together (independent sums, so the
 // result is that of three separate calls). The means come without R's
 // two passes where r_var_means3() can decide them (the same doubles).
@@ -62,23 +69,31 @@ inline void add_in_order(long double& s, const double* v, std::size_t n, Binade&
 // t, tsum: when not null, the n temperatures are added to *tsum in order
 // (in the second pass, an independent chain nearly free there, or by runs
 // with add_in_order()).
+// Whether r_var_means3() can decide R's means for the accumulator Acc (its
+// bound is long double's: for Acc = double, never).
+template <class Acc>
+bool r_var_means_available() {
+  return std::is_same<Acc, long double>::value && kernels::r_var_means_available();
+}
+
+template <class Acc>
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
-inline void r_sd3(const double* const* v, std::size_t n, const long double* sum1,
-                  const double* t, long double* tsum, double* out) {
-  const long double ln = static_cast<long double>(n);
+void r_sd3(const double* const* v, std::size_t n, const Acc* sum1, const double* t, Acc* tsum,
+           double* out) {
+  const Acc ln = static_cast<Acc>(n);
   const double* a = v[0];
   const double* b = v[1];
   const double* c = v[2];
   double mean[3];
-  if (kernels::active().r_var_means3(v, n, mean)) {
+  if (r_var_means_available<Acc>() && kernels::active().r_var_means3(v, n, mean)) {
     if (t != nullptr && tsum != nullptr) {
-      Binade bt;
+      Binade<Acc> bt;
       add_in_order(*tsum, t, n, bt);
     }
   } else {
-    long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
+    Acc sa = 0.0, sb = 0.0, sc = 0.0;
     if (sum1 != nullptr) {
       sa = sum1[0];
       sb = sum1[1];
@@ -90,14 +105,14 @@ inline void r_sd3(const double* const* v, std::size_t n, const long double* sum1
         sc += c[k];
       }
     }
-    long double m[3] = {sa / ln, sb / ln, sc / ln};
+    Acc m[3] = {sa / ln, sb / ln, sc / ln};
     const bool fin[3] = {std::isfinite(static_cast<double>(m[0])),
                          std::isfinite(static_cast<double>(m[1])),
                          std::isfinite(static_cast<double>(m[2]))};
-    sa = sb = sc = 0.0L;
-    const long double m0 = m[0], m1 = m[1], m2 = m[2];
+    sa = sb = sc = 0.0;
+    const Acc m0 = m[0], m1 = m[1], m2 = m[2];
     if (t != nullptr && tsum != nullptr) {
-      long double st = *tsum;
+      Acc st = *tsum;
       for (std::size_t k = 0; k < n; ++k) {
         sa += (a[k] - m0);
         sb += (b[k] - m1);
@@ -117,23 +132,24 @@ inline void r_sd3(const double* const* v, std::size_t n, const long double* sum1
     if (fin[2]) m[2] = m[2] + sc / ln;
     for (int k = 0; k < 3; ++k) mean[k] = static_cast<double>(m[k]);
   }
-  const long double ma = mean[0], mb = mean[1], mc = mean[2];
-  long double sa = 0.0L, sb = 0.0L, sc = 0.0L;
+  const Acc ma = mean[0], mb = mean[1], mc = mean[2];
+  Acc sa = 0.0, sb = 0.0, sc = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
-    const long double da = a[k] - ma, db = b[k] - mb, dc = c[k] - mc;
+    const Acc da = a[k] - ma, db = b[k] - mb, dc = c[k] - mc;
     sa += da * da;
     sb += db * db;
     sc += dc * dc;
   }
-  const long double d = static_cast<long double>(n - 1);
+  const Acc d = static_cast<Acc>(n - 1);
   out[0] = std::sqrt(static_cast<double>(sa / d));
   out[1] = std::sqrt(static_cast<double>(sb / d));
   out[2] = std::sqrt(static_cast<double>(sc / d));
 }
 
-class RExactStats {
+template <class Acc>
+class RExactStatsT {
  public:
-  RExactStats() { reset(); }
+  RExactStatsT() { reset(); }
 
   // The buffer for the open window's samples: at least 3 * (ceil(L) + 1)
   // doubles, outliving the policy. Returns false (and changes nothing) when
@@ -182,8 +198,8 @@ class RExactStats {
       if (whole_) {
         for (int a = 0; a < 3; ++a) s.sd[a] = wsd_[a];
       } else {
-        r_sd3(buffer_cols().p, static_cast<std::size_t>(c_.n_valid), nullptr, nullptr, nullptr,
-              s.sd);
+        r_sd3<Acc>(buffer_cols().p, static_cast<std::size_t>(c_.n_valid), nullptr, nullptr,
+                   nullptr, s.sd);
       }
     } else {
       for (int a = 0; a < 3; ++a) s.sd[a] = NAN;
@@ -199,7 +215,7 @@ class RExactStats {
   // R's cumulative sums start again (GGIR's next block).
   void restart() {
     for (int c = 0; c < 5; ++c) {
-      csum_[c] = 0.0L;
+      csum_[c] = 0.0;
       cprev_[c] = 0.0;
     }
   }
@@ -222,16 +238,20 @@ class RExactStats {
   // finite through windows of finite samples, so a non-finite sum here
   // means this window holds a non-finite value).
   struct Scan {
-    kernels::RScanOut o;
-    long double c[5];
+    kernels::RScanOutT<Acc> o;
+    Acc c[5];
     bool has_w;  // o.w holds the window's sums
     const double* cols[3];
   };
   bool scan(const double* x, const double* y, const double* z, std::size_t m, bool skip_zero,
             Scan& r) const {
     for (int k = 0; k < 5; ++k) r.c[k] = csum_[k];
-    r.has_w = !kernels::r_var_means_available();
-    kernels::active().r_scan(x, y, z, m, r.c, r.has_w, r.o);
+    r.has_w = !r_var_means_available<Acc>();
+    if constexpr (std::is_same<Acc, long double>::value) {
+      kernels::active().r_scan(x, y, z, m, r.c, r.has_w, r.o);
+    } else {
+      kernels::r_scan_scalar<Acc>(x, y, z, m, r.c, r.has_w, r.o);
+    }
     r.cols[0] = x;
     r.cols[1] = y;
     r.cols[2] = z;
@@ -246,9 +266,9 @@ class RExactStats {
   // temperature still sends the window to the sample-by-sample path.
   bool commit(const double* t, std::size_t m, Scan& r, bool exact) {
     if (exact && m > 1) {
-      r_sd3(r.cols, m, r.has_w ? r.o.w : nullptr, t, &r.c[4], wsd_);
+      r_sd3<Acc>(r.cols, m, r.has_w ? r.o.w : nullptr, t, &r.c[4], wsd_);
     } else if (t != nullptr) {
-      Binade b;
+      Binade<Acc> b;
       add_in_order(r.c[4], t, m, b);
     }
     if (t != nullptr && !std::isfinite(static_cast<double>(r.c[4]))) return false;
@@ -284,7 +304,7 @@ class RExactStats {
 
   double* buf_ = nullptr;  // the open window's valid samples, by axis
   std::size_t cap_ = 0;    // per axis
-  long double csum_[5];    // R's cumsum() of x, y, z, the norm, the temperature
+  Acc csum_[5];            // R's cumsum() of x, y, z, the norm, the temperature
   double cprev_[5];        // ... rounded, at the last window boundary
   WindowCounts c_;
   bool whole_ = false;     // the open window came whole: its sds in wsd_
@@ -306,7 +326,8 @@ struct LazySd {
     long double lo2[3] = {0, 0, 0}, hi2[3] = {0, 0, 0};
     const double* col[3] = {nullptr, nullptr, nullptr};  // its samples
     std::size_t m = 0;
-    long double w[3] = {0, 0, 0};  // their long double sums (R's first pass)
+    long double w[3] = {0, 0, 0};  // their sums in R's accumulator (its first
+                                   // pass; a double's sums are held exactly)
     bool has_w = false;
   };
   double max_sd = 0.0;     // the rest rule's threshold
@@ -326,7 +347,17 @@ struct LazySd {
 // whose distance from R's is bounded (fast_sd()), and which is on the same
 // side of max_sd and of the neighbours' sds as R's. Means are always R's.
 // Windows reach the sink one window late: finish() gives the last one.
-class LazyRStats : public RExactStats {
+template <class Acc>
+class LazyRStatsT : public RExactStatsT<Acc> {
+  using Base = RExactStatsT<Acc>;
+  using typename Base::Cols;
+  using typename Base::Scan;
+  using Base::buf_;
+  using Base::c_;
+  using Base::cap_;
+  using Base::whole_;
+  using Base::wsd_;
+
  public:
   // After lend(): the threshold, the caller's state and a buffer (3 *
   // (ceil(L) + 1) doubles, outliving the policy) for the samples of the
@@ -346,10 +377,10 @@ class LazyRStats : public RExactStats {
   bool whole(const double* x, const double* y, const double* z, const double* t, std::size_t m,
              bool skip_zero) {
     Scan r;
-    if (!scan(x, y, z, m, skip_zero, r)) return false;
+    if (!this->scan(x, y, z, m, skip_zero, r)) return false;
     LazySd::Window& h = lz_->cand;
     const bool fast = fast_sd(r.cols, m, r.o.lo, r.o.hi, r.o.ls, h);
-    if (!commit(t, m, r, !fast)) return false;
+    if (!this->commit(t, m, r, !fast)) return false;
     h.fast = fast;
     if (fast) {
       for (int a = 0; a < 3; ++a) {
@@ -366,13 +397,13 @@ class LazyRStats : public RExactStats {
   void close(WindowStats& s, Sink& sink) {
     LazySd::Window& h = lz_->cand;
     h.s = s;
-    means(h.s);
+    this->means(h.s);
     if (c_.n_valid > 1) {
       if (whole_) {
         for (int a = 0; a < 3; ++a) h.s.sd[a] = h.fast ? h.sd[a] : wsd_[a];
       } else {
         // the same choice as whole() makes, on the same values
-        const Cols v = buffer_cols();
+        const Cols v = this->buffer_cols();
         const std::size_t nv = static_cast<std::size_t>(c_.n_valid);
         double ls[3][4] = {};
         kernels::lane_sums(v.p, nv, ls);
@@ -385,14 +416,14 @@ class LazyRStats : public RExactStats {
           h.m = nv;
           h.has_w = false;
         } else {
-          r_sd3(v.p, nv, nullptr, nullptr, nullptr, h.s.sd);
+          r_sd3<Acc>(v.p, nv, nullptr, nullptr, nullptr, h.s.sd);
         }
       }
     } else {
       h.fast = false;
       for (int a = 0; a < 3; ++a) h.s.sd[a] = NAN;
     }
-    clear();
+    this->clear();
     deliver(h, sink);
   }
 
@@ -411,7 +442,7 @@ class LazyRStats : public RExactStats {
   }
 
   void reset() {
-    RExactStats::reset();
+    Base::reset();
     if (lz_ != nullptr) {
       lz_->held_on = false;
       lz_->ref_on = false;
@@ -427,7 +458,8 @@ class LazyRStats : public RExactStats {
   // (each lane a recursive sum of at most n / 4 + 1 values, two levels
   // joining the lanes, one division), |f| <= (n + 4) u (times 1.01); R's
   // is (s2 + n / (n - 1) dR^2) (1 + e), |dR| <= (2 u + (4 n + 8) 2^-64) M,
-  // |e| <= (n + 3) 2^-64 + 3 u. With eps = 4 (n + 16) u and dm = 4 (n + 8)
+  // |e| <= (n + 3) 2^-64 + 3 u (2^-53 for 2^-64 with Acc = double: still
+  // within the bounds below). With eps = 4 (n + 16) u and dm = 4 (n + 8)
   // u M + 1e-300 (covering either side), R's sd^2 lies in [(v / (1 + eps) -
   // 2 dm^2) (1 - eps), (v / (1 - eps) + 2 dm^2) (1 + eps)], v this sd^2.
   // Returns true (the sds in double may stand) only when some axis is
@@ -492,7 +524,8 @@ class LazyRStats : public RExactStats {
   // R's sds for a window kept in double.
   static void make_exact(LazySd::Window& h) {
     if (!h.fast) return;
-    r_sd3(h.col, h.m, h.has_w ? h.w : nullptr, nullptr, nullptr, h.s.sd);
+    Acc w[3] = {static_cast<Acc>(h.w[0]), static_cast<Acc>(h.w[1]), static_cast<Acc>(h.w[2])};
+    r_sd3<Acc>(h.col, h.m, h.has_w ? w : nullptr, nullptr, nullptr, h.s.sd);
     h.fast = false;
     point_bounds(h);
   }
@@ -570,6 +603,10 @@ class LazyRStats : public RExactStats {
 
   LazySd* lz_ = nullptr;
 };
+
+// R with long double (R's default)
+using RExactStats = RExactStatsT<long double>;
+using LazyRStats = LazyRStatsT<long double>;
 
 }  // namespace gravcal
 

@@ -291,25 +291,31 @@ inline void lane_sums(const double* const* v, std::size_t n, double (*s)[4]) {
 // ---------------------------------------------------------------------------
 // r_scan(x, y, z, m, c, want_w, o): a whole window of m >= 1 samples for
 // R's arithmetic. c: R's running sums (cumsum()) of x, y, z and the norm
-// sqrt(x^2 + y^2 + z^2) (each operation rounded to double, as R), in long
-// double, continued in sample order. want_w: also the window's own long
-// double sums of x, y, z (the first pass of R's sd). Then min, max, whether
-// some sample is all zeros, and the columns' sums in four lanes (ls). With a
-// non-finite sample c is not finite, and the rest is not defined.
+// sqrt(x^2 + y^2 + z^2) (each operation rounded to double, as R), in R's
+// accumulator (long double; double in an R without long double: then the
+// portable r_scan_scalar<double>() alone, called directly, not through the
+// table), continued in sample order. want_w: also the window's own sums of
+// x, y, z in that accumulator (the first pass of R's sd). Then min, max,
+// whether some sample is all zeros, and the columns' sums in four lanes
+// (ls). With a non-finite sample c is not finite, and the rest is not
+// defined.
 
-struct RScanOut {
+template <class Acc>
+struct RScanOutT {
   double lo[3] = {}, hi[3] = {}, ls[3][4] = {};
-  long double w[3] = {};
+  Acc w[3] = {};
   bool zero = false;
 };
+using RScanOut = RScanOutT<long double>;
 
 // The running sums in scalar accumulators, so that they stay in x87
 // registers; with want_w the window's sums ride along.
-inline void r_cumsums(const double* x, const double* y, const double* z, std::size_t k,
-                      std::size_t m, long double* c, bool want_w, RScanOut& o) {
-  long double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3];
+template <class Acc>
+void r_cumsums(const double* x, const double* y, const double* z, std::size_t k,
+               std::size_t m, Acc* c, bool want_w, RScanOutT<Acc>& o) {
+  Acc c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3];
   if (want_w) {
-    long double w0 = 0.0L, w1 = 0.0L, w2 = 0.0L;
+    Acc w0 = 0.0, w1 = 0.0, w2 = 0.0;
     for (; k < m; ++k) {
       const double xi = x[k], yi = y[k], zi = z[k];
       c0 += xi;
@@ -340,8 +346,9 @@ inline void r_cumsums(const double* x, const double* y, const double* z, std::si
   c[3] = c3;
 }
 
-inline void r_scan_finish(const double* const* col, std::size_t m, double* lo, double* hi,
-                          bool zero, RScanOut& o) {
+template <class Acc>
+void r_scan_finish(const double* const* col, std::size_t m, double* lo, double* hi, bool zero,
+                   RScanOutT<Acc>& o) {
   zero_signs(col, m, lo, hi);
   for (int a = 0; a < 3; ++a) {
     o.lo[a] = lo[a];
@@ -350,10 +357,11 @@ inline void r_scan_finish(const double* const* col, std::size_t m, double* lo, d
   o.zero = zero;
 }
 
-inline void r_scan_scalar(const double* x, const double* y, const double* z, std::size_t m,
-                          long double* c, bool want_w, RScanOut& o) {
+template <class Acc>
+void r_scan_scalar(const double* x, const double* y, const double* z, std::size_t m, Acc* c,
+                   bool want_w, RScanOutT<Acc>& o) {
   const double* col[3] = {x, y, z};
-  o = RScanOut();
+  o = RScanOutT<Acc>();
   r_cumsums(x, y, z, 0, m, c, want_w, o);
   lane_sums(col, m, o.ls);
   double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
@@ -517,7 +525,8 @@ GRAVCAL_TARGET_AVX2 inline void r_scan_avx2(const double* x, const double* y, co
 
 using RScanFn = void (*)(const double*, const double*, const double*, std::size_t,
                          long double*, bool, RScanOut&);
-constexpr Variants<RScanFn> r_scan_variants = {r_scan_scalar, GRAVCAL_IF_SSE2(r_scan_sse2),
+constexpr Variants<RScanFn> r_scan_variants = {r_scan_scalar<long double>,
+                                               GRAVCAL_IF_SSE2(r_scan_sse2),
                                                GRAVCAL_IF_AVX2(r_scan_avx2)};
 
 // ---------------------------------------------------------------------------
