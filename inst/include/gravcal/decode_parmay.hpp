@@ -37,7 +37,10 @@
 // gives every packet's samples at their times (from the packet's start to
 // its end less one period), without the grid, so that what a skipped packet
 // held is a gap (gaps, gap_seconds count the jumps of a second or more). A
-// packet too short for its header is skipped (short_packet). Nothing read
+// packet too short for its header, or with a negative count (GGIRread fails
+// on it), is skipped (short_packet, bad_packet_counts); in compat = 1 a
+// packet whose samples the file does not hold gives one row of NA (as
+// GGIRread's reading of no values does), compat = 0 gives none. Nothing read
 // from the file sizes memory: the packet table grows with the packets
 // actually found (at least 36 bytes each), and samples are read through
 // small fixed buffers.
@@ -153,10 +156,7 @@ class ParmayDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
     while (!out.full()) {
-      if (have_point_) {
-        emit(out);
-        continue;
-      }
+      if (next_point(out)) continue;
       if (finished_) break;
       if (max_units >= 0 && units >= max_units && acc_rows_.at_packet_start()) break;
       const std::int64_t before = acc_rows_.packets_done;
@@ -171,9 +171,7 @@ class ParmayDecoder : public Decoder {
       }
       if (!compat_) {
         // gravcal's own reading: the samples at their times, no grid
-        out.put(v[0], v[1], v[2],
-                any_temp_ ? temp_at(t) : std::numeric_limits<double>::quiet_NaN(), t);
-        ++report_.samples;
+        put(out, v, t);
         continue;
       }
       take(v, t);
@@ -182,7 +180,7 @@ class ParmayDecoder : public Decoder {
     return units;
   }
 
-  bool done() const override { return finished_ && !have_point_ && head_ >= ready_.size(); }
+  bool done() const override { return finished_ && held_.empty(); }
 
   std::size_t max_samples_per_unit() const override { return kMaxSamplesPerUnit; }
 
@@ -248,6 +246,13 @@ class ParmayDecoder : public Decoder {
       p.n_gyro = static_cast<std::int32_t>(le32(hd + 24));
       p.n_temp = static_cast<std::int32_t>(le32(hd + 28));
       p.n_heart = static_cast<std::int32_t>(le32(hd + 32));
+      if (p.n_acc < 0 || p.n_gyro < 0 || p.n_temp < 0 || p.n_heart < 0) {
+        // GGIRread cannot read such a packet either (a negative count)
+        report_.count("bad_packet_counts");
+        ++report_.skipped;
+        note("a packet with a negative sample count", p.at);
+        continue;
+      }
       p.ok = crc_of(p.at + 12, p.end) == stored;
       if (!p.ok) {
         report_.count("bad_checksum");
@@ -350,7 +355,7 @@ class ParmayDecoder : public Decoder {
       const int per = width() / 2;
       const std::int64_t want = static_cast<std::int64_t>(c) * per;
       const std::int64_t r = (want < words ? want : words) / per;
-      return r > 0 ? r : 1;
+      return r > 0 || !d->compat_ ? r : 1;
     }
     bool fetch(std::int64_t at, unsigned char* out, std::size_t k) {
       if (buf_at < 0 || at < buf_at || at + static_cast<std::int64_t>(k) > buf_at + static_cast<std::int64_t>(buf_n)) {
@@ -490,68 +495,80 @@ class ParmayDecoder : public Decoder {
   }
 
   // ---- resampling onto the grid start + k / rate
+  //
+  // Grid point k (at g = start + k / rate) takes the first raw interval
+  // (t[j-1], t[j]] with t[j] >= g. Points are made one at a time from the
+  // current interval (so a long gap costs time, never memory); the grid has
+  // floor((last - start) * rate) + 1 points, so a point is given once the
+  // raw times so far reach that far (`confirmed_`): the few that the last
+  // time does not confirm wait in `held_` (rounding makes at most one or
+  // two) and are dropped at the end.
 
   struct Point {
     std::int64_t k;
     double v[3];
   };
 
-  // One raw acceleration sample at time t: the grid points up to t, from
-  // the interval that ends at it.
+  // One raw acceleration sample at time t: the next interval.
   void take(const double* v, double t) {
     if (!have_prev_) {
       start_ = t;
       have_prev_ = true;
-      set_prev(v, t);
-      return;
+    } else {
+      have_interval_ = true;
     }
-    for (;;) {
-      const double g = start_ + static_cast<double>(k_) * by_;
-      if (!(g <= t)) break;
-      Point p;
-      p.k = k_++;
-      double u = (g - prev_t_) / (t - prev_t_);
-      if (u < 0 || u > 1) u = 0;
-      if (nearest_) u = ggir_nearest_weight(u);
-      for (int c = 0; c < 3; ++c) p.v[c] = u * (v[c] - prev_v_[c]) + prev_v_[c];
-      pending_.push_back(p);
+    for (int c = 0; c < 3; ++c) {
+      prev_v_[c] = cur_v_[c];
+      cur_v_[c] = v[c];
     }
-    set_prev(v, t);
-    // the grid has floor((last - start) * rate) + 1 points
-    confirm(std::floor((t - start_) * sf_) + 1);
+    prev_t_ = cur_t_;
+    cur_t_ = t;
+    confirmed_ = std::floor((t - start_) * sf_) + 1;
   }
 
-  void set_prev(const double* v, double t) {
-    for (int c = 0; c < 3; ++c) prev_v_[c] = v[c];
-    prev_t_ = t;
-  }
-
-  void confirm(double n_grid) {
-    std::size_t m = 0;
-    while (m < pending_.size() && static_cast<double>(pending_[m].k) < n_grid) ++m;
-    for (std::size_t a = 0; a < m; ++a) ready_.push_back(pending_[a]);
-    pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(m));
-    if (head_ < ready_.size()) have_point_ = true;
+  // Gives (or holds) the next grid point; false when the current interval
+  // has none left (a new raw sample is needed).
+  bool next_point(SampleBuffer& out) {
+    if (!held_.empty() && static_cast<double>(held_.front().k) < confirmed_) {
+      const Point p = held_.front();
+      held_.erase(held_.begin());
+      put(out, p.v, start_ + static_cast<double>(p.k) * by_);
+      return true;
+    }
+    if (!have_interval_ || finished_) return false;
+    const double g = start_ + static_cast<double>(k_) * by_;
+    if (!(g <= cur_t_)) {
+      have_interval_ = false;
+      return false;
+    }
+    Point p;
+    p.k = k_++;
+    double u = (g - prev_t_) / (cur_t_ - prev_t_);
+    if (u < 0 || u > 1) u = 0;
+    if (nearest_) u = ggir_nearest_weight(u);
+    for (int c = 0; c < 3; ++c) p.v[c] = u * (cur_v_[c] - prev_v_[c]) + prev_v_[c];
+    if (held_.empty() && static_cast<double>(p.k) < confirmed_) {
+      put(out, p.v, g);
+    } else {
+      if (held_.size() >= kMaxHeld) {
+        // raw times that ran backwards: the oldest held point is dropped
+        held_.erase(held_.begin());
+        report_.count("grid_points_dropped");
+      }
+      held_.push_back(p);
+    }
+    return true;
   }
 
   void finish() {
     finished_ = true;
-    pending_.clear();
+    held_.clear();
   }
 
-  void emit(SampleBuffer& out) {
-    while (head_ < ready_.size() && !out.full()) {
-      const Point& p = ready_[head_++];
-      const double g = start_ + static_cast<double>(p.k) * by_;
-      const double temp = any_temp_ ? temp_at(g) : std::numeric_limits<double>::quiet_NaN();
-      out.put(p.v[0], p.v[1], p.v[2], temp, g);
-      ++report_.samples;
-    }
-    if (head_ >= ready_.size()) {
-      ready_.clear();
-      head_ = 0;
-      have_point_ = false;
-    }
+  void put(SampleBuffer& out, const double* v, double g) {
+    const double temp = any_temp_ ? temp_at(g) : std::numeric_limits<double>::quiet_NaN();
+    out.put(v[0], v[1], v[2], temp, g);
+    ++report_.samples;
   }
 
   // The next usable temperature row (time, ambient): rows with a time and
@@ -634,13 +651,12 @@ class ParmayDecoder : public Decoder {
   Stream acc_rows_, acc_times_, temp_rows_, temp_times_;
   bool finished_ = false;
   // acceleration resampling
-  bool have_prev_ = false;
-  double start_ = 0, prev_t_ = 0;
-  double prev_v_[3] = {0, 0, 0};
+  static constexpr std::size_t kMaxHeld = 64;
+  bool have_prev_ = false, have_interval_ = false;
+  double start_ = 0, prev_t_ = 0, cur_t_ = 0, confirmed_ = 0;
+  double prev_v_[3] = {0, 0, 0}, cur_v_[3] = {0, 0, 0};
   std::int64_t k_ = 0;
-  std::vector<Point> pending_, ready_;
-  std::size_t head_ = 0;
-  bool have_point_ = false;
+  std::vector<Point> held_;
   // temperature resampling
   bool temp_started_ = false, temp_ended_ = false, temp_look_ = false;
   double temp_first_ = 0, look_t_ = 0, look_v_ = 0;
