@@ -84,6 +84,21 @@ test_that("file_format() tells a Parmay Matrix .BIN from a GENEActiv .bin", {
   expect_gt(nrow(d$data), 1000)
 })
 
+test_that("reader = 'reference' reads through GGIRread, with the same result", {
+  f <- mtx_files()[1]
+  a <- read_recording(f, reader = "reference")
+  r <- mtx_ref(f)
+  expect_identical(a$data$x, r$x)
+  expect_identical(a$data$temperature, r$temperature)
+  skip_if_not_installed("GGIR")
+  G1 <- gravcal::g.calibrate(f, verbose = FALSE, reader = "reference")
+  G2 <- gravcal::g.calibrate(f, verbose = FALSE)
+  expect_identical(G1[names(G1) != "bsc_qc"], G2[names(G2) != "bsc_qc"])
+  expect_error(gravcal::g.calibrate(f, verbose = FALSE, reader = "reference",
+                                    interpolationType = 2),
+               "`interpolationType` = 2 is taken by gravcal's own decoders only")
+})
+
 test_that("write_parmay_bin() writes what GGIRread reads", {
   skip_if_not_installed("GGIRread")
   for (sf in c(12.5, 25, 100)) {
