@@ -340,7 +340,9 @@ class ParmayDecoder : public Decoder {
     int width() const { return kind == kAcc ? 6 : 4; }
     std::int64_t offset(const Packet& p) const {
       std::int64_t o = p.at + 36;
-      if (kind == kTemp) o += 6 * static_cast<std::int64_t>(p.n_acc) + 6 * static_cast<std::int64_t>(p.n_gyro);
+      if (kind == kTemp) {
+        o += 6 * static_cast<std::int64_t>(p.n_acc) + 6 * static_cast<std::int64_t>(p.n_gyro);
+      }
       return o;
     }
     std::int32_t count(const Packet& p) const { return kind == kAcc ? p.n_acc : p.n_temp; }
@@ -358,7 +360,8 @@ class ParmayDecoder : public Decoder {
       return r > 0 || !d->compat_ ? r : 1;
     }
     bool fetch(std::int64_t at, unsigned char* out, std::size_t k) {
-      if (buf_at < 0 || at < buf_at || at + static_cast<std::int64_t>(k) > buf_at + static_cast<std::int64_t>(buf_n)) {
+      const std::int64_t end = at + static_cast<std::int64_t>(k);
+      if (buf_at < 0 || at < buf_at || end > buf_at + static_cast<std::int64_t>(buf_n)) {
         if (!d->src_.seek(at)) return false;
         buf_n = read_full(d->src_, buf, sizeof buf);
         buf_at = at;
