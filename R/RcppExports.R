@@ -37,6 +37,10 @@ gc_decoder_drain <- function(ptr) {
     .Call(`_gravcal_gc_decoder_drain`, ptr)
 }
 
+gc_crc32 <- function(bytes) {
+    .Call(`_gravcal_gc_crc32`, bytes)
+}
+
 gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace) {
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }

@@ -89,13 +89,31 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
   geneactiv = list(
-    ext = c(bin = "GENEActiv .bin"), detect = NULL,
+    ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
     label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE,
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
-    source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize))
+    source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize)),
+  # Parmay Matrix: "MDTC" at byte 512. GGIRread's reader reads from the
+  # block's first packet to the end of the file whatever end it is given, so
+  # GGIR's first block is the whole file (and its last)
+  parmay = list(
+    ext = c(bin = "Parmay Matrix .bin"), detect = function(file) is_parmay_bin(file),
+    label = "a Parmay Matrix .bin file", unit = "packet", own_rate = TRUE,
+    block_units = function(sf, chunksize) 2^52,
+    decoder = "parmay",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_parmay(file))
 )
+
+# Whether `file` is a Parmay Matrix file ("MDTC" at byte 512).
+is_parmay_bin <- function(file) {
+  con <- file(file, "rb")
+  on.exit(close(con))
+  b <- readBin(con, "raw", n = 516)
+  length(b) == 516 && identical(b[513:516], charToRaw("MDTC"))
+}
 
 # The `sf` a cohort's setting gives `file`: none for a file that records
 # its own rate (the setting is for the files that do not; see

@@ -65,7 +65,7 @@
 #' |---|---|---|
 #' | `chunksize`, `spherecrit`, `minloadcrit` | every format | honoured |
 #' | `printsummary` | (prints only) | honoured |
-#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
+#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |

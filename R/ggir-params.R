@@ -82,7 +82,8 @@ ggir_param_table <- function() {
                 describe(x), ".")
         }
       }, effect = paste0(".cwa (readAxivity's resampling), GENEActiv .bin at a ",
-                         "rate that is not whole (g.readaccfile's resampling); ",
+                         "rate that is not whole (g.readaccfile's resampling), ",
+                         "Parmay Matrix .bin (readParmayMatrix's resampling); ",
                          "Axivity csv, ad hoc csv with rmc.doresample")),
       row("frequency_tol", NA, 0.1, at_least_0,
           effect = ".cwa: readAxivity's tolerance on a block's rate before it imputes"),

@@ -176,7 +176,7 @@ check_reference_opts <- function(read_opts, format) {
   defaults <- list(interpolation = c(interpolationType = 1),
                    frequency_tol = c(frequency_tol = 0.1))
   used <- switch(format, cwa = c("interpolation", "frequency_tol"),
-                 geneactiv = , axivity_csv = "interpolation", character(0))
+                 geneactiv = , axivity_csv = , parmay = "interpolation", character(0))
   for (nm in intersect(intersect(names(read_opts), names(defaults)), used)) {
     d <- defaults[[nm]]
     if (!identical(as.numeric(read_opts[[nm]]), unname(d))) {
@@ -304,6 +304,26 @@ source_geneactiv <- function(file, chunksize) {
          if (is.null(P) || is.null(P$data.out) || !nrow(P$data.out)) return(NULL)
          d <- P$data.out[, intersect(c("x", "y", "z", "temperature"), names(P$data.out))]
          list(data = d, last = nrow(d) < B * 300)
+       })
+}
+
+# GGIRread's reader gives the whole file in one call (see R/formats.R).
+source_parmay <- function(file) {
+  need_ggirread("Parmay Matrix .bin")
+  sf <- tryCatch(GGIRread::readParmayMatrix(file, output = "sf"), error = function(e) NULL)
+  if (!isTRUE(is.numeric(sf) && length(sf) == 1 && is.finite(sf))) {
+    abort("Corrupt or unreadable Parmay Matrix .bin file \"", file, "\".")
+  }
+  list(format = "parmay", sf = sf, temperature = TRUE,
+       read = function(i) {
+         if (i > 1) return(NULL)
+         P <- tryCatch(GGIRread::readParmayMatrix(file, start = 1, end = 2^31 - 1),
+                       error = function(e) NULL)
+         if (is.null(P) || is.null(P$data) || !NROW(P$data)) return(NULL)
+         names(P$data) <- sub("^acc_", "", names(P$data))
+         names(P$data)[names(P$data) == "ambient_temp"] <- "temperature"
+         d <- P$data[, intersect(c("x", "y", "z", "temperature"), names(P$data))]
+         list(data = d, last = TRUE)
        })
 }
 

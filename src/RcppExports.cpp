@@ -109,6 +109,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_crc32
+double gc_crc32(Rcpp::RawVector bytes);
+RcppExport SEXP _gravcal_gc_crc32(SEXP bytesSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< Rcpp::RawVector >::type bytes(bytesSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_crc32(bytes));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fit_icp
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
 RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
@@ -307,6 +317,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
+    {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
     {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},

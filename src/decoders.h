@@ -14,6 +14,7 @@
 #include "gravcal/decode_geneactiv.hpp"
 #include "gravcal/decode_ggir_resample.hpp"
 #include "gravcal/decode_gt3x.hpp"
+#include "gravcal/decode_parmay.hpp"
 #include "gz_source.h"
 #include "zip_inflate.h"
 
@@ -82,6 +83,13 @@ inline DecoderPtr make_gt3x(gravcal::ByteSource& bytes, const gravcal::Options& 
   return DecoderPtr(new gravcal::Gt3xDecoder(bytes, opts, &inflater));
 }
 
+// A Parmay Matrix .bin: resampled onto its grid as GGIRread does (option
+// interpolation: GGIR's interpolationType; compat = 0 skips damaged packets)
+inline DecoderPtr make_parmay(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                              const std::string&) {
+  return DecoderPtr(new gravcal::ParmayDecoder(bytes, opts));
+}
+
 // The table's row for `format`, or null when there is none.
 inline const DecoderKind* find_decoder(const std::string& format) {
   static const DecoderKind kinds[] = {
@@ -92,6 +100,7 @@ inline const DecoderKind* find_decoder(const std::string& format) {
       {"gt3x", false, make_gt3x},
       {"cwa", false, make_cwa},
       {"geneactiv", false, make_geneactiv},
+      {"parmay", false, make_parmay},
   };
   for (const DecoderKind& k : kinds) {
     if (format == k.name) return &k;

@@ -213,3 +213,11 @@ double gc_decoder_drain(SEXP ptr) {
   }
   return samples;
 }
+
+// The CRC-32 of raw bytes (decode_parmay.hpp's), for the test writer of
+// Parmay Matrix files (R/write-parmay.R).
+// [[Rcpp::export(rng = false)]]
+double gc_crc32(Rcpp::RawVector bytes) {
+  return static_cast<double>(
+      gravcal::Crc32::update(0, bytes.begin(), static_cast<std::size_t>(bytes.size())));
+}

@@ -15,11 +15,15 @@ test_that("a file's format comes from its extension and, for csv, its first line
                 function(f) gravcal:::file_format(path(f)), "")
   expect_identical(unname(got), c("csv", "actigraph_csv", "actigraph_csv", "rds",
                                   "gt3x", "cwa", "geneactiv", "cwa"))
+  # a .bin (or .BIN) with "MDTC" at byte 512 is a Parmay Matrix file
+  writeBin(c(as.raw(rep(0, 512)), charToRaw("MDTC")), path("m.BIN"))
+  expect_identical(gravcal:::file_format(path("m.BIN")), "parmay")
   # the message lists what gravcal reads, as it did before the registry
   file.create(path("a.xyz"))
   expect_error(read_recording(path("a.xyz")), paste0(
     "`file` has an unsupported extension \".xyz\"; gravcal reads .csv ",
-    "(ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, .cwa and GENEActiv .bin."),
+    "(ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, .cwa, GENEActiv .bin and ",
+    "Parmay Matrix .bin."),
     fixed = TRUE)
   # calibrate_files() takes exactly the files of those extensions
   files <- calibrate_files
@@ -61,7 +65,7 @@ test_that("R's registry and the C++ table of decoders name the same decoders", {
   reg <- gravcal:::recording_formats
   decoders <- unlist(lapply(reg, `[[`, "decoder"), use.names = FALSE)
   expect_setequal(decoders, c("actigraph_csv", "axivity_csv", "csv", "adhoc_csv", "gt3x",
-                              "cwa", "geneactiv"))
+                              "cwa", "geneactiv", "parmay"))
   for (d in decoders) {
     # a decoder that exists fails on these bytes, as its format
     h <- gravcal:::gc_decoder_open(f, d, list())

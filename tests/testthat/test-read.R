@@ -246,7 +246,7 @@ test_that("empty, truncated and unusual .bin files: errors that say why", {
   file.create(empty)
   cut <- file.path(d, "cut.bin")
   writeBin(b[1:100], cut)
-  # a Matrix/Parmay .BIN, an older Genea file: other formats, said so
+  # a Matrix/Parmay .BIN without packets, an older Genea file: said so
   matrix_bin <- file.path(d, "matrix.BIN")
   writeBin(c(as.raw(rep(0, 512)), charToRaw("MDTC"), as.raw(rep(1, 600))),
            matrix_bin)
