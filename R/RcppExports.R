@@ -5,6 +5,10 @@ gc_fp_probe <- function(a, b, c) {
     .Call(`_gravcal_gc_fp_probe`, a, b, c)
 }
 
+gc_fp_probe_unpinned <- function(u, v) {
+    .Call(`_gravcal_gc_fp_probe_unpinned`, u, v)
+}
+
 gc_file_kind <- function(path) {
     .Call(`_gravcal_gc_file_kind`, path)
 }

@@ -23,6 +23,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_fp_probe_unpinned
+double gc_fp_probe_unpinned(Rcpp::NumericVector u, Rcpp::NumericVector v);
+RcppExport SEXP _gravcal_gc_fp_probe_unpinned(SEXP uSEXP, SEXP vSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type u(uSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type v(vSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fp_probe_unpinned(u, v));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_file_kind
 std::string gc_file_kind(std::string path);
 RcppExport SEXP _gravcal_gc_file_kind(SEXP pathSEXP) {
@@ -278,6 +289,7 @@ END_RCPP
 
 static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
+    {"_gravcal_gc_fp_probe_unpinned", (DL_FUNC) &_gravcal_gc_fp_probe_unpinned, 2},
     {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},

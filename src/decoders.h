@@ -48,7 +48,8 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
   // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
   if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
   const int interpolation = static_cast<int>(opts.num("interpolation", 1));
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation));
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation,
+                                               opts.num("resample_fused", 0) != 0));
 }
 
 // An Axivity csv export: the csv decoder with the layout in the options;
@@ -59,7 +60,8 @@ inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Op
   std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
   if (opts.num("compat", 1) == 0) return d;
   return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), opts.num("grid_sf", opts.num("sf", 0))));
+      std::move(d), opts.num("grid_sf", opts.num("sf", 0)), 1,
+      opts.num("resample_fused", 0) != 0));
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating
