@@ -5,8 +5,8 @@ gc_fp_probe <- function(a, b, c) {
     .Call(`_gravcal_gc_fp_probe`, a, b, c)
 }
 
-gc_fp_probe_unpinned <- function(u, v) {
-    .Call(`_gravcal_gc_fp_probe_unpinned`, u, v)
+gc_fp_probe_unpinned <- function(v, u) {
+    .Call(`_gravcal_gc_fp_probe_unpinned`, v, u)
 }
 
 gc_file_kind <- function(path) {

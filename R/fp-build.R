@@ -68,7 +68,7 @@ resample_probe <- function() {
   }
   from <- "GGIRread"
   if (is.null(got)) {
-    got <- gc_fp_probe_unpinned(o$u, o$v)
+    got <- gc_fp_probe_unpinned(matrix(o$v, 2, 1), o$u)
     from <- "compiler"
   }
   list(fused = !identical(got, 0), from = from)

@@ -24,13 +24,13 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_fp_probe_unpinned
-double gc_fp_probe_unpinned(Rcpp::NumericVector u, Rcpp::NumericVector v);
-RcppExport SEXP _gravcal_gc_fp_probe_unpinned(SEXP uSEXP, SEXP vSEXP) {
+double gc_fp_probe_unpinned(Rcpp::NumericMatrix v, double u);
+RcppExport SEXP _gravcal_gc_fp_probe_unpinned(SEXP vSEXP, SEXP uSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type u(uSEXP);
-    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type v(vSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_fp_probe_unpinned(u, v));
+    Rcpp::traits::input_parameter< Rcpp::NumericMatrix >::type v(vSEXP);
+    Rcpp::traits::input_parameter< double >::type u(uSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fp_probe_unpinned(v, u));
     return rcpp_result_gen;
 END_RCPP
 }

@@ -11,7 +11,9 @@
 #include <Rcpp.h>
 
 // [[Rcpp::export(rng = false)]]
-double gc_fp_probe_unpinned(Rcpp::NumericVector u, Rcpp::NumericVector v) {
-  // GGIRread's shape: a weight times a difference of two entries, plus the first
-  return u(0) * (v(1) - v(0)) + v(0);
+double gc_fp_probe_unpinned(Rcpp::NumericMatrix v, double u) {
+  // GGIRread's shape: a weight times a difference of two matrix entries,
+  // plus the first (NumericVector's checked v(i) would keep GCC from
+  // contracting where GGIRread's matrix access does not)
+  return u * (v(1, 0) - v(0, 0)) + v(0, 0);
 }

@@ -136,22 +136,57 @@ cp "$tree/tools/install-ggir.sh" "$root/tmp/gravcal-tools/"
 in_chroot ggir "bash /tmp/gravcal-tools/install-ggir.sh"
 stamp "GGIR and GGIRread" "$t"
 
-# --- gravcal from this tree (a fresh copy: no objects of the host's)
+# GRAVCAL_ARM64_CROSS=1: gravcal's objects compiled on the host by Debian's
+# aarch64 cross g++ (the same GCC 12.2 as the chroot's, with the chroot's
+# R, Rcpp and RcppEigen headers and R's own flags from R CMD config), then
+# linked and installed by the chroot's R: g++ under qemu takes about an hour
+# for gravcal on a busy two-core machine, the cross compiler minutes. The
+# default compiles in the chroot, as a user's R would.
+cross=${GRAVCAL_ARM64_CROSS:-0}
+cross_objects() {
+  dpkg -s g++-aarch64-linux-gnu >/dev/null 2>&1 ||
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends g++-aarch64-linux-gnu >/dev/null
+  local cfg
+  cfg=$(chroot "$root" /bin/sh -c 'echo "$(R CMD config CXX17) $(R CMD config CXX17STD)|$(R CMD config CXXPICFLAGS) $(R CMD config CXX17FLAGS) $(R CMD config CPPFLAGS)"')
+  local std=${cfg%%|*} flags=${cfg#*|}
+  std=${std#* }  # drop the compiler's name: the cross compiler replaces it
+  echo "arm64-chroot: cross-compiling gravcal's objects: aarch64-linux-gnu-g++ $std $flags" | tee "$logs/cross.log"
+  ls "$root"/gravcal/src/*.cpp | xargs -P 2 -I{} sh -c "aarch64-linux-gnu-g++ $std \
+    -I$root/usr/share/R/include -DNDEBUG -I$root/gravcal/inst/include \
+    -I$root/usr/lib/R/site-library/Rcpp/include -I$root/usr/lib/R/site-library/RcppEigen/include \
+    $flags -c {} -o \$(echo {} | sed 's/cpp\$/o/')" >> "$logs/cross.log" 2>&1
+  touch "$root"/gravcal/src/*.o
+}
+
+# --- gravcal from this tree (a fresh copy: no objects of the host's),
+# rebuilt only when the copy changed since the last install
 t=$(date +%s)
-rm -rf "$root/gravcal" "$root/gravcal-lib"
-mkdir -p "$root/gravcal" "$root/gravcal-lib"
+src_tar="$root/tmp/gravcal-src.tar"
 tar -C "$tree" --exclude=./_build --exclude=./.git --exclude='*.o' --exclude='*.so' \
-  --exclude='*.Rcheck' --exclude='*.tar.gz' -cf - . | tar -C "$root/gravcal" -xf -
-cp "$tree/tools/fma-count.sh" "$root/tmp/gravcal-tools/"
-in_chroot install "
-  set -e
-  cd /gravcal
-  R CMD INSTALL --no-multiarch -l /gravcal-lib .
-  echo; R CMD config CXX17; R CMD config CXX17FLAGS
-  sh /tmp/gravcal-tools/fma-count.sh /gravcal-lib/gravcal/libs/gravcal.so
-"
-tail -3 "$logs/install.log"
-stamp "gravcal built and installed" "$t"
+  --exclude='*.Rcheck' --exclude='*.tar.gz' --sort=name --mtime=@0 --owner=0 --group=0 \
+  -cf "$src_tar" .
+sum=$(sha256sum < "$src_tar" | cut -c1-64)
+if [ "$(cat "$root/gravcal-lib/.source-sha256" 2>/dev/null)" != "$sum" ]; then
+  rm -rf "$root/gravcal" "$root/gravcal-lib"
+  mkdir -p "$root/gravcal" "$root/gravcal-lib"
+  tar -C "$root/gravcal" -xf "$src_tar"
+  cp "$tree/tools/fma-count.sh" "$root/tmp/gravcal-tools/"
+  if [ "$cross" = 1 ]; then cross_objects; fi
+  in_chroot install "
+    set -e
+    cd /gravcal
+    R CMD INSTALL --no-multiarch -l /gravcal-lib .
+    echo; R CMD config CXX17; R CMD config CXX17FLAGS
+    sh /tmp/gravcal-tools/fma-count.sh /gravcal-lib/gravcal/libs/gravcal.so
+  "
+  echo "$sum" > "$root/gravcal-lib/.source-sha256"
+  tail -4 "$logs/install.log"
+  stamp "gravcal built and installed" "$t"
+else
+  # the tests run from the copy: refresh it (same sources, so no rebuild)
+  rm -rf "$root/gravcal"; mkdir -p "$root/gravcal"; tar -C "$root/gravcal" -xf "$src_tar"
+  stamp "gravcal already installed from these sources" "$t"
+fi
 
 # --- the tests: the GGIR-identity files (GGIR's and GGIRread's test files,
 # the real recordings, the synthetic 30-hour recordings), then with `all`

@@ -58,7 +58,7 @@ test_that("the resampling probe's operands tell GGIRread's fused step from two r
   # + v0 is 0; one fused multiply-add gives -2^-60
   expect_identical(o$v[2] - o$v[1], 1 + 2^-30)
   expect_identical(o$u * (o$v[2] - o$v[1]) + o$v[1], 0)
-  v <- gravcal:::gc_fp_probe_unpinned(o$u, o$v)
+  v <- gravcal:::gc_fp_probe_unpinned(matrix(o$v, 2, 1), o$u)
   expect_true(identical(v, 0) || identical(v, -2^-60))
 })
 
