@@ -10,6 +10,9 @@
 #               headless Chromium
 #   make test-noLD  (not part of make test) the tests that compare with
 #               R's and GGIR's numbers, on an R built without long double
+#   make test-arm64  the slow platform check, not part of make test (run
+#               before resolving): Debian's arm64 R in a chroot under qemu,
+#               GGIR from CRAN sources there, the GGIR-identity tests
 R ?= R
 RSCRIPT ?= Rscript
 BUILD := _build
@@ -28,7 +31,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-noLD test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -202,3 +205,15 @@ test-noLD:
 test-slurm: install setup-test
 	bash tools/slurm-setup.sh
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R
+
+# gravcal on Linux aarch64 with a real arm64 R (tools/arm64-chroot.sh, as
+# root): a Debian 12 arm64 chroot under qemu-user (in
+# GRAVCAL_ARM64_ROOT, default ~/.cache/gravcal/arm64; made once), Debian's
+# arm64 R and its prebuilt r-cran-* packages, GGIR installed from CRAN
+# sources as tools/install-ggir.sh does, gravcal from this tree, then the
+# GGIR-identity test files (ARM64_SCOPE=all: and then the whole suite)
+# with GRAVCAL_SHARED_DATA. Slow (qemu emulates every instruction): not
+# part of make test; logs and timings in _build/arm64.
+ARM64_SCOPE ?= identity
+test-arm64:
+	GRAVCAL_SHARED_DATA=$(SHARED_DATA) bash tools/arm64-chroot.sh $(ARM64_SCOPE)

@@ -13,6 +13,10 @@ gc_r_mean_sd <- function(x, long_double) {
     .Call(`_gravcal_gc_r_mean_sd`, x, long_double)
 }
 
+gc_fp_probe_unpinned <- function(v, u) {
+    .Call(`_gravcal_gc_fp_probe_unpinned`, v, u)
+}
+
 gc_file_kind <- function(path) {
     .Call(`_gravcal_gc_file_kind`, path)
 }

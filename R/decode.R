@@ -5,7 +5,7 @@
 # of single numbers or strings for the decoder. An error naming the file when
 # it cannot be read as that format.
 native_open <- function(file, format, options = list(), arg = "file") {
-  r <- gc_decoder_open(path.expand(file), format, options)
+  r <- gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
   if (is.null(r$ptr)) native_open_error(file, format, r$error, arg)
   r
 }

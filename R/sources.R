@@ -146,7 +146,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
   if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1
-  h <- gc_decoder_open(path.expand(file), format, opts)
+  h <- gc_decoder_open(path.expand(file), format, with_resample_fused(opts, format))
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)

@@ -44,6 +44,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_fp_probe_unpinned
+double gc_fp_probe_unpinned(Rcpp::NumericMatrix v, double u);
+RcppExport SEXP _gravcal_gc_fp_probe_unpinned(SEXP vSEXP, SEXP uSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< Rcpp::NumericMatrix >::type v(vSEXP);
+    Rcpp::traits::input_parameter< double >::type u(uSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_fp_probe_unpinned(v, u));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_file_kind
 std::string gc_file_kind(std::string path);
 RcppExport SEXP _gravcal_gc_file_kind(SEXP pathSEXP) {
@@ -311,6 +322,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
     {"_gravcal_gc_set_r_long_double", (DL_FUNC) &_gravcal_gc_set_r_long_double, 1},
     {"_gravcal_gc_r_mean_sd", (DL_FUNC) &_gravcal_gc_r_mean_sd, 2},
+    {"_gravcal_gc_fp_probe_unpinned", (DL_FUNC) &_gravcal_gc_fp_probe_unpinned, 2},
     {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},

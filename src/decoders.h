@@ -49,7 +49,8 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
   // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
   if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
   const int interpolation = static_cast<int>(opts.num("interpolation", 1));
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation));
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation, false,
+                                               opts.num("resample_fused", 0) != 0));
 }
 
 // An Axivity csv export: the csv decoder with the layout in the options;
@@ -61,7 +62,8 @@ inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Op
   if (opts.num("compat", 1) == 0) return d;
   return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
       std::move(d), opts.num("grid_sf", opts.num("sf", 0)),
-      static_cast<int>(opts.num("interpolation", 1))));
+      static_cast<int>(opts.num("interpolation", 1)), false,
+      opts.num("resample_fused", 0) != 0));
 }
 
 // GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
@@ -73,7 +75,8 @@ inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Opti
   const double grid = opts.num("grid_sf", 0);
   if (opts.num("compat", 1) == 0 || !(grid > 0)) return d;
   return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true));
+      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true,
+      opts.num("resample_fused", 0) != 0));
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating

@@ -162,6 +162,9 @@ Rcpp::List decode_kernel(const std::string& name, const Rcpp::List& a) {
     sp.step = Rcpp::as<double>(a["step"]);
     sp.end = Rcpp::as<double>(a["end"]);
     sp.temp = Rcpp::as<double>(a["temp"]);
+    // GGIRread's multiply-add fused (the scalar reference only: a caller
+    // that sets it runs no other variant)
+    sp.fused = a.containsElementNamed("fused") && Rcpp::as<bool>(a["fused"]);
     const std::int64_t pos = static_cast<std::int64_t>(Rcpp::as<double>(a["pos"]));
     const std::int64_t stop = static_cast<std::int64_t>(Rcpp::as<double>(a["stop"]));
     const int source0 = Rcpp::as<int>(a["source"]);

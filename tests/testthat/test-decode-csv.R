@@ -173,8 +173,16 @@ test_that("numbers equal fread's (compat = 1) or are correctly rounded (compat =
                    c("0x1.5be2e6ea85447p+0", "0x1.e5b2b3461309cp+0", "-0x1.dfe2e6ea85447p-2",
                      "0x1.7578811b1d92bp-1", "-0x1.19e600fc9507fp+0", "0x1.f7ced916872bp-4",
                      "-0x1.00ff972474539p+0", "0x1.0624dd2f1a9fcp-10"))
-  # fread 1.14.8 differs from those in the last bit for the first five
-  expect_identical(sum(d0$x != d1$x), 5L)
+  # fread 1.14.8 scales the digits by a power of ten in long double and
+  # rounds that to double: where it differs from the correctly rounded
+  # value, by one unit in the last place. With x87's 64-bit long double
+  # (x86) it differs for the first five; with IEEE quad (aarch64) the
+  # double rounding seldom shows, so elsewhere only the bound is checked
+  diff <- d0$x != d1$x
+  expect_true(all(abs(d0$x[diff] - d1$x[diff]) <= 2^-52 * abs(d0$x[diff])))
+  if (Sys.info()[["machine"]] %in% c("x86_64", "amd64", "i386", "i686")) {
+    expect_identical(sum(diff), 5L)
+  }
 })
 
 # Lines of the common shape are parsed where they lie in the read buffer

@@ -40,6 +40,9 @@
 //      frequency_tol (10 %), the grid points of b's span
 //      are filled with the last output sample normalised to 1 g (or 0, 0, 1
 //      when its norm is outside 0.8..1.2): "imputed", counted here.
+//    - GGIRread's resample() computes w (v1 - v0) + v0 in C++, compiled by
+//      the R it runs in: with option "resample_fused" = 1 (R/fp-build.R
+//      sets it from what that R's compiler does) as one fused multiply-add.
 //    - a window that starts with bad blocks skips them; a window whose end
 //      block is bad extends over it (so the next window skips it again).
 //    Where readAxivity stops with an error (and GGIR gets no samples for the
@@ -245,6 +248,7 @@ class CwaDecoder : public Decoder {
       : src_(src),
         compat_(opts.num("compat", 1) != 0),
         nearest_(opts.num("interpolation", 1) == 2),
+        fused_(opts.num("resample_fused", 0) != 0),
         frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)),
         r_long_double_(opts.num("r_long_double", 1) != 0) {}
 
@@ -283,6 +287,7 @@ class CwaDecoder : public Decoder {
   ByteSource& src_;
   bool compat_;
   bool nearest_;                   // interpolationType = 2
+  bool fused_;                     // GGIRread's resample() fused (option resample_fused)
   double frequency_tol_;
   bool r_long_double_;  // R's accumulator: long double, else double
   bool done_ = false;
@@ -860,8 +865,10 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     sp.end = end_ts_;
     sp.temp = p.h.temperature;
     sp.nearest = nearest_;
-    // nearest neighbour (interpolationType = 2): the scalar reference only
-    given = nearest_ ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
+    sp.fused = fused_;
+    // nearest neighbour (interpolationType = 2) or GGIRread's fused
+    // multiply-add: the scalar reference only
+    given = nearest_ || fused_ ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
                      : kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
   }
   pos_ += given;

@@ -295,7 +295,9 @@ class GeneactivDecoder : public Decoder {
   // several chunks (GgirResampler in decode_ggir_resample.hpp does).
   void continue_call(bool on) { continue_call_ = on; }
   GeneactivDecoder(ByteSource& src, const Options& opts)
-      : lines_(src), compat_(opts.num("compat", 1) != 0) {
+      : lines_(src),
+        compat_(opts.num("compat", 1) != 0),
+        fused_(opts.num("resample_fused", 0) != 0) {
     info_.format = "geneactiv";
   }
 
@@ -340,6 +342,13 @@ class GeneactivDecoder : public Decoder {
 
   geneactiv::LineReader lines_;
   bool compat_;
+  // GGIRread's reader is C++ compiled by the R it runs in: where that
+  // compiler contracted its ms + s * 1000 into one fused multiply-add
+  // (aarch64; option resample_fused, R/fp-build.R), so does ms_after()
+  bool fused_;
+  double ms_after(double ms, double seconds) const {
+    return fused_ ? std::fma(seconds, 1000.0, ms) : ms + seconds * 1000;
+  }
   bool done_ = false;
   // calibration: value of each 12-bit count per axis
   double gain_[3] = {0, 0, 0};
@@ -681,9 +690,9 @@ inline double GeneactivDecoder::anchor_time(const geneactiv::Stamp& s) const {
 // last sample's time plus one period, truncated.
 inline void GeneactivDecoder::advance_chain(double freq, std::size_t count) {
   if (count == 0) return;
-  const double last = static_cast<double>(chain_ms_) +
-                      static_cast<double>(count - 1) * (1.0 / freq) * 1000;
-  chain_ms_ = static_cast<std::int64_t>(last + (1.0 / freq) * 1000);
+  const double last = ms_after(static_cast<double>(chain_ms_),
+                               static_cast<double>(count - 1) * (1.0 / freq));
+  chain_ms_ = static_cast<std::int64_t>(ms_after(last, 1.0 / freq));
 }
 
 // Checks next_'s Page Time and Sequence Number against the last good page
@@ -794,7 +803,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
       const double i = static_cast<double>(emitted_ + j);
       if (compat_) {
         // Unix ms as the reference: truncated to an integer, then / 1000
-        const double t = static_cast<double>(p.base_ms) + i * inv * 1000;
+        const double t = ms_after(static_cast<double>(p.base_ms), i * inv);
         out.time[n + j] = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
       } else {
         out.time[n + j] = p.time_s + i / p.freq;

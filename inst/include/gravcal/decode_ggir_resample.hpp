@@ -11,7 +11,10 @@
 // with t[j] >= g (j >= 1), and takes u (v[j] - v[j-1]) + v[j-1] with u = (g
 // - t[j-1]) / (t[j] - t[j-1]), as GGIRread::resample computes it; with
 // GGIR's interpolationType = 2 (nearest neighbour) u is replaced by
-// ggir_nearest_weight(u) (kernels/decode.hpp).
+// ggir_nearest_weight(u) (kernels/decode.hpp). GGIRread::resample is C++
+// compiled by the R it runs in; where that compiler fused u (v[j] - v[j-1])
+// + v[j-1] into one multiply-add (GCC's default on aarch64), `fused` does
+// so too (kernels::ggir_lerp; R/fp-build.R finds out which).
 //
 // GgirResampler does this while the samples stream: a grid point is computed
 // once its interval has arrived and given on once the grid is known to go
@@ -58,11 +61,16 @@ template <class Inner>
 class GgirResamplerOf : public Decoder {
  public:
   // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
-  // linear, 2 nearest neighbour (GGIR's interpolationType)
+  // linear, 2 nearest neighbour (GGIR's interpolationType); fused: GGIRread's
+  // multiply-add rounded once
   explicit GgirResamplerOf(std::unique_ptr<Inner> inner, double grid_rate = 0,
-                           int interpolation = 1, bool keep_last = false)
-      : inner_(std::move(inner)), grid_rate_(grid_rate), nearest_(interpolation == 2),
-        keep_last_(keep_last) {}
+                           int interpolation = 1, bool keep_last = false,
+                           bool fused = false)
+      : inner_(std::move(inner)),
+        grid_rate_(grid_rate),
+        nearest_(interpolation == 2),
+        keep_last_(keep_last),
+        fused_(fused) {}
 
   bool open() override {
     const bool ok = inner_->open();
@@ -215,7 +223,7 @@ class GgirResamplerOf : public Decoder {
       p.k = k_++;
       double u = (g - prev_[4]) / (cur_[4] - prev_[4]);
       if (nearest_) u = ggir_nearest_weight(u);
-      for (int c = 0; c < 4; ++c) p.v[c] = u * (cur_[c] - prev_[c]) + prev_[c];
+      for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev_[c], cur_[c], fused_);
       p.v[4] = g;
       pending_.push_back(p);
     }
@@ -270,7 +278,7 @@ class GgirResamplerOf : public Decoder {
         p.k = k_++;
         double u = (last_ - prev2_[4]) / (prev_[4] - prev2_[4]);
         if (nearest_) u = ggir_nearest_weight(u);
-        for (int c = 0; c < 4; ++c) p.v[c] = u * (prev_[c] - prev2_[c]) + prev2_[c];
+        for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev2_[c], prev_[c], fused_);
         p.v[4] = last_;
         ready_.push_back(p);
       }
@@ -295,6 +303,7 @@ class GgirResamplerOf : public Decoder {
   double grid_rate_ = 0.0;
   bool nearest_ = false;
   bool keep_last_ = false;
+  bool fused_ = false;
   bool active_ = false;
   double by_ = 0.0;
   std::vector<double> raw_;

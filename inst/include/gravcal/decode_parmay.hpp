@@ -98,7 +98,8 @@ class ParmayDecoder : public Decoder {
   ParmayDecoder(ByteSource& src, const Options& opts)
       : src_(src),
         compat_(opts.num("compat", 1) != 0),
-        nearest_(opts.num("interpolation", 1) == 2) {}
+        nearest_(opts.num("interpolation", 1) == 2),
+        fused_(opts.num("resample_fused", 0) != 0) {}
 
   bool open() override {
     unsigned char h[524];
@@ -549,7 +550,7 @@ class ParmayDecoder : public Decoder {
     double u = (g - prev_t_) / (cur_t_ - prev_t_);
     if (u < 0 || u > 1) u = 0;
     if (nearest_) u = ggir_nearest_weight(u);
-    for (int c = 0; c < 3; ++c) p.v[c] = u * (cur_v_[c] - prev_v_[c]) + prev_v_[c];
+    for (int c = 0; c < 3; ++c) p.v[c] = kernels::ggir_lerp(u, prev_v_[c], cur_v_[c], fused_);
     if (held_.empty() && static_cast<double>(p.k) < confirmed_) {
       put(out, p.v, g);
     } else {
@@ -639,12 +640,13 @@ class ParmayDecoder : public Decoder {
     double u = (g - tp_t_) / (tc_t_ - tp_t_);
     if (u < 0 || u > 1) u = 0;
     if (nearest_) u = ggir_nearest_weight(u);
-    return u * (tc_v_ - tp_v_) + tp_v_;
+    return kernels::ggir_lerp(u, tp_v_, tc_v_, fused_);
   }
 
   ByteSource& src_;
   bool compat_ = true;
   bool nearest_ = false;
+  bool fused_ = false;  // GGIRread's resample() fused (option resample_fused)
   std::int32_t declared_ = 0;
   std::int16_t range_ = 0;
   std::int64_t size_ = 0;

@@ -196,6 +196,10 @@ constexpr Variants<SpanTimesFn> span_times_variants = {span_times_scalar, nullpt
 // follows, and a (the last point's values) and at (its time) are set when
 // any was. With s.nearest (interpolationType = 2), w becomes
 // ggir_nearest_weight(w): the scalar reference only (the caller chooses it).
+// With s.fused, w (v[k] - v[k - 1]) + v[k - 1] is one fused multiply-add
+// (std::fma: rounded once), as GGIRread's own resample() computes it where
+// R's compiler contracted it (GCC's default on aarch64; ggir_resample_fused
+// in R/fp-build.R finds out): the scalar reference only, too.
 
 struct InterpSpan {
   const double* time = nullptr;  // time[0] the point the span starts from, time[1..len] its samples'
@@ -205,7 +209,15 @@ struct InterpSpan {
   double start = 0, step = 0, end = 0;
   double temp = 0;  // written to o.t when not null
   bool nearest = false;  // ggir_nearest_weight() on w (the scalar reference only)
+  bool fused = false;    // std::fma for the value (the scalar reference only)
 };
+
+// GGIRread's w (v1 - v0) + v0, rounded twice (R's compiler did not contract
+// it) or once (it did).
+inline double ggir_lerp(double w, double v0, double v1, bool fused) {
+  const double d = v1 - v0;
+  return fused ? std::fma(w, d, v0) : w * d + v0;  // not contracted: fp_contract.hpp
+}
 
 struct InterpOut {
   double* x = nullptr;
@@ -240,9 +252,9 @@ inline std::int64_t cwa_interp_scalar(const InterpSpan& s, std::int64_t pos, std
     while (src < s.len && T[src] < t) ++src;
     double w = (t - T[src - 1]) / (T[src] - T[src - 1]);
     if (s.nearest) w = ggir_nearest_weight(w);
-    a0 = w * (X[src] - X[src - 1]) + X[src - 1];
-    a1 = w * (Y[src] - Y[src - 1]) + Y[src - 1];
-    a2 = w * (Z[src] - Z[src - 1]) + Z[src - 1];
+    a0 = ggir_lerp(w, X[src - 1], X[src], s.fused);
+    a1 = ggir_lerp(w, Y[src - 1], Y[src], s.fused);
+    a2 = ggir_lerp(w, Z[src - 1], Z[src], s.fused);
     ox[k] = a0;
     oy[k] = a1;
     oz[k] = a2;
