@@ -108,7 +108,8 @@ in_chroot() {  # in_chroot LOGNAME script (bash, run as root in the chroot)
 t=$(date +%s)
 suggests=$(sed -n '/^Suggests:/,/^[A-Z][A-Za-z]*:/p' "$tree/DESCRIPTION" | sed '1s/^Suggests://;$d' |
   tr ',' '\n' | sed 's/(.*//; s/[[:space:]]//g' | grep -v '^$' | tr '\n' ' ')
-ggir_deps="data.table foreach doParallel signal zoo unisensR ineq psych irr lubridate GGIRread
+# (one line: the list goes into the chroot's script as words of a for loop)
+ggir_deps="data.table foreach doParallel signal zoo unisensR ineq psych irr lubridate GGIRread \
 read.gt3x matlab bitops readxl jsonlite digest XML vroom lpSolve MASS"
 in_chroot apt "
   set -e

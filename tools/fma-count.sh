@@ -11,7 +11,8 @@
 # GGIRread's own arithmetic calls std::fma where R's compiler fused it
 # (chosen when the package runs: kernels::ggir_lerp, GeneactivDecoder's
 # ms_after), an instruction wherever the target has one: those functions
-# (cwa_interp_scalar, GgirResamplerOf::take, GeneactivDecoder's) are counted
+# (cwa_interp_scalar, GgirResamplerOf::generate and ::end_call,
+# GeneactivDecoder's, ParmayDecoder::put and ::next_point) are counted
 # apart. Every other one is a
 # contraction that gravcal/fp_contract.hpp should have stopped: the script
 # fails and lists the functions that hold them.
@@ -23,7 +24,7 @@ objdump=${2:-objdump}
   /\t(vfn?m(add|sub)|fn?m(add|sub)|fml[as])[a-z0-9.]*[ \t]/ {
     n++
     if (fn ~ /gc_fp_probe_unpinned/) { probe++; next }
-    if (fn ~ /cwa_interp_scalar|GgirResamplerOf.*4take|GeneactivDecoder/) { replay++; next }
+    if (fn ~ /cwa_interp_scalar|GgirResamplerOf.*(8generate|8end_call)Ev|GeneactivDecoder|ParmayDecoder(3put|10next_point)E/) { replay++; next }
     if (fn !~ /^<_ZN[KVR]*5Eigen/) { other++; where[fn]++ }
   }
   END {
