@@ -10,9 +10,8 @@
 # GGIRread's code, and fuses where that compiler does. gravcal's replay of
 # GGIRread's own arithmetic calls std::fma where R's compiler fused it
 # (chosen when the package runs: kernels::ggir_lerp, GeneactivDecoder's
-# ms_after), an instruction wherever the target has one: those functions
-# (cwa_interp_scalar, GgirResamplerOf::generate and ::end_call,
-# GeneactivDecoder's, ParmayDecoder::put and ::next_point) are counted
+# ms_after), an instruction wherever the target has one, always through
+# kernels::replay_fma, which is kept out of line: that function is counted
 # apart. Every other one is a
 # contraction that gravcal/fp_contract.hpp should have stopped: the script
 # fails and lists the functions that hold them.
@@ -24,7 +23,7 @@ objdump=${2:-objdump}
   /\t(vfn?m(add|sub)|fn?m(add|sub)|fml[as])[a-z0-9.]*[ \t]/ {
     n++
     if (fn ~ /gc_fp_probe_unpinned/) { probe++; next }
-    if (fn ~ /cwa_interp_scalar|GgirResamplerOf.*(8generate|8end_call)Ev|GeneactivDecoder|ParmayDecoder(3put|10next_point)E/) { replay++; next }
+    if (fn ~ /7kernels10replay_fma/) { replay++; next }
     if (fn !~ /^<_ZN[KVR]*5Eigen/) { other++; where[fn]++ }
   }
   END {

@@ -347,7 +347,7 @@ class GeneactivDecoder : public Decoder {
   // (aarch64; option resample_fused, R/fp-build.R), so does ms_after()
   bool fused_;
   double ms_after(double ms, double seconds) const {
-    return fused_ ? std::fma(seconds, 1000.0, ms) : ms + seconds * 1000;
+    return fused_ ? kernels::replay_fma(seconds, 1000.0, ms) : ms + seconds * 1000;
   }
   bool done_ = false;
   // calibration: value of each 12-bit count per axis

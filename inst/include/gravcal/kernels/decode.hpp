@@ -212,11 +212,23 @@ struct InterpSpan {
   bool fused = false;    // std::fma for the value (the scalar reference only)
 };
 
+// The replay's one deliberate fused multiply-add, a * b + c rounded once
+// (std::fma), kept out of line: wherever it is called, the instruction the
+// target has for it sits in this function alone, which tools/fma-count.sh
+// counts apart from contractions (a build with -march=native would
+// otherwise inline it into every caller).
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+inline double replay_fma(double a, double b, double c) {
+  return std::fma(a, b, c);
+}
+
 // GGIRread's w (v1 - v0) + v0, rounded twice (R's compiler did not contract
 // it) or once (it did).
 inline double ggir_lerp(double w, double v0, double v1, bool fused) {
   const double d = v1 - v0;
-  return fused ? std::fma(w, d, v0) : w * d + v0;  // not contracted: fp_contract.hpp
+  return fused ? replay_fma(w, d, v0) : w * d + v0;  // not contracted: fp_contract.hpp
 }
 
 struct InterpOut {
