@@ -145,6 +145,9 @@ stamp "GGIR and GGIRread" "$t"
 # default compiles in the chroot, as a user's R would.
 cross=${GRAVCAL_ARM64_CROSS:-0}
 cross_objects() {
+  # (Debian's g++-aarch64-linux-gnu conflicts with g++-multilib, which
+  # make test's setup installs for the 32-bit build of the core's tests:
+  # installing one removes the other, so do not run both at once)
   dpkg -s g++-aarch64-linux-gnu >/dev/null 2>&1 ||
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends g++-aarch64-linux-gnu >/dev/null
   local cfg
