@@ -199,9 +199,9 @@ static void test_short_numbers(int nd) {
 // Random numbers of 7 to 21 digits (15 to 19 significant are fread's and
 // the fast path's edges), and values next to rounding boundaries: the
 // shortest decimal of a double and of its neighbours, with a digit added.
-static void test_long_numbers(std::mt19937_64& rng) {
+static void test_long_numbers(std::mt19937_64& rng, int scale) {
   std::uniform_int_distribution<int> nd(7, 21), pos(0, 21), dig(0, 9), coin(0, 3);
-  for (int i = 0; i < 200000; ++i) {
+  for (int i = 0; i < 200000 / scale; ++i) {
     const int n = nd(rng);
     std::string s;
     for (int k = 0; k < n; ++k) s += static_cast<char>('0' + dig(rng));
@@ -211,7 +211,7 @@ static void test_long_numbers(std::mt19937_64& rng) {
   }
   std::uniform_real_distribution<double> u(-16, 16);
   char buf[64];
-  for (int i = 0; i < 100000; ++i) {
+  for (int i = 0; i < 100000 / scale; ++i) {
     const double x = u(rng);
     for (double y : {x, std::nextafter(x, 100.0), std::nextafter(x, -100.0)}) {
       for (int prec = 15; prec <= 19; ++prec) {
@@ -229,7 +229,7 @@ static void test_long_numbers(std::mt19937_64& rng) {
 // A run of stamps such as files hold (and some they should not): each
 // parsed by one parser, which keeps the last date and second, and by a
 // fresh one; the same success and bits.
-static void test_stamps(std::mt19937_64& rng) {
+static void test_stamps(std::mt19937_64& rng, int scale) {
   std::uniform_int_distribution<int> k(0, 99), sec(0, 61), ms(0, 999);
   const std::vector<std::string> dates = {"5/11/2023", "5/12/2023", "12/31/2023", "1/1/2024",
                                           "2023-05-11", "11/5/2023", "5/11/23", "2/30/2023"};
@@ -238,7 +238,7 @@ static void test_stamps(std::mt19937_64& rng) {
     csv::DateTimeParser kept(order);
     std::string date = dates[0];
     int hh = 9, mm = 0, ss = 0;
-    for (int i = 0; i < 200000; ++i) {
+    for (int i = 0; i < 200000 / scale; ++i) {
       const int c = k(rng);
       if (c == 0) date = dates[static_cast<std::size_t>(k(rng)) % dates.size()];
       if (c == 1) ss = sec(rng);
@@ -444,7 +444,12 @@ static void test_files(std::mt19937_64& rng) {
   std::printf("csv files: %d decodings in place and line by line compared\n", files);
 }
 
-int main() {
+// `--quick` (make valgrind: memcheck, not the numbers, is the point there;
+// `make test` runs the whole set natively): numbers of up to 4 digits
+// exhaustively instead of 6, a tenth of the random ones.
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  const int scale = quick ? 10 : 1;
   std::mt19937_64 rng(20240601);
   for (const char* s : {"0.121", "-0.891", "+1.5", "-0.000", "0", "-0", ".5", "5.", "-.5", "1e-3",
                         "1.358931", "-1.10116583029324", "123456789012345678",
@@ -466,9 +471,9 @@ int main() {
     CHECK(ok == !std::isnan(want), std::string(s) + " (range edge: taken)");
     if (ok && !std::isnan(want)) CHECK(same_bits(v, want), std::string(s) + " (range edge: bits)");
   }
-  test_short_numbers(6);
-  test_long_numbers(rng);
-  test_stamps(rng);
+  test_short_numbers(quick ? 4 : 6);
+  test_long_numbers(rng, scale);
+  test_stamps(rng, scale);
   test_files(rng);
   std::printf("csv (%s): %ld checks (%ld of the strtod path against %s), %s\n",
 #if defined(GRAVCAL_HAVE_FROM_CHARS)
