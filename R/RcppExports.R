@@ -13,6 +13,10 @@ gc_r_mean_sd <- function(x, long_double) {
     .Call(`_gravcal_gc_r_mean_sd`, x, long_double)
 }
 
+gc_csv_numbers <- function(s, rule) {
+    .Call(`_gravcal_gc_csv_numbers`, s, rule)
+}
+
 gc_fp_probe_unpinned <- function(v, u) {
     .Call(`_gravcal_gc_fp_probe_unpinned`, v, u)
 }

@@ -122,13 +122,56 @@ ggir_resample_fused <- function() {
 
 # The decoder options with "resample_fused" added for the reads that replay
 # GGIRread::resample (GGIR-compatible .cwa, GENEActiv, Parmay Matrix, Axivity
-# csv and ad hoc csv with rmc.doresample), unless
-# the caller gave it.
+# csv and ad hoc csv with rmc.doresample), and "fread_rule" for the csv
+# reads that replay data.table::fread's numbers, unless the caller gave them.
 with_resample_fused <- function(opts, format) {
+  compat <- !identical(as.numeric(opts$compat %||% 1), 0)
   if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay") &&
-      is.null(opts$resample_fused) &&
-      !identical(as.numeric(opts$compat %||% 1), 0)) {
+      is.null(opts$resample_fused) && compat) {
     opts$resample_fused <- as.numeric(ggir_resample_fused())
   }
+  if (format %in% c("csv", "actigraph_csv", "axivity_csv", "adhoc_csv") &&
+      is.null(opts$fread_rule) && compat) {
+    opts$fread_rule <- as.numeric(fread_number_rule())
+  }
   opts
+}
+
+# GGIR reads csv files with data.table::fread, whose value for a number with
+# many digits changed in data.table 1.15.0 (its issue 4461): before, the
+# digits times a negative power of ten; from it, divided by a positive one,
+# in long double both (rule 1 and rule 2 of decode_csv_text.hpp). The two
+# differ in the last bit of about one number in ten thousand of 15 digits.
+# Which one GGIR gets comes from the installed fread itself, on numbers
+# where the two rules differ in this build; where they give the same values
+# (a long double with no more bits than double: macOS arm64) the version
+# decides, and so it does without data.table (which GGIR needs anyway).
+fread_probe_numbers <- c(
+  "-6.94352849999999", "6.94352849999999", "1.358931", "-1.10116583029324",
+  "0.729435", "1.897258", "3.14159265358979", "-0.999999999999999")
+
+# list(rule = 1 or 2, from = "fread", "version" or "default"), found once
+# per session; a warning when the installed fread follows neither rule.
+fread_rule_probe <- function() {
+  s <- fread_probe_numbers
+  r1 <- gc_csv_numbers(s, 1L)
+  r2 <- gc_csv_numbers(s, 2L)
+  if (!requireNamespace("data.table", quietly = TRUE)) return(list(rule = 2L, from = "default"))
+  by_version <- if (utils::packageVersion("data.table") >= "1.15.0") 2L else 1L
+  if (identical(r1, r2)) return(list(rule = by_version, from = "version"))
+  got <- tryCatch(data.table::fread(text = c("v", s), colClasses = "numeric",
+                                    header = TRUE, showProgress = FALSE)[[1]],
+                  error = function(e) NULL)
+  if (identical(got, r1)) return(list(rule = 1L, from = "fread"))
+  if (identical(got, r2)) return(list(rule = 2L, from = "fread"))
+  warning("data.table ", format(utils::packageVersion("data.table")),
+          " reads numbers by a rule gravcal does not know: numbers in csv files may ",
+          "differ from GGIR's in the last bit, and so may GGIR-compatible results.",
+          call. = FALSE)
+  list(rule = by_version, from = "version")
+}
+
+fread_number_rule <- function() {
+  if (is.null(build_state$fread_rule)) build_state$fread_rule <- fread_rule_probe()
+  build_state$fread_rule$rule
 }

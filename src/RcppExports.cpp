@@ -44,6 +44,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_csv_numbers
+Rcpp::NumericVector gc_csv_numbers(Rcpp::CharacterVector s, int rule);
+RcppExport SEXP _gravcal_gc_csv_numbers(SEXP sSEXP, SEXP ruleSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< Rcpp::CharacterVector >::type s(sSEXP);
+    Rcpp::traits::input_parameter< int >::type rule(ruleSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_csv_numbers(s, rule));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fp_probe_unpinned
 double gc_fp_probe_unpinned(Rcpp::NumericMatrix v, double u);
 RcppExport SEXP _gravcal_gc_fp_probe_unpinned(SEXP vSEXP, SEXP uSEXP) {
@@ -322,6 +333,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe", (DL_FUNC) &_gravcal_gc_fp_probe, 3},
     {"_gravcal_gc_set_r_long_double", (DL_FUNC) &_gravcal_gc_set_r_long_double, 1},
     {"_gravcal_gc_r_mean_sd", (DL_FUNC) &_gravcal_gc_r_mean_sd, 2},
+    {"_gravcal_gc_csv_numbers", (DL_FUNC) &_gravcal_gc_csv_numbers, 2},
     {"_gravcal_gc_fp_probe_unpinned", (DL_FUNC) &_gravcal_gc_fp_probe_unpinned, 2},
     {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},

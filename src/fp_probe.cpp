@@ -7,6 +7,9 @@
 
 #include <Rcpp.h>
 
+#include <cstring>
+
+#include "gravcal/decode_csv_text.hpp"
 #include "gravcal/r_arith.hpp"
 #include "r_services.h"
 
@@ -43,4 +46,20 @@ Rcpp::NumericVector gc_r_mean_sd(Rcpp::NumericVector x, bool long_double) {
     });
   });
   return Rcpp::NumericVector::create(r.mean, r.sd);
+}
+
+// The csv decoder's value of each string by a number rule (0: correctly
+// rounded; 1, 2: data.table's fread before and from 1.15.0; see
+// decode_csv_text.hpp), NA where it is not a number: for the probe of the
+// installed fread (R/fp-build.R) and the tests.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector gc_csv_numbers(Rcpp::CharacterVector s, int rule) {
+  Rcpp::NumericVector out(s.size());
+  for (R_xlen_t i = 0; i < s.size(); ++i) {
+    const char* b = s[i];
+    const char* e = b + std::strlen(b);
+    double v = 0;
+    out[i] = gravcal::csv_text::parse_number(b, e, '.', rule, v) ? v : NA_REAL;
+  }
+  return out;
 }

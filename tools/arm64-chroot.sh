@@ -148,7 +148,9 @@ cross_objects() {
   # (Debian's g++-aarch64-linux-gnu conflicts with g++-multilib, which
   # make test's setup installs for the 32-bit build of the core's tests:
   # installing one removes the other, so do not run both at once)
-  dpkg -s g++-aarch64-linux-gnu >/dev/null 2>&1 ||
+  # (dpkg -s succeeds for a removed package whose configuration is left:
+  # ask for the compiler itself)
+  command -v aarch64-linux-gnu-g++ >/dev/null 2>&1 ||
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends g++-aarch64-linux-gnu >/dev/null
   local cfg
   cfg=$(chroot "$root" /bin/sh -c 'echo "$(R CMD config CXX17) $(R CMD config CXX17STD)|$(R CMD config CXXPICFLAGS) $(R CMD config CXX17FLAGS) $(R CMD config CPPFLAGS)"')

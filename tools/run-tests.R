@@ -10,6 +10,8 @@ suppressPackageStartupMessages({
 # GRAVCAL_TEST_FILTER: only the files whose name (without test- and .R)
 # matches this regular expression (make test-noLD)
 filter <- Sys.getenv("GRAVCAL_TEST_FILTER")
+# every failure printed, not the first ten
+options(testthat.summary.max_reports = 10000L)
 res <- as.data.frame(test_dir(".", reporter = "summary", stop_on_failure = FALSE,
                               package = "gravcal", load_package = "installed",
                               filter = if (nzchar(filter)) filter))

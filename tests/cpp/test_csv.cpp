@@ -1,11 +1,13 @@
 // Standalone tests of the csv decoder's numbers and of its lines parsed in
 // place (decode_csv_text.hpp, decode_csv.hpp), built without R:
 //   make -C tests/cpp
-// * parse_number (compat = 1) against fread 1.14.8's rule written out here
-//   on its own: the digits as an integer (at most 18 kept), times 10^e in
-//   long double (the literal's value, as strtold gives it), rounded to
-//   double, the sign applied to the long double product;
-// * parse_number (compat = 0) against std::from_chars (correctly rounded),
+// * parse_number (rules 1 and 2) against fread's rules written out here on
+//   their own: the digits as an integer (at most 18 kept), times 10^e in
+//   long double (rule 1, data.table before 1.15.0) or divided by 10^-e for
+//   e < 0 (rule 2, from 1.15.0; 10^-300 at most in one step), the powers the
+//   literals' values as strtold gives them, rounded to double, the sign
+//   applied to the long double value;
+// * parse_number (rule 0) against std::from_chars (correctly rounded),
 //   and the strtod path (decimal_to_double_strtod, used where the C++
 //   library lacks floating-point from_chars) against it on every number;
 //   `make` builds this file twice, the second time with
@@ -45,13 +47,14 @@ static long checked = 0;
 
 static bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-// fread 1.14.8's value of s ([+-]digits[.digits][(e|E)[+-]digits], the
-// whole text), written from its description: leading zeros skipped, at
+// fread's value of s ([+-]digits[.digits][(e|E)[+-]digits], the whole
+// text) by rule 1 or 2, written from its description: leading zeros skipped, at
 // most 18 digits kept (a longer integer needs a point or an exponent), at
-// most 3 exponent digits, the product of the kept digits and 10^e in long
-// double, rounded to double, the sign applied to the long double product.
-// NaN when it is not a number (|e| <= 300 here, where fread multiplies once).
-static double fread_rule(const std::string& s) {
+// most 3 exponent digits, the product of the kept digits and 10^e (rule 1)
+// or their quotient by 10^-e when e < 0 (rule 2) in long double, rounded to
+// double, the sign applied to the long double value. NaN when it is not a
+// number (|e| <= 300 here, where rule 2 divides once).
+static double fread_rule(const std::string& s, int rule = 1) {
   std::size_t i = 0;
   const bool neg = i < s.size() && s[i] == '-';
   if (i < s.size() && (s[i] == '-' || s[i] == '+')) ++i;
@@ -87,8 +90,12 @@ static double fread_rule(const std::string& s) {
     e += eneg ? -x : x;
   }
   const long double acc = digits.empty() ? 0.0L : std::strtold(digits.c_str(), nullptr);
-  const long double p10 = std::strtold(("1e" + std::to_string(e)).c_str(), nullptr);
-  const long double r = acc * p10;
+  long double r;
+  if (rule == 2 && e < 0) {
+    r = acc / std::strtold(("1e" + std::to_string(-e)).c_str(), nullptr);
+  } else {
+    r = acc * std::strtold(("1e" + std::to_string(e)).c_str(), nullptr);
+  }
   return static_cast<double>(neg ? -r : r);
 }
 
@@ -130,12 +137,12 @@ static void check_strtod_path(const std::string& s) {
   if (ok && !std::isnan(want)) CHECK(same_bits(v, want), u + " (strtod path: bits)");
 }
 
-static bool parse(const std::string& s, bool compat, double& v) {
-  return csv::parse_number(s.data(), s.data() + s.size(), '.', compat, v);
+static bool parse(const std::string& s, int rule, double& v) {
+  return csv::parse_number(s.data(), s.data() + s.size(), '.', rule, v);
 }
 
 // The plain shape on s (followed by a line end); false when not taken.
-static bool plain(const std::string& s, bool compat, double& v) {
+static bool plain(const std::string& s, int rule, double& v) {
   const std::string t = s + "\n";
   csv::PlainNumber n;
   const char* e = csv::scan_plain_number(t.data(), '.', n);
@@ -147,9 +154,9 @@ static bool plain(const std::string& s, bool compat, double& v) {
     CHECK(n3.acc == n.acc && n3.frac == n.frac && n3.neg == n.neg, s + " (scan_plain_number_3)");
   }
   if (e == nullptr || e != t.data() + s.size()) return false;
-  const bool ok = csv::plain_value(n, t.data(), e, '.', compat, v);
+  const bool ok = csv::plain_value(n, t.data(), e, '.', rule, v);
   // the look-up table of 1-3 decimals, where it applies: the same bits
-  const csv::Decimals& d = csv::decimals(compat);
+  const csv::Decimals& d = csv::decimals(rule);
   if (ok && n.frac >= 1 && n.frac <= 3 && n.acc < d.limit[n.frac]) {
     const double w = d.value[n.frac][n.acc] * (n.neg ? -1.0 : 1.0);
     CHECK(same_bits(v, w), s + " (decimals table)");
@@ -157,21 +164,23 @@ static bool plain(const std::string& s, bool compat, double& v) {
   return ok;
 }
 
-// What is a number is fread's in both modes; its value fread's (compat = 1)
-// or the correctly rounded one (compat = 0).
+// What is a number is fread's under every rule; its value fread's (rules 1
+// and 2) or the correctly rounded one (rule 0).
+static long rules_differ = 0;
 static void check_number(const std::string& s, bool strtod_too = true) {
   if (strtod_too) check_strtod_path(s);
-  const double fr = fread_rule(s);
-  for (int compat = 0; compat <= 1; ++compat) {
+  const double fr[3] = {0, fread_rule(s, 1), fread_rule(s, 2)};
+  if (!std::isnan(fr[1]) && !same_bits(fr[1], fr[2])) ++rules_differ;
+  for (int rule = 0; rule <= 2; ++rule) {
     double v = 0;
-    const bool ok = parse(s, compat != 0, v);
-    CHECK(ok == !std::isnan(fr), s);
+    const bool ok = parse(s, rule, v);
+    CHECK(ok == !std::isnan(fr[1]), s);
     if (ok) {
-      CHECK(same_bits(v, compat ? fr : correctly_rounded(s)),
-            s + (compat ? " (compat 1)" : " (compat 0)"));
+      CHECK(same_bits(v, rule ? fr[rule] : correctly_rounded(s)),
+            s + " (rule " + std::to_string(rule) + ")");
     }
     double w = 0;
-    if (plain(s, compat != 0, w)) CHECK(ok && same_bits(v, w), s + " (plain shape)");
+    if (plain(s, rule, w)) CHECK(ok && same_bits(v, w), s + " (plain shape)");
   }
 }
 
@@ -287,7 +296,9 @@ static Decoded decode(const std::string& text, const std::string& format, double
   Decoded d;
   gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(text.data()), text.size());
   gravcal::Options o;
-  o.set("compat", compat);
+  // compat 2: fread's numbers by rule 2 (option fread_rule)
+  o.set("compat", compat > 0 ? 1.0 : 0.0);
+  if (compat == 2) o.set("fread_rule", 2.0);
   o.set("fast", fast);
   o.set("buffer", buffer);
   if (text.compare(0, 6, "x,y,z\n") == 0) o.set("sf", 30.0);  // no time column
@@ -425,7 +436,7 @@ static void test_files(std::mt19937_64& rng) {
           text += eol ? "\r\n" : "\n";
         }
         if (rep == 2) text.resize(text.size() - 5);  // cut inside the last line
-        for (double compat : {0.0, 1.0}) {
+        for (double compat : {0.0, 1.0, 2.0}) {
           // small buffers: lines cross refills (an ActiLife header line needs 300)
           const double small = l.format == "csv" ? 64 : 300;
           for (double buffer : {small, 333.0, 1048576.0}) {
@@ -466,7 +477,7 @@ int main(int argc, char** argv) {
                         "123456789012345678e-340", "-1e-310", "-1e309"}) {
     check_strtod_path(s);
     double v = 0;
-    const bool ok = parse(s, false, v);
+    const bool ok = parse(s, 0, v);
     const double want = correctly_rounded(s);
     CHECK(ok == !std::isnan(want), std::string(s) + " (range edge: taken)");
     if (ok && !std::isnan(want)) CHECK(same_bits(v, want), std::string(s) + " (range edge: bits)");
@@ -475,6 +486,10 @@ int main(int argc, char** argv) {
   test_long_numbers(rng, scale);
   test_stamps(rng, scale);
   test_files(rng);
+  // the two fread rules are told apart by the inputs above (with x87's or
+  // quad's long double; where long double is double they may agree)
+  std::printf("csv: fread's rules 1 and 2 differ on %ld numbers\n", rules_differ);
+  if (sizeof(long double) > sizeof(double)) CHECK(rules_differ > 0, "rules 1 and 2 differ somewhere");
   std::printf("csv (%s): %ld checks (%ld of the strtod path against %s), %s\n",
 #if defined(GRAVCAL_HAVE_FROM_CHARS)
               "decoder on from_chars",

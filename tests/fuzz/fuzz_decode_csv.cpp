@@ -6,7 +6,7 @@
 // what the general line parser gives: a second decoder with option fast = 0
 // reads the same bytes in the same blocks, and every block, value (bit for
 // bit), counter and note must be the same. Last, the number at the start
-// of the input: scan_plain_number() and plain_value() agree with
+// of the input (every number rule): scan_plain_number() and plain_value() agree with
 // parse_number() whenever they take it.
 #include <cstdint>
 #include <cstring>
@@ -42,10 +42,10 @@ void check_number(const std::uint8_t* data, std::size_t size, char dec) {
     __builtin_trap();
   }
   if (e == nullptr || e != b + n) return;  // not taken, or not the whole field
-  for (int compat = 0; compat <= 1; ++compat) {
+  for (int rule = 0; rule <= 2; ++rule) {
     double fast = 0, exact = 0;
-    const bool ok_fast = gravcal::csv_text::plain_value(pn, b, e, dec, compat != 0, fast);
-    const bool ok_exact = gravcal::csv_text::parse_number(b, e, dec, compat != 0, exact);
+    const bool ok_fast = gravcal::csv_text::plain_value(pn, b, e, dec, rule, fast);
+    const bool ok_exact = gravcal::csv_text::parse_number(b, e, dec, rule, exact);
     if (ok_fast != ok_exact || (ok_fast && !same_bits(fast, exact))) __builtin_trap();
   }
 }

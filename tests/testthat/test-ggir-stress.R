@@ -403,8 +403,10 @@ test_that("duplicate filter: ties decided by R's last bit (csv, 15 digits)", {
   expect_gt(sum(kind == "shift" & same[kk - 1] == 3), 30)
   expect_gt(sum(kind == "shift" & same[kk - 1] < 3), 5)
   expect_gt(sum(same[kk - 1] == 3 & apply(ft[kk, 4:6], 1, max) >= 0.013), 30)
-  # constant windows: their means equal or not in the last bit
-  expect_gt(sum(same[1000:1099] == 3), 2)
+  # constant windows: their means equal or not in the last bit (so where
+  # R's cumsum() accumulates in long double: in double, on an R without
+  # it, these windows' means do not come out unequal)
+  if (isTRUE(gravcal:::build_state$r_long_double)) expect_gt(sum(same[1000:1099] == 3), 2)
   expect_gt(sum(same[1000:1099] > 3), 10)
   b <- run_both(f, c(pr, list(chunksize = 0.2)))
   expect_same_as_ggir(b)

@@ -62,6 +62,16 @@ class ByteSource {
   virtual bool seek(std::int64_t) { return false; }
 };
 
+// R's NA for doubles (NA_real_): a NaN whose low 32 bits are 1954. Where
+// GGIR's reader gives NA, a decoder in GGIR-compatible mode gives this (R's
+// identical() tells NA from NaN).
+inline double r_na_real() {
+  const std::uint64_t bits = 0x7FF00000000007A2ULL;
+  double v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
 // stdio's file position in 64 bits: std::fseek and std::ftell take a
 // long, 32 bits on Windows (and 32-bit Linux), so a file over 2 GiB would
 // lose its size and could not be seeked past 2 GiB. _fseeki64/_ftelli64

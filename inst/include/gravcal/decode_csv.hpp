@@ -65,8 +65,9 @@
 //   not a number, so a time-stamped export without column names loses its
 //   first row (compat = 1 does the same); compat = 0 keeps a line 11 whose
 //   first field is a time stamp.
-// * numbers: fread 1.14.8's long double product (compat = 1) or correctly
-//   rounded (compat = 0).
+// * numbers: fread's long double value (compat = 1), by the rule of the
+//   installed data.table (option "fread_rule": 1 before 1.15.0, 2 from it;
+//   see decode_csv_text.hpp), or correctly rounded (compat = 0).
 // fread's own behaviour on damage is not reproduced in either mode: it stops
 // its block at a malformed line (the rest of the block is lost), skips a
 // malformed first line of a block and then reads one row of the next block
@@ -111,13 +112,17 @@ class CsvDecoder : public Decoder {
   static constexpr double kGapSteps = 1.5;          // a step this many sample periods is a gap
 
   // `format`: "actigraph_csv" (the ActiLife header is required) or "csv"
-  // (either kind). Options: compat (1: fread/GGIR, 0: the format), sf;
+  // (either kind). Options: compat (1: fread/GGIR, 0: the format),
+  // fread_rule (with compat = 1: 1 or 2, data.table's rule for numbers), sf;
   // buffer (bytes of the read buffer, default 1 MiB) and fast (0: every
   // line through take_line(), none parsed in place; the same samples) for
   // tests and fuzzers.
   CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
       : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
     compat_ = opts.num("compat", 1) != 0;
+    const double fr = opts.num("fread_rule", 1);
+    number_rule_ = !compat_ ? csv_text::kCorrectlyRounded
+                   : fr == 2 ? csv_text::kFreadDivide : csv_text::kFreadMultiply;
     sf_option_ = opts.num("sf", 0);
     fast_ = opts.num("fast", 1) != 0;
     // an Axivity csv export (time stamp, x, y, z) is read by the same layout
@@ -255,7 +260,7 @@ class CsvDecoder : public Decoder {
       double v = 0;
       std::string num = s.substr(at + 4, hz - at - 4);
       std::replace(num.begin(), num.end(), ',', '.');  // as GGIR reads it
-      if (csv_text::parse_number(num.data(), num.data() + num.size(), '.', false, v) && v > 0) header_sf_ = v;
+      if (csv_text::parse_number(num.data(), num.data() + num.size(), '.', csv_text::kCorrectlyRounded, v) && v > 0) header_sf_ = v;
     }
   }
 
@@ -359,7 +364,7 @@ class CsvDecoder : public Decoder {
 
   bool is_number(const csv_text::Field& f) const {
     double v;
-    return csv_text::parse_number(f.b, f.e, dec_, false, v);
+    return csv_text::parse_number(f.b, f.e, dec_, csv_text::kCorrectlyRounded, v);
   }
   bool is_time(const csv_text::Field& f) {
     double t;
@@ -524,7 +529,7 @@ class CsvDecoder : public Decoder {
   bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
     if (!time_text_) {
       frac_digits = 9;
-      if (!csv_text::parse_number(f.b, f.e, dec_, compat_, t)) return false;
+      if (!csv_text::parse_number(f.b, f.e, dec_, number_rule_, t)) return false;
       if (adhoc_) t = t / time_div_ + time_offset_;
       return true;
     }
@@ -592,7 +597,7 @@ class CsvDecoder : public Decoder {
     }
     if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return;
     plain_ = nfields_ == 3 && role_[0] == kX && role_[1] == kY && role_[2] == kZ ? 2 : 1;
-    decimals_ = &csv_text::decimals(compat_);
+    decimals_ = &csv_text::decimals(number_rule_);
   }
 
   std::int64_t read_plain(SampleBuffer& out, std::int64_t max_lines) {
@@ -670,7 +675,7 @@ class CsvDecoder : public Decoder {
       v = decimals_->value[pn.frac][pn.acc] * kSign[pn.neg];
       return e;
     }
-    return csv_text::plain_value(pn, p, e, dec_, compat_, v) ? e : nullptr;
+    return csv_text::plain_value(pn, p, e, dec_, number_rule_, v) ? e : nullptr;
   }
 
   // The fields of the data line at q (whole, ending in '\n') when they are
@@ -747,10 +752,10 @@ class CsvDecoder : public Decoder {
     if (nf < nfields_) return skip_line(ln, "short_lines", "too few fields");
     if (nf > nfields_) return skip_line(ln, "long_lines", "too many fields");
     double x, y, z, temp = std::numeric_limits<double>::quiet_NaN();
-    if (!csv_text::parse_number(f[col_x_].b, f[col_x_].e, dec_, compat_, x) ||
-        !csv_text::parse_number(f[col_y_].b, f[col_y_].e, dec_, compat_, y) ||
-        !csv_text::parse_number(f[col_z_].b, f[col_z_].e, dec_, compat_, z) ||
-        (col_temp_ >= 0 && !csv_text::parse_number(f[col_temp_].b, f[col_temp_].e, dec_, compat_, temp))) {
+    if (!csv_text::parse_number(f[col_x_].b, f[col_x_].e, dec_, number_rule_, x) ||
+        !csv_text::parse_number(f[col_y_].b, f[col_y_].e, dec_, number_rule_, y) ||
+        !csv_text::parse_number(f[col_z_].b, f[col_z_].e, dec_, number_rule_, z) ||
+        (col_temp_ >= 0 && !csv_text::parse_number(f[col_temp_].b, f[col_temp_].e, dec_, number_rule_, temp))) {
       return skip_line(ln, "non_numeric_lines", "a value is not a number");
     }
     if (!ln.has_end) {
@@ -823,6 +828,7 @@ class CsvDecoder : public Decoder {
   csv_text::DateTimeParser dt_;
   bool want_actigraph_;
   bool compat_ = true;
+  int number_rule_ = csv_text::kFreadMultiply;  // a csv_text::NumberRule
   bool fast_ = true;
   double sf_option_ = 0;
   bool opened_ = false, done_ = false;
@@ -835,7 +841,7 @@ class CsvDecoder : public Decoder {
   int col_x_ = -1, col_y_ = -1, col_z_ = -1, col_time_ = -1, col_temp_ = -1;
   bool time_text_ = true;
   double step_ = 0;
-  const csv_text::Decimals* decimals_ = nullptr;  // csv_text::decimals(compat_)
+  const csv_text::Decimals* decimals_ = nullptr;  // csv_text::decimals(number_rule_)
   unsigned char role_[kMaxFields] = {};  // a Role for each field
   int plain_ = 0;  // lines parsed in place: 0 no, 1 yes, 2 yes and they are x, y, z
   // position

@@ -1,18 +1,25 @@
 // gravcal: the text primitives of the csv decoder (decode_csv.hpp): numbers,
 // date-times, a line reader over a fixed buffer, field splitting.
 //
-// Numbers. data.table::fread (1.14.8, the version GGIR runs with here) reads
-// a decimal as an integer of at most 18 significant digits times a power of
-// ten, both in long double, and rounds that product to double. That is not
-// correctly rounded: "1.358931", "-1.10116583029324" differ from strtod's
-// value in the last bit (about 1 in 4000 numbers of 6 or more digits; none
-// of 3 or 4 decimals, which ActiLife writes, and none of 17 digits). With
-// compat = 1 the decoder computes fread's product; with compat = 0 it gives
-// the correctly rounded value (std::from_chars where the C++ library has it
-// for double, else strtod in the "C" locale: see decimal_to_double()).
-// data.table 1.15.0 changed
-// this to a division by the power of ten (its issue 4461), which differs in
-// other last bits: compat follows the installed reference, 1.14.8.
+// Numbers. data.table::fread reads a decimal as an integer of at most 18
+// significant digits and scales it by a power of ten in long double, then
+// rounds that to double. That is not correctly rounded, and how it scales
+// changed in data.table 1.15.0 (its issue 4461):
+//  * rule 1 (data.table before 1.15.0; Debian 12's 1.14.8): the digits
+//    times 10^e, with a table of negative powers for e < 0. "1.358931",
+//    "-1.10116583029324" differ from strtod's value in the last bit (about
+//    1 in 4000 numbers of 6 or more digits; none of 3 or 4 decimals, which
+//    ActiLife writes, and none of 17 digits);
+//  * rule 2 (data.table 1.15.0 and later): the digits divided by 10^-e for
+//    e < 0 (times 10^e for e >= 0), the power beyond 10^300 applied first.
+//    "-6.94352849999999" is one where the two rules differ.
+// Rule 0 is the correctly rounded value (std::from_chars where the C++
+// library has it for double, else strtod in the "C" locale: see
+// decimal_to_double()). Which fread rule GGIR's reads follow is found in R
+// from the installed data.table's own fread (R/fp-build.R), and given to
+// the decoder as an option; the long double is the compiler's, as
+// data.table's is (x87's 64-bit mantissa, IEEE quad on aarch64, double on
+// macOS arm64), so each rule is data.table's on the same platform.
 #ifndef GRAVCAL_DECODE_CSV_TEXT_HPP
 #define GRAVCAL_DECODE_CSV_TEXT_HPP
 
@@ -116,15 +123,34 @@ inline long double pow10_far(int e) {
   return pow10_table()[e + kMaxExponent];
 }
 
-// fread 1.14.8's value of (-)acc * 10^exp10, for acc < 10^18 and |exp10| <=
-// kMaxExponent: acc and the power of ten in long double, their product
-// rounded to double (fread negates the product; the same value, above).
-GRAVCAL_CSV_INLINE double fread_value(std::uint64_t acc, int exp10, bool neg) {
-  const long double p10 = (exp10 >= -kNearExponent && exp10 <= kNearExponent)
-                              ? kPow10Signed.v[neg][exp10 + kNearExponent]
-                              : (neg ? -pow10_far(exp10) : pow10_far(exp10));
+// The rules for a number's value (see the top of this file).
+enum NumberRule : int { kCorrectlyRounded = 0, kFreadMultiply = 1, kFreadDivide = 2 };
+
+// fread's value of (-)acc * 10^exp10, for acc < 10^18 and |exp10| <=
+// kMaxExponent, by rule 1 (rule = kFreadMultiply) or rule 2: in long
+// double, rounded to double once (fread applies the sign to the long double
+// value; rounding to nearest is symmetric, so the same value).
+GRAVCAL_CSV_INLINE double fread_value(std::uint64_t acc, int exp10, bool neg, int rule = kFreadMultiply) {
   // acc < 10^18 < 2^63: a signed conversion, exact in long double
-  return static_cast<double>(static_cast<long double>(static_cast<std::int64_t>(acc)) * p10);
+  const long double a = static_cast<long double>(static_cast<std::int64_t>(acc));
+  if (rule != kFreadDivide) {
+    const long double p10 = (exp10 >= -kNearExponent && exp10 <= kNearExponent)
+                                ? kPow10Signed.v[neg][exp10 + kNearExponent]
+                                : (neg ? -pow10_far(exp10) : pow10_far(exp10));
+    return static_cast<double>(a * p10);
+  }
+  // rule 2: powers 10^0..10^300 only; beyond, the excess first
+  long double r = a;
+  int e = exp10;
+  if (e < -300 || e > 300) {
+    const int extra = e < 0 ? e + 300 : e - 300;
+    r = extra < 0 ? r / pow10_far(-extra) : r * pow10_far(extra);
+    e -= extra;
+  }
+  const int k = e < 0 ? -e : e;
+  const long double p = k <= kNearExponent ? kPow10Near[k + kNearExponent] : pow10_far(k);
+  r = e < 0 ? r / p : r * p;
+  return static_cast<double>(neg ? -r : r);
 }
 
 // The correctly rounded value of (-)acc * 10^exp10 when one IEEE operation
@@ -190,8 +216,8 @@ inline bool decimal_to_double(const char* s, std::size_t n, bool nonzero, double
 }
 
 // A number in [b, e): [+-]digits[<dec>digits][(e|E)[+-]digits], the whole
-// field. compat: fread 1.14.8's value; else the correctly rounded one.
-inline bool parse_number(const char* b, const char* e, char dec, bool compat, double& out) {
+// field. rule: a NumberRule (0: the correctly rounded value; 1, 2: fread's).
+inline bool parse_number(const char* b, const char* e, char dec, int rule, double& out) {
   const char* p = b;
   if (p == e) return false;
   const bool neg = *p == '-';
@@ -235,8 +261,8 @@ inline bool parse_number(const char* b, const char* e, char dec, bool compat, do
   }
   if (p != e) return false;
   if (exp10 < -kMaxExponent || exp10 > kMaxExponent) return false;
-  if (compat) {
-    out = fread_value(acc, exp10, neg);
+  if (rule != kCorrectlyRounded) {
+    out = fread_value(acc, exp10, neg, rule);
     return true;
   }
   // correctly rounded: one IEEE operation when it is exact (the first
@@ -347,13 +373,13 @@ GRAVCAL_CSV_INLINE const char* scan_plain_number_3(const char* p, char dec, Plai
 // as `n` (every digit kept, exp10 = -frac): fread_value() or exact_value(),
 // as parse_number computes it, else parse_number itself.
 GRAVCAL_CSV_INLINE bool plain_value(const PlainNumber& n, const char* b, const char* e, char dec,
-                                    bool compat, double& out) {
-  if (compat) {
-    out = fread_value(n.acc, -n.frac, n.neg);
+                                    int rule, double& out) {
+  if (rule != kCorrectlyRounded) {
+    out = fread_value(n.acc, -n.frac, n.neg, rule);
     return true;
   }
   if (exact_value(n.acc, -n.frac, n.neg, out)) return true;
-  return parse_number(b, e, dec, false, out);
+  return parse_number(b, e, dec, kCorrectlyRounded, out);
 }
 
 // 8 bytes at p as a word, byte 0 lowest (one load on a little-endian
@@ -398,8 +424,8 @@ GRAVCAL_CSV_INLINE const char* field_end(const char* p, char sep) {
 
 // The values of the numbers with 1, 2 or 3 decimals below 16.384 (ActiLife
 // writes up to 3 decimals, dropping trailing zeros), by their digits as one
-// integer k: decimals(compat).value[f][k] is the value of k / 10^f, fread's
-// (compat) or correctly rounded, for k < decimals().limit[f]. Computed once
+// integer k: decimals(rule).value[f][k] is the value of k / 10^f by the
+// NumberRule, for k < decimals().limit[f]. Computed once
 // per process, on first use, by fread_value / exact_value, the functions
 // parse_number uses (the three tables: about 150 KiB a mode).
 constexpr std::size_t kThousandths = 16384;
@@ -408,14 +434,14 @@ struct Decimals {
   const double* value[4] = {nullptr, nullptr, nullptr, nullptr};
   std::uint64_t limit[4] = {0, 0, 0, 0};
 };
-inline Decimals decimals_values(bool compat) {
+inline Decimals decimals_values(int rule) {
   Decimals d;
   std::uint64_t lim = kThousandths;
   for (int f = 3; f >= 1; --f, lim = (lim + 9) / 10) {
     std::vector<double>& t = d.table[f];
     t.resize(lim);
     for (std::uint64_t k = 0; k < lim; ++k) {
-      if (compat) t[k] = fread_value(k, -f, false);
+      if (rule != kCorrectlyRounded) t[k] = fread_value(k, -f, false, rule);
       else exact_value(k, -f, false, t[k]);  // (exact for every k here)
     }
     d.value[f] = t.data();
@@ -423,12 +449,16 @@ inline Decimals decimals_values(bool compat) {
   }
   return d;
 }
-inline const Decimals& decimals(bool compat) {
-  if (compat) {
-    static const Decimals t = decimals_values(true);
+inline const Decimals& decimals(int rule) {
+  if (rule == kFreadMultiply) {
+    static const Decimals t = decimals_values(kFreadMultiply);
     return t;
   }
-  static const Decimals t = decimals_values(false);
+  if (rule == kFreadDivide) {
+    static const Decimals t = decimals_values(kFreadDivide);
+    return t;
+  }
+  static const Decimals t = decimals_values(kCorrectlyRounded);
   return t;
 }
 

@@ -390,7 +390,7 @@ class ParmayDecoder : public Decoder {
       }
       const Packet& p = d->packets_[i];
       const std::int64_t r = j++;
-      const double na = std::numeric_limits<double>::quiet_NaN();
+      const double na = r_na_real();
       if (kind == kAcc) {
         if (!p.ok) {
           v[0] = 0;
@@ -455,7 +455,7 @@ class ParmayDecoder : public Decoder {
   // row of the good packet before it and the first row of the good packet
   // after it (one of them when the other is missing).
   void impute_temp(std::size_t i, double* out) {
-    const double na = std::numeric_limits<double>::quiet_NaN();
+    const double na = r_na_real();
     double prev[2] = {na, na}, next[2] = {na, na};
     bool have_prev_packet = false;
     for (std::size_t k = i; k-- > 0;) {
@@ -570,7 +570,7 @@ class ParmayDecoder : public Decoder {
   }
 
   void put(SampleBuffer& out, const double* v, double g) {
-    const double temp = any_temp_ ? temp_at(g) : std::numeric_limits<double>::quiet_NaN();
+    const double temp = any_temp_ ? temp_at(g) : r_na_real();
     out.put(v[0], v[1], v[2], temp, g);
     ++report_.samples;
   }
@@ -616,7 +616,7 @@ class ParmayDecoder : public Decoder {
 
   // The temperature at grid time g, as GGIRread resamples it.
   double temp_at(double g) {
-    const double na = std::numeric_limits<double>::quiet_NaN();
+    const double na = r_na_real();
     if (!temp_started_) {
       temp_started_ = true;
       if (!temp_raw(&tp_t_, &tp_v_) || !temp_raw(&tc_t_, &tc_v_)) {
