@@ -145,6 +145,15 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   rmc <- if (!is.null(pr$rmc.firstrow.acc) && is.character(datafile)) {
     pr[grepl("^rmc[.]", names(pr))]
   }
+  # the zone GGIR reads text time in (rmc.check4timegaps): configtz, else
+  # desiredtz, else the deprecated rmc.* ones
+  if (!is.null(rmc)) {
+    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else if (nzchar(pr$desiredtz %||% "")) {
+      pr$desiredtz
+    } else {
+      pr$rmc.configtz %||% pr$rmc.desiredtz %||% ""
+    }
+  }
   read_opts <- list(interpolation = pr$interpolationType,
                     frequency_tol = pr$frequency_tol)
   open <- function() {
