@@ -325,8 +325,8 @@ gap_lines <- function(n = 3700, sf = 10, text = FALSE) {
   xyz <- function(m) round(stats::rnorm(n, m, 0.6), 4)
   d <- data.frame(time = 1.6e9 + t, x = xyz(0), y = xyz(0), z = xyz(0.5),
                   temperature = round(stats::runif(n, 20, 30), 2))
-  # zero samples: a run, a block's (of 37 lines) last and next first, one
-  # before a gap, the file's first ones
+  # zero samples: a run, a block's (of 185 lines) last and the next one's
+  # first, one before a gap, the file's first ones
   zero <- c(5:9, 370, 371, 740, 1500:1530, 2999, 3000, 3330)
   d[zero, c("x", "y", "z")] <- 0
   d$time <- if (text) {
@@ -345,10 +345,11 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
   on.exit(unlink(f))
   pr0 <- list(rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.temp = 5, rmc.col.time = 1,
               rmc.sf = 10, rmc.check4timegaps = TRUE)
-  combos <- list(list(text = FALSE, B = 37, rs = FALSE, type = 1),
-                 list(text = FALSE, B = 37, rs = TRUE, type = 1),
+  # blocks of 185 lines: line 370 ends the second, 371 starts the third
+  combos <- list(list(text = FALSE, B = 185, rs = FALSE, type = 1),
+                 list(text = FALSE, B = 185, rs = TRUE, type = 1),
                  list(text = FALSE, B = 370, rs = TRUE, type = 2),
-                 list(text = TRUE, B = 37, rs = FALSE, type = 1),
+                 list(text = TRUE, B = 185, rs = FALSE, type = 1),
                  list(text = TRUE, B = 3700, rs = FALSE, type = 1))
   for (cb in combos) {
     utils::write.table(gap_lines(n, text = cb$text), f, sep = ",", quote = FALSE, row.names = FALSE)
@@ -387,27 +388,31 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
 test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with gaps", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
-  rec <- adhoc_rec(seed = 18)
-  B <- gravcal:::format_block_units("adhoc_csv", 10, 1)  # GGIR's block of lines
-  # three short gaps (0.4 s), a 30-minute gap, a 5 s gap between the last
-  # line of GGIR's first block and the first of its second (not filled:
-  # g.calibrate gives no previous block), a run of 600 zero samples
-  short <- c(20000, 150000, 400000) + rep(0:2, each = 3)
-  across <- B + length(short) + 1:50
-  drop <- sort(c(short, 600001:618000, across))
-  rec[700000:700600, c("x", "y", "z")] <- 0
   f <- tempfile(fileext = ".csv")
   on.exit(unlink(f))
   noise <- list(rmc.noise = 0.013 / 1.2)
+  # UNIX seconds at 10 Hz, text time at 5 Hz (GGIR's text parsing is slow)
   for (tm in c("UNIXsec", "character")) {
-    pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = tm, drop = drop)
+    sf <- if (tm == "UNIXsec") 10 else 5
+    rec <- adhoc_rec(sf = sf, seed = 18)
+    B <- gravcal:::format_block_units("adhoc_csv", sf, 1)  # GGIR's block of lines
+    # three short gaps (0.4 or 0.6 s), a 30-minute gap, a 5 s gap between
+    # the last line of GGIR's first block and the first of its second (not
+    # filled: g.calibrate gives no previous block), a run of 60 s of zeros
+    short <- c(20000, 150000, 400000) + rep(0:2, each = 3)
+    across <- B + length(short) + seq_len(5 * sf)
+    drop <- sort(c(short, 450000 + seq_len(1800 * sf), across))
+    rec[480000 + seq_len(60 * sf), c("x", "y", "z")] <- 0
+    pr <- gravcal:::write_adhoc_csv(rec, f, sf = sf, time = tm, drop = drop)
     pr$rmc.check4timegaps <- TRUE
     b <- expect_adhoc_same(f, c(pr, noise))
     expect_gt(b$ggir$npoints, 100)
     if (tm == "UNIXsec") {
-      # the gaps change GGIR's numbers: without filling them, others
-      b0 <- run_both(f, c(utils::modifyList(pr, list(rmc.check4timegaps = FALSE)), noise))
-      expect_false(identical(b0$ggir$spheredata, b$ggir$spheredata))
+      # the gaps change the numbers: without filling them, others
+      utils::capture.output(G0 <- suppressWarnings(gravcal::g.calibrate(
+        f, params_rawdata = c(utils::modifyList(pr, list(rmc.check4timegaps = FALSE)), noise),
+        verbose = FALSE)))
+      expect_false(identical(G0$spheredata, b$ggir$spheredata))
       # filled, then resampled
       expect_adhoc_same(f, c(pr, noise, list(rmc.doresample = TRUE)))
     }
