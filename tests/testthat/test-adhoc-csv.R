@@ -356,7 +356,7 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
     pr <- c(pr0, list(rmc.doresample = cb$rs),
             if (cb$text) list(rmc.unit.time = "character", rmc.format.time = "%d/%m/%Y %H:%M:%OS")
             else list(rmc.unit.time = "UNIXsec"))
-    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, ggir = FALSE)
+    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "UTC", ggir = FALSE)
     h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = cb$type), lay$opts))
     rows <- 0
     for (i in seq_len(n / cb$B)) {
@@ -389,7 +389,14 @@ test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with ga
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   f <- tempfile(fileext = ".csv")
-  on.exit(unlink(f))
+  # GGIR reads text time in desiredtz = "", the machine's zone: one of fixed
+  # offset here (a zone with daylight saving is refused, see below)
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "UTC")
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
   noise <- list(rmc.noise = 0.013 / 1.2)
   # UNIX seconds at 10 Hz, text time at 5 Hz (GGIR's text parsing is slow)
   for (tm in c("UNIXsec", "character")) {
@@ -422,7 +429,12 @@ test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with ga
 test_that("rmc.check4timegaps: what gravcal does not reproduce is an error naming it", {
   rec <- adhoc_rec(hours = 0.1, sf = 10, seed = 19)
   f <- tempfile(fileext = ".csv")
-  on.exit(unlink(f))
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "UTC")  # desiredtz = "": the machine's zone
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
   pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "character")
   pr$rmc.check4timegaps <- TRUE
   gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
