@@ -146,13 +146,11 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     pr[grepl("^rmc[.]", names(pr))]
   }
   # the zone GGIR reads text time in (rmc.check4timegaps): configtz, else
-  # desiredtz, else the deprecated rmc.* ones
+  # the deprecated rmc.configtz, else desiredtz ("" gives way to
+  # rmc.desiredtz), as read.myacc.csv settles them
   if (!is.null(rmc)) {
-    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else if (nzchar(pr$desiredtz %||% "")) {
-      pr$desiredtz
-    } else {
-      pr$rmc.configtz %||% pr$rmc.desiredtz %||% ""
-    }
+    desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
+    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
   }
   read_opts <- list(interpolation = pr$interpolationType,
                     frequency_tol = pr$frequency_tol)
