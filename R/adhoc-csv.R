@@ -23,7 +23,9 @@
 # time column (UNIXsec, UNIXmsec and ActivPAL read per sample, POSIX and
 # character text from the first stamp on, start + i / sf), except with
 # rmc.doresample and a UNIX time column: GGIR then resamples every block
-# onto sf from its time stamps (see rmc_layout()).
+# onto sf from its time stamps (see rmc_layout()), and rmc.check4timegaps:
+# GGIR then fills each block's time gaps and drops its zero samples
+# (g.imputeTimegaps; decode_ggir_timegaps.hpp), before any resampling.
 
 # The rmc.* parameters (their values from the parameter table,
 # ggir-params.R) as the decoder's layout for `file`: list(opts = decoder
@@ -40,7 +42,7 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
     abort("`", nm, "` = ", deparse(p[[nm]]), " is not supported by gravcal (", why,
           "); GGIR::g.calibrate() reads such files.")
   }
-  if (isTRUE(p$rmc.check4timegaps)) refuse("rmc.check4timegaps", "time gaps in ad hoc csv files are not imputed")
+  gaps <- isTRUE(p$rmc.check4timegaps) && length(p$rmc.col.time) > 0
   resample <- isTRUE(p$rmc.doresample) && length(p$rmc.col.time) > 0
   if (resample && !p$rmc.unit.time %in% c("UNIXsec", "UNIXmsec")) {
     refuse("rmc.doresample", paste0("resampled with a time column in UNIX seconds or ",
@@ -118,10 +120,87 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   # 2: nearest neighbour) from its first time stamp to its last, at sf
   # (decode_ggir_resample.hpp; GGIR-compatible reads only)
   if (resample) opts$grid_sf <- as.numeric(sf)
+  # rmc.check4timegaps: each block's gaps filled at sf and its zero samples
+  # dropped, as g.imputeTimegaps does (decode_ggir_timegaps.hpp), before
+  # any resampling
+  if (gaps) {
+    g <- rmc_gaps_opts(p, file, skip, tz, sf)
+    opts[names(g)] <- g
+    opts$timegaps <- as.numeric(sf)
+  }
   list(opts = opts, sf = sf, skip = skip, header = header,
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
        })
+}
+
+# rmc.check4timegaps: what the decoder needs to read the time stamps as
+# GGIR's gap imputation sees them (options time_format and time_utc_offset
+# for text time), or an error naming what gravcal does not reproduce. Only
+# the steps between time stamps decide the gaps; GGIR reads text time (and
+# ActivPAL days) in the zone configtz, else desiredtz: a zone whose UTC
+# offset changes (daylight saving) within 25 months of the first stamp is
+# refused; a fixed offset is subtracted from the stamps.
+rmc_gaps_opts <- function(p, file, skip, tz, sf) {
+  unit <- p$rmc.unit.time
+  if (unit %in% c("UNIXsec", "UNIXmsec")) return(list())
+  zone <- attr(p, "tz") %||% p$rmc.configtz %||% p$rmc.desiredtz %||% tz
+  lines <- readLines(file, n = skip + 1000, warn = FALSE)
+  lines <- lines[seq_along(lines) > skip]
+  stamps <- vapply(lines, function(l) rmc_fields(l)[p$rmc.col.time], "", USE.NAMES = FALSE)
+  refuse <- function(why) {
+    abort("`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"", unit, "\" is not supported by ",
+          "gravcal (", why, "); GGIR::g.calibrate() reads such files.")
+  }
+  if (unit == "ActivPAL") {
+    t <- suppressWarnings(as.numeric(stamps)) * 86400 - 25569 * 86400
+  } else {
+    fmt <- p$rmc.format.time
+    d <- regmatches(fmt, gregexpr("%O?.", fmt))[[1]]
+    bad <- setdiff(d, c("%Y", "%y", "%m", "%d", "%H", "%M", "%S", "%OS", "%T", "%%"))
+    if (length(bad)) {
+      refuse(paste0("its text time is read with `rmc.format.time` directives ",
+                    "%Y %y %m %d %H %M %S %OS %T only, not ", paste(bad, collapse = " ")))
+    }
+    t <- as.numeric(as.POSIXct(stamps, format = fmt, tz = "UTC"))
+    # GGIR spreads whole-second stamps that repeat over the second
+    # ("POSIX"): not reproduced
+    w <- t[!is.na(t)]
+    if (unit == "POSIX" && all(w == floor(w)) && anyDuplicated(w)) {
+      refuse("whole-second time stamps that repeat are spread over the second by GGIR")
+    }
+    # "POSIX": GGIR formats what fread gives; fread reads ISO 8601 stamps as
+    # date-times, whose format() drops the fraction of a second (and GGIR
+    # then spreads the repeated whole seconds)
+    if (unit == "POSIX" && any(grepl("[0-9]:[0-9]{2}[.,][0-9]", stamps)) &&
+        rmc_fread_datetime(lines[seq_len(min(5, length(lines)))], p$rmc.col.time)) {
+      refuse(paste0("GGIR reads ISO 8601 text time like \"", stamps[1], "\" through ",
+                    "data.table::fread(), losing its fractions of a second; with ",
+                    "rmc.unit.time = \"character\" GGIR keeps them and gravcal follows"))
+    }
+  }
+  t0 <- t[!is.na(t)][1]
+  if (is.na(t0)) refuse("the time column's first values cannot be read")
+  at <- t0 + (0:25) * 30.44 * 86400
+  txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+  off <- at - as.numeric(as.POSIXct(txt, tz = zone))
+  if (anyNA(off) || any(off != off[1])) {
+    refuse(paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)",
+                  " changes its UTC offset; give desiredtz / configtz a zone of fixed offset"))
+  }
+  if (unit == "ActivPAL") return(list())
+  list(time_format = p$rmc.format.time, time_utc_offset = off[1])
+}
+
+# Whether data.table::fread() reads column `col` of `lines` as date-times
+# (ISO 8601); without data.table, whether its first value looks like one.
+rmc_fread_datetime <- function(lines, col) {
+  if (requireNamespace("data.table", quietly = TRUE)) {
+    d <- tryCatch(data.table::fread(text = lines, header = FALSE, showProgress = FALSE,
+                                    data.table = FALSE), error = function(e) NULL)
+    if (!is.null(d) && ncol(d) >= col) return(inherits(d[[col]], "POSIXct"))
+  }
+  grepl("^[0-9]{4}-[0-9]{2}-[0-9]{2}[T ][0-9]{2}:[0-9]{2}:[0-9]{2}", rmc_fields(lines[1])[col])
 }
 
 # The fields of a line, split at the first of ';', tab or ',' it holds
@@ -199,6 +278,10 @@ source_adhoc <- function(file, sf, chunksize, arg, layout) {
   sf <- layout$sf
   if (!is.null(o$grid_sf)) {
     abort("`rmc.doresample` = TRUE is taken by gravcal's own csv decoder only ",
+          "(reader = \"native\"), not with reader = \"reference\".")
+  }
+  if (!is.null(o$timegaps)) {
+    abort("`rmc.check4timegaps` = TRUE is taken by gravcal's own csv decoder only ",
           "(reader = \"native\"), not with reader = \"reference\".")
   }
   B <- format_block_units("adhoc_csv", sf, chunksize)

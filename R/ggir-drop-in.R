@@ -85,10 +85,10 @@
 #' | `rmc.sf`, `rmc.firstrow.header`, `rmc.header.length`, `rmc.headername.sf`, `rmc.header.structure` | honoured: the sampling rate from the header, else `rmc.sf` |
 #' | `rmc.dec` | honoured (`","` with `;` or tab separated fields) |
 #' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
-#' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
-#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration |
+#' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time, except with `rmc.doresample` and `rmc.check4timegaps`); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
+#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration (`rmc.configtz`, `rmc.desiredtz`: the zone of text time for `rmc.check4timegaps` when `configtz` and `desiredtz` are not given) |
 #' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds (`rmc.unit.time`): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; other time units refused with an error |
-#' | `rmc.check4timegaps = TRUE` | refused with an error |
+#' | `rmc.check4timegaps = TRUE` with a time column | honoured: in each block of lines, samples with x = y = z = 0 dropped (the block's first becomes 0, 0, 1, its last takes the values before it) and every step of at least 0.25 s (or 2 / sf) filled by repeating the sample before it (normalised when its norm exceeds 1.005), as GGIR's `g.imputeTimegaps()` does, before `rmc.doresample`; a gap between two blocks stays, as in GGIR. For UNIX seconds or milliseconds, ActivPAL days, and text time read by `rmc.format.time` with `%Y %y %m %d %H %M %S %OS %T` in a zone (`configtz`, else `desiredtz`) of fixed UTC offset. Refused with an error: other directives, a zone with daylight saving, ISO 8601 text time as `"POSIX"` with fractions of a second (GGIR reads it through `fread()`, which drops them; `"character"` keeps them), whole-second text stamps that repeat, `reader = "reference"` |
 #'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
@@ -144,6 +144,13 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   # rmc.firstrow.acc: an ad hoc csv file, read by the rmc.* parameters
   rmc <- if (!is.null(pr$rmc.firstrow.acc) && is.character(datafile)) {
     pr[grepl("^rmc[.]", names(pr))]
+  }
+  # the zone GGIR reads text time in (rmc.check4timegaps): configtz, else
+  # the deprecated rmc.configtz, else desiredtz ("" gives way to
+  # rmc.desiredtz), as read.myacc.csv settles them
+  if (!is.null(rmc)) {
+    desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
+    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
   }
   read_opts <- list(interpolation = pr$interpolationType,
                     frequency_tol = pr$frequency_tol)

@@ -140,7 +140,12 @@ ggir_param_table <- function() {
       list("rmc.headername.sn", NULL, rmc_string, "the header's serial number (not used)"),
       list("rmc.headername.recordingid", NULL, rmc_string, "the header's recording id (not used)"),
       list("rmc.header.structure", NULL, rmc_string, "how header names and values are separated"),
-      list("rmc.check4timegaps", FALSE, check_flag, "TRUE refused: not implemented"),
+      list("rmc.check4timegaps", FALSE, check_flag,
+           paste0("TRUE with a time column: honoured (each block's time gaps filled and ",
+                  "zero samples dropped, as g.imputeTimegaps; UNIX s/ms, ActivPAL, text ",
+                  "time read by %Y %y %m %d %H %M %S %OS %T in a zone of fixed offset); ",
+                  "ISO 8601 text as \"POSIX\", repeated whole-second stamps, zones with ",
+                  "daylight saving and reader = \"reference\" refused")),
       list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX time column: honoured (block by block resampling); other time units refused"),
       # a wear column: g.calibrate() does not use it
       list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),

@@ -149,7 +149,9 @@ write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
 # sample: [time,] x, y, z[, temperature]. `unit`: "g" (`digits` decimals),
 # "mg" (`digits` - 3 decimals) or "bit" (unsigned counts of `bitrate` bits
 # over +-`dynamic_range` g); `time`: "none", "UNIXsec", "UNIXmsec" or
-# "POSIX" ("%Y-%m-%d %H:%M:%OS" text, millisecond decimals); `temp_unit`:
+# "POSIX" ("%Y-%m-%d %H:%M:%OS" text, millisecond decimals) or "character"
+# ("%d/%m/%Y %H:%M:%OS" text, millisecond decimals); `drop`: the indices of
+# samples left out (a time gap where their time stamps would be); `temp_unit`:
 # "C", "K" (written as GGIR reads it back: t - 272.15) or "F"; `sep` and
 # `dec`: separator and decimal mark. The sampling rate goes to rmc.sf, or
 # with `sf_header = TRUE` to a header line "sample_rate_hz,<sf>" read by
@@ -158,7 +160,7 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
                             unit = "g", time = "none", temperature = TRUE,
                             temp_unit = "C", bitrate = 12, dynamic_range = 8,
                             digits = 4, sep = ",", dec = ".", sf_header = FALSE,
-                            start = "2024-01-01 00:00:00") {
+                            start = "2024-01-01 00:00:00", drop = integer()) {
   s <- as_samples(x)
   if (sf_header) header <- c(header, paste0("sample_rate_hz", sep, format(sf)))
   acc <- switch(unit,
@@ -176,8 +178,11 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
     UNIXsec = round(t, 3),
     UNIXmsec = round(t * 1000),
     POSIX = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,
-                   "%Y-%m-%d %H:%M:%OS3"))
+                   "%Y-%m-%d %H:%M:%OS3"),
+    character = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,
+                       "%d/%m/%Y %H:%M:%OS3"))
   if (!is.null(tcol)) d <- c(list(time = tcol), d)
+  if (length(drop)) d <- lapply(d, function(v) v[-drop])
   writeLines(c(header, if (colnames) paste(names(d), collapse = sep)), file)
   data.table::fwrite(d, file, append = TRUE, col.names = FALSE, sep = sep, dec = dec)
   first <- length(header) + as.integer(colnames) + 1
@@ -191,6 +196,7 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
   if (!is.null(tcol)) {
     p$rmc.col.time <- 1
     p$rmc.unit.time <- time
+    if (time == "character") p$rmc.format.time <- "%d/%m/%Y %H:%M:%OS"
   }
   if (unit == "bit") {
     p$rmc.bitrate <- bitrate

@@ -13,9 +13,11 @@
 #include "gravcal/decode_cwa.hpp"
 #include "gravcal/decode_geneactiv.hpp"
 #include "gravcal/decode_ggir_resample.hpp"
+#include "gravcal/decode_ggir_timegaps.hpp"
 #include "gravcal/decode_gt3x.hpp"
 #include "gravcal/decode_parmay.hpp"
 #include "gz_source.h"
+#include "r_services.h"
 #include "zip_inflate.h"
 
 namespace gravcal_glue {
@@ -67,16 +69,31 @@ inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Op
 }
 
 // GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
+// rmc.check4timegaps and a time column (option timegaps > 0: the rate),
+// each block's time gaps filled as g.imputeTimegaps fills them; with
 // rmc.doresample and a UNIX time column (option grid_sf > 0; compat = 1),
-// resampled block by block onto that rate, the grid's last point kept.
+// resampled block by block onto that rate, the grid's last point kept
+// (after the gaps are filled, as read.myacc.csv does).
+template <class Inner>
+DecoderPtr adhoc_resampled(std::unique_ptr<Inner> d, const gravcal::Options& opts) {
+  const double grid = opts.num("grid_sf", 0);
+  if (opts.num("compat", 1) == 0 || !(grid > 0)) return DecoderPtr(d.release());
+  return DecoderPtr(new gravcal::GgirResamplerOf<Inner>(
+      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true,
+      opts.num("resample_fused", 0) != 0));
+}
+
 inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
                                  const std::string& name) {
   std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
-  const double grid = opts.num("grid_sf", 0);
-  if (opts.num("compat", 1) == 0 || !(grid > 0)) return d;
-  return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true,
-      opts.num("resample_fused", 0) != 0));
+  const double gaps = opts.num("timegaps", 0);
+  if (!(gaps > 0)) return adhoc_resampled(std::move(d), opts);
+  if (r_long_double()) {
+    using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, long double>;
+    return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps)), opts);
+  }
+  using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, double>;
+  return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps)), opts);
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating

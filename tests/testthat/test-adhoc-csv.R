@@ -288,7 +288,10 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
   pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "POSIX")
   gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
                                   verbose = FALSE)
-  expect_error(gc(rmc.check4timegaps = TRUE), "`rmc.check4timegaps` = TRUE is not supported")
+  # rmc.check4timegaps with ISO 8601 text time as "POSIX": GGIR reads it
+  # through fread, which drops the fractions of a second (see the gap tests)
+  expect_error(gc(rmc.check4timegaps = TRUE),
+               "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"POSIX\" is not supported")
   # rmc.doresample with a text time column: refused (UNIX times are
   # resampled, see below)
   expect_error(gc(rmc.doresample = TRUE), "`rmc.doresample` = TRUE is not supported")
@@ -305,4 +308,150 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
                "Unknown parameter in `rmc`: `rmc.nosuch`")
   expect_error(read_recording(f, rmc = list(rmc.sf = 10)), "`rmc` must give `rmc.firstrow.acc`")
   expect_error(calibrate(f, rmc = "x"), "`rmc` must be a named list")
+})
+
+# Time gaps (rmc.check4timegaps = TRUE): GGIR's read.myacc.csv hands each
+# block to g.imputeTimegaps (k = 0.25 s, or 2 / sf): zero samples dropped
+# (a block's first becomes 0, 0, 1, its last takes the values before it),
+# each gap filled by repeating the sample before it (normalised when its
+# norm exceeds 1.005), and g.calibrate passes no previous block: a gap
+# between two blocks stays.
+gap_lines <- function(n = 3700, sf = 10, text = FALSE) {
+  set.seed(7)
+  t <- (seq_len(n) - 1) / sf
+  t[1001:n] <- t[1001:n] + 0.35  # three samples missing
+  t[2001:n] <- t[2001:n] + 250   # a long gap
+  t[3001:n] <- t[3001:n] + 0.5
+  xyz <- function(m) round(stats::rnorm(n, m, 0.6), 4)
+  d <- data.frame(time = 1.6e9 + t, x = xyz(0), y = xyz(0), z = xyz(0.5),
+                  temperature = round(stats::runif(n, 20, 30), 2))
+  # zero samples: a run, a block's (of 185 lines) last and the next one's
+  # first, one before a gap, the file's first ones
+  zero <- c(5:9, 370, 371, 740, 1500:1530, 2999, 3000, 3330)
+  d[zero, c("x", "y", "z")] <- 0
+  d$time <- if (text) {
+    format(as.POSIXct(d$time, origin = "1970-01-01", tz = "UTC") + 5e-5, "%d/%m/%Y %H:%M:%OS3")
+  } else {
+    sprintf("%.2f", d$time)
+  }
+  d
+}
+
+test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  n <- 3700
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr0 <- list(rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.temp = 5, rmc.col.time = 1,
+              rmc.sf = 10, rmc.check4timegaps = TRUE)
+  # blocks of 185 lines: line 370 ends the second, 371 starts the third
+  combos <- list(list(text = FALSE, B = 185, rs = FALSE, type = 1),
+                 list(text = FALSE, B = 185, rs = TRUE, type = 1),
+                 list(text = FALSE, B = 370, rs = TRUE, type = 2),
+                 list(text = TRUE, B = 185, rs = FALSE, type = 1),
+                 list(text = TRUE, B = 3700, rs = FALSE, type = 1))
+  for (cb in combos) {
+    utils::write.table(gap_lines(n, text = cb$text), f, sep = ",", quote = FALSE, row.names = FALSE)
+    pr <- c(pr0, list(rmc.doresample = cb$rs),
+            if (cb$text) list(rmc.unit.time = "character", rmc.format.time = "%d/%m/%Y %H:%M:%OS")
+            else list(rmc.unit.time = "UNIXsec"))
+    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "UTC", ggir = FALSE)
+    h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = cb$type), lay$opts))
+    rows <- 0
+    for (i in seq_len(n / cb$B)) {
+      G <- do.call(GGIR:::read.myacc.csv, c(list(rmc.file = f, rmc.nrow = cb$B, rmc.skip = (i - 1) * cb$B,
+                                                 interpolationType = cb$type, desiredtz = "UTC"),
+                                            pr[names(pr) != "rmc.sf"], list(rmc.sf = 10)))$data
+      g <- gravcal:::native_block(h, max_units = cb$B, time = TRUE, capacity = 10000)
+      lab <- paste(cb$text, cb$B, cb$rs, cb$type, "block", i)
+      expect_equal(g$to, nrow(G), label = lab)
+      for (v in c("x", "y", "z", "temperature")) {
+        expect_identical(g$cols[[v]][seq_len(g$to)], G[[v]], label = paste(lab, v))
+      }
+      # UNIX time stamps to the bit; text ones as R's strptime reads them
+      if (cb$text) {
+        expect_equal(g$cols$time[seq_len(g$to)], G$time, tolerance = 1e-12, label = paste(lab, "time"))
+      } else {
+        expect_identical(g$cols$time[seq_len(g$to)], G$time, label = paste(lab, "time"))
+      }
+      rows <- rows + nrow(G)
+    }
+    rep <- gravcal:::native_report(h)
+    gravcal:::gc_decoder_close(h$ptr)
+    # the long gap was filled (about 2,500 samples)
+    expect_gt(rows, n + 2400)
+    expect_gt(rep$counters[["timegaps_imputed"]], 0)
+  }
+})
+
+test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with gaps", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  f <- tempfile(fileext = ".csv")
+  # GGIR reads text time in desiredtz = "", the machine's zone: one of fixed
+  # offset here (a zone with daylight saving is refused, see below)
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "UTC")
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
+  noise <- list(rmc.noise = 0.013 / 1.2)
+  # UNIX seconds at 10 Hz, text time at 5 Hz (GGIR's text parsing is slow)
+  for (tm in c("UNIXsec", "character")) {
+    sf <- if (tm == "UNIXsec") 10 else 5
+    rec <- adhoc_rec(sf = sf, seed = 18)
+    B <- gravcal:::format_block_units("adhoc_csv", sf, 1)  # GGIR's block of lines
+    # three short gaps (0.4 or 0.6 s), a 30-minute gap, a 5 s gap between
+    # the last line of GGIR's first block and the first of its second (not
+    # filled: g.calibrate gives no previous block), a run of 60 s of zeros
+    short <- c(20000, 150000, 400000) + rep(0:2, each = 3)
+    across <- B + length(short) + seq_len(5 * sf)
+    drop <- sort(c(short, 450000 + seq_len(1800 * sf), across))
+    rec[480000 + seq_len(60 * sf), c("x", "y", "z")] <- 0
+    pr <- gravcal:::write_adhoc_csv(rec, f, sf = sf, time = tm, drop = drop)
+    pr$rmc.check4timegaps <- TRUE
+    b <- expect_adhoc_same(f, c(pr, noise))
+    expect_gt(b$ggir$npoints, 100)
+    if (tm == "UNIXsec") {
+      # the gaps change the numbers: without filling them, others
+      utils::capture.output(G0 <- suppressWarnings(gravcal::g.calibrate(
+        f, params_rawdata = c(utils::modifyList(pr, list(rmc.check4timegaps = FALSE)), noise),
+        verbose = FALSE)))
+      expect_false(identical(G0$spheredata, b$ggir$spheredata))
+      # filled, then resampled
+      expect_adhoc_same(f, c(pr, noise, list(rmc.doresample = TRUE)))
+    }
+  }
+})
+
+test_that("rmc.check4timegaps: what gravcal does not reproduce is an error naming it", {
+  rec <- adhoc_rec(hours = 0.1, sf = 10, seed = 19)
+  f <- tempfile(fileext = ".csv")
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "UTC")  # desiredtz = "": the machine's zone
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "character")
+  pr$rmc.check4timegaps <- TRUE
+  gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
+                                  verbose = FALSE)
+  # a zone with daylight saving: GGIR's text times jump by an hour
+  expect_error(g.calibrate(f, params_rawdata = pr, params_general = list(desiredtz = "Europe/Amsterdam"),
+                           verbose = FALSE),
+               "the time zone \"Europe/Amsterdam\" changes its UTC offset")
+  expect_error(gc(rmc.format.time = "%d/%m/%Y %R:%OS"), "directives .* not %R")
+  expect_error(g.calibrate(f, params_rawdata = pr, verbose = FALSE, reader = "reference"),
+               "`rmc.check4timegaps` = TRUE is taken by gravcal's own csv decoder only")
+  # whole-second text stamps that repeat: GGIR spreads them over the second
+  d <- data.frame(time = format(as.POSIXct(1.6e9 + (0:99) %/% 10, origin = "1970-01-01", tz = "UTC"),
+                                "%d/%m/%Y %H:%M:%S"), x = 0.1, y = 0.2, z = 0.9)
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE, col.names = FALSE)
+  expect_error(read_recording(f, rmc = list(rmc.firstrow.acc = 1, rmc.col.acc = 2:4, rmc.col.time = 1,
+                                            rmc.unit.time = "POSIX", rmc.format.time = "%d/%m/%Y %H:%M:%OS",
+                                            rmc.sf = 10, rmc.check4timegaps = TRUE)),
+               "whole-second time stamps that repeat")
 })

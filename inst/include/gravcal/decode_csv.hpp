@@ -25,7 +25,10 @@
 // layout comes in options: skip (lines before the data), col_x, col_y,
 // col_z, col_temp, col_time (1-based; 0: none), time_div (1: the time
 // column holds seconds, 1000: milliseconds; 0: text, not read: time is
-// start_time + i / sf), time_offset (seconds added to numeric time), dec
+// start_time + i / sf, unless time_format is given: text read by that
+// strptime() format (%Y %y %m %d %H %M %S %OS %T and literal characters;
+// time_utc_offset seconds subtracted: a zone of fixed offset), for GGIR's
+// gap imputation), time_offset (seconds added to numeric time), dec
 // ("," for decimal commas), sf (required), and the units: acc_div (1000
 // for mg), acc_scale, bit (1 unsigned, 2 signed) with bit_pow (2^bitrate)
 // and bit_range, temp_unit (1 K, 2 F). Values are converted as GGIR's
@@ -137,7 +140,10 @@ class CsvDecoder : public Decoder {
       for (int i = 0; i < 5; ++i) *to[i] = c[i] >= 1 && c[i] <= kMaxFields ? static_cast<int>(c[i]) - 1 : -1;
       time_div_ = opts.num("time_div", 0);
       time_offset_ = opts.num("time_offset", 0);
-      if (!(time_div_ > 0)) col_time_ = -1;  // text time: not read (start_time + i / sf)
+      time_fmt_ = opts.str("time_format", "");
+      time_utc_offset_ = opts.num("time_utc_offset", 0);
+      // text time: not read (start_time + i / sf) unless a format is given
+      if (!(time_div_ > 0) && time_fmt_.empty()) col_time_ = -1;
       time_text_ = false;
       info_.start_time = opts.num("start_time", std::numeric_limits<double>::quiet_NaN());
       adhoc_dec_ = opts.str("dec", ".") == "," ? ',' : '.';
@@ -527,6 +533,10 @@ class CsvDecoder : public Decoder {
   }
 
   bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
+    if (adhoc_ && !time_fmt_.empty()) {
+      frac_digits = 9;  // taken as it is (no spreading of coarse stamps)
+      return parse_formatted(f.b, f.e, t);
+    }
     if (!time_text_) {
       frac_digits = 9;
       if (!csv_text::parse_number(f.b, f.e, dec_, number_rule_, t)) return false;
@@ -534,6 +544,94 @@ class CsvDecoder : public Decoder {
       return true;
     }
     return dt_.parse(f.b, f.e, t, frac_digits);
+  }
+
+  // A text time stamp by time_fmt_, as R's strptime() reads it (the
+  // directives listed at the top; blanks in the format match any blanks;
+  // text after the format ignored), in seconds since 1970 less
+  // time_utc_offset_: R's as.POSIXct() in a zone of that fixed offset
+  // (whole seconds plus the fraction of %OS).
+  bool parse_formatted(const char* p, const char* e, double& t) const {
+    int year = 1970, mon = 1, day = 1, hour = 0, min = 0;
+    double sec = 0;
+    auto num = [&](int width, int& v) {
+      while (p < e && *p == ' ') ++p;
+      int k = 0;
+      v = 0;
+      while (k < width && p < e && *p >= '0' && *p <= '9') v = 10 * v + (*p++ - '0'), ++k;
+      return k > 0;
+    };
+    auto secs = [&](bool fraction) {
+      while (p < e && *p == ' ') ++p;
+      long double a = 0;
+      int k = 0, dec = 0;
+      while (p < e && *p >= '0' && *p <= '9' && (fraction || k < 2)) a = 10 * a + (*p++ - '0'), ++k;
+      if (k == 0) return false;
+      if (fraction && p < e && *p == '.') {
+        for (++p; p < e && *p >= '0' && *p <= '9'; ++p, ++dec) a = 10 * a + (*p - '0');
+      }
+      long double f = 1;
+      for (int i = 0; i < dec; ++i) f *= 10;
+      sec = static_cast<double>(a / f);
+      return sec >= 0 && sec <= 61;
+    };
+    const std::string& f = time_fmt_;
+    for (std::size_t i = 0; i < f.size();) {
+      const char c = f[i];
+      if (c == '%') {
+        if (++i >= f.size()) return false;
+        const char d = f[i++];
+        bool ok = true;
+        int y2 = 0;
+        switch (d) {
+          case 'Y': ok = num(4, year); break;
+          case 'y':
+            ok = num(2, y2);
+            year = y2 < 69 ? 2000 + y2 : 1900 + y2;
+            break;
+          case 'm': ok = num(2, mon); break;
+          case 'd': ok = num(2, day); break;
+          case 'H': ok = num(2, hour); break;
+          case 'M': ok = num(2, min); break;
+          case 'S': ok = secs(false); break;
+          case 'T':
+            ok = num(2, hour) && p < e && *p++ == ':' && num(2, min) && p < e && *p++ == ':' &&
+                 secs(false);
+            break;
+          case 'O':
+            if (i >= f.size() || f[i] != 'S') return false;
+            ++i;
+            while (i < f.size() && f[i] >= '0' && f[i] <= '9') ++i;
+            ok = secs(true);
+            break;
+          case '%': ok = p < e && *p++ == '%'; break;
+          default: return false;
+        }
+        if (!ok) return false;
+      } else if (c == ' ' || c == '\t') {
+        ++i;
+        while (p < e && (*p == ' ' || *p == '\t')) ++p;
+      } else {
+        if (p >= e || *p != c) return false;
+        ++p;
+        ++i;
+      }
+    }
+    static const int kDays[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+    if (mon < 1 || mon > 12 || day < 1 || day > kDays[mon - 1] || hour > 24 || min > 59) return false;
+    const bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    if (mon == 2 && day == 29 && !leap) return false;
+    // days since 1970-01-01 of the civil date (H. Hinnant's algorithm)
+    const int y = mon <= 2 ? year - 1 : year;
+    const int era = (y >= 0 ? y : y - 399) / 400;
+    const int yoe = y - era * 400;
+    const int doy = (153 * (mon + (mon > 2 ? -3 : 9)) + 2) / 5 + day - 1;
+    const int doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    const double days = static_cast<double>(era) * 146097 + doe - 719468;
+    const double whole = std::floor(sec);
+    const double base = days * 86400 + hour * 3600.0 + min * 60.0 + whole - time_utc_offset_;
+    t = base + (sec - whole);
+    return true;
   }
 
   // As sf_from_time() in R/read.R, on the first kSfLines time stamps; reads
@@ -855,6 +953,8 @@ class CsvDecoder : public Decoder {
   std::int64_t adhoc_skip_ = 0;
   char adhoc_dec_ = '.';
   double time_div_ = 0, time_offset_ = 0;
+  std::string time_fmt_;  // text time stamps' strptime() format ("": not read)
+  double time_utc_offset_ = 0;
   double acc_div_ = 1, acc_scale_ = 1, bit_pow_ = 1, bit_range_ = 1;
   int bit_ = 0, temp_unit_ = 0;
 };

@@ -1,0 +1,85 @@
+// libFuzzer harness: arbitrary bytes as an ad hoc csv of time stamp, x, y, z
+// (and temperature) through the csv decoder and GGIR's gap imputation of
+// rmc.check4timegaps (GgirTimegapsOf<CsvDecoder>), then, for some inputs,
+// GGIR's block resampling after it (rmc.doresample), in GGIR-compatible mode.
+// The first byte chooses the rate, the time (UNIX seconds, milliseconds, or
+// text read by a strptime() format), the resampling, the block (lines per
+// reader call) and buffer sizes. Checks: no crash, n <= capacity, units
+// within their limit, progress on every read until done, the report's
+// samples those given, no zero sample (x = y = z = 0) given, and within a
+// block no step of k = max(0.25, 2 / sf) s or more left unfilled after a
+// sample whose copies would fit (steps backwards and beyond the fill limit
+// excepted).
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "gravcal/decode_csv.hpp"
+#include "gravcal/decode_ggir_resample.hpp"
+#include "gravcal/decode_ggir_timegaps.hpp"
+
+using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, long double>;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  const std::uint8_t mode = data[0];
+  gravcal::MemorySource src(data + 1, size - 1);
+  gravcal::Options o;
+  o.set("compat", 1.0);
+  const double sf = (mode & 1) ? 12.5 : 10.0;
+  o.set("sf", sf);
+  o.set("skip", 0.0);
+  o.set("col_time", 1.0);
+  if ((mode & 6) == 6) {
+    o.set("time_format", std::string("%d/%m/%Y %H:%M:%OS"));
+    o.set("time_utc_offset", 3600.0);
+  } else {
+    o.set("time_div", (mode & 2) ? 1000.0 : 1.0);
+  }
+  o.set("col_x", 2.0);
+  o.set("col_y", 3.0);
+  o.set("col_z", 4.0);
+  if (mode & 4) o.set("col_temp", 5.0);
+  o.set("buffer", 64.0 + 61.0 * (mode >> 5));
+  std::unique_ptr<gravcal::CsvDecoder> csv(new gravcal::CsvDecoder(src, o, "adhoc_csv"));
+  std::unique_ptr<Gaps> gaps(new Gaps(std::move(csv), sf));
+  std::unique_ptr<gravcal::Decoder> dec;
+  const bool resample = (mode & 8) != 0;
+  if (resample) {
+    dec.reset(new gravcal::GgirResamplerOf<Gaps>(std::move(gaps), sf, (mode & 16) ? 2 : 1, true));
+  } else {
+    dec.reset(gaps.release());
+  }
+  if (!dec->open()) return 0;
+  const std::size_t cap = 1 + (mode >> 3);  // 1 .. 32
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  const std::int64_t max_units = (mode & 0x40) ? -1 : 1 + (mode >> 5) * 3;
+  const double k = std::fmax(0.25, 2 / sf);
+  std::int64_t given = 0;
+  double last = std::nan("");
+  for (int calls = 0; calls < 200000 && !dec->done() && given < 1000000; ++calls) {
+    gravcal::SampleBuffer b;
+    b.x = x.data(); b.y = y.data(); b.z = z.data(); b.t = t.data(); b.time = tm.data();
+    b.capacity = cap;
+    const std::int64_t u = dec->read(b, max_units);
+    if (b.n > cap) __builtin_trap();
+    if (u < 0 || (max_units >= 0 && u > max_units)) __builtin_trap();
+    if (u == 0 && b.n == 0 && !dec->done()) __builtin_trap();  // no progress
+    for (std::size_t i = 0; i < b.n; ++i) {
+      if (!resample && x[i] == 0 && y[i] == 0 && z[i] == 0) __builtin_trap();
+      const double step = tm[i] - last;
+      // a filled gap leaves steps of 1 / sf; one of k or more only where its
+      // fill would pass the limit (1e8 samples) or the times are not finite
+      if (!resample && std::isfinite(step) && step >= k && step * sf <= 1e7 &&
+          std::fabs(last) < 1e12 && std::fabs(tm[i]) < 1e12) {
+        __builtin_trap();
+      }
+      last = tm[i];
+    }
+    if (u > 0) last = std::nan("");  // a block ended: its gap to the next stays
+    given += static_cast<std::int64_t>(b.n);
+  }
+  if (given < 1000000 && dec->done() && dec->report().samples != given) __builtin_trap();
+  return 0;
+}
