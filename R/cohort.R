@@ -315,7 +315,7 @@ cohort_files <- function(files, pattern, recursive, outdir) {
     path <- file.path(root, rel)
     # regular files only: a folder is not a recording, and opening a named
     # pipe would wait for a writer
-    keep <- vapply(path, file_kind, "") == "file"
+    keep <- vapply(path, file_kind, "") == "file" & !in_unisens_folder(path)
     if (recursive) keep <- keep & !under_output(path, root, outdir)
     rel <- rel[keep]
     if (!length(rel)) {

@@ -125,7 +125,7 @@ ggir_resample_fused <- function() {
 # csv and ad hoc csv with rmc.doresample), unless
 # the caller gave it.
 with_resample_fused <- function(opts, format) {
-  if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay") &&
+  if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay", "movisens") &&
       is.null(opts$resample_fused) &&
       !identical(as.numeric(opts$compat %||% 1), 0)) {
     opts$resample_fused <- as.numeric(ggir_resample_fused())
