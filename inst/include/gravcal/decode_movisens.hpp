@@ -12,7 +12,8 @@
 // everything and a partial last frame is left out (and reported).
 //
 // Temperature, as GGIR's g.readtemp_movisens gives it, per GGIR block of
-// `block_samples` acceleration samples (GGIR: sf * 60 * 1440 / 2, whatever
+// `block_samples` acceleration samples (GGIR: sf * 60 * 1440 / 2 with sf =
+// 64, as g.inspectfile sets it for every Movisens recording, whatever
 // chunksize): for the block's samples from..to (1-based) it reads the
 // temperature samples ceiling(from / sf * r)..ceiling(to / sf * r), first with
 // r = 1 and then, when temp.bin's rate differs, with its rate (either range
@@ -338,7 +339,8 @@ class MovisensDecoder : public Decoder {
       report_.note("acc.bin ends in a partial sample of " + std::to_string(acc_.tail_bytes()) +
                    " bytes (after " + std::to_string(n_) + " samples): left out");
     }
-    const double b = block_opt_ > 0 ? std::floor(block_opt_) : sf_ * 60 * 1440 / 2;
+    // GGIR's block: sf * 60 * 1440 / 2 with its sf, 64 Hz for every Movisens
+    const double b = block_opt_ > 0 ? std::floor(block_opt_) : 64.0 * 60 * 1440 / 2;
     block_ = b >= 1 && b < 9e15 ? static_cast<std::int64_t>(b) : 1;
     open_temperature(doc);
     info_.format = "movisens";
