@@ -71,15 +71,21 @@ test_that("the decoder gives unisensR's samples and g.readtemp_movisens' tempera
   }
 })
 
-# 30 hours at 64 Hz (GGIR's blocks: 12 h, so three), written once
+# 30 hours at 64 Hz (GGIR's blocks: 12 h, so three), written once: one
+# simulated 6 hours five times over, each copy 0.7 degrees warmer
+# (simulating 30 hours at 64 Hz takes longer than the rest of this file)
 movisens_30h <- local({
   d <- NULL
   function() {
     if (is.null(d)) {
       d <<- file.path(tempfile("mv30"), "rec")
-      rec <- simulate_recording(hours = 30, sf = 64, seed = 43,
+      rec <- simulate_recording(hours = 6, sf = 64, seed = 43,
                                 tempoffset = c(0.002, -0.001, 0.0015))
-      gravcal:::write_movisens(rec, d)
+      n <- nrow(rec)
+      k <- rep(0:4, each = n)
+      gravcal:::write_movisens(data.frame(x = rep(rec$x, 5), y = rep(rec$y, 5),
+                                          z = rep(rec$z, 5),
+                                          temperature = rep(rec$temperature, 5) + 0.7 * k), d)
     }
     d
   }
@@ -130,9 +136,12 @@ test_that("damaged Movisens recordings: a cut acc.bin, no temp.bin, a bad unisen
   bb <- run_both(f)
   expect_same_as_ggir(bb)
   expect_true(all(bb$gravcal$tempoffset == 0))
-  r <- read_recording(d)
-  expect_true(any(grepl("temp.bin is missing", r$input$report$notes, fixed = TRUE)))
-  # unisens.xml: malformed, or without acc.bin's entry
+  src <- gravcal:::open_source(d)
+  expect_true(any(grepl("temp.bin is missing", src$report()$notes, fixed = TRUE)))
+  expect_false(src$temperature)
+  # unisens.xml: malformed, or without acc.bin's entry (a short recording)
+  d <- file.path(dirname(d), "short")
+  gravcal:::write_movisens(short_movisens(64 * 60), d)
   xml <- readLines(file.path(d, "unisens.xml"))
   writeLines(sub("sampleRate=\"64\"", "sampleRate=\"64", xml), file.path(d, "unisens.xml"))
   expect_error(read_recording(d), "unisens.xml is malformed")
