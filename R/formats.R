@@ -134,6 +134,14 @@ unisens_acc <- function(path) {
   path
 }
 
+# A recording's name as GGIR gives it (its coefficient file's rows, the
+# source of a fit): the file name, or for a Movisens recording its
+# folder's name (GGIR's datadir2fnames and g.inspectfile).
+ggir_file_name <- function(path) {
+  mv <- vapply(path, is_movisens_bin, TRUE, USE.NAMES = FALSE)
+  ifelse(mv, basename(dirname(path)), basename(path))
+}
+
 # Files of a unisens folder other than its acc.bin are not recordings of
 # their own (calibrate_files()' listing of a folder).
 in_unisens_folder <- function(path) {

@@ -50,7 +50,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   }
   if (!is.null(layout$serial)) src$info$serial <- layout$serial
   check_sf_agrees(sf, src$sf, format, datafile)
-  src$filename <- basename(datafile)
+  src$filename <- ggir_file_name(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
 }

@@ -152,3 +152,22 @@ test_that("damaged Movisens recordings: a cut acc.bin, no temp.bin, a bad unisen
   expect_identical(read_recording(d)$sf, 32)
   expect_error(gravcal::g.calibrate(d, verbose = FALSE), "reads every Movisens recording as 64 Hz")
 })
+
+test_that("calibrate_files() takes unisens folders, named as GGIR names them", {
+  root <- tempfile("mvc")
+  on.exit(unlink(root, recursive = TRUE))
+  for (p in c("p01", "p02")) {
+    gravcal:::write_movisens(short_movisens(64 * 600), file.path(root, "site", p))
+  }
+  out <- file.path(root, "out")
+  # a directory of unisens folders: their acc.bin, not temp.bin
+  res <- suppressWarnings(calibrate_files(file.path(root, "site"), outdir = out,
+                                          recursive = TRUE))
+  expect_identical(res$file, c("p01/acc.bin", "p02/acc.bin"))
+  # the folders themselves, in method "ggir" (GGIR's coefficient file names
+  # a Movisens recording by its folder, so two acc.bin do not clash)
+  res <- suppressWarnings(calibrate_files(file.path(root, "site", c("p01", "p02")),
+                                          outdir = file.path(root, "out2")))
+  expect_identical(nrow(res), 2L)
+  expect_identical(gravcal:::ggir_file_name(file.path(root, "site", "p01", "acc.bin")), "p01")
+})
