@@ -136,9 +136,22 @@ test_that("damaged Movisens recordings: a cut acc.bin, no temp.bin, a bad unisen
   bb <- run_both(f)
   expect_same_as_ggir(bb)
   expect_true(all(bb$gravcal$tempoffset == 0))
-  src <- gravcal:::open_source(d)
-  expect_true(any(grepl("temp.bin is missing", src$report()$notes, fixed = TRUE)))
-  expect_false(src$temperature)
+  s0 <- gravcal:::open_source(d)
+  expect_true(any(grepl("temp.bin is missing", s0$report()$notes, fixed = TRUE)))
+  expect_false(s0$temperature)
+  # temp.bin cut to 26 h: GGIR fails in its third block ("subscript out of
+  # bounds"), gravcal's drop-in says why; gravcal's own reading goes on
+  file.copy(file.path(src, "temp.bin"), d)
+  tb <- file.path(d, "temp.bin")
+  writeBin(readBin(tb, raw(), 26 * 3600 * 2), tb)
+  expect_error(suppressWarnings(GGIR::g.calibrate(f, inspectfileobject = GGIR::g.inspectfile(f),
+                                                  verbose = FALSE)))
+  expect_error(gravcal::g.calibrate(f, verbose = FALSE),
+               "temp.bin does not cover samples 5529601 to 6911999")
+  r <- read_recording(d)
+  expect_identical(r$input$report$counters[["temperature_blocks_unreadable"]], 1)
+  expect_true(all(is.nan(r$data$temperature[5529601:6911999])))
+  expect_false(anyNA(r$data$temperature[1:5529600]))
   # unisens.xml: malformed, or without acc.bin's entry (a short recording)
   d <- file.path(dirname(d), "short")
   gravcal:::write_movisens(short_movisens(64 * 60), d)

@@ -22,8 +22,10 @@
 // seq(1, m, length.out = n) gives: linear, or nearest neighbour with
 // interpolation = 2 (GGIR's interpolationType), fused where GGIRread's
 // compiler fused it (option resample_fused). GGIR takes the temperature
-// only when the first block has it; a later block without it gives NaN
-// and is counted ("temperature_blocks_unreadable"), where GGIR fails.
+// only when the first block has it; a later block without it makes GGIR
+// fail: in GGIR's mode (option compat = 1) the decoder refuses such a
+// recording when it opens it, in gravcal's own (compat = 0) it gives NaN
+// there and counts the block ("temperature_blocks_unreadable").
 //
 // The decoder reads acc.bin from its ByteSource, the xml as text and
 // temp.bin from a second ByteSource that it owns (null: none), so that it
@@ -304,6 +306,7 @@ class MovisensDecoder : public Decoder {
       : acc_src_(acc),
         temp_src_(std::move(temp)),
         xml_(std::move(xml)),
+        compat_(opts.num("compat", 1) != 0),
         nearest_(opts.num("interpolation", 1) == 2),
         fused_(opts.num("resample_fused", 0) != 0),
         block_opt_(opts.num("block_samples", 0)) {}
@@ -350,6 +353,19 @@ class MovisensDecoder : public Decoder {
     info_.has_temperature = temp_ok_ && block_temperature_ok(1, n_ < block_ ? n_ : block_);
     if (temp_ok_ && !info_.has_temperature && n_ > 0) {
       report_.note("temp.bin does not cover the first block: no temperature");
+    }
+    // GGIR fails on a recording whose first block has a temperature and a
+    // later one none: in its mode, so does the decoder (at once)
+    if (compat_ && info_.has_temperature) {
+      for (std::int64_t from = block_; from < n_; from += block_) {
+        const std::int64_t to = n_ - from < block_ ? n_ : from + block_;
+        if (!block_temperature_ok(from + 1, to)) {
+          return fail("temp.bin does not cover samples " + std::to_string(from + 1) + " to " +
+                      std::to_string(to) +
+                      " (a later GGIR block than the first), on which GGIR's g.calibrate "
+                      "fails; gravcal's own methods read it (compat = 0)");
+        }
+      }
     }
     return true;
   }
@@ -520,7 +536,7 @@ class MovisensDecoder : public Decoder {
   ByteSource& acc_src_;
   std::unique_ptr<ByteSource> temp_src_;
   std::string xml_;
-  bool nearest_ = false, fused_ = false;
+  bool compat_ = true, nearest_ = false, fused_ = false;
   double block_opt_ = 0;
   double sf_ = 0;
   UnisensSignal acc_, temp_;
