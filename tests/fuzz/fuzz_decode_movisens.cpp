@@ -5,7 +5,8 @@
 // come from the next bytes, so that the fuzzer reaches the samples; bit 1
 // drops temp.bin; bit 2 picks the interpolation (GGIR's interpolationType
 // 2); bits 3-4 the block (GGIR's, or a few samples, so that many blocks and
-// their temperature ranges are tried) and bit 5 the buffer. Checks: no
+// their temperature ranges are tried), bit 5 the buffer, bit 6 the units
+// a call and bit 7 gravcal's own reading (compat = 0). Checks: no
 // crash, no write past the buffer, progress on every call, no more samples
 // than acc.bin holds whole frames of, finite acceleration when lsbValue and
 // baseline are, report counts consistent with what was given, nothing
@@ -70,6 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!(mode & 2)) temp_src.reset(new gravcal::MemorySource(temp.data(), temp.size()));
   gravcal::Options opts;
   opts.set("interpolation", (mode & 4) ? 2.0 : 1.0);
+  opts.set("compat", (mode & 128) ? 0.0 : 1.0);
   const int blk = (mode >> 3) & 3;
   if (blk) opts.set("block_samples", blk == 1 ? 1.0 : blk == 2 ? 7.0 : 130.0);
   gravcal::MovisensDecoder dec(acc_src, opts, xml, std::move(temp_src));
