@@ -71,6 +71,22 @@ test_that("the decoder gives unisensR's samples and g.readtemp_movisens' tempera
   }
 })
 
+test_that("lsbValue and baseline are read as R reads them (unisensR's as.numeric)", {
+  skip_if_not_installed("unisensR")
+  root <- tempfile("mvl")
+  on.exit(unlink(root, recursive = TRUE))
+  s <- short_movisens(2000, seed = 4)
+  # the writer gives 17 significant digits: long decimals, not only binary fractions
+  for (lsb in c(0.000598550415, 0.1, 0.0001, 1 / 3000, 9.80665 / 4096, 0.3)) {
+    d <- file.path(root, format(lsb))
+    gravcal:::write_movisens(s, d, lsb = lsb, baseline = 0.5)
+    a <- unisensR::readUnisensSignalEntry(d, "acc.bin")
+    r <- read_recording(d)
+    expect_identical(r$data$x, a[[1]], label = format(lsb))
+    expect_identical(r$data$z, a[[3]], label = format(lsb))
+  }
+})
+
 # 30 hours at 64 Hz (GGIR's blocks: 12 h, so three), written once: one
 # simulated 6 hours five times over, each copy 0.7 degrees warmer
 # (simulating 30 hours at 64 Hz takes longer than the rest of this file)
