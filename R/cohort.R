@@ -277,7 +277,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
     ok <- tab$status %in% c("ok", "high_error", "given") &
       !vapply(fits, is.null, TRUE)
     ggir_rows <- if (any(ok)) {
-      ggir_coef_table(stats::setNames(fits[ok], basename(paths[ok])))
+      ggir_coef_table(stats::setNames(fits[ok], ggir_file_name(paths[ok])))
     } else empty_ggir_coefs()
     write_owned(csv_bytes(ggir_rows), outputs[2], store)
   } else {
@@ -315,7 +315,7 @@ cohort_files <- function(files, pattern, recursive, outdir) {
     path <- file.path(root, rel)
     # regular files only: a folder is not a recording, and opening a named
     # pipe would wait for a writer
-    keep <- vapply(path, file_kind, "") == "file"
+    keep <- vapply(path, file_kind, "") == "file" & !in_unisens_folder(path)
     if (recursive) keep <- keep & !under_output(path, root, outdir)
     rel <- rel[keep]
     if (!length(rel)) {
@@ -325,6 +325,8 @@ cohort_files <- function(files, pattern, recursive, outdir) {
     o <- order(rel)
     return(list(path = path[keep][o], id = rel[o]))
   }
+  # unisens folders (Movisens recordings) stand for their acc.bin
+  files <- unname(vapply(files, unisens_acc, ""))
   absent <- !file.exists(files)
   if (any(absent)) {
     abort("`files`: ", sum(absent), " file(s) do not exist: ",
@@ -374,7 +376,7 @@ under_output <- function(paths, root, outdir) {
 # backup.cal.coef) matches its rows to recordings by file name: two
 # recordings of one name in different folders are refused before any work.
 check_ggir_names <- function(paths, ids) {
-  name <- basename(paths)
+  name <- ggir_file_name(paths)
   d <- anyDuplicated(name)
   if (d) {
     both <- ids[name == name[d]]

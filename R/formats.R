@@ -88,6 +88,17 @@ recording_formats <- list(
     decoder = "cwa",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
+  # Movisens: a unisens folder (unisens.xml, acc.bin, temp.bin), named by
+  # the folder or its acc.bin (GGIR's filename); GGIR reads it in blocks of
+  # sf * 60 * 1440 / 2 samples whatever chunksize, and assumes 64 Hz
+  movisens = list(
+    ext = c(bin = "Movisens (a unisens folder or its acc.bin)"),
+    detect = function(file) is_movisens_bin(file),
+    label = "a Movisens recording", unit = "sample", own_rate = TRUE,
+    block_units = function(sf, chunksize) movisens_block(),
+    decoder = "movisens",
+    read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
     label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE,
@@ -106,6 +117,36 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_parmay(file))
 )
+
+# Whether `file` is the acc.bin of a unisens folder (a Movisens recording).
+is_movisens_bin <- function(file) {
+  tolower(basename(file)) == "acc.bin" &&
+    file.exists(file.path(dirname(file), "unisens.xml"))
+}
+
+# A unisens folder stands for its acc.bin (what GGIR's `datafile` names);
+# any other path is returned as it is.
+unisens_acc <- function(path) {
+  if (is.character(path) && length(path) == 1 && !is.na(path) && dir.exists(path) &&
+      file.exists(file.path(path, "unisens.xml"))) {
+    return(file.path(path, "acc.bin"))
+  }
+  path
+}
+
+# A recording's name as GGIR gives it (its coefficient file's rows, the
+# source of a fit): the file name, or for a Movisens recording its
+# folder's name (GGIR's datadir2fnames and g.inspectfile).
+ggir_file_name <- function(path) {
+  mv <- vapply(path, is_movisens_bin, TRUE, USE.NAMES = FALSE)
+  ifelse(mv, basename(dirname(path)), basename(path))
+}
+
+# Files of a unisens folder other than its acc.bin are not recordings of
+# their own (calibrate_files()' listing of a folder).
+in_unisens_folder <- function(path) {
+  file.exists(file.path(dirname(path), "unisens.xml")) & tolower(basename(path)) != "acc.bin"
+}
 
 # Whether `file` is a Parmay Matrix file ("MDTC" at byte 512).
 is_parmay_bin <- function(file) {

@@ -126,7 +126,7 @@ ggir_resample_fused <- function() {
 # reads that replay data.table::fread's numbers, unless the caller gave them.
 with_resample_fused <- function(opts, format) {
   compat <- !identical(as.numeric(opts$compat %||% 1), 0)
-  if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay") &&
+  if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay", "movisens") &&
       is.null(opts$resample_fused) && compat) {
     opts$resample_fused <- as.numeric(ggir_resample_fused())
   }

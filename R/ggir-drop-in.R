@@ -45,8 +45,10 @@
 #'
 #' Formats: ActiGraph csv exports, Axivity csv exports (OMGUI, UNIX time
 #' stamps; resampled block by block as GGIR does, linearly), csv files with
-#' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa` and GENEActiv
-#' `.bin`. They are read by gravcal's own decoders, which give what GGIR's
+#' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa`, GENEActiv
+#' `.bin`, Parmay Matrix `.bin` and Movisens recordings (the unisens folder or,
+#' as GGIR takes it, its `acc.bin`; at 64 Hz, the rate GGIR assumes for them:
+#' another rate is an error). They are read by gravcal's own decoders, which give what GGIR's
 #' readers give (GGIRread's resampling of `.cwa` included), block by block
 #' as GGIR reads them, in bounded memory; a damaged file keeps its good
 #' samples where GGIR's readers stop. `reader = "reference"` in `...` reads
@@ -65,7 +67,7 @@
 #' |---|---|---|
 #' | `chunksize`, `spherecrit`, `minloadcrit` | every format | honoured |
 #' | `printsummary` | (prints only) | honoured |
-#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
+#' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Movisens (its temperature); Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |

@@ -84,6 +84,7 @@ ggir_param_table <- function() {
       }, effect = paste0(".cwa (readAxivity's resampling), GENEActiv .bin at a ",
                          "rate that is not whole (g.readaccfile's resampling), ",
                          "Parmay Matrix .bin (readParmayMatrix's resampling); ",
+                         "Movisens (g.readtemp_movisens' temperature); ",
                          "Axivity csv, ad hoc csv with rmc.doresample")),
       row("frequency_tol", NA, 0.1, at_least_0,
           effect = ".cwa: readAxivity's tolerance on a block's rate before it imputes"),

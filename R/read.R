@@ -57,6 +57,7 @@
 #' head(rec$data)
 read_recording <- function(file, sf = NULL, reader = c("native", "reference"),
                            rmc = NULL) {
+  file <- unisens_acc(file)
   check_file(file, "file")
   reader <- match_choice(reader, "reader")
   if (!is.null(rmc)) return(read_adhoc(file, reader, rmc_values(rmc)))

@@ -23,6 +23,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
+  datafile <- unisens_acc(datafile)
   if (!is.character(datafile) || length(datafile) != 1 || is.na(datafile)) {
     abort("`", arg, "` must be a file path or a data frame of raw samples, ",
           "not ", describe(datafile), ".")
@@ -49,7 +50,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   }
   if (!is.null(layout$serial)) src$info$serial <- layout$serial
   check_sf_agrees(sf, src$sf, format, datafile)
-  src$filename <- basename(datafile)
+  src$filename <- ggir_file_name(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   src
 }
@@ -138,6 +139,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
+  if (format == "movisens") opts$block_samples <- movisens_block(file)
   if (format == "axivity_csv") {
     lay <- axivity_csv_layout(file, sf)
     sf <- lay$sf
@@ -152,6 +154,12 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
     native_open_error(file, format, h$error, arg)
   }
   if (is.null(sf) || isTRUE(format_entry(format)$own_rate)) sf <- h$info$sf
+  # GGIR takes every Movisens recording for 64 Hz (g.inspectfile)
+  if (format == "movisens" && isTRUE(compat) && !identical(sf, 64)) {
+    abort("\"", file, "\" is a Movisens recording at ", format(sf), " Hz; GGIR ",
+          "reads every Movisens recording as 64 Hz, so its results for this one ",
+          "would be wrong: use calibrate() (gravcal's own methods) instead.")
+  }
   if (!isTRUE(is.finite(sf) && sf > 0)) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
@@ -176,7 +184,8 @@ check_reference_opts <- function(read_opts, format) {
   defaults <- list(interpolation = c(interpolationType = 1),
                    frequency_tol = c(frequency_tol = 0.1))
   used <- switch(format, cwa = c("interpolation", "frequency_tol"),
-                 geneactiv = , axivity_csv = , parmay = "interpolation", character(0))
+                 geneactiv = , axivity_csv = , parmay = , movisens = "interpolation",
+                 character(0))
   for (nm in intersect(intersect(names(read_opts), names(defaults)), used)) {
     d <- defaults[[nm]]
     if (!identical(as.numeric(read_opts[[nm]]), unname(d))) {
@@ -324,6 +333,41 @@ source_parmay <- function(file) {
          names(P$data)[names(P$data) == "ambient_temp"] <- "temperature"
          d <- P$data[, intersect(c("x", "y", "z", "temperature"), names(P$data))]
          list(data = d, last = TRUE)
+       })
+}
+
+# GGIR's block of a Movisens recording, in samples: sf * 60 * 1440 / 2 with
+# its sf, which g.inspectfile sets to 64 whatever unisens.xml says.
+movisens_block <- function(file = NULL) 64 * 60 * 1440 / 2
+
+# GGIR's own reading of a Movisens recording, block by block: unisensR for
+# the acceleration, GGIR's g.readtemp_movisens for the temperature.
+source_movisens <- function(file) {
+  if (!requireNamespace("unisensR", quietly = TRUE) ||
+      !requireNamespace("GGIR", quietly = TRUE)) {
+    abort("Reading Movisens recordings by GGIR's reader needs the unisensR and GGIR packages.")
+  }
+  dir <- dirname(file)
+  n <- tryCatch(unisensR::getUnisensSignalSampleCount(dir, "acc.bin"),
+                error = function(e) NULL)
+  if (!isTRUE(is.numeric(n) && length(n) == 1 && n >= 1)) {
+    abort("Corrupt or unreadable Movisens recording \"", file, "\".")
+  }
+  B <- movisens_block(file)
+  list(format = "movisens", sf = 64, temperature = TRUE,
+       read = function(i) {
+         from <- (i - 1) * B + 1
+         if (from > n) return(NULL)
+         to <- min(n, from + B - 1)
+         d <- unisensR::readUnisensSignalEntry(dir, "acc.bin", startIndex = from,
+                                              endIndex = to)
+         d <- as.data.frame(d)
+         names(d) <- c("x", "y", "z")
+         tt <- tryCatch(utils::getFromNamespace("g.readtemp_movisens", "GGIR")(file, from = from, to = to,
+                                                    acc_sf = 64, acc_length = nrow(d)),
+                        error = function(e) NULL)
+         if (!is.null(tt)) d$temperature <- as.vector(tt)
+         list(data = d, last = to >= n)
        })
 }
 

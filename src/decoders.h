@@ -15,6 +15,7 @@
 #include "gravcal/decode_ggir_resample.hpp"
 #include "gravcal/decode_ggir_timegaps.hpp"
 #include "gravcal/decode_gt3x.hpp"
+#include "gravcal/decode_movisens.hpp"
 #include "gravcal/decode_parmay.hpp"
 #include "gz_source.h"
 #include "r_services.h"
@@ -110,6 +111,31 @@ inline DecoderPtr make_parmay(gravcal::ByteSource& bytes, const gravcal::Options
   return DecoderPtr(new gravcal::ParmayDecoder(bytes, opts));
 }
 
+// A Movisens recording: `bytes` are its acc.bin; unisens.xml and temp.bin
+// come from the same folder (the folder of option file_path). The xml is read whole, up
+// to 16 MB (a real one is a few kB); temp.bin may be absent.
+inline DecoderPtr make_movisens(gravcal::ByteSource& bytes, const gravcal::Options& opts,
+                                const std::string&) {
+  const std::string path = opts.str("file_path", "acc.bin");
+  const std::size_t slash = path.find_last_of("/\\");
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
+  std::string xml;
+  gravcal::FileSource xf((dir + "/unisens.xml").c_str());
+  if (xf.is_open()) {
+    const std::size_t cap = 16u << 20;
+    unsigned char buf[65536];
+    std::size_t got = 0;
+    while ((got = xf.read(buf, sizeof buf)) > 0 && xml.size() < cap) {
+      xml.append(reinterpret_cast<const char*>(buf), got);
+    }
+    if (xml.size() >= cap) xml = "<toolong";
+  }
+  std::unique_ptr<gravcal::FileSource> temp(new gravcal::FileSource((dir + "/temp.bin").c_str()));
+  std::unique_ptr<gravcal::ByteSource> t;
+  if (temp->is_open()) t = std::move(temp);
+  return DecoderPtr(new gravcal::MovisensDecoder(bytes, opts, xml, std::move(t)));
+}
+
 // The table's row for `format`, or null when there is none.
 inline const DecoderKind* find_decoder(const std::string& format) {
   static const DecoderKind kinds[] = {
@@ -121,6 +147,7 @@ inline const DecoderKind* find_decoder(const std::string& format) {
       {"cwa", false, make_cwa},
       {"geneactiv", false, make_geneactiv},
       {"parmay", false, make_parmay},
+      {"movisens", false, make_movisens},
   };
   for (const DecoderKind& k : kinds) {
     if (format == k.name) return &k;

@@ -104,7 +104,9 @@ Rcpp::List info_list(const gravcal::DeviceInfo& d) {
 Rcpp::List gc_decoder_open(const std::string& path, const std::string& format,
                            const Rcpp::List& options) {
   std::unique_ptr<OpenFile> f(new OpenFile());
-  const gravcal::Options opts = to_options(options);
+  gravcal::Options opts = to_options(options);
+  // where the file is, for a format whose recording is a folder (Movisens)
+  opts.set("file_path", path);
   std::string why;
   f->bytes = gravcal_glue::open_bytes(path, format, opts, why);
   if (!f->bytes) {

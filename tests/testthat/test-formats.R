@@ -18,12 +18,21 @@ test_that("a file's format comes from its extension and, for csv, its first line
   # a .bin (or .BIN) with "MDTC" at byte 512 is a Parmay Matrix file
   writeBin(c(as.raw(rep(0, 512)), charToRaw("MDTC")), path("m.BIN"))
   expect_identical(gravcal:::file_format(path("m.BIN")), "parmay")
+  # acc.bin beside a unisens.xml is a Movisens recording (its temp.bin is not)
+  dir.create(path("mv"))
+  file.create(path(c("mv/unisens.xml", "mv/acc.bin", "mv/temp.bin")))
+  expect_identical(gravcal:::file_format(path("mv/acc.bin")), "movisens")
+  expect_identical(gravcal:::file_format(path("mv/temp.bin")), "geneactiv")
+  expect_identical(gravcal:::unisens_acc(path("mv")), path("mv/acc.bin"))
+  expect_identical(gravcal:::in_unisens_folder(path(c("mv/acc.bin", "mv/temp.bin", "a.bin"))),
+                   c(FALSE, TRUE, FALSE))
+  unlink(path("mv"), recursive = TRUE)
   # the message lists what gravcal reads, as it did before the registry
   file.create(path("a.xyz"))
   expect_error(read_recording(path("a.xyz")), paste0(
     "`file` has an unsupported extension \".xyz\"; gravcal reads .csv ",
-    "(ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, .cwa, GENEActiv .bin and ",
-    "Parmay Matrix .bin."),
+    "(ActiGraph or x,y,z columns), .csv.gz, .rds, .gt3x, .cwa, Movisens (a unisens ",
+    "folder or its acc.bin), GENEActiv .bin and Parmay Matrix .bin."),
     fixed = TRUE)
   # calibrate_files() takes exactly the files of those extensions
   files <- calibrate_files
@@ -55,6 +64,8 @@ test_that("each format's words, unit and GGIR block come from the registry", {
   expect_identical(units("gt3x", 30), 43200)
   expect_identical(units("csv", 30), 1306200)
   expect_identical(units("actigraph_csv", 30, 0.2), 261300)
+  # Movisens: sf * 60 * 1440 / 2 samples with GGIR's 64 Hz, whatever chunksize
+  expect_identical(units("movisens", 64, 0.2), 2764800)
   expect_false(gravcal:::format_has_decoder("rds"))
 })
 
@@ -65,7 +76,7 @@ test_that("R's registry and the C++ table of decoders name the same decoders", {
   reg <- gravcal:::recording_formats
   decoders <- unlist(lapply(reg, `[[`, "decoder"), use.names = FALSE)
   expect_setequal(decoders, c("actigraph_csv", "axivity_csv", "csv", "adhoc_csv", "gt3x",
-                              "cwa", "geneactiv", "parmay"))
+                              "cwa", "geneactiv", "parmay", "movisens"))
   for (d in decoders) {
     # a decoder that exists fails on these bytes, as its format
     h <- gravcal:::gc_decoder_open(f, d, list())
