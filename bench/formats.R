@@ -46,7 +46,12 @@ t_start <- Sys.time()
 quick <- nzchar(Sys.getenv("GRAVCAL_BENCH_QUICK"))
 runs <- if (quick) 1L else 3L       # gravcal's contenders: median of `runs`
 sf <- 100
-days <- if (quick) 1L else 7L
+# GRAVCAL_BENCH_DAYS=<n>: n-day files instead; GRAVCAL_BENCH_OUT=<name>:
+# results in bench/results/<name>.md and .csv (default "formats")
+days <- if (nzchar(Sys.getenv("GRAVCAL_BENCH_DAYS"))) {
+  as.integer(Sys.getenv("GRAVCAL_BENCH_DAYS"))
+} else if (quick) 1L else 7L
+out_name <- Sys.getenv("GRAVCAL_BENCH_OUT", "formats")
 data_dir <- Sys.getenv("GRAVCAL_BENCH_DATA",
                        file.path(dirname(tempdir()), "gravcal-bench-formats"))
 dir.create(data_dir, showWarnings = FALSE, recursive = TRUE)
@@ -266,7 +271,7 @@ for (i in seq_len(nrow(specs))) {
 unlink(keep_dir, recursive = TRUE)
 res <- do.call(rbind, rows)
 kept_note <- ""
-old_csv <- file.path(out_dir, "formats.csv")
+old_csv <- file.path(out_dir, paste0(out_name, ".csv"))
 if (nzchar(kinds) && file.exists(old_csv)) {
   old <- utils::read.csv(old_csv, stringsAsFactors = FALSE)
   old <- old[!old$kind %in% res$kind & old$days == days, names(res)]
@@ -299,7 +304,7 @@ res$ggir_status <- of("status", "GGIR::g.calibrate")
 res$path <- basename(res$path)
 minutes <- as.numeric(difftime(Sys.time(), t_start, units = "mins"))
 dir.create(out_dir, showWarnings = FALSE, recursive = TRUE)
-utils::write.csv(res, file.path(out_dir, "formats.csv"), row.names = FALSE)
+utils::write.csv(res, file.path(out_dir, paste0(out_name, ".csv")), row.names = FALSE)
 
 cpu <- tryCatch({
   l <- grep("model name", readLines("/proc/cpuinfo"), value = TRUE)[1]
@@ -314,8 +319,8 @@ md <- c("# The formats of issue 29 end to end from the file",
                 utils::packageVersion("GGIR"), utils::packageVersion("GGIRread"),
                 utils::packageVersion("gravcal"),
                 paste0(if (quick) " Quick run (GRAVCAL_BENCH_QUICK)." else "", kept_note)),
-        sprintf("%d days at 100 Hz (one simulated day repeated; scale, offset and temperature errors GGIR's model fits). Each contender in its own R process, given the same params_rawdata. Seconds are the call's CPU time, user + system (median of %d runs for gravcal, one for GGIR): the machine's two cores were shared with other work, which inflates wall time unevenly; `formats.csv` has the wall times too. Ratios are GGIR's seconds over the contender's. Peak is that process's peak resident memory, R included (an R process that has loaded gravcal holds about %.0f MB before the call). Files in the page cache. identical: gravcal::g.calibrate's returned list against GGIR's by `identical()`, element by element (every element but `bsc_qc`, and the names), in each of its runs.",
-                days, runs, stats::median(res$base_mb[grepl("gravcal|calibrate\\(", res$contender)], na.rm = TRUE)),
+        sprintf("%d days at 100 Hz (one simulated day repeated; scale, offset and temperature errors GGIR's model fits). Each contender in its own R process, given the same params_rawdata. Seconds are the call's CPU time, user + system (median of %d runs for gravcal, one for GGIR): the machine's two cores were shared with other work, which inflates wall time unevenly; `%s.csv` has the wall times too. Ratios are GGIR's seconds over the contender's. Peak is that process's peak resident memory, R included (an R process that has loaded gravcal holds about %.0f MB before the call). Files in the page cache. identical: gravcal::g.calibrate's returned list against GGIR's by `identical()`, element by element (every element but `bsc_qc`, and the names), in each of its runs.",
+                days, runs, out_name, stats::median(res$base_mb[grepl("gravcal|calibrate\\(", res$contender)], na.rm = TRUE)),
         "",
         "| file | size (MB) | GGIR::g.calibrate (s, peak MB) | gravcal::g.calibrate (s, ratio, peak MB, identical) | calibrate ggir (s, ratio, peak MB) | calibrate lightweight (s, ratio, peak MB) | decode floor (s) | cat (s) |",
         "|---|---|---|---|---|---|---|---|")
@@ -347,6 +352,9 @@ for (k in unique(res$kind)) {
                       if (nrow(dd)) sprintf("%s s", fmt_s(dd$seconds)) else "",
                       g("cat (read-once floor of the system)")$seconds))
 }
+if (ggir_max_gb > 0) {
+  md <- c(md, "", sprintf("GGIR ran with at most %g GB of address space (GRAVCAL_BENCH_GGIR_MAX_GB, so as not to take the shared machine's memory); a failed GGIR row ran out of it (GGIR then stops with a later error: its reader's failure is caught and ignored), and its ratios are lower bounds: the CPU seconds GGIR had used when it stopped over the contender's.", ggir_max_gb))
+}
 md <- c(md, "", "Issue 29's targets: binary decoders at least 50 times faster than GGIR with a peak under 250 MB; ad hoc csv at least 20 times faster.", "")
 for (k in unique(res$kind)) {
   x <- res[res$kind == k & res$contender == "gravcal::g.calibrate", ]
@@ -364,5 +372,5 @@ for (k in unique(res$kind)) {
   r <- res[res$kind == k & res$contender == "GGIR::g.calibrate", ]
   if (nrow(r)) md <- c(md, sprintf("- %s: %s", r$path, gsub("|", "/", gsub("_", " ", r$status), fixed = TRUE)))
 }
-writeLines(md, file.path(out_dir, "formats.md"))
-say("wrote", file.path(out_dir, "formats.md"), sprintf("(%.1f minutes)", minutes))
+writeLines(md, file.path(out_dir, paste0(out_name, ".md")))
+say("wrote", file.path(out_dir, paste0(out_name, ".md")), sprintf("(%.1f minutes)", minutes))
