@@ -31,7 +31,8 @@
 # reading and decoding the whole file in its own mode, samples dropped).
 #
 # Run from the package root with gravcal and GGIR installed (`make
-# bench-formats`, about 15 minutes; GRAVCAL_BENCH_QUICK=1 for a smoke run
+# bench-formats`, about 30 minutes, half of it writing the files the first
+# time; GRAVCAL_BENCH_QUICK=1 for a smoke run
 # of 1-day files). The files (about 5 GB) are written once into
 # GRAVCAL_BENCH_DATA (default: a folder in tempdir()'s parent) and kept for
 # reruns, each with its parameters (<file>.params.rds). Writes
