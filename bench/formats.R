@@ -33,7 +33,7 @@
 # Run from the package root with gravcal and GGIR installed (`make
 # bench-formats`, about 30 minutes, half of it writing the files the first
 # time; GRAVCAL_BENCH_QUICK=1 for a smoke run
-# of 1-day files). The files (about 5 GB) are written once into
+# of 1-day files). The files (about 8 GB) are written once into
 # GRAVCAL_BENCH_DATA (default: a folder in tempdir()'s parent) and kept for
 # reruns, each with its parameters (<file>.params.rds). Writes
 # bench/results/formats.md and formats.csv.
