@@ -31,7 +31,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files refresh-vignettes clean
+.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -161,6 +161,12 @@ bench-memory: install setup-test
 # process (about 30 minutes; writes about 9 GB of files once, see the script)
 bench-files: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/files.R
+
+# issue 29's formats (Parmay .bin, ad hoc csv, Axivity csv; 7 days) against
+# GGIR, each contender in its own process (about an hour on a busy machine;
+# writes about 8 GB of files once, see the script)
+bench-formats: install setup-test
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) bench/formats.R
 
 # recompute the vignettes' cached results (about 10 minutes)
 refresh-vignettes: install setup-test

@@ -2,7 +2,15 @@
 # that the peak resident memory it reports (VmHWM: the most this process,
 # R itself included, held at any time) is its own.
 #
-#   Rscript bench/files-one.R <contender> <file>
+#   Rscript bench/files-one.R <contender> <file> [<params.rds> [<result.rds>]]
+#
+# <params.rds> (optional, "-" for none): a list of GGIR params_rawdata
+# entries (e.g. an ad hoc csv file's rmc.* parameters) given to every
+# contender: to GGIR over its defaults, to gravcal::g.calibrate as
+# params_rawdata, to calibrate() as `rmc` (its rmc.* entries). <result.rds>
+# (optional): where the g.calibrate contenders save the list they return,
+# after the measurement, so that bench/formats.R can compare GGIR's and
+# gravcal's with identical().
 #
 # Prints one line: RESULT <contender> <seconds> <peak MB> <baseline MB>
 # <coefficients as exact hexadecimal doubles, comma-separated> <status>
@@ -12,6 +20,9 @@
 args <- commandArgs(trailingOnly = TRUE)
 contender <- args[1]
 file <- args[2]
+params <- if (length(args) >= 3 && args[3] != "-") readRDS(args[3]) else list()
+save_to <- if (length(args) >= 4) args[4] else NULL
+rmc <- params[grepl("^rmc[.]", names(params))]
 
 proc_mb <- function(field) {
   l <- grep(paste0("^", field, ":"), readLines("/proc/self/status"), value = TRUE)
@@ -33,27 +44,45 @@ base <- proc_mb("VmRSS")
 
 run <- switch(contender,
   "GGIR::g.calibrate" = function() {
-    pr <- GGIR::load_params()$params_rawdata
+    pr <- utils::modifyList(GGIR::load_params()$params_rawdata, params)
     I <- quiet(GGIR::g.inspectfile(file, params_rawdata = pr))
     r <- quiet(GGIR::g.calibrate(file, params_rawdata = pr,
                                  inspectfileobject = I, verbose = FALSE))
-    list(coef = c(r$scale, r$offset, r$tempoffset), status = r$QCmessage)
+    list(coef = c(r$scale, r$offset, r$tempoffset), status = r$QCmessage, result = r)
   },
   "gravcal::g.calibrate" = function() {
-    r <- quiet(gravcal::g.calibrate(file, verbose = FALSE))
-    list(coef = c(r$scale, r$offset, r$tempoffset), status = r$QCmessage)
+    r <- if (length(params)) {
+      quiet(gravcal::g.calibrate(file, params_rawdata = params, verbose = FALSE))
+    } else {
+      quiet(gravcal::g.calibrate(file, verbose = FALSE))
+    }
+    list(coef = c(r$scale, r$offset, r$tempoffset), status = r$QCmessage, result = r)
   },
   "calibrate(method = \"ggir\")" = function() {
-    f <- quiet(gravcal::calibrate(file, method = "ggir"))
+    f <- if (length(rmc)) {
+      quiet(gravcal::calibrate(file, method = "ggir", rmc = rmc))
+    } else {
+      quiet(gravcal::calibrate(file, method = "ggir"))
+    }
     list(coef = c(diag(f$K), f$offset), status = f$status)
   },
   "calibrate(method = \"lightweight\")" = function() {
-    f <- quiet(gravcal::calibrate(file, method = "lightweight"))
+    f <- if (length(rmc)) {
+      quiet(gravcal::calibrate(file, method = "lightweight", rmc = rmc))
+    } else {
+      quiet(gravcal::calibrate(file, method = "lightweight"))
+    }
     list(coef = c(diag(f$K), f$offset), status = f$status)
   },
   "decode (read-once floor of the decoder)" = function() {
-    fmt <- gravcal:::file_format(file)
-    h <- gravcal:::native_open(file, fmt, list(compat = 0))
+    if (length(rmc) || gravcal:::file_format(file) == "axivity_csv") {
+      # csv files whose layout the decoder is given (an ad hoc csv file's
+      # rmc.* parameters; an Axivity export's rate from its time stamps)
+      h <- gravcal:::open_source(file, compat = FALSE, rmc = gravcal:::rmc_values(rmc))$native
+    } else {
+      fmt <- gravcal:::file_format(file)
+      h <- gravcal:::native_open(file, fmt, list(compat = 0))
+    }
     on.exit(gravcal:::gc_decoder_close(h$ptr))
     n <- gravcal:::gc_decoder_drain(h$ptr)
     list(coef = n, status = "decoded")
@@ -74,5 +103,7 @@ t <- st[["elapsed"]]
 cpu <- st[["user.self"]] + st[["sys.self"]]
 status <- gsub("[[:space:]]+", "_", paste(v$status, collapse = "_"))
 if (!nzchar(status)) status <- "-"
+peak <- proc_mb("VmHWM")
+if (!is.null(save_to) && !is.null(v$result)) saveRDS(v$result, save_to)
 cat(sprintf("RESULT\t%s\t%.3f\t%.1f\t%.1f\t%s\t%s\t%.3f\n", contender, t,
-            proc_mb("VmHWM"), base, hex(v$coef), status, cpu))
+            peak, base, hex(v$coef), status, cpu))
