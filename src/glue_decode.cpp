@@ -76,13 +76,9 @@ OpenFile* get(SEXP ptr) { return gravcal_glue::open_file(ptr); }
 // that the decoder fills and the core reads, over and over.
 struct ChunkBuffer {
   static constexpr std::size_t chunk = 1u << 16;
-  explicit ChunkBuffer(bool temperature) : buf((temperature ? 4u : 3u) * chunk) {
-    out.x = buf.data();
-    out.y = out.x + chunk;
-    out.z = out.y + chunk;
-    out.t = temperature ? out.z + chunk : nullptr;
-    out.capacity = chunk;
-  }
+  explicit ChunkBuffer(bool temperature)
+      : buf((temperature ? 4u : 3u) * chunk),
+        out(gravcal::SampleBuffer::columns(buf.data(), chunk, temperature, false)) {}
   std::vector<double> buf;
   gravcal::SampleBuffer out;
 };

@@ -260,6 +260,18 @@ struct SampleBuffer {
   std::size_t n = 0;
   bool full() const { return n >= capacity; }
   std::size_t room() const { return capacity - n; }
+  // A buffer over consecutive columns of `cap` values at `base`: x, y, z,
+  // then temperature and time when asked (base holds 3 to 5 columns).
+  static SampleBuffer columns(double* base, std::size_t cap, bool temperature, bool with_time) {
+    SampleBuffer b;
+    b.x = base;
+    b.y = b.x + cap;
+    b.z = b.y + cap;
+    b.t = temperature ? b.z + cap : nullptr;
+    b.time = with_time ? (temperature ? b.t : b.z) + cap : nullptr;
+    b.capacity = cap;
+    return b;
+  }
   void put(double xi, double yi, double zi, double ti, double timei) {
     x[n] = xi;
     y[n] = yi;

@@ -539,8 +539,21 @@ class CsvDecoder : public Decoder {
     }
     if (!time_text_) {
       frac_digits = 9;
-      if (!csv_text::parse_number(f.b, f.e, dec_, number_rule_, t)) return false;
-      if (adhoc_) t = t / time_div_ + time_offset_;
+      // the common shape (digits, a point, digits) by the plain scan, which
+      // gives parse_number's value; any other shape by parse_number (the
+      // field lies in a line, so a byte that ends the scan follows it)
+      csv_text::PlainNumber pn;
+      const char* e = csv_text::scan_plain_number(f.b, dec_, pn);
+      if (e == f.e && f.b < f.e) {
+        if (!csv_text::plain_value(pn, f.b, e, dec_, number_rule_, t)) return false;
+      } else if (!csv_text::parse_number(f.b, f.e, dec_, number_rule_, t)) {
+        return false;
+      }
+      if (adhoc_) {
+        // (t / 1 is t: the division only for milliseconds and days)
+        if (time_div_ != 1) t = t / time_div_;
+        t = t + time_offset_;
+      }
       return true;
     }
     return dt_.parse(f.b, f.e, t, frac_digits);

@@ -159,13 +159,7 @@ class GgirResamplerOf : public Decoder {
   // Raw samples of the current call from the inner decoder; false when it
   // gave nothing.
   bool refill() {
-    SampleBuffer b;
-    b.x = raw_.data();
-    b.y = b.x + kRawChunk;
-    b.z = b.y + kRawChunk;
-    b.t = b.z + kRawChunk;
-    b.time = b.t + kRawChunk;
-    b.capacity = kRawChunk;
+    SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true);
     inner_->continue_call(!first_read_);
     first_read_ = false;
     const std::int64_t u = inner_->read(b, left_);

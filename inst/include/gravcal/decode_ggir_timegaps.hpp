@@ -110,13 +110,7 @@ class GgirTimegapsOf : public Decoder {
   }
 
   bool refill() {
-    SampleBuffer b;
-    b.x = raw_.data();
-    b.y = b.x + kRawChunk;
-    b.z = b.y + kRawChunk;
-    b.t = b.z + kRawChunk;
-    b.time = b.t + kRawChunk;
-    b.capacity = kRawChunk;
+    SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true);
     const std::int64_t u = inner_->read(b, left_);
     call_units_ += u;
     if (left_ > 0) left_ -= u;
