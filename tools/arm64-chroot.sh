@@ -6,7 +6,9 @@
 # against GGIR in that R. `make test-arm64` runs it; it is slow (qemu
 # emulates every instruction) and not part of `make test`.
 #
-#   sudo bash tools/arm64-chroot.sh [identity|all]
+#   sudo bash tools/arm64-chroot.sh [identity|all|table]
+# (table: only tools/identity-table.R, gravcal::g.calibrate() against
+# GGIR on GGIRread's test files and synthetic 30-hour recordings)
 #
 # Root is needed (debootstrap, chroot, mounts). Idempotent: the chroot, its
 # Debian packages and GGIR are set up once and reused; gravcal is copied
@@ -20,7 +22,7 @@
 set -euo pipefail
 
 scope=${1:-identity}
-case "$scope" in identity | all) ;; *) echo "arm64-chroot: the argument is identity or all, not '$scope'" >&2; exit 2 ;; esac
+case "$scope" in identity | all | table) ;; *) echo "arm64-chroot: the argument is identity, all or table, not '$scope'" >&2; exit 2 ;; esac
 if [ "$(id -u)" != 0 ]; then
   echo "arm64-chroot: needs root (debootstrap, chroot, mounts): sudo bash $0 $scope" >&2
   exit 2
@@ -198,6 +200,15 @@ fi
 # the real recordings, the synthetic 30-hour recordings), then with `all`
 # the whole suite
 t=$(date +%s)
+if [ "$scope" = table ]; then
+  # only the table of gravcal::g.calibrate() against GGIR's on GGIRread's
+  # test files and synthetic 30-hour recordings (tools/identity-table.R)
+  in_chroot table "cd /gravcal && R_LIBS=/gravcal-lib Rscript tools/identity-table.R /tmp/identity-table.md && cp /tmp/identity-table.md /gravcal-lib/identity-table.md"
+  cp "$root/gravcal-lib/identity-table.md" "$logs/identity-table.md" 2>/dev/null || true
+  stamp "table" "$t"
+  stamp "total" "$t_all"
+  exit 0
+fi
 identity="test-fp-build.R test-ggir.R test-ggir-params.R test-ggir-interpolation.R test-ggir-segments.R
 test-decode-cwa.R test-decode-geneactiv.R test-decode-gt3x.R test-decode-csv.R test-axivity-csv.R
 test-adhoc-csv.R test-windows.R test-fit-icp.R test-simd.R test-formats.R"
