@@ -40,6 +40,11 @@ synth <- list(
     r <- rec30(20, 65); f <- tempfile(fileext = ".csv")
     list(file = f, params = write_adhoc(r, f, 20))
   },
+  Movisens = function() {
+    r <- rec30(64, 67); d <- tempfile("movisens")
+    gravcal:::write_movisens(r, d, sf = 64)
+    file.path(d, "acc.bin")
+  },
   `Parmay Matrix` = function() {
     r <- rec30(25, 66); f <- tempfile(fileext = ".BIN")
     gravcal:::write_parmay_bin(r, f, sf = 25)
