@@ -34,6 +34,7 @@
 #ifndef GRAVCAL_DECODE_MOVISENS_HPP
 #define GRAVCAL_DECODE_MOVISENS_HPP
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -249,7 +250,11 @@ class UnisensSignal {
     if (bytes < 0) return false;
     count_ = bytes / static_cast<std::int64_t>(frame_);
     tail_ = bytes % static_cast<std::int64_t>(frame_);
-    buf_.assign(kBufFrames * frame_, 0);
+    // the channel count comes from unisens.xml: the buffer never holds more
+    // frames than the file has (nor more than kBufFrames)
+    const std::int64_t frames = std::max<std::int64_t>(1, std::min<std::int64_t>(count_, kBufFrames));
+    buf_.assign(static_cast<std::size_t>(frames) * frame_, 0);
+    buf_frames_ = static_cast<std::size_t>(frames);
     return true;
   }
   std::int64_t count() const { return count_; }
@@ -272,7 +277,7 @@ class UnisensSignal {
  private:
   bool fill(std::int64_t k) {
     std::int64_t want = count_ - k;
-    if (want > static_cast<std::int64_t>(kBufFrames)) want = static_cast<std::int64_t>(kBufFrames);
+    if (want > static_cast<std::int64_t>(buf_frames_)) want = static_cast<std::int64_t>(buf_frames_);
     have_ = 0;
     first_ = k;
     if (want <= 0 || failed_) return false;
@@ -291,6 +296,7 @@ class UnisensSignal {
   ByteSource* src_ = nullptr;
   int size_ = 2, nch_ = 1;
   std::size_t frame_ = 2;
+  std::size_t buf_frames_ = 0;  // frames buf_ holds
   bool scale_ = false;
   double lsb_ = 1, baseline_ = 0;
   std::int64_t count_ = 0, tail_ = 0;
