@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const double k = std::fmax(0.25, 2 / sf);
   std::int64_t given = 0;
   double last = std::nan("");
-  for (int calls = 0; calls < 200000 && !dec->done() && given < 1000000; ++calls) {
+  for (int calls = 0; calls < 50000 && !dec->done() && given < 200000; ++calls) {
     gravcal::SampleBuffer b;
     b.x = x.data(); b.y = y.data(); b.z = z.data(); b.t = t.data(); b.time = tm.data();
     b.capacity = cap;

@@ -201,6 +201,16 @@ test_that("rmc.doresample: a gap in the time stamps is filled as GGIR fills it, 
   expect_lt(nrow(r), 400)
   expect_identical(rep$counters[["resample_gaps_not_filled"]], 1)
   expect_true(any(grepl("time stamps jump by 20000000", rep$notes, fixed = TRUE)))
+  # time stamps so far out that a grid step is below their resolution
+  # (1e300 s: before, the grid's loops never ended on them) are left out
+  # with their samples, as non-finite ones are
+  d$time <- sprintf("%.1f", (0:299) * 0.1)
+  d$time[151:152] <- "1e300"
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  r <- gravcal:::native_read_all(f, "adhoc_csv", c(list(compat = 1), lay$opts))
+  rep <- attr(r, "report")
+  expect_identical(rep$counters[["resample_bad_time"]], 2)
+  expect_lt(nrow(r), 400)
 })
 
 test_that("ad hoc csv samples equal GGIR's read.myacc.csv, sample for sample", {

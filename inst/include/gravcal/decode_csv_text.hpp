@@ -422,13 +422,17 @@ GRAVCAL_CSV_INLINE const char* field_end(const char* p, char sep) {
   }
 }
 
-// The values of the numbers with 1, 2 or 3 decimals below 16.384 (ActiLife
-// writes up to 3 decimals, dropping trailing zeros), by their digits as one
+// The values of the numbers with 1, 2 or 3 decimals whose digits are below
+// 16384 (ActiLife writes up to 3 decimals of g, dropping trailing zeros; ad
+// hoc files often 1 decimal of mg, temperatures 2), by their digits as one
 // integer k: decimals(rule).value[f][k] is the value of k / 10^f by the
 // NumberRule, for k < decimals().limit[f]. Computed once
 // per process, on first use, by fread_value / exact_value, the functions
-// parse_number uses (the three tables: about 150 KiB a mode).
+// parse_number uses (the three tables: 384 KiB a rule).
 constexpr std::size_t kThousandths = 16384;
+// the integers k of each table: k / 10^f below 16.384 for three decimals
+// (g), below 1638.4 and 163.84 for one and two (mg, degrees)
+constexpr std::uint64_t kDecimalsLimit[4] = {0, 16384, 16384, kThousandths};
 struct Decimals {
   std::vector<double> table[4];
   const double* value[4] = {nullptr, nullptr, nullptr, nullptr};
@@ -436,8 +440,8 @@ struct Decimals {
 };
 inline Decimals decimals_values(int rule) {
   Decimals d;
-  std::uint64_t lim = kThousandths;
-  for (int f = 3; f >= 1; --f, lim = (lim + 9) / 10) {
+  for (int f = 3; f >= 1; --f) {
+    const std::uint64_t lim = kDecimalsLimit[f];
     std::vector<double>& t = d.table[f];
     t.resize(lim);
     for (std::uint64_t k = 0; k < lim; ++k) {

@@ -40,7 +40,8 @@
 // memory; a gap of more than kMaxGapPoints grid points (about 11.6 days at
 // 100 Hz, where GGIR would need gigabytes) is not filled but counted and
 // noted ("resample_gaps_not_filled"), and a time stamp that is not a finite
-// number is left out with its sample ("resample_bad_time").
+// number, or lies more than 2^51 grid steps from 1970, is left out with its
+// sample ("resample_bad_time").
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 
@@ -139,6 +140,7 @@ class GgirResamplerOf : public Decoder {
   static constexpr std::size_t kRawChunk = 4096;
   static constexpr std::size_t kGenBatch = 4096;
   static constexpr double kMaxGapPoints = 1e8;
+  static constexpr double kMaxTimeSteps = 2251799813685248.0;  // 2^51
   static constexpr std::size_t kRawCols = 5;  // x, y, z, t, time
   struct Point {
     std::int64_t k;
@@ -175,7 +177,11 @@ class GgirResamplerOf : public Decoder {
   // interval that ends at it.
   void take(std::size_t i) {
     for (std::size_t c = 0; c < kRawCols; ++c) cur_[c] = raw_[c * kRawChunk + i];
-    if (!std::isfinite(cur_[4])) {
+    // a time stamp so far from 1970 that one grid step is below its
+    // resolution (beyond 2^51 steps: more than 700,000 years at 100 Hz)
+    // has no grid around it: left out as a non-finite one is (the grid's
+    // k and its points would stop moving, and the loops with them)
+    if (!(std::fabs(cur_[4]) < kMaxTimeSteps * by_)) {
       ++bad_time_;
       return;
     }
