@@ -1,11 +1,24 @@
 # Native decoders for device files (inst/include/gravcal/decode*.hpp), as
 # seen from R: open a file, pull blocks of samples, read what was skipped.
 
+# The one call that opens a native decoder: the options with what this R
+# itself decides (with_resample_fused(): GGIRread's rounding, fread's rule
+# for numbers; a Movisens unisens.xml's numbers as R's as.numeric() reads
+# them), as gc_decoder_open() answers (ptr NULL, with error or unsupported,
+# when it cannot).
+decoder_open <- function(file, format, options = list()) {
+  if (format == "movisens") {
+    nums <- unisens_r_numbers(file)
+    options[names(nums)] <- nums
+  }
+  gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
+}
+
 # Open `file` with the native decoder of `format`; `options` is a named list
 # of single numbers or strings for the decoder. An error naming the file when
 # it cannot be read as that format.
 native_open <- function(file, format, options = list(), arg = "file") {
-  r <- gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
+  r <- decoder_open(file, format, options)
   if (is.null(r$ptr)) native_open_error(file, format, r$error, arg)
   r
 }

@@ -214,7 +214,7 @@ read_native <- function(file, format, sf, arg = "file", extra = NULL) {
     sf <- lay$sf
     opts[names(lay$opts)] <- lay$opts
   }
-  h <- gc_decoder_open(path.expand(file), format, opts)
+  h <- decoder_open(file, format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)

@@ -148,7 +148,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does
   if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1
-  h <- gc_decoder_open(path.expand(file), format, with_resample_fused(opts, format))
+  h <- decoder_open(file, format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)
@@ -339,6 +339,31 @@ source_parmay <- function(file) {
 # GGIR's block of a Movisens recording, in samples: sf * 60 * 1440 / 2 with
 # its sf, which g.inspectfile sets to 64 whatever unisens.xml says.
 movisens_block <- function(file = NULL) 64 * 60 * 1440 / 2
+
+# The number attributes of a Movisens recording's unisens.xml (sampleRate,
+# lsbValue, baseline) as R's as.numeric() reads them, which is how unisensR
+# reads them: R's digits accumulate in its long double (in double in an R
+# built without one), so a long number such as 1/3000 written to 17 digits
+# can end in other bits than strtod's. Named "r_number:<text>" for the
+# decoder, which takes these values for those texts. Nothing when the file
+# cannot be read (the decoder says why).
+unisens_r_numbers <- function(file) {
+  xml <- file.path(dirname(file), "unisens.xml")
+  size <- file.size(xml)
+  if (!isTRUE(size > 0 && size <= 16 * 2^20)) return(list())
+  txt <- tryCatch(paste(readLines(xml, warn = FALSE, encoding = "UTF-8"), collapse = "\n"),
+                  error = function(e) "")
+  m <- tryCatch(regmatches(txt, gregexpr("(sampleRate|lsbValue|baseline)[[:space:]]*=[[:space:]]*(\"[^\"]*\"|'[^']*')",
+                                         txt, useBytes = TRUE))[[1]],
+                error = function(e) character(0))
+  if (!length(m)) return(list())
+  quoted <- sub("^[^=]*=[[:space:]]*", "", m)
+  val <- trimws(substr(quoted, 2L, nchar(quoted) - 1L), whitespace = "[ \t\r\n]")
+  val <- unique(val[nzchar(val)])
+  out <- as.list(suppressWarnings(as.numeric(val)))
+  names(out) <- paste0("r_number:", val)
+  out
+}
 
 # GGIR's own reading of a Movisens recording, block by block: unisensR for
 # the acceleration, GGIR's g.readtemp_movisens for the temperature.

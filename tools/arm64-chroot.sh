@@ -210,8 +210,11 @@ if [ "$scope" = table ]; then
   exit 0
 fi
 identity="test-fp-build.R test-ggir.R test-ggir-params.R test-ggir-interpolation.R test-ggir-segments.R
-test-decode-cwa.R test-decode-geneactiv.R test-decode-gt3x.R test-decode-csv.R test-axivity-csv.R
-test-adhoc-csv.R test-windows.R test-fit-icp.R test-simd.R test-formats.R"
+test-ggir-stress.R test-decode-cwa.R test-decode-geneactiv.R test-decode-gt3x.R test-decode-csv.R
+test-decode-parmay.R test-decode-movisens.R test-axivity-csv.R test-adhoc-csv.R test-windows.R
+test-fit-icp.R test-simd.R test-formats.R"
+# with `all`, every test file once: the identity files first, then the rest
+# (so a run cut short still has them); one row printed as each file ends
 in_chroot tests "
   cd /gravcal/tests/testthat
   export R_LIBS=/gravcal-lib NOT_CRAN=true
@@ -220,23 +223,26 @@ in_chroot tests "
                   .Machine\$sizeof.longdouble, \"bytes; GGIR\", format(packageVersion(\"GGIR\")), \"GGIRread\",
                   format(packageVersion(\"GGIRread\")), \"\n\"); library(gravcal);
               cat(\"GGIRread::resample fused here:\", gravcal:::ggir_resample_fused(), \"\n\")'
-  status=0
   Rscript -e '
     suppressPackageStartupMessages({ library(testthat); library(gravcal) })
+    options(testthat.summary.max_reports = 10000L)
     files <- strsplit(\"$(echo $identity)\", \" \")[[1]]
-    res <- do.call(rbind, lapply(files, function(f) {
+    if (\"$scope\" == \"all\") files <- c(files, setdiff(sort(list.files(\".\", \"^test-.*[.]R\$\")), files))
+    row <- function(f) {
       t0 <- proc.time()[[3]]
       r <- as.data.frame(test_file(f, reporter = \"summary\", package = \"gravcal\", load_package = \"installed\"))
-      data.frame(file = f, tests = nrow(r), expectations = sum(r\$nb), failed = sum(r\$failed) + sum(r\$error),
-                 skipped = sum(r\$skipped), seconds = round(proc.time()[[3]] - t0))
-    }))
+      d <- data.frame(file = f, tests = nrow(r), expectations = sum(r\$nb), failed = sum(r\$failed) + sum(r\$error),
+                      skipped = sum(r\$skipped), seconds = round(proc.time()[[3]] - t0))
+      cat(sprintf(\"file-row: %-28s %4d tests %6d expectations %3d failed %3d skipped %6d s\n\", d\$file, d\$tests,
+                  d\$expectations, d\$failed, d\$skipped, d\$seconds))
+      d
+    }
+    res <- do.call(rbind, lapply(files, row))
     print(res, row.names = FALSE)
-    cat(sprintf(\"identity files: %d tests, %d expectations, %d failed, %d skipped\n\", sum(res\$tests),
-                sum(res\$expectations), sum(res\$failed), sum(res\$skipped)))
-    quit(status = sum(res\$failed) > 0)' || status=1
-  if [ \"\$SCOPE\" = all ]; then Rscript ../../tools/run-tests.R || status=1; fi
-  exit \$status
+    cat(sprintf(\"%s files: %d files, %d tests, %d expectations, %d failed, %d skipped\n\", \"$scope\", nrow(res),
+                sum(res\$tests), sum(res\$expectations), sum(res\$failed), sum(res\$skipped)))
+    quit(status = sum(res\$failed) > 0)'
 "
-grep -E "^ *test-|identity files:|tests in .* files|fused here|R version" "$logs/tests.log" || true
+grep -E "^file-row:|(identity|all) files:|fused here|R version" "$logs/tests.log" || true
 stamp "tests ($scope)" "$t"
 stamp "total" "$t_all"

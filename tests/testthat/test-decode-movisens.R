@@ -85,6 +85,38 @@ test_that("lsbValue and baseline are read as R reads them (unisensR's as.numeric
     expect_identical(r$data$x, a[[1]], label = format(lsb))
     expect_identical(r$data$z, a[[3]], label = format(lsb))
   }
+  # lsbValue and baseline texts of 22 significant digits that this R's
+  # as.numeric() reads otherwise than a correctly rounded parse (R sums the
+  # digits in its long double, or in double where it has none; about one in
+  # four thousand such texts differs by an ulp), looked for among random
+  # ones: the decoder takes R's values, so its samples are unisensR's
+  correct <- function(x) gravcal:::gc_csv_numbers(x, 0L)
+  set.seed(11)
+  pick <- function(lead) {
+    for (i in 1:200000) {
+      s <- paste0(lead, paste(sample(0:9, 22, TRUE), collapse = ""))
+      if (!identical(as.numeric(s), correct(s))) return(s)
+    }
+    NULL
+  }
+  lsb_txt <- pick("0.000")
+  base_txt <- pick("0.")
+  if (is.null(lsb_txt) || is.null(base_txt)) {
+    skip("this R's as.numeric() read 200,000 long decimals as a correctly rounded parse does")
+  }
+  d <- file.path(root, "long")
+  gravcal:::write_movisens(s, d, lsb = 1 / 2048, baseline = 0.5)
+  xml <- readLines(file.path(d, "unisens.xml"))
+  xml <- sub('lsbValue="[^"]*"', paste0('lsbValue="', lsb_txt, '"'), xml)
+  xml <- sub('baseline="[^"]*"', paste0('baseline=" ', base_txt, ' "'), xml)
+  writeLines(xml, file.path(d, "unisens.xml"))
+  a <- unisensR::readUnisensSignalEntry(d, "acc.bin")
+  r <- read_recording(d)
+  expect_identical(r$data$x, a[[1]])
+  expect_identical(r$data$y, a[[2]])
+  # and those samples are not the correctly rounded numbers' (the test can fail)
+  raw <- round(as.numeric(a[[1]]) / as.numeric(lsb_txt) + as.numeric(base_txt))
+  expect_false(identical(r$data$x, (raw - correct(base_txt)) * correct(lsb_txt)))
 })
 
 # 30 hours at 64 Hz (GGIR's blocks: 12 h, so three), written once: one

@@ -295,6 +295,12 @@ class Options {
     }
     return fallback;
   }
+  bool has_num(const char* name) const {
+    for (const auto& kv : num_) {
+      if (kv.first == name) return true;
+    }
+    return false;
+  }
   std::string str(const char* name, const std::string& fallback) const {
     for (auto it = str_.rbegin(); it != str_.rend(); ++it) {
       if (it->first == name) return it->second;

@@ -218,14 +218,22 @@ class UnisensXml {
   }
 };
 
-// A number as R's as.numeric() reads an attribute (surrounding blanks
-// allowed); NaN when it is not one.
-inline double unisens_number(const std::string& s) {
+// An attribute's text without the blanks around it.
+inline std::string unisens_trim(const std::string& s) {
   std::size_t a = 0, b = s.size();
   while (a < b && (s[a] == ' ' || s[a] == '\t' || s[a] == '\n' || s[a] == '\r')) ++a;
   while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t' || s[b - 1] == '\n' || s[b - 1] == '\r')) --b;
-  if (a == b) return std::numeric_limits<double>::quiet_NaN();
-  const std::string t = s.substr(a, b - a);
+  return s.substr(a, b - a);
+}
+
+// A number attribute (surrounding blanks allowed), correctly rounded by
+// strtod; NaN when it is not one. unisensR reads these with R's
+// as.numeric(), whose digits accumulate in R's long double (in double where
+// R has none), so a long number can differ in its last bits: the caller
+// gives R's values where it has them (option "r_number:" + text).
+inline double unisens_number(const std::string& s) {
+  const std::string t = unisens_trim(s);
+  if (t.empty()) return std::numeric_limits<double>::quiet_NaN();
   char* end = nullptr;
   const double v = std::strtod(t.c_str(), &end);
   if (end != t.c_str() + t.size()) return std::numeric_limits<double>::quiet_NaN();
@@ -315,7 +323,8 @@ class MovisensDecoder : public Decoder {
         compat_(opts.num("compat", 1) != 0),
         nearest_(opts.num("interpolation", 1) == 2),
         fused_(opts.num("resample_fused", 0) != 0),
-        block_opt_(opts.num("block_samples", 0)) {}
+        block_opt_(opts.num("block_samples", 0)),
+        opts_(opts) {}
 
   bool open() override {
     if (xml_.empty()) return fail("unisens.xml is missing, empty or unreadable");
@@ -334,7 +343,7 @@ class MovisensDecoder : public Decoder {
       return fail("acc.bin has " + std::to_string(acc->channels.size()) +
                   " channels in unisens.xml, not 3 (x, y, z)");
     }
-    sf_ = acc->has_rate ? unisens_number(acc->sample_rate) : std::nan("");
+    sf_ = acc->has_rate ? number(acc->sample_rate) : std::nan("");
     if (!(sf_ > 0) || !std::isfinite(sf_) || sf_ > 1e6) {
       return fail("acc.bin's sampleRate in unisens.xml is not a positive number");
     }
@@ -408,6 +417,14 @@ class MovisensDecoder : public Decoder {
     return false;
   }
 
+  // A number attribute as R reads it where the caller gave R's value for
+  // this text, else strtod's.
+  double number(const std::string& s) const {
+    const std::string key = "r_number:" + unisens_trim(s);
+    if (opts_.has_num(key.c_str())) return opts_.num(key.c_str(), 0);
+    return unisens_number(s);
+  }
+
   // dataType, lsbValue and baseline of a binary entry; false (error set for
   // acc.bin) when they cannot be read as unisensR would.
   bool entry_format(const UnisensEntry& e, const std::string& id, int& size, double& lsb,
@@ -419,8 +436,8 @@ class MovisensDecoder : public Decoder {
     if (e.data_type == "int16") size = 2;
     else if (e.data_type == "int32") size = 4;
     else return fail(id + "'s dataType \"" + e.data_type + "\" is not int16 or int32");
-    lsb = e.has_lsb ? unisens_number(e.lsb_value) : 1.0;
-    base = e.has_baseline ? unisens_number(e.baseline) : 0.0;
+    lsb = e.has_lsb ? number(e.lsb_value) : 1.0;
+    base = e.has_baseline ? number(e.baseline) : 0.0;
     if (!std::isfinite(lsb)) return fail(id + "'s lsbValue in unisens.xml is not a number");
     if (!std::isfinite(base)) return fail(id + "'s baseline in unisens.xml is not a number");
     return true;
@@ -447,7 +464,7 @@ class MovisensDecoder : public Decoder {
             break;
           }
         }
-        temp_rate_ = e->has_rate ? unisens_number(e->sample_rate) : std::nan("");
+        temp_rate_ = e->has_rate ? number(e->sample_rate) : std::nan("");
         if (temp_chan_ < 0) why = "temp.bin has no channel named \"temp\"";
         else if (!std::isfinite(temp_rate_)) why = "temp.bin's sampleRate is not a number";
         else if (!temp_.setup(temp_src_.get(), size, static_cast<int>(e->channels.size()), lsb,
@@ -544,6 +561,7 @@ class MovisensDecoder : public Decoder {
   std::string xml_;
   bool compat_ = true, nearest_ = false, fused_ = false;
   double block_opt_ = 0;
+  Options opts_;
   double sf_ = 0;
   UnisensSignal acc_, temp_;
   bool temp_ok_ = false;
