@@ -4,9 +4,17 @@
 # The one call that opens a native decoder: the options with what this R
 # itself decides (with_resample_fused(): GGIRread's rounding, fread's rule
 # for numbers; a Movisens unisens.xml's numbers as R's as.numeric() reads
-# them), as gc_decoder_open() answers (ptr NULL, with error or unsupported,
+# them; a .cwa calendar's offsets in GGIR's zone), as gc_decoder_open() answers (ptr NULL, with error or unsupported,
 # when it cannot).
 decoder_open <- function(file, format, options = list()) {
+  # "zone": GGIR's zone for a GGIR-compatible .cwa read (R/zone.R)
+  if (!is.null(tz <- options$zone)) {
+    options$zone <- NULL
+    if (format == "cwa" && !identical(as.numeric(options$compat %||% 1), 0)) {
+      zo <- zone_options(tz)
+      options[names(zo)] <- zo
+    }
+  }
   if (format == "movisens") {
     nums <- unisens_r_numbers(file)
     options[names(nums)] <- nums

@@ -69,7 +69,7 @@
 #' | `printsummary` | (prints only) | honoured |
 #' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Movisens (its temperature); Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
-#' | `desiredtz`, `configtz` | `.cwa`, where the zone's UTC offset changes during the recording | honoured where the offset stays the same; an error naming it where it changes |
+#' | `desiredtz`, `configtz` | `.cwa` (the zone of its block times) | honoured, across changes of UTC offset (daylight saving) too, by the zone rules of the R it runs in; an error naming it only where a block of GGIR's reading starts or ends at a calendar time that exists twice or not at all in that zone, and with `reader = "reference"` where the offset changes |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
 #' | other `rmc.*` | ad hoc csv | see "Ad hoc csv files" |
 #'
@@ -154,14 +154,18 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
     attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
   }
+  # the zone of a .cwa file's calendar times (readAxivity's configtz, else
+  # desiredtz): offsets that change (daylight saving) move block times
+  tz <- if (length(pr$configtz)) pr$configtz else pr$desiredtz
+  tz_arg <- if (length(pr$configtz)) "configtz" else "desiredtz"
   read_opts <- list(interpolation = pr$interpolationType,
-                    frequency_tol = pr$frequency_tol)
+                    frequency_tol = pr$frequency_tol, zone = tz %||% "")
   open <- function() {
     open_source(datafile, sf = sf, chunksize = pr$chunksize,
                 reader = pr$reader, compat = TRUE, read_opts = read_opts, rmc = rmc)
   }
   src <- open()
-  ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
+  if (is.null(src$native)) ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
   # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike
@@ -176,6 +180,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                         minloadcrit = pr$minloadcrit,
                         sdcriter = sdcriter, verbose = verbose,
                         printsummary = pr$printsummary)
+  ggir_check_zone_read(src, tz %||% "", tz_arg)
   attr(out, "gravcal") <- NULL
   invisible(out)
 }
@@ -215,7 +220,26 @@ ggir_params <- function(params_rawdata, params_general, dots) {
                                  from(params_general, "general"), dots))
 }
 
-# desiredtz / configtz (GGIR's params_general) for a .cwa file: readAxivity
+# After a GGIR-compatible .cwa read in a zone whose offset changes: a block
+# of GGIR's reading that starts or ends at a calendar time that exists twice
+# or not at all there (R/zone.R) has a time that depends on R's conversions
+# before it, which gravcal does not know: an error naming the parameter.
+ggir_check_zone_read <- function(src, tz, arg) {
+  if (!identical(src$format, "cwa") || is.null(src$report)) return(invisible())
+  n <- src$report()$counters["zone_ambiguous"]
+  if (isTRUE(n > 0)) {
+    abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",
+          ": a block of GGIR's reading of this .cwa file starts or ends at a time ",
+          "that exists twice or not at all in that zone (a change of UTC offset), ",
+          "where GGIR's time depends on R's conversions before it; gravcal does ",
+          "not reproduce that. Give a zone without a change there (\"UTC\", or a ",
+          "fixed offset such as \"Etc/GMT-1\"), or another `chunksize`.")
+  }
+  invisible()
+}
+
+# desiredtz / configtz (GGIR's params_general) for a .cwa file read by
+# GGIR's own reader (reader = "reference"): readAxivity
 # converts each block's calendar time to seconds in that zone (configtz,
 # else desiredtz; "" is the session's zone); gravcal's decoder converts in
 # UTC. A constant offset moves every time by the same whole seconds, which

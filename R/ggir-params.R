@@ -92,8 +92,10 @@ ggir_param_table <- function() {
           effect = paste0(".cwa: the zone of readAxivity's block times (configtz ",
                           "when that is not given); a change of UTC offset ",
                           "(daylight saving) during the recording moves them; ",
-                          "honoured where the offset stays the same, refused ",
-                          "otherwise. Ad hoc csv: time stamps only (rmc.desiredtz)")),
+                          "honoured, across such changes too (refused only where ",
+                          "a block of GGIR's reading starts at a time that exists ",
+                          "twice or not at all there, and with reader = ",
+                          "\"reference\"). Ad hoc csv: time stamps only (rmc.desiredtz)")),
       row("configtz", NA, NULL, tz_check, list = "general",
           effect = "as desiredtz, which it replaces when given"),
       # checked where the source is opened (open_source())

@@ -21,6 +21,15 @@ synth <- list(
                         temperature = r$temperature, range = 8)
     f
   },
+  # the end of daylight saving in the session's zone (desiredtz = ""):
+  # readAxivity's block times jump an hour (R/zone.R)
+  `cwa across a change of UTC offset (TZ Europe/Amsterdam)` = function() {
+    r <- rec30(25, 68); f <- tempfile(fileext = ".cwa")
+    start <- as.numeric(as.POSIXct("2023-10-28 12:00:00", tz = "UTC"))
+    gravcal:::write_cwa(as.matrix(r[, c("x", "y", "z")]), f, sf = 25, start = start,
+                        temperature = r$temperature, range = 8)
+    list(file = f, tz = "Europe/Amsterdam")
+  },
   `GENEActiv bin` = function() {
     r <- rec30(20, 62); f <- tempfile(fileext = ".bin")
     gravcal:::write_geneactiv_bin(r, f, sf = 20)
@@ -50,6 +59,7 @@ synth <- list(
     gravcal:::write_parmay_bin(r, f, sf = 25)
     f
   })
+`%||%` <- function(a, b) if (is.null(a)) b else a
 ggirread <- c("ax3_testfile.cwa", "ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa",
               "ax6_testfile.cwa", "GENEActiv_testfile.bin", "mtx_12.5Hz_acc.BIN",
               "mtx_25Hz_acc_HR.BIN", "mtx_100Hz_acc_HR_temp.BIN", "mtx_corrupted.bin")
@@ -70,8 +80,12 @@ for (nm in names(files)) {
     f <- files[[nm]]
     if (is.function(f)) f <- f()
     params <- list()
-    if (is.list(f)) { params <- f$params; f <- f$file }
-    b <- run_both(f, params)
+    tz <- NULL
+    if (is.list(f)) { params <- f$params %||% list(); tz <- f$tz; f <- f$file }
+    old_tz <- Sys.getenv("TZ", unset = NA)
+    if (!is.null(tz)) Sys.setenv(TZ = tz)
+    b <- tryCatch(run_both(f, params),
+                  finally = if (is.na(old_tz)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old_tz))
     R <- b$ggir; G <- b$gravcal
     el <- setdiff(names(R), "bsc_qc")
     bad <- el[!vapply(el, function(k) identical(G[[k]], R[[k]]), TRUE)]

@@ -1,7 +1,8 @@
 # GGIR's reading parameters on .cwa files: interpolationType (1 linear, 2
 # nearest neighbour) and frequency_tol, honoured by the native decoder
-# (decode_cwa.hpp); desiredtz / configtz honoured where the zone's UTC offset
-# stays the same over the recording, refused where it changes.
+# (decode_cwa.hpp); desiredtz / configtz honoured, across changes of the
+# zone's UTC offset too (R/zone.R), refused only where a block of GGIR's
+# reading starts at a calendar time that exists twice or not at all.
 # References: GGIRread 1.2.0's readAxivity() on the same bytes, called as
 # GGIR 3.3-9's g.readaccfile calls it, and GGIR::g.calibrate() itself.
 
@@ -172,27 +173,115 @@ test_that("interpolationType 2: GENEActiv at a rate that is not whole, GGIR's to
   expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
 })
 
-test_that("desiredtz: across a change of UTC offset GGIR's result moves, and gravcal refuses", {
+# readAxivity window after window in the session's zone `tz` (configtz =
+# desiredtz = ""), as ref_cwa() in UTC
+ref_cwa_tz <- function(f, B, tz) {
+  with_tz(tz, {
+    out <- list()
+    s <- 0
+    header <- NULL
+    repeat {
+      P <- tryCatch(suppressWarnings(GGIRread::readAxivity(
+        f, start = s, end = s + B, progressBar = FALSE, desiredtz = "",
+        configtz = "", header = header)), error = function(e) NULL)
+      if (is.null(P) || is.null(P$data)) break
+      header <- P$header
+      out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time")]
+      s <- s + B
+    }
+    d <- do.call(rbind, out)
+    names(d)[4] <- "temperature"
+    rownames(d) <- NULL
+    d
+  })
+}
+
+# GGIR's and gravcal's g.calibrate() with GGIR's params_general changed by
+# `general` (desiredtz, configtz)
+run_both_general <- function(f, general, rawdata = list()) {
+  pr <- utils::modifyList(GGIR::load_params()$params_rawdata, rawdata)
+  pg <- utils::modifyList(GGIR::load_params()$params_general, general)
+  quiet <- function(expr) {
+    out <- NULL
+    utils::capture.output(out <- suppressWarnings(expr))
+    out
+  }
+  I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+  list(ggir = quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
+                                      inspectfileobject = I, verbose = FALSE)),
+       gravcal = quiet(g.calibrate(f, params_rawdata = pr, params_general = pg,
+                                   verbose = FALSE)))
+}
+
+test_that("desiredtz: across a change of UTC offset the decoder gives readAxivity's block times", {
+  skip_if_not_installed("GGIRread")
+  # 30 hours across the end of daylight saving in Europe/Amsterdam (its
+  # calendar 03:00 on 2023-10-29 is 02:00 UTC, not 01:00: readAxivity's
+  # times jump an hour there, and its grid fills the hour) and across its
+  # start in Europe/London (2024-03-31, 01:00 to 02:00 does not exist: the
+  # times go back an hour and the grid skips it); the device's calendar
+  # runs on without a jump
+  B <- gravcal:::format_block_units("cwa", 25, 1)
+  cases <- list(list(tz = "Europe/Amsterdam", start = "2023-10-28 12:00:00", rows = 31),
+                list(tz = "Europe/London", start = "2024-03-30 12:00:00", rows = 29))
+  for (cs in cases) {
+    f <- synth_cwa(seed = 65, start = as.numeric(as.POSIXct(cs$start, tz = "UTC")))
+    ref <- ref_cwa_tz(f, B, cs$tz)
+    nat <- nat_cwa(f, B, list(zone = cs$tz))
+    expect_identical(nat, ref, label = cs$tz)
+    # the hour filled or skipped: 31 or 29 hours of grid from 30 of samples
+    expect_equal(nrow(ref) / (25 * 3600), cs$rows, tolerance = 0.01, label = cs$tz)
+    # in UTC (no zone) the times are the calendar's, an hour apart in places
+    utc <- nat_cwa(f, B, list())
+    expect_false(identical(utc$time, nat$time))
+    unlink(f)
+  }
+})
+
+test_that("desiredtz, configtz: across a change of UTC offset g.calibrate() gives GGIR's result", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
-  # 30 hours across the end of daylight saving in Europe/Amsterdam
-  # (2023-10-29 01:00 UTC): readAxivity's block times go back an hour there
+  # the end of daylight saving in the session's zone (desiredtz = ""), with
+  # interpolationType 1 and 2
   f <- synth_cwa(seed = 65, start = as.numeric(as.POSIXct("2023-10-28 12:00:00", tz = "UTC")))
   on.exit(unlink(f))
-  quiet_ggir <- function() {
-    pr <- GGIR::load_params()$params_rawdata
-    I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr))
-    suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
-                                       verbose = FALSE))
+  res <- list()
+  for (it in 1:2) {
+    b <- with_tz("Europe/Amsterdam", run_both(f, list(interpolationType = it)))
+    expect_same_as_ggir(b)
+    res[[it]] <- b$ggir
   }
-  utc <- with_tz("UTC", quiet_ggir())
-  ams <- with_tz("Europe/Amsterdam", quiet_ggir())
-  expect_false(identical(utc$spheredata, ams$spheredata))
-  # gravcal gives GGIR's UTC result, and refuses the other
-  G <- with_tz("UTC", suppressWarnings(g.calibrate(f, verbose = FALSE)))
-  expect_identical(G$scale, utc$scale)
-  expect_identical(unname(as.matrix(G$spheredata)), unname(as.matrix(utc$spheredata)))
+  # the zone changes GGIR's result (the test can fail): UTC's differs
+  utc <- with_tz("UTC", run_both(f))
+  expect_same_as_ggir(utc)
+  expect_false(identical(utc$ggir$spheredata, res[[1]]$spheredata))
+  # the start of daylight saving, named by desiredtz, and by configtz over
+  # a desiredtz without it, in a session in UTC
+  f2 <- synth_cwa(seed = 66, start = as.numeric(as.POSIXct("2024-03-30 12:00:00", tz = "UTC")))
+  on.exit(unlink(f2), add = TRUE)
+  for (g in list(list(desiredtz = "Europe/London"),
+                 list(desiredtz = "UTC", configtz = "Europe/London"))) {
+    b <- with_tz("UTC", run_both_general(f2, g))
+    expect_same_as_ggir(b)
+    expect_gt(b$ggir$npoints, 50)
+  }
+})
+
+test_that("desiredtz: a block of GGIR's reading that starts at a time that exists twice is refused", {
+  # Europe/Amsterdam's calendar 02:00 to 03:00 on 2023-10-29 exists twice;
+  # GGIR's first block starts there, where readAxivity's time depends on R's
+  # conversions before it
+  f <- synth_cwa(hours = 2, seed = 67,
+                 start = as.numeric(as.POSIXct("2023-10-29 02:20:00", tz = "UTC")))
+  on.exit(unlink(f))
   expect_error(with_tz("Europe/Amsterdam", g.calibrate(f, verbose = FALSE)),
-               "`desiredtz` = \"\" (the session's time zone): the recording spans a change of UTC offset",
+               "`desiredtz` = \"\" (the session's time zone): a block of GGIR's reading",
                fixed = TRUE)
+  expect_error(with_tz("UTC", g.calibrate(f, verbose = FALSE, configtz = "Europe/Amsterdam")),
+               "`configtz` = \"Europe/Amsterdam\": a block", fixed = TRUE)
+  # an hour later the calendar is unambiguous again
+  f2 <- synth_cwa(hours = 2, seed = 67,
+                  start = as.numeric(as.POSIXct("2023-10-29 03:20:00", tz = "UTC")))
+  on.exit(unlink(f2), add = TRUE)
+  expect_silent(with_tz("Europe/Amsterdam", suppressWarnings(g.calibrate(f2, verbose = FALSE))))
 })

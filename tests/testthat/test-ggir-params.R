@@ -136,10 +136,12 @@ test_that("a reading parameter gravcal cannot honour is an error naming it", {
                             nonwear_range_threshold = 100))
 })
 
-test_that("desiredtz / configtz: refused for a .cwa that spans a change of UTC offset", {
+test_that("desiredtz / configtz: GGIR's own reader refuses a .cwa that spans a change of UTC offset", {
   # 30 hours across the end of daylight saving in Europe/Amsterdam
-  # (2023-10-29 01:00 UTC): GGIR's readAxivity sees its block times go back
-  # an hour there; a fixed-offset zone, or UTC, is taken
+  # (2023-10-29 01:00 UTC): GGIR's readAxivity sees its block times jump an
+  # hour there. gravcal's decoder follows (test-ggir-interpolation.R);
+  # reader = "reference" does not, and refuses; a fixed-offset zone, or
+  # UTC, is taken
   rec <- simulate_recording(hours = 2, sf = 25, seed = 3)
   f <- tempfile(fileext = ".cwa")
   on.exit(unlink(f))
@@ -148,10 +150,11 @@ test_that("desiredtz / configtz: refused for a .cwa that spans a change of UTC o
   # (only the first and last block times are read: one at each end is enough)
   gravcal:::write_cwa(as.matrix(rec[1:120, c("x", "y", "z")]), f, sf = 25,
                       start = start + 30 * 3600, append = TRUE, block0 = 10^4)
-  expect_error(g.calibrate(f, verbose = FALSE,
+  skip_if_not_installed("GGIRread")
+  expect_error(g.calibrate(f, verbose = FALSE, reader = "reference",
                            params_general = list(desiredtz = "Europe/Amsterdam")),
                "`desiredtz` = \"Europe/Amsterdam\": the recording spans a change of UTC offset")
-  expect_error(g.calibrate(f, verbose = FALSE, desiredtz = "UTC",
+  expect_error(g.calibrate(f, verbose = FALSE, desiredtz = "UTC", reader = "reference",
                            configtz = "Europe/London"),
                "`configtz` = \"Europe/London\"", fixed = TRUE)
   # the same two hours a day and a half before the change are taken

@@ -74,6 +74,8 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gravcal/decode.hpp"
 #include "gravcal/kernels.hpp"
@@ -231,13 +233,63 @@ inline void scale_columns(const unsigned char* b, const Header& h, const Params&
 struct Block {
   Header h;
   std::int64_t index = 0;
-  double rtc = 0;    // the RTC time, whole seconds since 1970
+  double cal = 0;    // the RTC's calendar time read as UTC, seconds since 1970
+  double rtc = 0;    // the RTC time in the zone (ZoneTable), whole seconds since 1970
   double start = 0;  // the first sample's time
   double frequency = 0;
   // samples by axis: xyz[a][i + 1] is sample i's; xyz[a][0] is free for
   // the value interpolation starts from (emit_span())
   double xyz[3][max_samples + 1];
   unsigned char bytes[block_bytes];
+};
+
+// The UTC offset readAxivity's as.POSIXct() gives a calendar time in the
+// zone GGIR names (configtz, else desiredtz), as seconds to subtract from
+// the calendar read as UTC: a step function of the calendar minute, with the
+// minutes whose offset depends on R's earlier conversions (a time that
+// exists twice, or not at all, at a change of offset) marked. R works it out
+// in the R the package runs in (R/zone.R) and passes it as options: tz_n
+// steps (tz_at_i: the calendar second from which tz_off_i holds; before
+// the first, the first's offset), tz_amb_n marked spans [tz_amb_lo_j,
+// tz_amb_hi_j). None: the calendar read as UTC.
+class ZoneTable {
+ public:
+  static constexpr int kMax = 4096;
+  explicit ZoneTable(const Options& opts) {
+    const double n = opts.num("tz_n", 0), na = opts.num("tz_amb_n", 0);
+    if (!(n >= 1 && n <= kMax && na >= 0 && na <= kMax)) return;
+    for (int i = 0; i < static_cast<int>(n); ++i) {
+      const std::string k = std::to_string(i);
+      at_.push_back(opts.num(("tz_at_" + k).c_str(), 0));
+      off_.push_back(opts.num(("tz_off_" + k).c_str(), 0));
+    }
+    for (int j = 0; j < static_cast<int>(na); ++j) {
+      const std::string k = std::to_string(j);
+      amb_.emplace_back(opts.num(("tz_amb_lo_" + k).c_str(), 0), opts.num(("tz_amb_hi_" + k).c_str(), 0));
+    }
+  }
+  bool empty() const { return at_.empty(); }
+  // the offset for calendar time c (seconds, read as UTC)
+  double offset(double c) const {
+    if (at_.empty()) return 0;
+    std::size_t lo = 0, hi = at_.size();  // the last step at or before c
+    while (hi - lo > 1) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (at_[mid] <= c) lo = mid;
+      else hi = mid;
+    }
+    return off_[lo];
+  }
+  bool ambiguous(double c) const {
+    for (const auto& a : amb_) {
+      if (c >= a.first && c < a.second) return true;
+    }
+    return false;
+  }
+
+ private:
+  std::vector<double> at_, off_;
+  std::vector<std::pair<double, double>> amb_;
 };
 
 }  // namespace cwa
@@ -250,7 +302,8 @@ class CwaDecoder : public Decoder {
         nearest_(opts.num("interpolation", 1) == 2),
         fused_(opts.num("resample_fused", 0) != 0),
         frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)),
-        r_long_double_(opts.num("r_long_double", 1) != 0) {}
+        r_long_double_(opts.num("r_long_double", 1) != 0),
+        zone_(opts) {}
 
   bool open() override;
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
@@ -268,6 +321,7 @@ class CwaDecoder : public Decoder {
               cwa::Block& b, bool count, bool keep_bytes = false);
   void skip(cwa::Status s, std::int64_t index);
   void check_time(const cwa::Block& b);
+  void zone_check(const cwa::Block& b);
 
   // --- compat = 0
   std::int64_t read_raw(SampleBuffer& out, std::int64_t max_units);
@@ -290,6 +344,7 @@ class CwaDecoder : public Decoder {
   bool fused_;                     // GGIRread's resample() fused (option resample_fused)
   double frequency_tol_;
   bool r_long_double_;  // R's accumulator: long double, else double
+  cwa::ZoneTable zone_;  // GGIR's zone (compat = 1 only)
   bool done_ = false;
   std::int64_t n_blocks_ = -1;     // complete data blocks in the file; -1 unknown
   double header_f_ = 0;            // rate in the header (GGIR's grid rate)
@@ -477,9 +532,10 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
     return false;
   }
   b.index = index;
-  b.rtc = T;
+  b.cal = T;
+  b.rtc = compat_ ? T - zone_.offset(T) : T;
   b.frequency = b.h.rate == 0 ? b.h.offset26 : use.frequency;
-  b.start = cwa::block_start(T, b.h, use);
+  b.start = cwa::block_start(b.rtc, b.h, use);
   if (keep_bytes) {  // the caller scales the samples (scale_columns())
     std::memcpy(b.bytes, raw, cwa::block_bytes);
     return true;
@@ -635,7 +691,10 @@ inline double CwaDecoder::window_end_time(std::int64_t& end) {
     const std::int64_t stop = std::min(n_blocks_, end + cwa::max_bad_run + 1);
     for (std::int64_t j = end; j < stop; ++j) {
       if (fetch(j, raw) != Got::block) return inf;
-      if (decode(raw, j, nullptr, b, false)) return b.start;
+      if (decode(raw, j, nullptr, b, false)) {
+        zone_check(b);
+        return b.start;
+      }
     }
     if (stop < n_blocks_) return inf;
   }
@@ -643,6 +702,7 @@ inline double CwaDecoder::window_end_time(std::int64_t& end) {
   for (std::int64_t j = n_blocks_ - 1; j >= lo; --j) {
     if (fetch(j, raw) != Got::block) continue;
     if (decode(raw, j, nullptr, b, false)) {
+      zone_check(b);
       const double step = 1.0 / header_f_;
       const double t = b.start + block_length_ * step;
       return t + 2 * block_length_ * step;
@@ -678,6 +738,7 @@ inline bool CwaDecoder::start_window(std::int64_t max_units) {
     return true;
   }
   check_time(b);
+  zone_check(b);
   wp_ = cwa::own_params(b.h);
   cache_ts_ = b.rtc;
   cache_sec_ = static_cast<int>(b.h.coded & 0x3f);
@@ -688,6 +749,18 @@ inline bool CwaDecoder::start_window(std::int64_t max_units) {
   bad_run_ = 0;
   set_grid(b.start, end_ts);
   return true;
+}
+
+// A block whose time readAxivity converts without the minute before it
+// (a window's first block, and the block its end time comes from): where
+// its calendar minute is one whose offset in GGIR's zone depends on R's
+// earlier conversions, counted ("zone_ambiguous"; R refuses the result).
+inline void CwaDecoder::zone_check(const cwa::Block& b) {
+  if (!compat_ || zone_.empty() || !zone_.ambiguous(b.cal)) return;
+  report_.count("zone_ambiguous");
+  report_.note("block " + std::to_string(b.index + 1) +
+               ": its calendar time exists twice or not at all in GGIR's zone and starts or ends a "
+               "block of GGIR's reading");
 }
 
 // readAxivity's time of a block in a window: the calendar when the RTC

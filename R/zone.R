@@ -1,0 +1,101 @@
+# GGIR's zone for a .cwa file's times (configtz, else desiredtz; "" is the
+# session's zone). GGIRread's readAxivity converts each block's calendar
+# time (the device's clock, year, month, day, hour, minute, second) with
+# as.POSIXct() in that zone, once a minute, and adds the seconds between
+# blocks of the same minute. gravcal's decoder reads the calendar as UTC and
+# subtracts the offset R gives that calendar minute (decode_cwa.hpp's
+# ZoneTable), worked out here in the R the package runs in, so that the
+# decoder follows that R's zone rules, however its platform resolves them.
+#
+# Where the offset changes (daylight saving), a calendar time can exist
+# twice (clocks go back) or not at all (clocks go forward). What
+# as.POSIXct() gives such a time depends on R's conversion before it (the C
+# library keeps its last offset as the guess for the next). In readAxivity
+# the conversion before a minute is the minute before it, so the table is
+# made by converting the minutes around each change in order. The minutes
+# whose offset would differ had the conversions come the other way (in
+# reverse order) are marked: where one of them starts or ends a block of
+# GGIR's reading, readAxivity's conversion before it is not the minute
+# before, and g.calibrate() refuses rather than guess.
+
+# The table for `tz` over the years a .cwa calendar can hold (2000 to
+# 2063): list(at, off, amb_lo, amb_hi) in seconds (calendar read as UTC),
+# or NULL when the offset never changes there (a fixed offset moves every
+# time by the same whole seconds, which leaves GGIR's result unchanged, and
+# the decoder reads in UTC). Cached for the session, by zone.
+zone_table <- function(tz) {
+  key <- if (nzchar(tz)) tz else paste0("|", Sys.getenv("TZ"), "|", Sys.timezone())
+  if (is.null(build_state$zones)) build_state$zones <- list()
+  if (!is.null(build_state$zones[[key]])) return(build_state$zones[[key]]$table)
+  table <- zone_table_make(tz)
+  build_state$zones[[key]] <- list(table = table)
+  table
+}
+
+zone_table_make <- function(tz) {
+  # by how much as.POSIXct() of each calendar time (seconds, read as UTC)
+  # in the zone moves it, converted in the order given
+  off_of <- function(at) {
+    txt <- format(.POSIXct(at, tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+    at - as.numeric(as.POSIXct(txt, tz = tz))
+  }
+  changes <- function(v) which(v[-1] != v[-length(v)])
+  lo <- as.numeric(as.POSIXct("2000-01-01", tz = "UTC"))
+  hi <- as.numeric(as.POSIXct("2064-01-01", tz = "UTC"))
+  days <- seq(lo, hi, by = 86400)
+  d_off <- off_of(days)
+  if (anyNA(d_off)) {
+    abort("`desiredtz`/`configtz` = \"", tz, "\": R cannot convert calendar times in this zone.")
+  }
+  if (!length(changes(d_off))) return(NULL)
+  # each change found to the hour, then the minutes three hours either side
+  # of it converted in order (forwards: the table; backwards: the marks)
+  starts <- numeric(0)
+  for (i in changes(d_off)) {
+    h <- days[i] + 3600 * (0:24)
+    starts <- c(starts, h[changes(off_of(h))])
+  }
+  at <- lo
+  off <- d_off[1]
+  amb <- matrix(numeric(0), ncol = 2)
+  for (h in sort(unique(starts))) {
+    m <- h + 60 * (-180:240)
+    fwd <- off_of(m)
+    bwd <- rev(off_of(rev(m)))
+    if (anyNA(fwd) || anyNA(bwd)) {
+      abort("`desiredtz`/`configtz` = \"", tz, "\": R cannot convert some calendar times ",
+            "in this zone (near ", format(.POSIXct(h, tz = "UTC")), ").")
+    }
+    k <- changes(fwd)
+    at <- c(at, m[k + 1])
+    off <- c(off, fwd[k + 1])
+    d <- which(fwd != bwd)
+    if (length(d)) amb <- rbind(amb, cbind(m[d], m[d] + 60))
+  }
+  # steps in order, each a change of offset
+  o <- order(at)
+  at <- at[o]
+  off <- off[o]
+  keep <- c(TRUE, off[-1] != off[-length(off)])
+  list(at = at[keep], off = off[keep], amb_lo = amb[, 1], amb_hi = amb[, 2])
+}
+
+# The decoder options for the table of `tz` (none for a fixed offset).
+zone_options <- function(tz) {
+  z <- zone_table(tz)
+  if (is.null(z)) return(list())
+  n <- length(z$at)
+  na <- length(z$amb_lo)
+  if (n > 4096 || na > 4096) {
+    abort("`desiredtz`/`configtz` = \"", tz, "\" changes its UTC offset more often than ",
+          "gravcal's .cwa decoder holds (4096 changes).")
+  }
+  opts <- c(list(tz_n = n, tz_amb_n = na),
+            stats::setNames(as.list(z$at), paste0("tz_at_", seq_len(n) - 1L)),
+            stats::setNames(as.list(z$off), paste0("tz_off_", seq_len(n) - 1L)))
+  if (na) {
+    opts <- c(opts, stats::setNames(as.list(z$amb_lo), paste0("tz_amb_lo_", seq_len(na) - 1L)),
+              stats::setNames(as.list(z$amb_hi), paste0("tz_amb_hi_", seq_len(na) - 1L)))
+  }
+  opts
+}
