@@ -24,7 +24,9 @@
 # time by the same whole seconds, which leaves GGIR's result unchanged, and
 # the decoder reads in UTC). Cached for the session, by zone.
 zone_table <- function(tz) {
-  key <- if (nzchar(tz)) tz else paste0("|", Sys.getenv("TZ"), "|", Sys.timezone())
+  # "": the session's zone, which TZ names when set (else the system's,
+  # fixed for the session)
+  key <- if (nzchar(tz)) tz else paste0("|", Sys.getenv("TZ", unset = "(unset)"))
   if (is.null(build_state$zones)) build_state$zones <- list()
   if (!is.null(build_state$zones[[key]])) return(build_state$zones[[key]]$table)
   table <- zone_table_make(tz)
