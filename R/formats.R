@@ -34,6 +34,20 @@ recording_formats <- list(
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+  # GENEActiv's csv export: refused where GGIR's result is asked for (GGIR
+  # reads it no more), else read as the ad hoc csv file its header
+  # describes (R/geneactiv-csv.R)
+  geneactiv_csv = list(
+    ext = c(csv = NA, csv.gz = NA), detect = function(file) is_geneactiv_csv(file),
+    label = "a GENEActiv csv export", unit = "line", own_rate = TRUE,
+    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    decoder = NULL,
+    read = function(file, sf, reader, arg) {
+      read_adhoc(file, reader, rmc_values(geneactiv_csv_rmc(file, arg)))$data
+    },
+    source = function(file, sf, chunksize, arg) {
+      open_source(file, sf, chunksize, arg, compat = FALSE)
+    }),
   # Axivity's csv export (OMGUI): no header, lines of UNIX time stamp, x,
   # y, z; GGIR resamples each block onto the rate it finds from the first
   # 100000 time stamps (R/axivity-csv.R)

@@ -48,7 +48,9 @@
 #' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa`, GENEActiv
 #' `.bin`, Parmay Matrix `.bin` and Movisens recordings (the unisens folder or,
 #' as GGIR takes it, its `acc.bin`; at 64 Hz, the rate GGIR assumes for them:
-#' another rate is an error). They are read by gravcal's own decoders, which give what GGIR's
+#' another rate is an error). A GENEActiv csv export, which GGIR no longer reads
+#' (its `g.inspectfile()` stops), is refused as GGIR refuses it, the error naming
+#' the `rmc.*` parameters that read it as an ad hoc csv file (GGIR's advice). The other formats are read by gravcal's own decoders, which give what GGIR's
 #' readers give (GGIRread's resampling of `.cwa` included), block by block
 #' as GGIR reads them, in bounded memory; a damaged file keeps its good
 #' samples where GGIR's readers stop. `reader = "reference"` in `...` reads

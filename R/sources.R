@@ -37,6 +37,12 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
     sf <- layout$sf
   } else {
     format <- file_format(datafile, arg)
+    if (format == "geneactiv_csv") {
+      if (isTRUE(compat)) geneactiv_csv_refuse(datafile, arg)
+      format <- "adhoc_csv"
+      layout <- rmc_layout(rmc_values(geneactiv_csv_rmc(datafile, arg)), datafile, ggir = FALSE)
+      sf <- layout$sf
+    }
   }
   src <- NULL
   if (reader == "native" && format_has_decoder(format)) {

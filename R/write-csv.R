@@ -211,3 +211,41 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
   }
   p
 }
+
+# GENEActiv's csv export as its PC software writes it (R/geneactiv-csv.R):
+# 100 header lines of "name,value" (device, rate as "Measurement Frequency,
+# <sf> Hz", start time; the rest filled with the calibration and subject
+# rows), then time stamp ("YYYY-MM-DD hh:mm:ss:mmm"), x, y, z in g with 4
+# decimals, light, button, temperature with 1 decimal. `rec`: x, y, z and
+# optionally temperature; `start` in seconds since 1970 (UTC).
+write_geneactiv_csv <- function(rec, file, sf, start = 1.6e9, chunk = 500000L) {
+  n <- nrow(rec)
+  t0 <- as.POSIXct(start, origin = "1970-01-01", tz = "UTC")
+  stamp <- function(t) paste0(format(t, "%Y-%m-%d %H:%M:%S"), ":000")
+  hdr <- c("Device Type,GENEActiv", "Device Model,1.1", "Device Unique Serial Code,012345",
+           "Device Firmware Version,Ver06.17.15", "Calibration Date,2019-02-20 08:53:49:000",
+           "Application name & version,GENEActiv PC Software 3.2",
+           paste0("Measurement Frequency,", format(sf), " Hz"),
+           paste0("Measurement Period,", ceiling(n / sf / 3600), " Hours"),
+           paste0("Start Time,", stamp(t0)), "Study Centre,", "Study Code,",
+           "Investigator ID,", "Exercise Type,", "Device Location Code,left wrist",
+           "Subject Code,", "Date of Birth,", "Sex,", "Height,", "Weight,", "Handedness Code,",
+           "x gain,25548", "x offset,-5", "y gain,25428", "y offset,-12",
+           "z gain,25636", "z offset,8", "Volts,300", "Lux,800")
+  hdr <- c(hdr, paste0("Extension line ", seq_len(100 - length(hdr)), ","))
+  con <- file(file, "w")
+  on.exit(close(con))
+  writeLines(hdr, con)
+  temp <- if (is.null(rec$temperature)) rep(25, n) else rec$temperature
+  for (a in seq(1L, n, by = chunk)) {
+    i <- a:min(n, a + chunk - 1L)
+    k <- i - 1L
+    sec <- t0 + k %/% sf
+    ms <- round((k %% sf) * 1000 / sf)
+    ts <- paste0(format(sec, "%Y-%m-%d %H:%M:%S"), ":", sprintf("%03d", as.integer(ms)))
+    writeLines(paste(ts, sprintf("%.4f", rec$x[i]), sprintf("%.4f", rec$y[i]),
+                     sprintf("%.4f", rec$z[i]), "0", "0", sprintf("%.1f", temp[i]), sep = ","),
+               con)
+  }
+  invisible(file)
+}
