@@ -20,9 +20,10 @@ with_tz <- function(tz, code) {
   code
 }
 
-# readAxivity window after window (B blocks), as g.readaccfile calls it
-ref_cwa <- function(f, B, interpolationType = 1, frequency_tol = 0.1) {
-  with_tz("UTC", {
+# readAxivity window after window (B blocks), as g.readaccfile calls it, in
+# the session's zone `tz` (configtz = desiredtz = "")
+ref_cwa <- function(f, B, interpolationType = 1, frequency_tol = 0.1, tz = "UTC") {
+  with_tz(tz, {
     out <- list()
     s <- 0
     header <- NULL
@@ -173,29 +174,6 @@ test_that("interpolationType 2: GENEActiv at a rate that is not whole, GGIR's to
   expect_false(identical(res[[1]]$spheredata, res[[2]]$spheredata))
 })
 
-# readAxivity window after window in the session's zone `tz` (configtz =
-# desiredtz = ""), as ref_cwa() in UTC
-ref_cwa_tz <- function(f, B, tz) {
-  with_tz(tz, {
-    out <- list()
-    s <- 0
-    header <- NULL
-    repeat {
-      P <- tryCatch(suppressWarnings(GGIRread::readAxivity(
-        f, start = s, end = s + B, progressBar = FALSE, desiredtz = "",
-        configtz = "", header = header)), error = function(e) NULL)
-      if (is.null(P) || is.null(P$data)) break
-      header <- P$header
-      out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time")]
-      s <- s + B
-    }
-    d <- do.call(rbind, out)
-    names(d)[4] <- "temperature"
-    rownames(d) <- NULL
-    d
-  })
-}
-
 # GGIR's and gravcal's g.calibrate() with GGIR's params_general changed by
 # `general` (desiredtz, configtz)
 run_both_general <- function(f, general, rawdata = list()) {
@@ -226,7 +204,7 @@ test_that("desiredtz: across a change of UTC offset the decoder gives readAxivit
                 list(tz = "Europe/London", start = "2024-03-30 12:00:00", rows = 29))
   for (cs in cases) {
     f <- synth_cwa(seed = 65, start = as.numeric(as.POSIXct(cs$start, tz = "UTC")))
-    ref <- ref_cwa_tz(f, B, cs$tz)
+    ref <- ref_cwa(f, B, tz = cs$tz)
     nat <- nat_cwa(f, B, list(zone = cs$tz))
     expect_identical(nat, ref, label = cs$tz)
     # the hour filled or skipped: 31 or 29 hours of grid from 30 of samples
