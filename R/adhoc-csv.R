@@ -44,9 +44,10 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   }
   gaps <- isTRUE(p$rmc.check4timegaps) && length(p$rmc.col.time) > 0
   resample <- isTRUE(p$rmc.doresample) && length(p$rmc.col.time) > 0
-  if (resample && !p$rmc.unit.time %in% c("UNIXsec", "UNIXmsec")) {
+  if (resample && !p$rmc.unit.time %in% c("UNIXsec", "UNIXmsec", "character", "POSIX")) {
     refuse("rmc.doresample", paste0("resampled with a time column in UNIX seconds or ",
-                                    "milliseconds, not rmc.unit.time = \"", p$rmc.unit.time, "\""))
+                                    "milliseconds, or text, not rmc.unit.time = \"",
+                                    p$rmc.unit.time, "\""))
   }
   header <- rmc_header(p, file)
   sf <- rmc_sf(p, header, file)
@@ -122,26 +123,28 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   if (resample) opts$grid_sf <- as.numeric(sf)
   # rmc.check4timegaps: each block's gaps filled at sf and its zero samples
   # dropped, as g.imputeTimegaps does (decode_ggir_timegaps.hpp), before
-  # any resampling
-  if (gaps) {
-    g <- rmc_gaps_opts(p, file, skip, tz, sf)
+  # any resampling. Both read the time stamps (text time as R's
+  # as.POSIXct() reads it: rmc_time_opts())
+  if (gaps || resample) {
+    g <- rmc_time_opts(p, file, skip, tz, if (gaps) "rmc.check4timegaps" else "rmc.doresample")
     opts[names(g)] <- g
-    opts$timegaps <- as.numeric(sf)
   }
+  if (gaps) opts$timegaps <- as.numeric(sf)
   list(opts = opts, sf = sf, skip = skip, header = header,
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
        })
 }
 
-# rmc.check4timegaps: what the decoder needs to read the time stamps as
-# GGIR's gap imputation sees them (options time_format and time_utc_offset
-# for text time), or an error naming what gravcal does not reproduce. Only
-# the steps between time stamps decide the gaps; GGIR reads text time (and
-# ActivPAL days) in the zone configtz, else desiredtz: a zone whose UTC
+# rmc.check4timegaps and rmc.doresample (`what`): what the decoder needs to
+# read the time stamps as GGIR's gap imputation and resampling see them
+# (options time_format and time_utc_offset for text time), or an error
+# naming `what` and what gravcal does not reproduce. GGIR reads text time
+# (and ActivPAL days) in the zone configtz, else desiredtz: a zone whose UTC
 # offset changes (daylight saving) within 25 months of the first stamp is
-# refused; a fixed offset is subtracted from the stamps.
-rmc_gaps_opts <- function(p, file, skip, tz, sf) {
+# refused; a fixed offset is subtracted from the stamps, as as.POSIXct()
+# does (the resampling's grid starts at the first stamp: its value counts).
+rmc_time_opts <- function(p, file, skip, tz, what) {
   unit <- p$rmc.unit.time
   if (unit %in% c("UNIXsec", "UNIXmsec")) return(list())
   zone <- attr(p, "tz") %||% p$rmc.configtz %||% p$rmc.desiredtz %||% tz
@@ -149,7 +152,7 @@ rmc_gaps_opts <- function(p, file, skip, tz, sf) {
   lines <- lines[seq_along(lines) > skip]
   stamps <- vapply(lines, function(l) rmc_fields(l)[p$rmc.col.time], "", USE.NAMES = FALSE)
   refuse <- function(why) {
-    abort("`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"", unit, "\" is not supported by ",
+    abort("`", what, "` = TRUE with `rmc.unit.time` = \"", unit, "\" is not supported by ",
           "gravcal (", why, "); GGIR::g.calibrate() reads such files.")
   }
   if (unit == "ActivPAL") {

@@ -149,7 +149,7 @@ ggir_param_table <- function() {
                   "time read by %Y %y %m %d %H %M %S %OS %T in a zone of fixed offset); ",
                   "ISO 8601 text as \"POSIX\", repeated whole-second stamps, zones with ",
                   "daylight saving and reader = \"reference\" refused")),
-      list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX time column: honoured (block by block resampling); other time units refused"),
+      list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX or text time column: honoured (block by block resampling; text time as for rmc.check4timegaps); ActivPAL days refused"),
       # a wear column: g.calibrate() does not use it
       list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),
       list("rmc.dec", ".", rmc_choice(c(".", ",")), "the decimal mark"),

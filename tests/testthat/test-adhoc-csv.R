@@ -302,10 +302,11 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
   # through fread, which drops the fractions of a second (see the gap tests)
   expect_error(gc(rmc.check4timegaps = TRUE),
                "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"POSIX\" is not supported")
-  # rmc.doresample with a text time column: refused (UNIX times are
-  # resampled, see below)
-  expect_error(gc(rmc.doresample = TRUE), "`rmc.doresample` = TRUE is not supported")
-  expect_error(gc(rmc.doresample = TRUE), "not rmc.unit.time = \"POSIX\"", fixed = TRUE)
+  # rmc.doresample: the same ISO 8601 text, and ActivPAL days
+  expect_error(gc(rmc.doresample = TRUE),
+               "`rmc.doresample` = TRUE with `rmc.unit.time` = \"POSIX\" is not supported", fixed = TRUE)
+  expect_error(gc(rmc.doresample = TRUE, rmc.unit.time = "ActivPAL"),
+               "not rmc.unit.time = \"ActivPAL\"", fixed = TRUE)
   expect_error(gc(rmc.unit.acc = "kg"), "`rmc.unit.acc` must be one of \"g\", \"mg\", \"bit\"")
   expect_error(gc(rmc.unit.acc = "bit"), "`rmc.unit.acc` = \"bit\" needs `rmc.bitrate`")
   expect_error(gc(rmc.col.acc = c(2, 2, 3)), "`rmc.col.acc` must be 3 different column numbers")
@@ -430,10 +431,35 @@ test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with ga
         f, params_rawdata = c(utils::modifyList(pr, list(rmc.check4timegaps = FALSE)), noise),
         verbose = FALSE)))
       expect_false(identical(G0$spheredata, b$ggir$spheredata))
-      # filled, then resampled
-      expect_adhoc_same(f, c(pr, noise, list(rmc.doresample = TRUE)))
     }
+    # filled, then resampled from the time stamps (text time as
+    # as.POSIXct() reads it)
+    expect_adhoc_same(f, c(pr, noise, list(rmc.doresample = TRUE)))
   }
+})
+
+test_that("rmc.doresample with text time: g.calibrate() is GGIR's, in a zone of fixed offset", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  f <- tempfile(fileext = ".csv")
+  # desiredtz = "": the session's zone, UTC + 1 all year; the grid starts at
+  # the first stamp as as.POSIXct() reads it there
+  old <- Sys.getenv("TZ", unset = NA)
+  Sys.setenv(TZ = "Etc/GMT-1")
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
+  noise <- list(rmc.noise = 0.013 / 1.2)
+  rec <- adhoc_rec(sf = 5, seed = 21)
+  # a sample rate 1 % off the nominal one: resampling moves every sample
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 5 * 1.01, time = "character")
+  pr$rmc.sf <- 5
+  b <- expect_adhoc_same(f, c(pr, noise, list(rmc.doresample = TRUE)))
+  expect_gt(b$ggir$npoints, 100)
+  # resampled: other numbers than the lines as they are
+  b0 <- run_both(f, c(pr, noise))
+  expect_false(identical(b0$ggir$spheredata, b$ggir$spheredata))
 })
 
 test_that("rmc.check4timegaps: what gravcal does not reproduce is an error naming it", {
