@@ -187,12 +187,29 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   at <- t0 + (0:25) * 30.44 * 86400
   txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
   off <- at - as.numeric(as.POSIXct(txt, tz = zone))
-  if (anyNA(off) || any(off != off[1])) {
-    refuse(paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)",
-                  " changes its UTC offset; give desiredtz / configtz a zone of fixed offset"))
+  if (!anyNA(off) && all(off == off[1])) {
+    if (unit == "ActivPAL") return(list())
+    return(list(time_format = p$rmc.format.time, time_utc_offset = off[1]))
   }
-  if (unit == "ActivPAL") return(list())
-  list(time_format = p$rmc.format.time, time_utc_offset = off[1])
+  zone_name <- paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)")
+  # ActivPAL days: GGIR moves them into the zone with lubridate::force_tz()
+  if (unit == "ActivPAL") {
+    refuse(paste0(zone_name, " changes its UTC offset; give desiredtz / configtz a zone of fixed ",
+                  "offset"))
+  }
+  # a zone whose offset changes: text time read in it as as.POSIXct() reads
+  # it, minute by minute (R/zone.R); GGIR converts a block's stamps in
+  # order, so a stamp that exists twice or not at all in the zone takes the
+  # offset of the conversion before it, which gravcal knows except for the
+  # first stamp of a block (the decoder counts those, and g.calibrate()
+  # refuses: ggir_check_zone_read())
+  lo <- as.numeric(as.POSIXct("2000-01-01", tz = "UTC"))
+  hi <- as.numeric(as.POSIXct("2064-01-01", tz = "UTC"))
+  if (t0 < lo || t0 >= hi) {
+    refuse(paste0(zone_name, " changes its UTC offset, and gravcal follows its changes from 2000 ",
+                  "to 2063 only"))
+  }
+  c(list(time_format = p$rmc.format.time, time_utc_offset = 0), zone_options(zone))
 }
 
 # Whether data.table::fread() reads column `col` of `lines` as date-times

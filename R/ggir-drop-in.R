@@ -91,8 +91,8 @@
 #' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
 #' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time, except with `rmc.doresample` and `rmc.check4timegaps`); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
 #' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration (`rmc.configtz`, `rmc.desiredtz`: the zone of text time for `rmc.check4timegaps` when `configtz` and `desiredtz` are not given) |
-#' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds and for text time (`"character"`, `"POSIX"`, read by `rmc.format.time` as for `rmc.check4timegaps`, in a zone of fixed UTC offset): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; ActivPAL days, and the text time `rmc.check4timegaps` refuses, refused with an error |
-#' | `rmc.check4timegaps = TRUE` with a time column | honoured: in each block of lines, samples with x = y = z = 0 dropped (the block's first becomes 0, 0, 1, its last takes the values before it) and every step of at least 0.25 s (or 2 / sf) filled by repeating the sample before it (normalised when its norm exceeds 1.005), as GGIR's `g.imputeTimegaps()` does, before `rmc.doresample`; a gap between two blocks stays, as in GGIR. For UNIX seconds or milliseconds, ActivPAL days, and text time read by `rmc.format.time` with `%Y %y %m %d %H %M %S %OS %T` in a zone (`configtz`, else `desiredtz`) of fixed UTC offset. Refused with an error: other directives, a zone with daylight saving, ISO 8601 text time as `"POSIX"` with fractions of a second (GGIR reads it through `fread()`, which drops them; `"character"` keeps them), whole-second text stamps that repeat, `reader = "reference"` |
+#' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds and for text time (`"character"`, `"POSIX"`, read by `rmc.format.time` as for `rmc.check4timegaps`): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; ActivPAL days, and the text time `rmc.check4timegaps` refuses, refused with an error |
+#' | `rmc.check4timegaps = TRUE` with a time column | honoured: in each block of lines, samples with x = y = z = 0 dropped (the block's first becomes 0, 0, 1, its last takes the values before it) and every step of at least 0.25 s (or 2 / sf) filled by repeating the sample before it (normalised when its norm exceeds 1.005), as GGIR's `g.imputeTimegaps()` does, before `rmc.doresample`; a gap between two blocks stays, as in GGIR. For UNIX seconds or milliseconds, ActivPAL days, and text time read by `rmc.format.time` with `%Y %y %m %d %H %M %S %OS %T` in the zone `configtz`, else `desiredtz` (across changes of its UTC offset too, as for `.cwa`). Refused with an error: other directives, ActivPAL days in a zone with daylight saving, a block of GGIR's reading whose first stamp exists twice or not at all in the zone, ISO 8601 text time as `"POSIX"` with fractions of a second (GGIR reads it through `fread()`, which drops them; `"character"` keeps them), whole-second text stamps that repeat, `reader = "reference"` |
 #'
 #' @param datafile Path of the recording, or a data frame of raw samples.
 #' @param params_rawdata,params_general,params_cleaning GGIR's parameter
@@ -155,6 +155,9 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   if (!is.null(rmc)) {
     desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
     attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
+    attr(rmc, "tz_arg") <- if (length(pr$configtz)) "configtz" else if (!is.null(pr$rmc.configtz)) {
+      "rmc.configtz"
+    } else if (nzchar(pr$desiredtz %||% "") || is.null(pr$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
   }
   # the zone of a .cwa file's calendar times (readAxivity's configtz, else
   # desiredtz): offsets that change (daylight saving) move block times
@@ -182,7 +185,11 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                         minloadcrit = pr$minloadcrit,
                         sdcriter = sdcriter, verbose = verbose,
                         printsummary = pr$printsummary)
-  ggir_check_zone_read(src, tz %||% "", tz_arg)
+  if (identical(src$format, "adhoc_csv") && !is.null(rmc)) {
+    ggir_check_zone_read(src, attr(rmc, "tz") %||% "", attr(rmc, "tz_arg"))
+  } else {
+    ggir_check_zone_read(src, tz %||% "", tz_arg)
+  }
   attr(out, "gravcal") <- NULL
   invisible(out)
 }
@@ -222,16 +229,17 @@ ggir_params <- function(params_rawdata, params_general, dots) {
                                  from(params_general, "general"), dots))
 }
 
-# After a GGIR-compatible .cwa read in a zone whose offset changes: a block
-# of GGIR's reading that starts or ends at a calendar time that exists twice
-# or not at all there (R/zone.R) has a time that depends on R's conversions
-# before it, which gravcal does not know: an error naming the parameter.
+# After a GGIR-compatible .cwa or ad hoc csv read in a zone whose offset
+# changes: a block of GGIR's reading that starts (or, .cwa, ends) at a
+# calendar time that exists twice or not at all there (R/zone.R) has a time
+# that depends on R's conversions before it, which gravcal does not know:
+# an error naming the parameter.
 ggir_check_zone_read <- function(src, tz, arg) {
-  if (!identical(src$format, "cwa") || is.null(src$report)) return(invisible())
+  if (!isTRUE(src$format %in% c("cwa", "adhoc_csv")) || is.null(src$report)) return(invisible())
   n <- src$report()$counters["zone_ambiguous"]
   if (isTRUE(n > 0)) {
     abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",
-          ": a block of GGIR's reading of this .cwa file starts or ends at a time ",
+          ": a block of GGIR's reading of this file starts or ends at a time ",
           "that exists twice or not at all in that zone (a change of UTC offset), ",
           "where GGIR's time depends on R's conversions before it; gravcal does ",
           "not reproduce that. Give a zone without a change there (\"UTC\", or a ",

@@ -146,9 +146,10 @@ ggir_param_table <- function() {
       list("rmc.check4timegaps", FALSE, check_flag,
            paste0("TRUE with a time column: honoured (each block's time gaps filled and ",
                   "zero samples dropped, as g.imputeTimegaps; UNIX s/ms, ActivPAL, text ",
-                  "time read by %Y %y %m %d %H %M %S %OS %T in a zone of fixed offset); ",
-                  "ISO 8601 text as \"POSIX\", repeated whole-second stamps, zones with ",
-                  "daylight saving and reader = \"reference\" refused")),
+                  "time read by %Y %y %m %d %H %M %S %OS %T, in a zone with daylight saving too); ",
+                  "ISO 8601 text as \"POSIX\", repeated whole-second stamps, ActivPAL days ",
+                  "in a zone with daylight saving, a block whose first stamp exists twice or ",
+                  "not at all in the zone, and reader = \"reference\" refused")),
       list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX or text time column: honoured (block by block resampling; text time as for rmc.check4timegaps); ActivPAL days refused"),
       # a wear column: g.calibrate() does not use it
       list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),

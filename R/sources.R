@@ -146,6 +146,9 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
   if (format == "movisens") opts$block_samples <- movisens_block(file)
+  # GGIR's block of lines: where its first line's text time is ambiguous in
+  # a zone with daylight saving (rmc_time_opts())
+  if (format == "adhoc_csv" && !is.null(sf)) opts$block_lines <- format_block_units(format, sf, chunksize)
   if (format == "axivity_csv") {
     lay <- axivity_csv_layout(file, sf)
     sf <- lay$sf

@@ -438,6 +438,33 @@ test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with ga
   }
 })
 
+test_that("text time in a zone with daylight saving: g.calibrate() is GGIR's across its changes", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  f <- tempfile(fileext = ".csv")
+  old <- Sys.getenv("TZ", unset = NA)
+  on.exit({
+    unlink(f)
+    if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old)
+  })
+  noise <- list(rmc.noise = 0.013 / 1.2)
+  # desiredtz = "": the session's zone. The device's calendar runs on; read
+  # in the zone, its times jump an hour forward at the end of daylight
+  # saving in Europe/Amsterdam (2023-10-29 03:00, a gap GGIR fills) and
+  # back an hour at its start in Europe/London (2024-03-31 01:00)
+  cases <- list(list(tz = "Europe/Amsterdam", start = "2023-10-28 12:00:00", seed = 22),
+                list(tz = "Europe/London", start = "2024-03-30 12:00:00", seed = 23))
+  for (cs in cases) {
+    Sys.setenv(TZ = cs$tz)
+    rec <- adhoc_rec(sf = 5, seed = cs$seed)
+    pr <- gravcal:::write_adhoc_csv(rec, f, sf = 5, time = "character", start = cs$start)
+    for (extra in list(list(rmc.check4timegaps = TRUE), list(rmc.doresample = TRUE))) {
+      b <- expect_adhoc_same(f, c(pr, noise, extra))
+      expect_gt(b$ggir$npoints, 100)
+    }
+  }
+})
+
 test_that("rmc.doresample with text time: g.calibrate() is GGIR's, in a zone of fixed offset", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
@@ -475,10 +502,17 @@ test_that("rmc.check4timegaps: what gravcal does not reproduce is an error namin
   pr$rmc.check4timegaps <- TRUE
   gc <- function(...) g.calibrate(f, params_rawdata = utils::modifyList(pr, list(...)),
                                   verbose = FALSE)
-  # a zone with daylight saving: GGIR's text times jump by an hour
-  expect_error(g.calibrate(f, params_rawdata = pr, params_general = list(desiredtz = "Europe/Amsterdam"),
-                           verbose = FALSE),
-               "the time zone \"Europe/Amsterdam\" changes its UTC offset")
+  # a zone with daylight saving is followed (see below); the first stamp
+  # of a block of GGIR's reading at a time that exists twice there is not
+  d2 <- data.frame(time = format(as.POSIXct("2023-10-29 02:20:00", tz = "UTC") + (0:599) / 10,
+                                 "%d/%m/%Y %H:%M:%OS3"), x = 0, y = 0, z = 1)
+  f2 <- tempfile(fileext = ".csv")
+  on.exit(unlink(f2), add = TRUE)
+  utils::write.csv(d2, f2, row.names = FALSE, quote = FALSE)
+  expect_error(g.calibrate(f2, params_rawdata = utils::modifyList(pr, list(rmc.col.temp = NULL)),
+                           params_general = list(desiredtz = "Europe/Amsterdam"), verbose = FALSE),
+               "`desiredtz` = \"Europe/Amsterdam\": a block of GGIR's reading of this file starts",
+               fixed = TRUE)
   expect_error(gc(rmc.format.time = "%d/%m/%Y %R:%OS"), "directives .* not %R")
   expect_error(g.calibrate(f, params_rawdata = pr, verbose = FALSE, reader = "reference"),
                "`rmc.check4timegaps` = TRUE is taken by gravcal's own csv decoder only")

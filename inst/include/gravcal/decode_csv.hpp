@@ -142,6 +142,8 @@ class CsvDecoder : public Decoder {
       time_offset_ = opts.num("time_offset", 0);
       time_fmt_ = opts.str("time_format", "");
       time_utc_offset_ = opts.num("time_utc_offset", 0);
+      zone_ = ZoneTable(opts);
+      block_lines_ = static_cast<std::int64_t>(opts.num("block_lines", 0));
       // text time: not read (start_time + i / sf) unless a format is given
       if (!(time_div_ > 0) && time_fmt_.empty()) col_time_ = -1;
       time_text_ = false;
@@ -642,7 +644,10 @@ class CsvDecoder : public Decoder {
     const int doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
     const double days = static_cast<double>(era) * 146097 + doe - 719468;
     const double whole = std::floor(sec);
-    const double base = days * 86400 + hour * 3600.0 + min * 60.0 + whole - time_utc_offset_;
+    // the calendar read as UTC, less the zone's offset (whole seconds: exact)
+    const double cal = days * 86400 + hour * 3600.0 + min * 60.0 + whole;
+    const double base = cal - (zone_.empty() ? time_utc_offset_ : zone_.offset(cal));
+    last_cal_ = cal;
     t = base + (sec - whole);
     return true;
   }
@@ -890,7 +895,17 @@ class CsvDecoder : public Decoder {
   double stamp_time(const csv_text::Field& f, const csv_text::Line& ln) {
     double s;
     int fd = 0;
-    if (!time_of(f, s, fd)) {
+    const bool ok = time_of(f, s, fd);
+    // the first line of one of GGIR's blocks (block_lines lines from the
+    // first data line): where its text time exists twice or not at all in
+    // the zone, R's conversion of it depends on conversions before it
+    if (ok && !zone_.empty() && block_lines_ > 0 && ln.number > adhoc_skip_ &&
+        (ln.number - 1 - adhoc_skip_) % block_lines_ == 0 && zone_.ambiguous(last_cal_)) {
+      report_.count("zone_ambiguous");
+      report_.note("line " + std::to_string(ln.number) + ": its time exists twice or not at all in "
+                   "GGIR's zone and starts a block of GGIR's reading");
+    }
+    if (!ok) {
       report_.count("bad_timestamps");
       report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
                    "): unreadable time stamp; time from the line before");
@@ -968,6 +983,9 @@ class CsvDecoder : public Decoder {
   double time_div_ = 0, time_offset_ = 0;
   std::string time_fmt_;  // text time stamps' strptime() format ("": not read)
   double time_utc_offset_ = 0;
+  ZoneTable zone_;  // a zone whose offset changes (options tz_*), else time_utc_offset_
+  std::int64_t block_lines_ = 0;  // lines in one of GGIR's blocks (option block_lines)
+  mutable double last_cal_ = 0;   // the last text time read, as its calendar read as UTC
   double acc_div_ = 1, acc_scale_ = 1, bit_pow_ = 1, bit_range_ = 1;
   int bit_ = 0, temp_unit_ = 0;
 };

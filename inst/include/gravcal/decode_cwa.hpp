@@ -243,55 +243,6 @@ struct Block {
   unsigned char bytes[block_bytes];
 };
 
-// The UTC offset readAxivity's as.POSIXct() gives a calendar time in the
-// zone GGIR names (configtz, else desiredtz), as seconds to subtract from
-// the calendar read as UTC: a step function of the calendar minute, with the
-// minutes whose offset depends on R's earlier conversions (a time that
-// exists twice, or not at all, at a change of offset) marked. R works it out
-// in the R the package runs in (R/zone.R) and passes it as options: tz_n
-// steps (tz_at_i: the calendar second from which tz_off_i holds; before
-// the first, the first's offset), tz_amb_n marked spans [tz_amb_lo_j,
-// tz_amb_hi_j). None: the calendar read as UTC.
-class ZoneTable {
- public:
-  static constexpr int kMax = 4096;
-  explicit ZoneTable(const Options& opts) {
-    const double n = opts.num("tz_n", 0), na = opts.num("tz_amb_n", 0);
-    if (!(n >= 1 && n <= kMax && na >= 0 && na <= kMax)) return;
-    for (int i = 0; i < static_cast<int>(n); ++i) {
-      const std::string k = std::to_string(i);
-      at_.push_back(opts.num(("tz_at_" + k).c_str(), 0));
-      off_.push_back(opts.num(("tz_off_" + k).c_str(), 0));
-    }
-    for (int j = 0; j < static_cast<int>(na); ++j) {
-      const std::string k = std::to_string(j);
-      amb_.emplace_back(opts.num(("tz_amb_lo_" + k).c_str(), 0), opts.num(("tz_amb_hi_" + k).c_str(), 0));
-    }
-  }
-  bool empty() const { return at_.empty(); }
-  // the offset for calendar time c (seconds, read as UTC)
-  double offset(double c) const {
-    if (at_.empty()) return 0;
-    std::size_t lo = 0, hi = at_.size();  // the last step at or before c
-    while (hi - lo > 1) {
-      const std::size_t mid = lo + (hi - lo) / 2;
-      if (at_[mid] <= c) lo = mid;
-      else hi = mid;
-    }
-    return off_[lo];
-  }
-  bool ambiguous(double c) const {
-    for (const auto& a : amb_) {
-      if (c >= a.first && c < a.second) return true;
-    }
-    return false;
-  }
-
- private:
-  std::vector<double> at_, off_;
-  std::vector<std::pair<double, double>> amb_;
-};
-
 }  // namespace cwa
 
 class CwaDecoder : public Decoder {
@@ -344,7 +295,7 @@ class CwaDecoder : public Decoder {
   bool fused_;                     // GGIRread's resample() fused (option resample_fused)
   double frequency_tol_;
   bool r_long_double_;  // R's accumulator: long double, else double
-  cwa::ZoneTable zone_;  // GGIR's zone (compat = 1 only)
+  ZoneTable zone_;  // GGIR's zone (compat = 1 only)
   bool done_ = false;
   std::int64_t n_blocks_ = -1;     // complete data blocks in the file; -1 unknown
   double header_f_ = 0;            // rate in the header (GGIR's grid rate)
