@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "gravcal/decode.hpp"
 #include "gravcal/ggir_procedure.hpp"
 #include "gravcal/pipeline.hpp"
 
@@ -170,7 +171,44 @@ static void test_procedure() {
   CHECK(z.stopped);
 }
 
+// A zone's offsets by calendar time (decode.hpp's ZoneTable, as R/zone.R
+// hands them to the .cwa and csv decoders): the step at or before a time,
+// the first step's offset before it, the marked spans; a table that does
+// not hold together is no table.
+static void test_zone() {
+  gravcal::Options o;
+  o.set("tz_n", 3);
+  o.set("tz_at_0", 0);
+  o.set("tz_off_0", 0);
+  o.set("tz_at_1", 100);
+  o.set("tz_off_1", 3600);
+  o.set("tz_at_2", 200);
+  o.set("tz_off_2", 0);
+  o.set("tz_amb_n", 1);
+  o.set("tz_amb_lo_0", 150);
+  o.set("tz_amb_hi_0", 160);
+  const gravcal::ZoneTable z(o);
+  CHECK(!z.empty());
+  CHECK(z.offset(-5) == 0);
+  CHECK(z.offset(99.5) == 0);
+  CHECK(z.offset(100) == 3600);
+  CHECK(z.offset(199.5) == 3600);
+  CHECK(z.offset(200) == 0);
+  CHECK(z.offset(1e9) == 0);
+  CHECK(!z.ambiguous(149.5));
+  CHECK(z.ambiguous(150));
+  CHECK(z.ambiguous(159.9));
+  CHECK(!z.ambiguous(160));
+  gravcal::Options none;
+  CHECK(gravcal::ZoneTable(none).empty());
+  CHECK(gravcal::ZoneTable(none).offset(12345) == 0);
+  gravcal::Options big;
+  big.set("tz_n", 5000);  // more than it holds: none
+  CHECK(gravcal::ZoneTable(big).empty());
+}
+
 int main() {
+  test_zone();
   test_pump();
   test_procedure();
   std::printf("pipeline: %s\n", failures ? "FAILED" : "all checks passed");
