@@ -8,6 +8,7 @@
 // whether pulled through a large buffer or a 7-sample one, and with or
 // without the AVX2 paths.
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "fuzz_input.hpp"
@@ -24,11 +25,26 @@ struct Run {
 };
 
 bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t window,
-         std::size_t cap, Run& r, double interpolation = 1) {
+         std::size_t cap, Run& r, double interpolation = 1, bool zone = false) {
   gravcal::MemorySource src(file.data(), file.size());
   gravcal::Options opts;
   opts.set("compat", compat ? 1.0 : 0.0);
   opts.set("interpolation", interpolation);
+  if (zone) {
+    // a zone whose offset changes every year from 2000 (as R/zone.R gives
+    // them), each change's hour marked: block times that jump back and forth
+    opts.set("tz_n", 129.0);
+    opts.set("tz_amb_n", 64.0);
+    for (int i = 0; i < 129; ++i) {
+      const double at = 946684800.0 + (i == 0 ? 0 : (i - 1) * 15778800.0 + 7200);
+      opts.set("tz_at_" + std::to_string(i), at);
+      opts.set("tz_off_" + std::to_string(i), (i % 2) ? 3600.0 : 0.0);
+      if (i % 2 == 0 && i > 0) {
+        opts.set("tz_amb_lo_" + std::to_string(i / 2 - 1), at - 3600);
+        opts.set("tz_amb_hi_" + std::to_string(i / 2 - 1), at);
+      }
+    }
+  }
   gravcal::CwaDecoder dec(src, opts);
   if (!dec.open()) {
     if (dec.error().empty()) __builtin_trap();
@@ -96,17 +112,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (fix & 1) repair(file, (fix & 2) != 0);
   const bool compat = mode & 1;
   const double interpolation = (mode & 4) ? 2 : 1;
+  const bool zone = (mode & 8) != 0;
   if (window == 0) return 0;
   const std::size_t blocks = file.size() > 1024 ? (file.size() - 1024) / 512 : 0;
   Run big, small;
   const std::size_t cap = 4096;
-  const bool ok = run(file, compat, window, cap, big, interpolation);
-  if (run(file, compat, window, 7, small, interpolation) != ok) __builtin_trap();
+  const bool ok = run(file, compat, window, cap, big, interpolation, zone);
+  if (run(file, compat, window, 7, small, interpolation, zone) != ok) __builtin_trap();
   // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
   if (gravcal::use_avx2()) {
     Run base;
     gravcal::set_avx2(false);
-    const bool ok2 = run(file, compat, window, cap, base, interpolation);
+    const bool ok2 = run(file, compat, window, cap, base, interpolation, zone);
     gravcal::set_avx2(true);
     if (ok2 != ok || base.v.size() != big.v.size() || base.units != big.units ||
         base.report.skipped != big.report.skipped || !same(big, base)) {

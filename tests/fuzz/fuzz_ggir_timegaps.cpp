@@ -34,6 +34,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if ((mode & 6) == 6) {
     o.set("time_format", std::string("%d/%m/%Y %H:%M:%OS"));
     o.set("time_utc_offset", 3600.0);
+    if (mode & 16) {
+      // a zone whose offset changes (R/zone.R's table): 2023's two changes
+      // in Europe/Amsterdam, the autumn hour marked, blocks of 50 lines
+      o.set("tz_n", 3.0);
+      o.set("tz_at_0", 946684800.0);
+      o.set("tz_off_0", 3600.0);
+      o.set("tz_at_1", 1679796000.0);
+      o.set("tz_off_1", 7200.0);
+      o.set("tz_at_2", 1698548400.0);
+      o.set("tz_off_2", 3600.0);
+      o.set("tz_amb_n", 1.0);
+      o.set("tz_amb_lo_0", 1698544800.0);
+      o.set("tz_amb_hi_0", 1698548400.0);
+      o.set("block_lines", 50.0);
+    }
   } else {
     o.set("time_div", (mode & 2) ? 1000.0 : 1.0);
   }
