@@ -43,7 +43,9 @@ recording_formats <- list(
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
     decoder = NULL,
     read = function(file, sf, reader, arg) {
-      read_adhoc(file, reader, rmc_values(geneactiv_csv_rmc(file, arg)))$data
+      d <- read_adhoc(file, reader, rmc_values(geneactiv_csv_rmc(file, arg)))$data
+      if (is.list(attr(d, "input"))) attr(d, "input")$format <- "geneactiv_csv"
+      d
     },
     source = function(file, sf, chunksize, arg) {
       open_source(file, sf, chunksize, arg, compat = FALSE)

@@ -31,6 +31,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   check_file(datafile, arg)
   reader <- match_choice(reader, "reader", c("native", "reference"))
   layout <- NULL
+  shown <- NULL  # the format fits and tables name, where it is read as another
   if (!is.null(rmc$rmc.firstrow.acc)) {
     format <- "adhoc_csv"
     layout <- rmc_layout(rmc, datafile, ggir = compat)
@@ -39,6 +40,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
     format <- file_format(datafile, arg)
     if (format == "geneactiv_csv") {
       if (isTRUE(compat)) geneactiv_csv_refuse(datafile, arg)
+      shown <- format
       format <- "adhoc_csv"
       layout <- rmc_layout(rmc_values(geneactiv_csv_rmc(datafile, arg)), datafile, ggir = FALSE)
       sf <- layout$sf
@@ -58,6 +60,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   check_sf_agrees(sf, src$sf, format, datafile)
   src$filename <- ggir_file_name(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
+  if (!is.null(shown)) src$format <- shown
   src
 }
 

@@ -63,5 +63,6 @@ test_that("g.calibrate() refuses a GENEActiv csv export as GGIR does, and GGIR's
   # gravcal's own method reads it as it is
   fit <- calibrate(f)
   expect_s3_class(fit, "gravcal_fit")
-  expect_identical(fit$input$format, "adhoc_csv")
+  expect_identical(fit$input$format, "geneactiv_csv")
+  expect_identical(read_recording(f)$input$format, "geneactiv_csv")
 })
