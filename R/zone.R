@@ -38,8 +38,8 @@ zone_table_make <- function(tz) {
   # by how much as.POSIXct() of each calendar time (seconds, read as UTC)
   # in the zone moves it, converted in the order given
   off_of <- function(at) {
-    txt <- format(.POSIXct(at, tz = "UTC"), "%Y-%m-%d %H:%M:%S")
-    at - as.numeric(as.POSIXct(txt, tz = tz))
+    fmt <- "%Y-%m-%d %H:%M:%S"
+    at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = tz))
   }
   changes <- function(v) which(v[-1] != v[-length(v)])
   lo <- as.numeric(as.POSIXct("2000-01-01", tz = "UTC"))
@@ -79,7 +79,15 @@ zone_table_make <- function(tz) {
   at <- at[o]
   off <- off[o]
   keep <- c(TRUE, off[-1] != off[-length(off)])
-  list(at = at[keep], off = off[keep], amb_lo = amb[, 1], amb_hi = amb[, 2])
+  # marked minutes as spans, each run of minutes one span
+  lo_span <- hi_span <- numeric(0)
+  if (nrow(amb)) {
+    amb <- unique(amb[order(amb[, 1]), , drop = FALSE])
+    run <- cumsum(c(TRUE, amb[-1, 1] > amb[-nrow(amb), 2]))
+    lo_span <- as.numeric(tapply(amb[, 1], run, min))
+    hi_span <- as.numeric(tapply(amb[, 2], run, max))
+  }
+  list(at = at[keep], off = off[keep], amb_lo = lo_span, amb_hi = hi_span)
 }
 
 # The decoder options for the table of `tz` (none for a fixed offset).

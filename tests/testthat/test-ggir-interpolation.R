@@ -191,6 +191,30 @@ run_both_general <- function(f, general, rawdata = list()) {
                                    verbose = FALSE)))
 }
 
+test_that("a zone's offsets by calendar minute, as this R converts (R/zone.R)", {
+  # Europe/Amsterdam from 2000 to 2063: two changes a year; the calendar hour
+  # that exists twice each autumn marked as one span, 02:00 to 03:00
+  z <- gravcal:::zone_table("Europe/Amsterdam")
+  expect_identical(length(z$at), 129L)
+  expect_identical(sort(unique(z$off)), c(3600, 7200))
+  autumn <- as.numeric(as.POSIXct("2023-10-29 02:00:00", tz = "UTC"))
+  expect_true(autumn %in% z$amb_lo)
+  expect_true(all(z$amb_hi - z$amb_lo == 3600))
+  fmt <- "%Y-%m-%d %H:%M:%S"
+  for (txt in c("2023-03-26 01:59:00", "2023-03-26 03:00:00", "2023-10-29 03:00:00", "2023-07-01 12:00:00")) {
+    cal <- as.numeric(as.POSIXct(txt, tz = "UTC"))
+    off <- z$off[findInterval(cal, z$at)]
+    expect_identical(cal - off, as.numeric(as.POSIXct(txt, format = fmt, tz = "Europe/Amsterdam")),
+                     label = txt)
+  }
+  # a fixed offset: no table (the calendar read as UTC shifts every time alike)
+  expect_null(gravcal:::zone_table("UTC"))
+  expect_null(gravcal:::zone_table("Etc/GMT-1"))
+  o <- gravcal:::zone_options("Europe/Amsterdam")
+  expect_identical(o$tz_n, 129L)
+  expect_identical(o$tz_amb_n, 64L)
+})
+
 test_that("desiredtz: across a change of UTC offset the decoder gives readAxivity's block times", {
   skip_if_not_installed("GGIRread")
   # 30 hours across the end of daylight saving in Europe/Amsterdam (its
