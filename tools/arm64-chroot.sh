@@ -18,6 +18,9 @@
 #                         bound read-only into the chroot when present
 #   GRAVCAL_DEBIAN_MIRROR the Debian mirror (default http://deb.debian.org/debian)
 #   GRAVCAL_CRAN          the CRAN mirror (tools/install-ggir.sh)
+#   ARM64_FILES           with identity or all: run only these test files
+#                         (space-separated names, e.g. the ones a run cut
+#                         short did not reach), in the order given
 # Logs and timings: _build/arm64/.
 set -euo pipefail
 
@@ -228,6 +231,11 @@ in_chroot tests "
     options(testthat.summary.max_reports = 10000L)
     files <- strsplit(\"$(echo $identity)\", \" \")[[1]]
     if (\"$scope\" == \"all\") files <- c(files, setdiff(sort(list.files(\".\", \"^test-.*[.]R\$\")), files))
+    only <- strsplit(\"$(echo ${ARM64_FILES:-})\", \" \")[[1]]
+    if (length(only)) {
+      if (!all(file.exists(only))) stop(\"ARM64_FILES names no test file: \", paste(only[!file.exists(only)], collapse = \" \"))
+      files <- only
+    }
     row <- function(f) {
       t0 <- proc.time()[[3]]
       r <- as.data.frame(test_file(f, reporter = \"summary\", package = \"gravcal\", load_package = \"installed\"))
