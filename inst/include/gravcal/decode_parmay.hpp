@@ -172,31 +172,34 @@ class ParmayDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
     while (!out.full()) {
-      if (next_point(out)) continue;
+      if (compat_ && (run(out) || next_points(out))) continue;
       if (finished_) break;
-      if (max_units >= 0 && units >= max_units && acc_rows_.at_packet_start()) break;
-      const std::int64_t before = acc_rows_.packets_done;
-      double v[3];
-      double t;
-      const bool got_row = acc_rows_.next_row(v);
-      const bool got_time = got_row && acc_times_.next_time(&t);
-      units += acc_rows_.packets_done - before;
-      if (!got_time) {
-        finish();
+      if (chunk_.i >= chunk_.n) {
+        // the next raw samples: the rest of a packet at most, so that a
+        // call can stop at a packet's start
+        if (chunk_.last) {
+          finish();
+          continue;
+        }
+        if (max_units >= 0 && units >= max_units && acc_rows_.at_packet_start()) break;
+        units += fill_chunk();
+        if (chunk_.n == 0) finish();
         continue;
       }
+      const int i = chunk_.i++;
+      const double v[3] = {chunk_.x[i], chunk_.y[i], chunk_.z[i]};
       if (!compat_) {
         // gravcal's own reading: the samples at their times, no grid
-        put(out, v, t);
+        put(out, v, chunk_.t[i]);
         continue;
       }
-      take(v, t);
+      take(v, chunk_.t[i]);
     }
     report_.units = acc_rows_.packets_done;
     return units;
   }
 
-  bool done() const override { return finished_ && held_.empty(); }
+  bool done() const override { return finished_ && held_n_ == 0; }
 
   std::size_t max_samples_per_unit() const override { return kMaxSamplesPerUnit; }
 
@@ -225,10 +228,14 @@ class ParmayDecoder : public Decoder {
       const std::size_t got = src_.read(buf + carry, 65536);
       const std::size_t n = carry + got;
       if (n >= 8) {
-        for (std::size_t i = 0; i + 8 <= n; ++i) {
-          if (buf[i] == 'M' && std::memcmp(buf + i, pat, 8) == 0) {
-            starts.push_back(base + static_cast<std::int64_t>(i));
-          }
+        const unsigned char* q = buf;
+        const unsigned char* const last = buf + n - 8;  // the last place a pattern can start
+        while (q <= last) {
+          const void* m = std::memchr(q, 'M', static_cast<std::size_t>(last - q) + 1);
+          if (m == nullptr) break;
+          q = static_cast<const unsigned char*>(m);
+          if (std::memcmp(q, pat, 8) == 0) starts.push_back(base + (q - buf));
+          ++q;
         }
       }
       if (got == 0) {
@@ -447,6 +454,56 @@ class ParmayDecoder : public Decoder {
       v[1] = static_cast<double>(static_cast<std::int16_t>(le16(b + 2))) / 10;
       return true;
     }
+    // next_rows: up to `max` rows of acceleration (kind kAcc), all from one
+    // packet, as next_row() gives them one by one; 0 at the end. A good
+    // packet's rows that the file holds are read in one go.
+    int next_rows(double* x, double* y, double* z, int max) {
+      while (n < 0 || j >= n) {
+        if (n >= 0) {
+          ++i;
+          ++packets_done;
+        }
+        if (i >= d->packets_.size()) {
+          n = 0;
+          j = 0;
+          return 0;
+        }
+        n = rows(d->packets_[i]);
+        j = 0;
+      }
+      const Packet& p = d->packets_[i];
+      std::int64_t m = n - j;
+      if (m > max) m = max;
+      int k = 0;
+      if (p.ok && j + m <= p.n_acc) {
+        unsigned char b[6 * kChunk];
+        const std::int64_t at = offset(p) + 6 * j;
+        const std::size_t got = d->src_.seek(at) ? read_full(d->src_, b, static_cast<std::size_t>(6 * m)) : 0;
+        buf_at = -1;  // the source moved: fetch() reads afresh
+        const double* unit = d->acc_unit_;
+        const int whole = static_cast<int>(got / 6);
+        for (; k < whole; ++k) {
+          const unsigned char* r = b + 6 * k;
+          const int wx = static_cast<std::int16_t>(le16(r));
+          const int wy = static_cast<std::int16_t>(le16(r + 2));
+          const int wz = static_cast<std::int16_t>(le16(r + 4));
+          x[k] = static_cast<double>(wx) * unit[wx < 0];
+          y[k] = static_cast<double>(wy) * unit[wy < 0];
+          z[k] = static_cast<double>(wz) * unit[wz < 0];
+        }
+        j += k;
+        const double na = r_na_real();
+        for (; k < m; ++k, ++j) x[k] = y[k] = z[k] = na;  // not read: as fetch() failing
+        return k;
+      }
+      for (double v[3]; k < m; ++k) {
+        next_row(v);
+        x[k] = v[0];
+        y[k] = v[1];
+        z[k] = v[2];
+      }
+      return k;
+    }
     // next_time: the next time stamp; false at the end
     bool next_time(double* t) {
       while (n < 0 || j >= n) {
@@ -472,7 +529,58 @@ class ParmayDecoder : public Decoder {
       else *t = t_from + static_cast<double>(r) * t_step;
       return true;
     }
+    // next_times: up to `max` times, as next_time() gives them one by one;
+    // how many (fewer at the end)
+    int next_times(double* t, int max) {
+      int got = 0;
+      while (got < max) {
+        if (n < 0 || j >= n || j == 0) {
+          // a packet's first time: next_time() sets its spread
+          if (!next_time(t + got)) break;
+          ++got;
+          continue;
+        }
+        std::int64_t m = n - j;
+        if (m > max - got) m = max - got;
+        for (const std::int64_t e = j + m; j < e; ++j) {
+          if (n <= 1 || t_from == t_to) t[got++] = t_from;
+          else if (j == n - 1) t[got++] = t_to;
+          else t[got++] = t_from + static_cast<double>(j) * t_step;
+        }
+      }
+      return got;
+    }
   };
+
+  // Raw acceleration samples read ahead: rows and times, paired in order
+  // as GGIRread pairs them (the two streams count a packet's samples each
+  // its own way, see Stream::rows()), at most the rest of one packet of
+  // rows at a time.
+  static constexpr int kChunk = 1024;
+  struct Chunk {
+    std::vector<double> buf = std::vector<double>(4 * kChunk);
+    double* x = buf.data();
+    double* y = x + kChunk;
+    double* z = y + kChunk;
+    double* t = z + kChunk;
+    int n = 0, i = 0;
+    bool last = false;  // the times (or rows) ended within this chunk
+    Chunk() = default;
+    Chunk(const Chunk&) = delete;  // x..t point into buf
+    Chunk& operator=(const Chunk&) = delete;
+  };
+
+  // Fills the chunk; returns the packets the row stream moved past. An
+  // empty chunk: the end.
+  std::int64_t fill_chunk() {
+    const std::int64_t before = acc_rows_.packets_done;
+    const int rows = acc_rows_.next_rows(chunk_.x, chunk_.y, chunk_.z, kChunk);
+    const int times = rows > 0 ? acc_times_.next_times(chunk_.t, rows) : 0;
+    chunk_.n = times;
+    chunk_.i = 0;
+    chunk_.last = times < rows;
+    return acc_rows_.packets_done - before;
+  }
 
   // The temperature GGIRread gives a damaged packet: the mean of the last
   // row of the good packet before it and the first row of the good packet
@@ -528,7 +636,7 @@ class ParmayDecoder : public Decoder {
   // current interval (so a long gap costs time, never memory); the grid has
   // floor((last - start) * rate) + 1 points, so a point is given once the
   // raw times so far reach that far (`confirmed_`): the few that the last
-  // time does not confirm wait in `held_` (rounding makes at most one or
+  // time does not confirm wait in `held_` (a ring; rounding makes at most one or
   // two) and are dropped at the end.
 
   struct Point {
@@ -553,43 +661,203 @@ class ParmayDecoder : public Decoder {
     confirmed_ = std::floor((t - start_) * sf_) + 1;
   }
 
-  // Gives (or holds) the next grid point; false when the current interval
-  // has none left (a new raw sample is needed).
-  bool next_point(SampleBuffer& out) {
-    if (!held_.empty() && static_cast<double>(held_.front().k) < confirmed_) {
-      const Point p = held_.front();
-      held_.erase(held_.begin());
-      put(out, p.v, start_ + static_cast<double>(p.k) * by_);
-      return true;
-    }
-    if (!have_interval_ || finished_) return false;
-    const double g = start_ + static_cast<double>(k_) * by_;
-    if (!(g <= cur_t_)) {
-      have_interval_ = false;
-      return false;
-    }
-    Point p;
-    p.k = k_++;
-    double u = (g - prev_t_) / (cur_t_ - prev_t_);
-    if (u < 0 || u > 1) u = 0;
-    if (nearest_) u = ggir_nearest_weight(u);
-    for (int c = 0; c < 3; ++c) p.v[c] = kernels::ggir_lerp(u, prev_v_[c], cur_v_[c], fused_);
-    if (held_.empty() && static_cast<double>(p.k) < confirmed_) {
-      put(out, p.v, g);
-    } else {
-      if (held_.size() >= kMaxHeld) {
+  // Gives grid points while the buffer has room: first the held ones the
+  // raw times now confirm, then those of the current interval (held, in
+  // order, while an earlier one is); false when it gave or held none (a
+  // new raw sample is needed).
+  bool next_points(SampleBuffer& out) {
+    bool any = false;
+    while (!out.full()) {
+      if (held_n_ > 0 && static_cast<double>(held_[held_at_].k) < confirmed_) {
+        const Point& p = held_[held_at_];
+        put(out, p.v, start_ + static_cast<double>(p.k) * by_);
+        held_at_ = (held_at_ + 1) % kMaxHeld;
+        --held_n_;
+        any = true;
+        continue;
+      }
+      if (!have_interval_ || finished_) break;
+      const double g = start_ + static_cast<double>(k_) * by_;
+      if (!(g <= cur_t_)) {
+        have_interval_ = false;
+        break;
+      }
+      double u = (g - prev_t_) / (cur_t_ - prev_t_);
+      if (u < 0 || u > 1) u = 0;
+      if (nearest_) u = ggir_nearest_weight(u);
+      double v[3];
+      for (int c = 0; c < 3; ++c) v[c] = kernels::ggir_lerp(u, prev_v_[c], cur_v_[c], fused_);
+      const std::int64_t k = k_++;
+      any = true;
+      if (held_n_ == 0 && static_cast<double>(k) < confirmed_) {
+        put(out, v, g);
+        continue;
+      }
+      if (held_n_ == kMaxHeld) {
         // raw times that ran backwards: the oldest held point is dropped
-        held_.erase(held_.begin());
+        held_at_ = (held_at_ + 1) % kMaxHeld;
+        --held_n_;
         report_.count("grid_points_dropped");
       }
-      held_.push_back(p);
+      Point& p = held_[(held_at_ + held_n_) % kMaxHeld];
+      p.k = k;
+      for (int c = 0; c < 3; ++c) p.v[c] = v[c];
+      ++held_n_;
     }
-    return true;
+    return any;
+  }
+
+  // temp_at()'s arithmetic where the temperature's interval stays put
+  // (run()'s copy of its state): mode 0 no temperature, 1 NA from here,
+  // 2 interpolated between (tp_t, tp_v) and (tc_t, tc_v).
+  struct TempSpan {
+    int mode;
+    double first, tp_t, tc_t, tp_v, tc_v;
+    bool nearest, fused;
+    double na;
+    // false where the interval must move (temp_at() then)
+    bool at(double g, double* out) const {
+      *out = na;
+      if (mode != 2 || g < first) return true;
+      if (tc_t < g) return false;
+      double w = (g - tp_t) / (tc_t - tp_t);
+      if (w < 0 || w > 1) w = 0;
+      if (nearest) w = ggir_nearest_weight(w);
+      *out = kernels::ggir_lerp(w, tp_v, tc_v, fused);
+      return true;
+    }
+  };
+
+  // The usual case of next_points() and take() in one loop, the state in
+  // locals (the output columns could alias the members): points given
+  // as soon as made (none held), the temperature's interval not to move.
+  // Leaves the rest (a point to hold, the next temperature row, the first
+  // sample, a new chunk) to next_points(), take() and temp_at(), with the
+  // same arithmetic; false when it did nothing.
+  bool run(SampleBuffer& out) {
+    if (held_n_ != 0 || finished_ || !have_prev_) return false;
+    const bool temp_cols = out.t != nullptr, time_col = out.time != nullptr;
+    const double na = r_na_real();
+    // the temperature: 0 none (NA), 1 NA from here, 2 interpolated
+    int temp_mode = 0;
+    if (any_temp_) {
+      if (!temp_started_) return false;
+      temp_mode = temp_ended_ ? 1 : 2;
+    }
+    const double start = start_, by = by_, sf = sf_, tp_t = tp_t_, tc_t = tc_t_, tp_v = tp_v_,
+                 tc_v = tc_v_, temp_first = temp_first_;
+    const bool nearest = nearest_, fused = fused_;
+    double prev_t = prev_t_, cur_t = cur_t_, confirmed = confirmed_;
+    double p0 = prev_v_[0], p1 = prev_v_[1], p2 = prev_v_[2];
+    double c0 = cur_v_[0], c1 = cur_v_[1], c2 = cur_v_[2];
+    bool interval = have_interval_;
+    std::int64_t k = k_;
+    int i = chunk_.i;
+    const int n_raw = chunk_.n;
+    std::size_t o = out.n;
+    const std::size_t cap = out.capacity;
+    bool progress = false;
+    // one point the raw times do not yet confirm (as held_ holds it: its
+    // temperature when given); a second leaves the loop
+    bool pend = false;
+    double pk = 0;
+    double pv[3] = {0, 0, 0};
+    // k < confirmed, confirmed = floor(x) + 1 with x = (cur_t - start) sf,
+    // is k <= x for a whole k (and false for x NaN either way)
+    double x_conf = (cur_t - start) * sf;
+    double kd = static_cast<double>(k);
+    TempSpan ts{temp_mode, temp_first, tp_t, tc_t, tp_v, tc_v, nearest, fused, na};
+    for (;;) {
+      if (pend && pk <= x_conf) {
+        if (o >= cap) break;
+        const double g = start + pk * by;
+        double temp;
+        if (!ts.at(g, &temp)) break;
+        out.x[o] = pv[0];
+        out.y[o] = pv[1];
+        out.z[o] = pv[2];
+        if (temp_cols) out.t[o] = temp;
+        if (time_col) out.time[o] = g;
+        ++o;
+        pend = false;
+      }
+      while (interval && o < cap) {
+        const double g = start + kd * by;
+        if (!(g <= cur_t)) {
+          interval = false;
+          break;
+        }
+        if (pend) goto leave;  // a second point to hold
+        const bool hold = !(kd <= x_conf);
+        double temp = na;
+        if (!hold && !ts.at(g, &temp)) goto leave;  // the next temperature row
+        double u = (g - prev_t) / (cur_t - prev_t);
+        if (u < 0 || u > 1) u = 0;
+        if (nearest) u = ggir_nearest_weight(u);
+        const double v0 = kernels::ggir_lerp(u, p0, c0, fused);
+        const double v1 = kernels::ggir_lerp(u, p1, c1, fused);
+        const double v2 = kernels::ggir_lerp(u, p2, c2, fused);
+        if (hold) {
+          pend = true;
+          pk = kd;
+          pv[0] = v0;
+          pv[1] = v1;
+          pv[2] = v2;
+        } else {
+          out.x[o] = v0;
+          out.y[o] = v1;
+          out.z[o] = v2;
+          if (temp_cols) out.t[o] = temp;
+          if (time_col) out.time[o] = g;
+          ++o;
+        }
+        kd += 1;
+        progress = true;
+      }
+      if (o >= cap || i >= n_raw) break;
+      // take(): the next raw sample
+      p0 = c0;
+      p1 = c1;
+      p2 = c2;
+      c0 = chunk_.x[i];
+      c1 = chunk_.y[i];
+      c2 = chunk_.z[i];
+      prev_t = cur_t;
+      cur_t = chunk_.t[i];
+      x_conf = (cur_t - start) * sf;
+      interval = true;
+      ++i;
+      progress = true;
+    }
+  leave:
+    k = static_cast<std::int64_t>(kd);
+    confirmed = std::floor(x_conf) + 1;
+    if (pend) {
+      Point& p = held_[(held_at_ + held_n_) % kMaxHeld];
+      p.k = static_cast<std::int64_t>(pk);
+      for (int c = 0; c < 3; ++c) p.v[c] = pv[c];
+      ++held_n_;
+    }
+    report_.samples += static_cast<std::int64_t>(o - out.n);
+    out.n = o;
+    chunk_.i = i;
+    k_ = k;
+    have_interval_ = interval;
+    prev_t_ = prev_t;
+    cur_t_ = cur_t;
+    confirmed_ = confirmed;
+    prev_v_[0] = p0;
+    prev_v_[1] = p1;
+    prev_v_[2] = p2;
+    cur_v_[0] = c0;
+    cur_v_[1] = c1;
+    cur_v_[2] = c2;
+    return progress;
   }
 
   void finish() {
     finished_ = true;
-    held_.clear();
+    held_n_ = 0;
   }
 
   void put(SampleBuffer& out, const double* v, double g) {
@@ -679,6 +947,7 @@ class ParmayDecoder : public Decoder {
   double sf_ = 0, by_ = 0;
   bool any_temp_ = false, any_gyro_ = false, any_heart_ = false;
   Stream acc_rows_, acc_times_, temp_rows_, temp_times_;
+  Chunk chunk_;
   bool finished_ = false;
   // acceleration resampling
   static constexpr std::size_t kMaxHeld = 64;
@@ -686,7 +955,8 @@ class ParmayDecoder : public Decoder {
   double start_ = 0, prev_t_ = 0, cur_t_ = 0, confirmed_ = 0;
   double prev_v_[3] = {0, 0, 0}, cur_v_[3] = {0, 0, 0};
   std::int64_t k_ = 0;
-  std::vector<Point> held_;
+  Point held_[kMaxHeld];  // a ring: held_n_ points from held_at_
+  std::size_t held_at_ = 0, held_n_ = 0;
   // temperature resampling
   bool temp_started_ = false, temp_ended_ = false, temp_look_ = false;
   double temp_first_ = 0, look_t_ = 0, look_v_ = 0;
