@@ -5,12 +5,17 @@
 // fuzzer reaches the samples of packets that pass their check. Checks: no
 // crash, no write past the buffer, progress on every call, finite times
 // (and finite acceleration in gravcal's own reading, compat = 0), report
-// counts consistent with what was given, nothing after the end. A packet's
+// counts consistent with what was given, nothing after the end; and the
+// same samples, bit for bit, and the same counts from the decoder's
+// point-by-point path alone (option run_loop = 0, one big buffer, no block
+// limit): the grid's fast loop must not change a bit. A packet's
 // header times can ask for any length of grid (GGIRread's resampling), so
 // the harness stops after kMaxSamples samples.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "fuzz_input.hpp"
@@ -26,21 +31,33 @@
 
 static const std::int64_t kMaxSamples = 200000;
 
-static void decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mode) {
+// What a decoding gave: every sample's five values, and the report.
+struct Decoded {
+  std::vector<double> v;  // x, y, z, temperature, time of each sample
+  bool opened = false, capped = false;
+  std::int64_t skipped = 0, gaps = 0;
+  std::vector<std::pair<std::string, std::int64_t>> counts;
+};
+
+static Decoded decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mode, bool run_loop) {
+  Decoded res;
   gravcal::MemorySource src(bytes.data(), bytes.size());
   gravcal::Options opts;
   const bool compat = (mode & 2) == 0;
   opts.set("compat", compat ? 1.0 : 0.0);
   opts.set("interpolation", (mode & 8) ? 2.0 : 1.0);
+  opts.set("resample_fused", (mode & 128) ? 1.0 : 0.0);
+  opts.set("run_loop", run_loop ? 1.0 : 0.0);
   gravcal::ParmayDecoder dec(src, opts);
   if (!dec.open()) {
     CHECK(!dec.error().empty());
-    return;
+    return res;
   }
+  res.opened = true;
   CHECK(dec.info().sf == 12.5 || dec.info().sf == 25 || dec.info().sf == 50 ||
         dec.info().sf == 100);
-  const std::int64_t max_units = (mode & 4) ? -1 : 1 + ((mode >> 4) & 1);
-  const std::size_t cap = (mode & 32) ? 7 : 600;
+  const std::int64_t max_units = !run_loop || (mode & 4) ? -1 : 1 + ((mode >> 4) & 1);
+  const std::size_t cap = run_loop && (mode & 32) ? 7 : 600;
   std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
   std::int64_t samples = 0, units = 0;
   bool capped = false;
@@ -59,6 +76,9 @@ static void decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mod
       CHECK(std::isfinite(tm[i]));
       if (!compat) CHECK(std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(z[i]));
     }
+    for (std::size_t i = 0; i < out.n; ++i) {
+      for (const double* c : {x.data(), y.data(), z.data(), t.data(), tm.data()}) res.v.push_back(c[i]);
+    }
     samples += static_cast<std::int64_t>(out.n);
     units += u;
     if (samples > kMaxSamples) {
@@ -70,7 +90,11 @@ static void decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mod
   CHECK(r.samples == samples);
   CHECK(r.notes.size() <= gravcal::Report::max_notes);
   CHECK(r.gaps >= 0 && r.gap_seconds >= 0);
-  if (capped) return;
+  res.capped = capped;
+  res.skipped = r.skipped;
+  res.gaps = r.gaps;
+  res.counts = r.counters;
+  if (capped) return res;
   CHECK(r.units == units);
   gravcal::SampleBuffer out;
   out.x = x.data();
@@ -78,6 +102,7 @@ static void decode_all(const std::vector<unsigned char>& bytes, std::uint8_t mod
   out.z = z.data();
   out.capacity = cap;
   CHECK(dec.read(out, -1) == 0 && out.n == 0);
+  return res;
 }
 
 static void fix_crcs(std::vector<unsigned char>& b) {
@@ -107,6 +132,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   bytes.insert(bytes.end(), in.p, in.p + in.n);
   if (mode & 64) fix_crcs(bytes);
-  decode_all(bytes, mode);
+  const Decoded a = decode_all(bytes, mode, true);
+  const Decoded b = decode_all(bytes, mode, false);
+  CHECK(a.opened == b.opened);
+  if (a.opened && !a.capped && !b.capped) {
+    CHECK(a.v.size() == b.v.size());
+    CHECK(a.v.empty() || std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(double)) == 0);
+    CHECK(a.skipped == b.skipped && a.gaps == b.gaps && a.counts == b.counts);
+  }
   return 0;
 }

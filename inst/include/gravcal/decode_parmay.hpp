@@ -112,7 +112,8 @@ class ParmayDecoder : public Decoder {
       : src_(src),
         compat_(opts.num("compat", 1) != 0),
         nearest_(opts.num("interpolation", 1) == 2),
-        fused_(opts.num("resample_fused", 0) != 0) {}
+        fused_(opts.num("resample_fused", 0) != 0),
+        run_loop_(opts.num("run_loop", 1) != 0) {}
 
   bool open() override {
     unsigned char h[524];
@@ -172,7 +173,7 @@ class ParmayDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
     while (!out.full()) {
-      if (compat_ && (run(out) || next_points(out))) continue;
+      if (compat_ && ((run_loop_ && run(out)) || next_points(out))) continue;
       if (finished_) break;
       if (chunk_.i >= chunk_.n) {
         // the next raw samples: the rest of a packet at most, so that a
@@ -729,11 +730,18 @@ class ParmayDecoder : public Decoder {
   };
 
   // The usual case of next_points() and take() in one loop, the state in
-  // locals (the output columns could alias the members): points given
-  // as soon as made (none held), the temperature's interval not to move.
-  // Leaves the rest (a point to hold, the next temperature row, the first
-  // sample, a new chunk) to next_points(), take() and temp_at(), with the
-  // same arithmetic; false when it did nothing.
+  // locals (the output columns could alias the members), the temperature's
+  // interval not to move. A point the raw times do not yet confirm (about
+  // every other one where samples and grid share the rate: a rounding
+  // decides) is written at once all the same, and counted as unconfirmed
+  // until a later raw time confirms it: no branch on that rounding. Points
+  // leave in the order made, as held_ gives them, and one's temperature
+  // does not depend on when it is given (temp_at()'s interval moves only
+  // for a later time); the unconfirmed ones still at the end go back to
+  // held_. Leaves the rest (the first sample, the temperature's next row,
+  // more unconfirmed points than kMaxUnconfirmed, a new chunk) to
+  // next_points(), take() and temp_at(), with the same arithmetic; false
+  // when it did nothing.
   bool run(SampleBuffer& out) {
     if (held_n_ != 0 || finished_ || !have_prev_) return false;
     const bool temp_cols = out.t != nullptr, time_col = out.time != nullptr;
@@ -744,73 +752,48 @@ class ParmayDecoder : public Decoder {
       if (!temp_started_) return false;
       temp_mode = temp_ended_ ? 1 : 2;
     }
-    const double start = start_, by = by_, sf = sf_, tp_t = tp_t_, tc_t = tc_t_, tp_v = tp_v_,
-                 tc_v = tc_v_, temp_first = temp_first_;
+    const TempSpan ts{temp_mode, temp_first_, tp_t_, tc_t_, tp_v_, tc_v_, nearest_, fused_, na};
+    const double start = start_, by = by_, sf = sf_;
     const bool nearest = nearest_, fused = fused_;
-    double prev_t = prev_t_, cur_t = cur_t_, confirmed = confirmed_;
+    double prev_t = prev_t_, cur_t = cur_t_;
     double p0 = prev_v_[0], p1 = prev_v_[1], p2 = prev_v_[2];
     double c0 = cur_v_[0], c1 = cur_v_[1], c2 = cur_v_[2];
     bool interval = have_interval_;
-    std::int64_t k = k_;
+    double kd = static_cast<double>(k_);
     int i = chunk_.i;
     const int n_raw = chunk_.n;
     std::size_t o = out.n;
     const std::size_t cap = out.capacity;
     bool progress = false;
-    // one point the raw times do not yet confirm (as held_ holds it: its
-    // temperature when given); a second leaves the loop
-    bool pend = false;
-    double pk = 0;
-    double pv[3] = {0, 0, 0};
-    // k < confirmed, confirmed = floor(x) + 1 with x = (cur_t - start) sf,
-    // is k <= x for a whole k (and false for x NaN either way)
+    // k < confirmed_ (= floor(x) + 1, x = (cur_t - start) sf) is k <= x for
+    // a whole k (false for x NaN either way)
     double x_conf = (cur_t - start) * sf;
-    double kd = static_cast<double>(k);
-    TempSpan ts{temp_mode, temp_first, tp_t, tc_t, tp_v, tc_v, nearest, fused, na};
+    // the unconfirmed points: the last `unconf` written, from k = k_unconf
+    int unconf = 0;
+    double k_unconf = 0;
     for (;;) {
-      if (pend && pk <= x_conf) {
-        if (o >= cap) break;
-        const double g = start + pk * by;
-        double temp;
-        if (!ts.at(g, &temp)) break;
-        out.x[o] = pv[0];
-        out.y[o] = pv[1];
-        out.z[o] = pv[2];
-        if (temp_cols) out.t[o] = temp;
-        if (time_col) out.time[o] = g;
-        ++o;
-        pend = false;
-      }
       while (interval && o < cap) {
         const double g = start + kd * by;
         if (!(g <= cur_t)) {
           interval = false;
           break;
         }
-        if (pend) goto leave;  // a second point to hold
-        const bool hold = !(kd <= x_conf);
-        double temp = na;
-        if (!hold && !ts.at(g, &temp)) goto leave;  // the next temperature row
+        if (unconf == kMaxUnconfirmed) goto leave;
+        double temp;
+        if (!ts.at(g, &temp)) goto leave;  // the next temperature row
         double u = (g - prev_t) / (cur_t - prev_t);
         if (u < 0 || u > 1) u = 0;
         if (nearest) u = ggir_nearest_weight(u);
-        const double v0 = kernels::ggir_lerp(u, p0, c0, fused);
-        const double v1 = kernels::ggir_lerp(u, p1, c1, fused);
-        const double v2 = kernels::ggir_lerp(u, p2, c2, fused);
-        if (hold) {
-          pend = true;
-          pk = kd;
-          pv[0] = v0;
-          pv[1] = v1;
-          pv[2] = v2;
-        } else {
-          out.x[o] = v0;
-          out.y[o] = v1;
-          out.z[o] = v2;
-          if (temp_cols) out.t[o] = temp;
-          if (time_col) out.time[o] = g;
-          ++o;
-        }
+        out.x[o] = kernels::ggir_lerp(u, p0, c0, fused);
+        out.y[o] = kernels::ggir_lerp(u, p1, c1, fused);
+        out.z[o] = kernels::ggir_lerp(u, p2, c2, fused);
+        if (temp_cols) out.t[o] = temp;
+        if (time_col) out.time[o] = g;
+        ++o;
+        // held_ would hold it: after an unconfirmed one, or not confirmed
+        const bool hold = unconf > 0 || !(kd <= x_conf);
+        k_unconf = unconf == 0 ? kd : k_unconf;
+        unconf += hold;
         kd += 1;
         progress = true;
       }
@@ -828,24 +811,37 @@ class ParmayDecoder : public Decoder {
       interval = true;
       ++i;
       progress = true;
+      // the unconfirmed points this time confirms, in order (at most two
+      // without a branch)
+      int c = (k_unconf <= x_conf) + (k_unconf + 1 <= x_conf);
+      c = c < unconf ? c : unconf;
+      unconf -= c;
+      k_unconf += c;
+      while (unconf > 0 && k_unconf <= x_conf) {
+        --unconf;
+        k_unconf += 1;
+      }
     }
   leave:
-    k = static_cast<std::int64_t>(kd);
-    confirmed = std::floor(x_conf) + 1;
-    if (pend) {
+    // the unconfirmed points back to held_, in order
+    for (int h = 0; h < unconf; ++h) {
+      const std::size_t at = o - static_cast<std::size_t>(unconf) + static_cast<std::size_t>(h);
       Point& p = held_[(held_at_ + held_n_) % kMaxHeld];
-      p.k = static_cast<std::int64_t>(pk);
-      for (int c = 0; c < 3; ++c) p.v[c] = pv[c];
+      p.k = static_cast<std::int64_t>(k_unconf) + h;
+      p.v[0] = out.x[at];
+      p.v[1] = out.y[at];
+      p.v[2] = out.z[at];
       ++held_n_;
     }
+    o -= static_cast<std::size_t>(unconf);
     report_.samples += static_cast<std::int64_t>(o - out.n);
     out.n = o;
     chunk_.i = i;
-    k_ = k;
+    k_ = static_cast<std::int64_t>(kd);
     have_interval_ = interval;
     prev_t_ = prev_t;
     cur_t_ = cur_t;
-    confirmed_ = confirmed;
+    confirmed_ = std::floor(x_conf) + 1;
     prev_v_[0] = p0;
     prev_v_[1] = p1;
     prev_v_[2] = p2;
@@ -938,6 +934,9 @@ class ParmayDecoder : public Decoder {
   bool compat_ = true;
   bool nearest_ = false;
   bool fused_ = false;  // GGIRread's resample() fused (option resample_fused)
+  // run()'s loop (option run_loop; 0: next_points() and take() alone, the
+  // point-by-point path the fuzzer compares it with)
+  bool run_loop_ = true;
   std::int32_t declared_ = 0;
   std::int16_t range_ = 0;
   // g per count, GGIRread's range / 32767 (counts >= 0) and range / 32768
@@ -951,6 +950,7 @@ class ParmayDecoder : public Decoder {
   bool finished_ = false;
   // acceleration resampling
   static constexpr std::size_t kMaxHeld = 64;
+  static constexpr int kMaxUnconfirmed = 8;  // run(): at most this many (held_ takes them)
   bool have_prev_ = false, have_interval_ = false;
   double start_ = 0, prev_t_ = 0, cur_t_ = 0, confirmed_ = 0;
   double prev_v_[3] = {0, 0, 0}, cur_v_[3] = {0, 0, 0};
