@@ -142,14 +142,31 @@ writers <- list(
       gravcal:::write_axivity_csv(d, file, true_sf = sf, start = start + k * 86400)
       list()
     })
+  },
+  # a unisens folder (its acc.bin is the file given to the contenders) at
+  # Movisens' 64 Hz: the same simulated day at that rate, repeated, and 10
+  # minutes more (GGIR 3.3-9 stops with "startIndex out of bounds" on a
+  # recording of whole days: its reader of acc.bin asks for a block after
+  # the last when the samples fill its last block exactly)
+  movisens = function(tmp) {
+    d64 <- simulate_recording(hours = 24, sf = 64, seed = 1,
+                              params = c(1.015, 0.985, 1.01, 0, 0, 0, 0.03, -0.025, 0.02),
+                              tempoffset = c(0.002, -0.001, 0.0015))
+    d64 <- d64[c(rep(seq_len(nrow(d64)), days), seq_len(600 * 64)), c("x", "y", "z", "temperature")]
+    dir <- dirname(tmp)
+    part <- paste0(dir, ".part")
+    unlink(c(part, dir), recursive = TRUE)
+    gravcal:::write_movisens(d64, part, sf = 64, start = format(start, "%Y-%m-%d %H:%M:%S"))
+    file.rename(part, dir)
+    list()
   })
 
 specs <- data.frame(
-  kind = c("parmay", "adhoc_unix", "adhoc_text", "axivity_csv"),
+  kind = c("parmay", "adhoc_unix", "adhoc_text", "axivity_csv", "movisens"),
   label = c("Parmay Matrix .bin", "ad hoc csv: UNIX s, mg, temperature",
             "ad hoc csv: text time, 2 header lines, g, temperature",
-            "Axivity csv export (no temperature)"),
-  ext = c("bin", "csv", "csv", "csv"), stringsAsFactors = FALSE)
+            "Axivity csv export (no temperature)", "Movisens (unisens folder, 64 Hz)"),
+  ext = c("bin", "csv", "csv", "csv", ""), stringsAsFactors = FALSE)
 # GRAVCAL_BENCH_FORMATS=<kinds, comma-separated>: only these files; the
 # other files' rows are kept from the existing formats.csv (of the same
 # number of days)
@@ -158,14 +175,18 @@ if (nzchar(kinds)) specs <- specs[specs$kind %in% strsplit(kinds, ",")[[1]], ]
 specs$days <- days
 specs$path <- file.path(data_dir, sprintf("%s-%dd.%s", gsub("_", "-", specs$kind),
                                           days, specs$ext))
-specs$params <- paste0(specs$path, ".params.rds")
+# a Movisens recording is a folder: the contenders are given its acc.bin,
+# and its parameters file sits beside the folder
+mv <- specs$kind == "movisens"
+specs$path[mv] <- file.path(data_dir, sprintf("movisens-%dd", days), "acc.bin")
+specs$params <- ifelse(mv, paste0(dirname(specs$path), ".params.rds"), paste0(specs$path, ".params.rds"))
 for (i in seq_len(nrow(specs))) {
   if (!file.exists(specs$path[i]) || !file.exists(specs$params[i])) {
     say("writing", basename(specs$path[i]))
     tmp <- paste0(specs$path[i], ".part")
     p <- writers[[specs$kind[i]]](tmp)
     saveRDS(p, specs$params[i])
-    file.rename(tmp, specs$path[i])
+    if (file.exists(tmp)) file.rename(tmp, specs$path[i])  # (a Movisens folder is in place already)
   }
 }
 day <- NULL
@@ -302,7 +323,9 @@ res$wall_speedup_vs_ggir <- of("wall", "GGIR::g.calibrate") / res$wall
 res$same_coef_as_ggir <- ifelse(res$contender == "gravcal::g.calibrate",
                                 res$coef == of("coef", "GGIR::g.calibrate"), NA)
 res$ggir_status <- of("status", "GGIR::g.calibrate")
-res$path <- basename(res$path)
+# (a Movisens folder's acc.bin named with its folder)
+res$path <- ifelse(basename(res$path) == "acc.bin", file.path(basename(dirname(res$path)), "acc.bin"),
+                   basename(res$path))
 minutes <- as.numeric(difftime(Sys.time(), t_start, units = "mins"))
 dir.create(out_dir, showWarnings = FALSE, recursive = TRUE)
 utils::write.csv(res, file.path(out_dir, paste0(out_name, ".csv")), row.names = FALSE)
@@ -362,11 +385,12 @@ for (k in unique(res$kind)) {
   if (!nrow(x)) next
   r <- if (!is.na(x$speedup_vs_ggir)) x$speedup_vs_ggir else x$speedup_at_least
   if (is.na(r)) next
-  target <- if (k == "parmay") 50 else 20
+  binary <- k %in% c("parmay", "movisens")
+  target <- if (binary) 50 else 20
   md <- c(md, sprintf("- %s: gravcal::g.calibrate %s%.0fx (target %dx: %s), peak %.0f MB%s.", x$label,
                       if (is.na(x$speedup_vs_ggir)) "at least " else "", r, target,
                       if (r >= target) "met" else if (is.na(x$speedup_vs_ggir)) "not shown" else "NOT met", x$peak_mb,
-                      if (k == "parmay") sprintf(" (target 250 MB: %s)", if (x$peak_mb < 250) "met" else "NOT met") else ""))
+                      if (binary) sprintf(" (target 250 MB: %s)", if (x$peak_mb < 250) "met" else "NOT met") else ""))
 }
 md <- c(md, "", "GGIR's QC message on each file:", "")
 for (k in unique(res$kind)) {

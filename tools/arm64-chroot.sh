@@ -86,8 +86,15 @@ mount_once "$root/proc" -t proc proc
 mount_once "$root/dev/pts" -t devpts devpts
 have_data=0
 if [ -d "$data" ]; then
+  # a bind left by an earlier run may hold a folder since replaced (an
+  # empty view): bind afresh, and check that the recordings show
+  if mountpoint -q "$root/shared/data"; then umount "$root/shared/data" 2>/dev/null || umount -l "$root/shared/data"; fi
   mount_once "$root/shared/data" --bind "$data"
   mount -o remount,bind,ro "$root/shared/data" 2>/dev/null || true
+  if [ "$(ls -A "$data" | wc -l)" != "$(ls -A "$root/shared/data" | wc -l)" ]; then
+    echo "arm64-chroot: $data does not show in the chroot at /shared/data" >&2
+    exit 1
+  fi
   have_data=1
 else
   echo "arm64-chroot: no recordings at $data: the tests that need them skip"

@@ -272,11 +272,23 @@ class UnisensSignal {
   // Channel c of frame k (0-based, k < count()), scaled; NaN when it could
   // not be read.
   double value(std::int64_t k, int c) {
+    std::int64_t n = 0;
+    const unsigned char* f = frames(k, &n);
+    return f != nullptr ? decode(f, c) : std::numeric_limits<double>::quiet_NaN();
+  }
+  // Frame k's bytes, and in *n how many frames from k on the buffer holds
+  // (read in when it does not hold k); nullptr when k cannot be read.
+  const unsigned char* frames(std::int64_t k, std::int64_t* n) {
     if (k < first_ || k >= first_ + have_) {
-      if (!fill(k)) return std::numeric_limits<double>::quiet_NaN();
+      if (!fill(k)) return nullptr;
     }
-    const unsigned char* p = buf_.data() + static_cast<std::size_t>(k - first_) * frame_ +
-                             static_cast<std::size_t>(c) * static_cast<std::size_t>(size_);
+    *n = first_ + have_ - k;
+    return buf_.data() + static_cast<std::size_t>(k - first_) * frame_;
+  }
+  std::size_t frame_bytes() const { return frame_; }
+  // Channel c of a frame, as value() gives it.
+  double decode(const unsigned char* frame, int c) const {
+    const unsigned char* p = frame + static_cast<std::size_t>(c) * static_cast<std::size_t>(size_);
     const double v = size_ == 2 ? static_cast<double>(static_cast<std::int16_t>(le16(p)))
                                 : static_cast<double>(static_cast<std::int32_t>(le32(p)));
     return scale_ ? (v - baseline_) * lsb_ : v;
@@ -387,21 +399,29 @@ class MovisensDecoder : public Decoder {
 
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
     while (next_ < n_ && !out.full() && (max_units < 0 || units < max_units)) {
       if (next_ == block_end_) start_block();
-      const double x = acc_.value(next_, 0), y = acc_.value(next_, 1), z = acc_.value(next_, 2);
-      if (acc_.failed() && !(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) {
+      // the samples the buffer holds, in this block, that fit
+      std::int64_t m = 0;
+      const unsigned char* f = acc_.frames(next_, &m);
+      if (f == nullptr) {
         report_.read_error = true;
         report_.note("acc.bin could not be read past sample " + std::to_string(next_));
         n_ = next_;
         break;
       }
-      const double t = info_.has_temperature ? temperature(next_ - block_from_) :
-                                               std::numeric_limits<double>::quiet_NaN();
-      out.put(x, y, z, t, std::numeric_limits<double>::quiet_NaN());
-      ++next_;
-      ++units;
-      ++report_.samples;
+      if (m > block_end_ - next_) m = block_end_ - next_;
+      if (m > static_cast<std::int64_t>(out.room())) m = static_cast<std::int64_t>(out.room());
+      if (max_units >= 0 && m > max_units - units) m = max_units - units;
+      const std::size_t step = acc_.frame_bytes();
+      for (std::int64_t i = 0; i < m; ++i, f += step) {
+        const double t = info_.has_temperature ? temperature(next_ + i - block_from_) : nan;
+        out.put(acc_.decode(f, 0), acc_.decode(f, 1), acc_.decode(f, 2), t, nan);
+      }
+      next_ += m;
+      units += m;
+      report_.samples += m;
     }
     report_.units += units;
     return units;
@@ -538,8 +558,14 @@ class MovisensDecoder : public Decoder {
     const double r0 = static_cast<double>(pos_), r1 = static_cast<double>(pos_ + 1);
     double u = (g - r0) / (r1 - r0);
     if (nearest_) u = ggir_nearest_weight(u);
-    return kernels::ggir_lerp(u, temp_.value(t0 + pos_ - 1, temp_chan_),
-                              temp_.value(t0 + pos_, temp_chan_), fused_);
+    // the two temperature samples, read once for the samples between them
+    // (after a read error, every time: value() then gives NaN past it)
+    if (t0 + pos_ != tv_at_ || temp_.failed()) {
+      tv_at_ = t0 + pos_;
+      tv_[0] = temp_.value(tv_at_ - 1, temp_chan_);
+      tv_[1] = temp_.value(tv_at_, temp_chan_);
+    }
+    return kernels::ggir_lerp(u, tv_[0], tv_[1], fused_);
   }
 
   // "YYYY-MM-DDTHH:MM:SS[.fff]" as seconds since 1970 UTC; NaN otherwise.
@@ -571,6 +597,8 @@ class MovisensDecoder : public Decoder {
   std::int64_t block_from_ = 0, block_end_ = 0, bn_ = 0;
   bool block_temp_ = false;
   std::int64_t tfrom_ = 1, tm_ = 0, pos_ = 1;
+  std::int64_t tv_at_ = -1;  // temperature(): the sample index tv_ holds, from tv_at_ - 1
+  double tv_[2] = {0, 0};
 };
 
 }  // namespace gravcal

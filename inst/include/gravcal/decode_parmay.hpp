@@ -637,8 +637,10 @@ class ParmayDecoder : public Decoder {
   // current interval (so a long gap costs time, never memory); the grid has
   // floor((last - start) * rate) + 1 points, so a point is given once the
   // raw times so far reach that far (`confirmed_`): the few that the last
-  // time does not confirm wait in `held_` (a ring; rounding makes at most one or
-  // two) and are dropped at the end.
+  // time does not confirm wait in `held_` (a ring; rounding makes at most
+  // one or two) and are dropped at the end. next_points() and take() do
+  // this point by point; run() does the same in one loop for the usual
+  // case (the fuzzer compares the two, option run_loop).
 
   struct Point {
     std::int64_t k;
