@@ -397,7 +397,9 @@ class ParmayDecoder : public Decoder {
     }
     // next_row: the next row of values (acceleration: x, y, z in g; temperature: body,
     // ambient in degrees C); false at the end
-    bool next_row(double* v) {
+    // Moves on to the packet holding the next row (a damaged packet's
+    // imputed temperature set); false at the end.
+    bool at_next_row() {
       while (n < 0 || j >= n) {
         if (n >= 0) {
           ++i;
@@ -412,6 +414,10 @@ class ParmayDecoder : public Decoder {
         j = 0;
         if (kind == kTemp && !d->packets_[i].ok) d->impute_temp(i, imputed);
       }
+      return true;
+    }
+    bool next_row(double* v) {
+      if (!at_next_row()) return false;
       const Packet& p = d->packets_[i];
       const std::int64_t r = j++;
       const double na = r_na_real();
@@ -459,19 +465,7 @@ class ParmayDecoder : public Decoder {
     // packet, as next_row() gives them one by one; 0 at the end. A good
     // packet's rows that the file holds are read in one go.
     int next_rows(double* x, double* y, double* z, int max) {
-      while (n < 0 || j >= n) {
-        if (n >= 0) {
-          ++i;
-          ++packets_done;
-        }
-        if (i >= d->packets_.size()) {
-          n = 0;
-          j = 0;
-          return 0;
-        }
-        n = rows(d->packets_[i]);
-        j = 0;
-      }
+      if (!at_next_row()) return 0;
       const Packet& p = d->packets_[i];
       std::int64_t m = n - j;
       if (m > max) m = max;
