@@ -221,7 +221,7 @@ test-slurm: install setup-test
 # arm64 R and its prebuilt r-cran-* packages, GGIR installed from CRAN
 # sources as tools/install-ggir.sh does, gravcal from this tree, then the
 # GGIR-identity test files (ARM64_SCOPE=all: every test file; =table:
-# tools/identity-table.R alone)
+# tools/identity-table.R alone; ARM64_FILES="test-a.R ...": only those)
 # with GRAVCAL_SHARED_DATA. Slow (qemu emulates every instruction): not
 # part of make test; logs and timings in _build/arm64.
 ARM64_SCOPE ?= identity
