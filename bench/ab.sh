@@ -9,6 +9,9 @@
 # they may be the same library, with AB_ENV_A / AB_ENV_B set to what each
 # side's process gets in its environment (for one build with a kernel
 # forced to its scalar reference: AB_ENV_B="GRAVCAL_KERNELS=r_scan=scalar").
+# A file's GGIR parameters (an ad hoc csv file's rmc.*, as bench/formats.R
+# writes them) are read from <file>.params.rds, or <folder>.params.rds for
+# a Movisens acc.bin, where that exists.
 # Prints, per file, the median CPU seconds of each and B's time over A's,
 # and whether the two gave the same coefficients (exact hexadecimal).
 set -euo pipefail
@@ -18,9 +21,12 @@ median() { sort -n | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (
 printf "| file | A (s) | B (s) | B / A | same coefficients |\n|---|---|---|---|---|\n"
 for f in "$@"; do
   ta=(); tb=(); ca=""; cb=""
+  params=-
+  if [ -f "$f.params.rds" ]; then params=$f.params.rds
+  elif [ -f "$(dirname "$f").params.rds" ]; then params=$(dirname "$f").params.rds; fi
   for ((i = 0; i < runs; i++)); do
-    la=$(env ${AB_ENV_A:-} R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
-    lb=$(env ${AB_ENV_B:-} R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" | grep "^RESULT")
+    la=$(env ${AB_ENV_A:-} R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" "$params" | grep "^RESULT")
+    lb=$(env ${AB_ENV_B:-} R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" "$params" | grep "^RESULT")
     ta+=("$(cut -f 8 <<< "$la")"); tb+=("$(cut -f 8 <<< "$lb")")
     ca=$(cut -f 6 <<< "$la"); cb=$(cut -f 6 <<< "$lb")
   done

@@ -14,7 +14,7 @@
 #
 # Prints one line: RESULT <contender> <seconds> <peak MB> <baseline MB>
 # <coefficients as exact hexadecimal doubles, comma-separated> <status>
-# <CPU seconds>.
+# <CPU seconds> <user seconds> <system seconds>.
 # <seconds> is the call's wall time, library loading excluded; <baseline MB>
 # the resident memory after loading the packages, before the call.
 args <- commandArgs(trailingOnly = TRUE)
@@ -105,5 +105,5 @@ status <- gsub("[[:space:]]+", "_", paste(v$status, collapse = "_"))
 if (!nzchar(status)) status <- "-"
 peak <- proc_mb("VmHWM")
 if (!is.null(save_to) && !is.null(v$result)) saveRDS(v$result, save_to)
-cat(sprintf("RESULT\t%s\t%.3f\t%.1f\t%.1f\t%s\t%s\t%.3f\n", contender, t,
-            peak, base, hex(v$coef), status, cpu))
+cat(sprintf("RESULT\t%s\t%.3f\t%.1f\t%.1f\t%s\t%s\t%.3f\t%.3f\t%.3f\n", contender, t,
+            peak, base, hex(v$coef), status, cpu, st[["user.self"]], st[["sys.self"]]))

@@ -83,8 +83,9 @@
 //
 // Speed: a line whose fields are all plain numbers ([+-]digits[.digits],
 // up to 18 digits) or text the layout does not parse as a number (a time
-// stamp) is parsed where it lies in the read buffer, with 3-decimal values
-// looked up (read_plain_as); any other line, damaged or unusual, goes
+// stamp) is parsed where it lies in the read buffer, values of 1 to 4
+// decimals looked up and a time column of numbers read as the values are
+// (read_plain_as, number_stamp); any other line, damaged or unusual, goes
 // through take_line() and the general parser. Both give the same samples,
 // counters and notes (option fast = 0 takes every line through
 // take_line(); tests/cpp/test_csv and the fuzzer compare the two).
@@ -501,7 +502,7 @@ class CsvDecoder : public Decoder {
 
   // GGIR's conversions of an ad hoc csv's values (read.myacc.csv's order
   // and arithmetic; see the top of this file).
-  double adhoc_acc(double a) const {
+  GRAVCAL_CSV_INLINE double adhoc_acc(double a) const {
     if (acc_div_ != 1) a = a / acc_div_;
     if (acc_scale_ != 1) a = a * acc_scale_;
     if (bit_ == 1) {
@@ -511,7 +512,7 @@ class CsvDecoder : public Decoder {
     }
     return a;
   }
-  double adhoc_temp(double t) const {
+  GRAVCAL_CSV_INLINE double adhoc_temp(double t) const {
     if (temp_unit_ == 1) return t + 272.15;
     if (temp_unit_ == 2) return (t - 32) * (5.0 / 9.0);
     return t;
@@ -694,8 +695,9 @@ class CsvDecoder : public Decoder {
 
   // ---- data lines -----------------------------------------------------------
 
-  // What each field of a data line is for.
-  enum Role : unsigned char { kSkip, kX, kY, kZ, kTemp, kTime };
+  // What each field of a data line is for: kTime a time stamp read by
+  // time_of(), kTimeNumber one that is a number (read as the values are).
+  enum Role : unsigned char { kSkip, kX, kY, kZ, kTemp, kTime, kTimeNumber };
 
   // The role of each field; lines are parsed in place when every field has
   // one column at most (plain_ = 2 when the fields are x, y, z and no
@@ -712,6 +714,9 @@ class CsvDecoder : public Decoder {
       role_[cols[i]] = roles[i];
     }
     if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return;
+    // numeric time (time_of()'s plain number) is parsed in place too
+    number_time_ = col_time_ >= 0 && !time_text_ && !(adhoc_ && !time_fmt_.empty()) && zone_.empty();
+    if (number_time_) role_[col_time_] = kTimeNumber;
     plain_ = nfields_ == 3 && role_[0] == kX && role_[1] == kY && role_[2] == kZ ? 2 : 1;
     decimals_ = &csv_text::decimals(number_rule_);
   }
@@ -742,12 +747,14 @@ class CsvDecoder : public Decoder {
     const char* q = p0;
     std::size_t i = first;
     for (; i < last && q < end; ++i) {
-      double v[kTime];  // by role
+      double v[kTimeNumber + 1];  // by role
       csv_text::Field tf{q, q};
       const char* nl = kXyz ? xyz_fields(q, v) : plain_fields(q, v, tf);
       if (nl == nullptr) break;
       double t = 0;
-      if (!kXyz && col_time_ >= 0) {
+      if (!kXyz && number_time_) {
+        t = number_stamp(v[kTimeNumber], line0 + static_cast<std::int64_t>(i - first) + 1, offset0 + (q - p0));
+      } else if (!kXyz && col_time_ >= 0) {
         csv_text::Line ln;
         ln.number = line0 + static_cast<std::int64_t>(i - first) + 1;
         ln.offset = offset0 + (q - p0);
@@ -777,14 +784,39 @@ class CsvDecoder : public Decoder {
     return k;
   }
 
+  // stamp_time() of a time stamp that is a plain number, given its value as
+  // read in place (line `number`, at byte `offset`): time_of()'s
+  // conversion, and the checks with its resolution (time_of() gives 9
+  // decimals: res 0, never coarse).
+  GRAVCAL_CSV_INLINE double number_stamp(double s, std::int64_t number, std::int64_t offset) {
+    if (adhoc_) {
+      if (time_div_ != 1) s = s / time_div_;
+      s = s + time_offset_;
+    }
+    if (s == last_stamp_) ++run_;
+    else run_ = 0;
+    last_stamp_ = s;
+    if (std::isfinite(last_time_)) {
+      const double dt = s - last_time_;
+      if (dt > kGapSteps * step_ + 0.0 || dt < -(step_ / 2 + 0.0)) {
+        csv_text::Line ln;
+        ln.number = number;
+        ln.offset = offset;
+        check_step(dt, 0, ln);
+      }
+    }
+    last_time_ = s;
+    return s;
+  }
+
   // The value of the plain number (csv_text::scan_plain_number) at p when
   // the byte after it is `a` or `b` (the field ends there); returns that
   // byte's address, or nullptr.
   GRAVCAL_CSV_INLINE const char* plain_number(const char* p, char a, char b, double& v) const {
     csv_text::PlainNumber pn;
-    const char* e = csv_text::scan_plain_number_3(p, dec_, pn);
+    const char* e = csv_text::scan_plain_number(p, dec_, pn);
     if (e == nullptr || (*e != a && *e != b)) return nullptr;
-    if (pn.frac >= 1 && pn.frac <= 3 && pn.acc < decimals_->limit[pn.frac]) {
+    if (pn.frac >= 1 && pn.frac <= csv_text::kTableDecimals && pn.acc < decimals_->limit[pn.frac]) {
       // a look-up instead of a long double product or a division; the sign
       // by a product with -1: exact, and -(+0) is -0, as above
       static constexpr double kSign[2] = {1.0, -1.0};
@@ -824,7 +856,7 @@ class CsvDecoder : public Decoder {
       tf.e = p - 1;  // CRLF: the line ends before the '\r'
     }
     if (*p != '\n') return nullptr;
-    if (col_time_ >= 0) tf = csv_text::field_of(tf.b, tf.e);
+    if (col_time_ >= 0 && !number_time_) tf = csv_text::field_of(tf.b, tf.e);
     return p;
   }
 
@@ -970,6 +1002,7 @@ class CsvDecoder : public Decoder {
   const csv_text::Decimals* decimals_ = nullptr;  // csv_text::decimals(number_rule_)
   unsigned char role_[kMaxFields] = {};  // a Role for each field
   int plain_ = 0;  // lines parsed in place: 0 no, 1 yes, 2 yes and they are x, y, z
+  bool number_time_ = false;  // with a time column of numbers (role kTimeNumber)
   // position
   std::int64_t index_ = 0;  // data lines consumed
   double last_time_ = std::numeric_limits<double>::quiet_NaN();
