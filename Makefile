@@ -31,7 +31,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test test-rest sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -51,7 +51,23 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check core cross-check flags-check sanitize valgrind fuzz-short test-slurm site
+test: check
+	$(MAKE) test-rest
+
+# make test after the check: the sanitizer run (the longest step, about 30
+# minutes) in the background, built from the tarball just checked (so in a
+# directory of its own, not in src/, where the steps beside it build), and
+# the other steps one after another beside it on the second core; fails
+# when either does. Its output: $(BUILD)/sanitize-make.log.
+TEST_REST := core cross-check flags-check valgrind fuzz-short test-slurm site
+test-rest:
+	@$(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) > $(BUILD)/sanitize-make.log 2>&1 & san=$$!; \
+	  echo "test: sanitize runs in the background (log: $(BUILD)/sanitize-make.log)"; \
+	  $(MAKE) $(TEST_REST); rest=$$?; \
+	  wait $$san; st=$$?; \
+	  if [ $$st -ne 0 ]; then tail -80 $(BUILD)/sanitize-make.log; echo "test: sanitize failed"; \
+	  else tail -2 $(BUILD)/sanitize-make.log; fi; \
+	  test $$rest -eq 0 && test $$st -eq 0
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
@@ -111,12 +127,17 @@ flags-check: setup-test
 # the whole test suite against the package built with AddressSanitizer and
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not
 # instrumented, so the runtimes are preloaded. Any report fails.
+# SANITIZE_SRC: what is installed (default: this tree, built in src/; make
+# test gives it the checked tarball, built in a directory of its own).
 ASAN_RT = $(shell gcc -print-file-name=libasan.so) $(shell gcc -print-file-name=libubsan.so)
+SANITIZE_SRC ?= .
 sanitize: setup-test
+	$(MAKE) sanitize-run
+sanitize-run:
 	mkdir -p $(BUILD)/asan
 	R_MAKEVARS_USER=$(abspath tools/sanitize.mk) $(R) CMD INSTALL --preclean --no-multiarch \
-	  --no-test-load -l $(BUILD)/asan . > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
-	rm -f src/*.o src/*.so
+	  --no-test-load -l $(BUILD)/asan $(SANITIZE_SRC) > $(BUILD)/asan-install.log 2>&1 || (cat $(BUILD)/asan-install.log; exit 1)
+	if [ "$(SANITIZE_SRC)" = "." ]; then rm -f src/*.o src/*.so; fi
 	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
 	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" \
