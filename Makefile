@@ -31,7 +31,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test test-rest sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -51,19 +51,18 @@ install: setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-test: check
-	$(MAKE) test-rest
-
-# make test after the check: the sanitizer run (the longest step, about 30
-# minutes) in the background, built from the tarball just checked (so in a
-# directory of its own, not in src/, where the steps beside it build), and
-# the other steps one after another beside it on the second core; fails
-# when either does. Its output: $(BUILD)/sanitize-make.log.
+# make test: the tarball, then the sanitizer run (the whole suite under
+# ASan and UBSan, the longest step: 30 to 60 minutes) in the background,
+# installed from that tarball (so built in a directory of its own, not in
+# src/, where the steps beside it build), while the check and then the other
+# steps run one after another beside it on the second core; fails when
+# either side does. The sanitizer's output: $(BUILD)/sanitize-make.log.
 TEST_REST := core cross-check flags-check valgrind fuzz-short test-slurm site
-test-rest:
+test: setup-test
+	$(MAKE) tarball
 	@$(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) > $(BUILD)/sanitize-make.log 2>&1 & san=$$!; \
 	  echo "test: sanitize runs in the background (log: $(BUILD)/sanitize-make.log)"; \
-	  $(MAKE) $(TEST_REST); rest=$$?; \
+	  $(MAKE) check-run && $(MAKE) $(TEST_REST); rest=$$?; \
 	  wait $$san; st=$$?; \
 	  if [ $$st -ne 0 ]; then tail -80 $(BUILD)/sanitize-make.log; echo "test: sanitize failed"; \
 	  else tail -2 $(BUILD)/sanitize-make.log; fi; \
@@ -159,8 +158,12 @@ fuzz-short: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=30
 
 check: setup-test
+	$(MAKE) tarball
+	$(MAKE) check-run
+tarball:
 	mkdir -p $(BUILD)
 	cd $(BUILD) && $(R) CMD build --no-manual .. > build.log 2>&1 || (cat build.log; exit 1)
+check-run:
 	cd $(BUILD) && env $(CHECK_ENV) $(R) CMD check --as-cran --no-manual $(TARBALL) > check.log 2>&1 || true
 	bash tools/check-result.sh $(BUILD)/gravcal.Rcheck
 
