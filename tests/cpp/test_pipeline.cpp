@@ -1,15 +1,21 @@
 // The one pump (pipeline.hpp) and GGIR's procedure (ggir_procedure.hpp)
 // without R: the same windows whether a source lends its samples or writes
 // them where the stage asks, in blocks of any size; the procedure recovers
-// a known miscalibration, and stops when its host says so.
+// a known miscalibration, and stops when its host says so. The Movisens
+// decoder's samples and temperatures against a sample-by-sample replay of
+// unisensR and GGIR's g.readtemp_movisens, in runs of any length.
 #include "gravcal/fp_contract.hpp"  // first: see there
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "gravcal/decode.hpp"
+#include "gravcal/decode_movisens.hpp"
 #include "gravcal/ggir_procedure.hpp"
 #include "gravcal/pipeline.hpp"
 
@@ -207,7 +213,134 @@ static void test_zone() {
   CHECK(gravcal::ZoneTable(big).empty());
 }
 
+// The Movisens decoder, read in runs of `cap` samples, against a replay of
+// what GGIR gets sample by sample (from the format's description: unisensR's
+// (v - baseline) * lsbValue; g.readtemp_movisens' range of temperature
+// samples per block, R's seq(1, m, length.out = n) and GGIRread::resample's
+// interpolation, found afresh for each sample). Temperature rates below,
+// at and above the acceleration's (several temperature samples per
+// acceleration sample), blocks of a few samples to many, linear and
+// nearest, rounded twice and fused.
+static void le_put(std::vector<unsigned char>& b, long v, int size) {
+  for (int k = 0; k < size; ++k) b.push_back(static_cast<unsigned char>((v >> (8 * k)) & 0xff));
+}
+
+static void test_movisens() {
+  const double sf = 64;
+  const std::int64_t n = 64 * 90 + 37;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> acc_v(-4000, 4000), temp_v(200, 380);
+  std::vector<unsigned char> acc;
+  std::vector<long> raw;
+  for (std::int64_t i = 0; i < 3 * n; ++i) {
+    raw.push_back(acc_v(rng));
+    le_put(acc, raw.back(), 2);
+  }
+  const char* rates[] = {"1", "0.7", "3.3", "64", "100", "250"};
+  const double rate_v[] = {1, 0.7, 3.3, 64, 100, 250};
+  const double blocks[] = {7, 130, 1000, 64.0 * 60 * 1440 / 2};
+  const std::size_t caps[] = {1, 17, 4096};
+  int compared = 0;
+  for (int ri = 0; ri < 6; ++ri) {
+    const double r = rate_v[ri];
+    // enough temperature samples for the whole recording at rate r
+    const std::int64_t nt = static_cast<std::int64_t>(std::ceil(n / sf * std::max(r, 1.0))) + 2;
+    std::vector<unsigned char> temp;
+    std::vector<long> traw;
+    for (std::int64_t i = 0; i < nt; ++i) {
+      traw.push_back(temp_v(rng));
+      le_put(temp, traw.back(), 2);
+    }
+    const std::string xml =
+        std::string("<unisens timestampStart=\"2024-01-01T00:00:00.000\">"
+                    "<signalEntry id=\"acc.bin\" dataType=\"int16\" sampleRate=\"64\" "
+                    "lsbValue=\"0.00048828125\" baseline=\"3\"><binFileFormat/>"
+                    "<channel name=\"x\"/><channel name=\"y\"/><channel name=\"z\"/></signalEntry>"
+                    "<signalEntry id=\"temp.bin\" dataType=\"int16\" sampleRate=\"") +
+        rates[ri] + "\" lsbValue=\"0.1\"><binFileFormat/><channel name=\"temp\"/></signalEntry></unisens>";
+    for (double blk : blocks) {
+      for (int interp = 1; interp <= 2; ++interp) {
+        for (int fused = 0; fused <= 1; ++fused) {
+          // the replay
+          std::vector<double> want_t(static_cast<std::size_t>(n));
+          for (std::int64_t from = 0; from < n; from += static_cast<std::int64_t>(blk)) {
+            const std::int64_t to = std::min(n, from + static_cast<std::int64_t>(blk));
+            const std::int64_t bn = to - from;
+            auto first_last = [&](double rr, std::int64_t& a, std::int64_t& b) {
+              a = static_cast<std::int64_t>(std::ceil(static_cast<double>(from + 1) / sf * rr));
+              b = static_cast<std::int64_t>(std::ceil(static_cast<double>(to) / sf * rr));
+            };
+            std::int64_t a = 0, b = 0;
+            first_last(1.0, a, b);
+            if (r != 1.0) first_last(r, a, b);
+            const std::int64_t m = b - a + 1;
+            for (std::int64_t q = 0; q < bn; ++q) {
+              double v;
+              if (m == 1) {
+                v = traw[a - 1] * 0.1;
+              } else {
+                const double g = q == 0 ? 1.0 : q == bn - 1 ? static_cast<double>(m)
+                               : 1 + q * ((static_cast<double>(m) - 1) / static_cast<double>(bn - 1));
+                std::int64_t j = 1;  // the interval (j, j + 1] of positions 1..m
+                while (j < m - 1 && static_cast<double>(j + 1) < g) ++j;
+                double u = (g - static_cast<double>(j)) /
+                           (static_cast<double>(j + 1) - static_cast<double>(j));
+                if (interp == 2) u = (u < 0 || u > 1) ? 0 : std::ceil(u - 0.5);
+                const double v0 = traw[a - 1 + j - 1] * 0.1, v1 = traw[a - 1 + j] * 0.1;
+                v = fused ? std::fma(u, v1 - v0, v0) : u * (v1 - v0) + v0;
+              }
+              want_t[static_cast<std::size_t>(from + q)] = v;
+            }
+          }
+          for (std::size_t cap : caps) {
+            gravcal::MemorySource as(acc.data(), acc.size());
+            std::unique_ptr<gravcal::ByteSource> ts(new gravcal::MemorySource(temp.data(), temp.size()));
+            gravcal::Options o;
+            o.set("compat", 1.0);
+            o.set("interpolation", static_cast<double>(interp));
+            o.set("resample_fused", static_cast<double>(fused));
+            o.set("block_samples", blk);
+            gravcal::MovisensDecoder dec(as, o, xml, std::move(ts));
+            CHECK(dec.open());
+            CHECK(dec.info().has_temperature);
+            std::vector<double> x(cap), y(cap), z(cap), t(cap);
+            std::int64_t k = 0;
+            bool ok = true;
+            while (!dec.done()) {
+              gravcal::SampleBuffer buf;
+              buf.x = x.data();
+              buf.y = y.data();
+              buf.z = z.data();
+              buf.t = t.data();
+              buf.capacity = cap;
+              // units per call: all that fit, or a few
+              const std::int64_t got = dec.read(buf, (k % 3 == 1) ? 5 : -1);
+              if (got <= 0) break;
+              for (std::size_t i = 0; i < buf.n; ++i, ++k) {
+                const double* col[3] = {x.data(), y.data(), z.data()};
+                for (int c = 0; c < 3; ++c) {
+                  ok = ok && col[c][i] == (static_cast<double>(raw[3 * k + c]) - 3) * 0.00048828125;
+                }
+                ok = ok && std::memcmp(&t[i], &want_t[static_cast<std::size_t>(k)], sizeof(double)) == 0;
+              }
+            }
+            CHECK(k == n);
+            CHECK(ok);
+            if (!ok) {
+              std::printf("  movisens: rate %s, block %g, interpolation %d, fused %d, run %zu\n",
+                          rates[ri], blk, interp, fused, cap);
+            }
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  CHECK(compared == 6 * 4 * 2 * 2 * 3);
+}
+
 int main() {
+  test_movisens();
   test_zone();
   test_pump();
   test_procedure();

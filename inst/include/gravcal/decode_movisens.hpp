@@ -293,8 +293,37 @@ class UnisensSignal {
                                 : static_cast<double>(static_cast<std::int32_t>(le32(p)));
     return scale_ ? (v - baseline_) * lsb_ : v;
   }
+  // Channels 0, 1, 2 of m consecutive frames of 3 channels from f, as
+  // decode() gives them, into x, y, z.
+  void decode3(const unsigned char* f, std::size_t m, double* x, double* y, double* z) const {
+    if (size_ == 2) decode3_as<2>(f, m, x, y, z);
+    else decode3_as<4>(f, m, x, y, z);
+  }
 
  private:
+  template <int S>
+  static double raw(const unsigned char* p) {
+    if (S == 2) return static_cast<double>(static_cast<std::int16_t>(le16(p)));
+    return static_cast<double>(static_cast<std::int32_t>(le32(p)));
+  }
+  template <int S>
+  void decode3_as(const unsigned char* f, std::size_t m, double* x, double* y, double* z) const {
+    const double b = baseline_, l = lsb_;
+    if (scale_) {
+      for (std::size_t i = 0; i < m; ++i, f += 3 * S) {
+        x[i] = (raw<S>(f) - b) * l;
+        y[i] = (raw<S>(f + S) - b) * l;
+        z[i] = (raw<S>(f + 2 * S) - b) * l;
+      }
+    } else {
+      for (std::size_t i = 0; i < m; ++i, f += 3 * S) {
+        x[i] = raw<S>(f);
+        y[i] = raw<S>(f + S);
+        z[i] = raw<S>(f + 2 * S);
+      }
+    }
+  }
+
   bool fill(std::int64_t k) {
     std::int64_t want = count_ - k;
     if (want > static_cast<std::int64_t>(buf_frames_)) want = static_cast<std::int64_t>(buf_frames_);
@@ -414,11 +443,15 @@ class MovisensDecoder : public Decoder {
       if (m > block_end_ - next_) m = block_end_ - next_;
       if (m > static_cast<std::int64_t>(out.room())) m = static_cast<std::int64_t>(out.room());
       if (max_units >= 0 && m > max_units - units) m = max_units - units;
-      const std::size_t step = acc_.frame_bytes();
-      for (std::int64_t i = 0; i < m; ++i, f += step) {
-        const double t = info_.has_temperature ? temperature(next_ + i - block_from_) : nan;
-        out.put(acc_.decode(f, 0), acc_.decode(f, 1), acc_.decode(f, 2), t, nan);
+      // a run of m samples, column by column (acc.bin has 3 channels)
+      const std::size_t k = out.n, mm = static_cast<std::size_t>(m);
+      acc_.decode3(f, mm, out.x + k, out.y + k, out.z + k);
+      if (out.t != nullptr) {
+        if (info_.has_temperature) temperatures(next_ - block_from_, m, out.t + k);
+        else std::fill(out.t + k, out.t + k + mm, nan);
       }
+      if (out.time != nullptr) std::fill(out.time + k, out.time + k + mm, nan);
+      out.n += mm;
       next_ += m;
       units += m;
       report_.samples += m;
@@ -543,29 +576,65 @@ class MovisensDecoder : public Decoder {
     pos_ = 1;
   }
 
-  // The temperature of the block's sample p (0-based): R's seq(1, m,
-  // length.out = n)[p + 1], then GGIRread::resample's interpolation.
-  double temperature(std::int64_t p) {
-    if (!block_temp_) return std::numeric_limits<double>::quiet_NaN();
-    const double m = static_cast<double>(tm_);
-    const std::int64_t t0 = tfrom_ - 1;  // 0-based first temperature sample
-    if (tm_ == 1) return temp_.value(t0, temp_chan_);
-    double g;
-    if (p == 0) g = 1;
-    else if (p == bn_ - 1) g = m;
-    else g = 1 + static_cast<double>(p) * ((m - 1) / static_cast<double>(bn_ - 1));
-    while (pos_ < tm_ - 1 && static_cast<double>(pos_ + 1) < g) ++pos_;
-    const double r0 = static_cast<double>(pos_), r1 = static_cast<double>(pos_ + 1);
-    double u = (g - r0) / (r1 - r0);
-    if (nearest_) u = ggir_nearest_weight(u);
-    // the two temperature samples, read once for the samples between them
-    // (after a read error, every time: value() then gives NaN past it)
-    if (t0 + pos_ != tv_at_ || temp_.failed()) {
-      tv_at_ = t0 + pos_;
-      tv_[0] = temp_.value(tv_at_ - 1, temp_chan_);
-      tv_[1] = temp_.value(tv_at_, temp_chan_);
+  // The temperatures of the block's samples p..p + m - 1 (0-based), into
+  // out: for sample q, R's seq(1, tm, length.out = n)[q + 1] (1 + q * by, by
+  // = (tm - 1) / (n - 1), its ends exact), then GGIRread::resample's
+  // interpolation between the temperature samples around it. Its weight
+  // (g - r0) / (r1 - r0) is g - r0: r1 - r0 is exactly 1 (positions below
+  // 2^53) and a division by 1 is exact.
+  void temperatures(std::int64_t p, std::int64_t m, double* out) {
+    if (!block_temp_) {
+      std::fill(out, out + m, std::numeric_limits<double>::quiet_NaN());
+      return;
     }
-    return kernels::ggir_lerp(u, tv_[0], tv_[1], fused_);
+    if (tm_ == 1) {
+      for (std::int64_t i = 0; i < m; ++i) out[i] = temp_.value(tfrom_ - 1, temp_chan_);
+      return;
+    }
+    if (nearest_) temperatures_as<true, false>(p, m, out);
+    else if (fused_) temperatures_as<false, true>(p, m, out);
+    else temperatures_as<false, false>(p, m, out);
+  }
+
+  template <bool Nearest, bool Fused>
+  void temperatures_as(std::int64_t p, std::int64_t m, double* out) {
+    const std::int64_t t0 = tfrom_ - 1;  // 0-based first temperature sample
+    const double tm = static_cast<double>(tm_);
+    const double by = (tm - 1) / static_cast<double>(bn_ - 1);
+    const std::int64_t last = bn_ - 1;
+    auto position = [&](std::int64_t q) {
+      return q == 0 ? 1.0 : q == last ? tm : 1 + static_cast<double>(q) * by;
+    };
+    // whether position g lies beyond the interval (pos, pos + 1] (never
+    // beyond the last one): one test, for the search and for the run
+    auto beyond = [&](std::int64_t pos, double g) {
+      return pos < tm_ - 1 && static_cast<double>(pos + 1) < g;
+    };
+    std::int64_t pos = pos_;
+    std::int64_t i = 0;
+    while (i < m) {
+      // the interval that holds sample i's position
+      const double gi = position(p + i);
+      while (beyond(pos, gi)) ++pos;
+      // the temperature samples at its ends, read once for the samples in
+      // it (after a read error, every time: value() then gives NaN past it)
+      if (t0 + pos != tv_at_ || temp_.failed()) {
+        tv_at_ = t0 + pos;
+        tv_[0] = temp_.value(tv_at_ - 1, temp_chan_);
+        tv_[1] = temp_.value(tv_at_, temp_chan_);
+      }
+      const double v0 = tv_[0], v1 = tv_[1];
+      const double r0 = static_cast<double>(pos);
+      // sample i and those after it in the same interval
+      for (; i < m; ++i) {
+        const double g = position(p + i);
+        if (beyond(pos, g)) break;
+        double u = g - r0;
+        if (Nearest) u = ggir_nearest_weight(u);
+        out[i] = kernels::ggir_lerp(u, v0, v1, Fused);
+      }
+    }
+    pos_ = pos;
   }
 
   // "YYYY-MM-DDTHH:MM:SS[.fff]" as seconds since 1970 UTC; NaN otherwise.
