@@ -99,7 +99,8 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
                                               static_cast<double>(c[2]), static_cast<double>(c[3])),
           Rcpp::_["w"] = want_w ? Rcpp::RObject(ld_bytes(o.w, 3)) : Rcpp::RObject(),
           Rcpp::_["lo"] = num(o.lo, 3), Rcpp::_["hi"] = num(o.hi, 3),
-          Rcpp::_["ls"] = lanes12(o.ls), Rcpp::_["zero"] = o.zero);
+          Rcpp::_["ls"] = lanes12(o.ls), Rcpp::_["zero"] = o.zero,
+          Rcpp::_["repeats"] = static_cast<double>(o.repeats));
     });
   }
   if (name == "r_var_means3") {

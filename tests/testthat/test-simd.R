@@ -246,6 +246,36 @@ test_that("r_scan: R's running sums, min, max, zero test and lanes of the refere
   expect_identical(kernel_diffs("r_scan", nonfinite, sums_finite), character(0))
 })
 
+test_that("r_scan counts the samples equal to the one before in x, y and z", {
+  set.seed(4)
+  # runs of repeated samples (a stuck sensor, an idle-sleep stretch), some
+  # equal on two axes only, zeros of both signs (equal), every length
+  cases <- list()
+  for (n in c(1:33, 200, 501)) {
+    for (want_w in c(TRUE, FALSE)) {
+      i <- cumsum(c(TRUE, stats::runif(n - 1) < 0.4))
+      v <- list(x = c(0.6, -0, 0, 1 + 2^-52, 0.5)[(i %% 5) + 1],
+                y = sample(c(-0.2, 0.1), max(i), replace = TRUE)[i],
+                z = 0.7 + 0.01 * stats::rnorm(max(i))[i])
+      # a change on one axis alone breaks a repeat
+      if (n > 5) v$z[seq(3, n, by = 7)] <- v$z[seq(3, n, by = 7)] + 2^-40
+      cases[[paste(n, want_w)]] <- c(v, list(c = c(1, 2, 3, 4), want_w = want_w))
+    }
+  }
+  expect_identical(kernel_diffs("r_scan", cases), character(0))
+  # the reference's count is R's
+  counted <- vapply(cases, function(a) {
+    gc_kernel_check("r_scan", a)$scalar$repeats
+  }, numeric(1))
+  expected <- vapply(cases, function(a) {
+    n <- length(a$x)
+    if (n < 2) return(0)
+    as.double(sum(a$x[-1] == a$x[-n] & a$y[-1] == a$y[-n] & a$z[-1] == a$z[-n]))
+  }, numeric(1))
+  expect_identical(counted, expected)
+  expect_gt(sum(expected), 1000)
+})
+
 test_that("r_var_means3: the means it decides are R's (mean())", {
   set.seed(5)
   cases <- column_cases()

@@ -273,7 +273,7 @@ class RExactStatsT {
     }
     if (t != nullptr && !std::isfinite(static_cast<double>(r.c[4]))) return false;
     for (int k = 0; k < 5; ++k) csum_[k] = r.c[k];
-    c_.set_whole(m, t != nullptr, r.o.lo, r.o.hi, count_repeats(r.cols[0], r.cols[1], r.cols[2], m));
+    c_.set_whole(m, t != nullptr, r.o.lo, r.o.hi, r.o.repeats);
     whole_ = true;
     return true;
   }

@@ -37,11 +37,12 @@ struct WindowStats {
 };
 
 // Of m samples, how many equal the one before them in x, y and z (the
-// whole-window twin of WindowCounts::add_valid()'s count, window_cutter.hpp).
+// whole-window twin of WindowCounts::add_valid()'s count, window_cutter.hpp);
+// only those from sample `from` on (the vector kernels count the rest).
 inline std::int64_t count_repeats(const double* x, const double* y, const double* z,
-                                  std::size_t m) {
+                                  std::size_t m, std::size_t from = 1) {
   std::int64_t r = 0;
-  for (std::size_t k = 1; k < m; ++k) {
+  for (std::size_t k = from > 1 ? from : 1; k < m; ++k) {
     r += (x[k] == x[k - 1]) & (y[k] == y[k - 1]) & (z[k] == z[k - 1]);
   }
   return r;

@@ -296,15 +296,18 @@ inline void lane_sums(const double* const* v, std::size_t n, double (*s)[4]) {
 // portable r_scan_scalar<double>() alone, called directly, not through the
 // table), continued in sample order. want_w: also the window's own sums of
 // x, y, z in that accumulator (the first pass of R's sd). Then min, max,
-// whether some sample is all zeros, and the columns' sums in four lanes
-// (ls). With a non-finite sample c is not finite, and the rest is not
-// defined.
+// whether some sample is all zeros, the columns' sums in four lanes (ls),
+// and how many samples equal the one before them in x, y and z
+// (count_repeats(), window_stats.hpp; in the vector variants nearly free
+// beside the long double sums). With a non-finite sample c is not finite,
+// and the rest is not defined.
 
 template <class Acc>
 struct RScanOutT {
   double lo[3] = {}, hi[3] = {}, ls[3][4] = {};
   Acc w[3] = {};
   bool zero = false;
+  std::int64_t repeats = 0;
 };
 using RScanOut = RScanOutT<long double>;
 
@@ -368,6 +371,7 @@ void r_scan_scalar(const double* x, const double* y, const double* z, std::size_
   bool zero = false;
   min_max_tail(col, 0, m, lo, hi, zero);
   r_scan_finish(col, m, lo, hi, zero, o);
+  o.repeats = count_repeats(x, y, z, m);
 }
 
 #if defined(GRAVCAL_SSE2)
@@ -383,10 +387,17 @@ inline void r_scan_sse2(const double* x, const double* y, const double* z, std::
   __m128d lo0 = _mm_set1_pd(lo[0]), lo1 = _mm_set1_pd(lo[1]), lo2 = _mm_set1_pd(lo[2]);
   __m128d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
   __m128d s0a = zr, s0b = zr, s1a = zr, s1b = zr, s2a = zr, s2b = zr;
+  __m128i rep = _mm_setzero_si128();
   bool odd = false;  // whether lanes 2 and 3 come next
   std::size_t k = 0;
   for (; k + 2 <= m; k += 2) {
     const __m128d a = _mm_loadu_pd(x + k), b = _mm_loadu_pd(y + k), cc = _mm_loadu_pd(z + k);
+    if (k > 0) {  // samples k, k + 1 equal to the one before (all-ones lanes: -1)
+      const __m128d e = _mm_and_pd(_mm_and_pd(_mm_cmpeq_pd(a, _mm_loadu_pd(x + k - 1)),
+                                              _mm_cmpeq_pd(b, _mm_loadu_pd(y + k - 1))),
+                                   _mm_cmpeq_pd(cc, _mm_loadu_pd(z + k - 1)));
+      rep = _mm_sub_epi64(rep, _mm_castpd_si128(e));
+    }
     if (odd) {
       s0b = _mm_add_pd(s0b, a);
       s1b = _mm_add_pd(s1b, b);
@@ -426,6 +437,11 @@ inline void r_scan_sse2(const double* x, const double* y, const double* z, std::
   }
   min_max_tail(col, k, m, lo, hi, zero);
   r_scan_finish(col, m, lo, hi, zero, o);
+  // the loop counted samples 2..k - 1; the first two and the tail here
+  std::int64_t r[2];
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(r), rep);
+  o.repeats = r[0] + r[1] + count_repeats(x, y, z, m < 2 ? m : 2) +
+              count_repeats(x, y, z, m, k > 2 ? k : 2);
 }
 #endif
 
@@ -439,8 +455,10 @@ template <bool Sums>
 GRAVCAL_TARGET_AVX2 inline std::size_t r_scan_loop_avx2(const double* x, const double* y,
                                                         const double* z, std::size_t m,
                                                         long double* c, double* lo, double* hi,
-                                                        bool& zero, double (*ls)[4]) {
+                                                        bool& zero, double (*ls)[4],
+                                                        std::int64_t& repeats) {
   const __m256d zr = _mm256_setzero_pd();
+  __m256i rep = _mm256_setzero_si256();
   __m256d lo0 = _mm256_set1_pd(lo[0]), lo1 = _mm256_set1_pd(lo[1]), lo2 = _mm256_set1_pd(lo[2]);
   __m256d hi0 = lo0, hi1 = lo1, hi2 = lo2, zacc = zr;
   __m256d s0 = zr, s1 = zr, s2 = zr;
@@ -478,6 +496,18 @@ GRAVCAL_TARGET_AVX2 inline std::size_t r_scan_loop_avx2(const double* x, const d
     zacc = _mm256_or_pd(zacc, _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a, zr, _CMP_EQ_OQ),
                                                           _mm256_cmp_pd(b, zr, _CMP_EQ_OQ)),
                                             _mm256_cmp_pd(cc, zr, _CMP_EQ_OQ)));
+    if (k > 0) {  // samples k..k + 3 equal to the one before (all-ones lanes: -1)
+      const __m256d e = _mm256_and_pd(
+          _mm256_and_pd(_mm256_cmp_pd(a, _mm256_loadu_pd(x + k - 1), _CMP_EQ_OQ),
+                        _mm256_cmp_pd(b, _mm256_loadu_pd(y + k - 1), _CMP_EQ_OQ)),
+          _mm256_cmp_pd(cc, _mm256_loadu_pd(z + k - 1), _CMP_EQ_OQ));
+      rep = _mm256_sub_epi64(rep, _mm256_castpd_si256(e));
+    }
+  }
+  {
+    alignas(32) std::int64_t r[4];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(r), rep);
+    repeats = (r[0] + r[1]) + (r[2] + r[3]);
   }
   if (Sums) {
     c[0] = c0;
@@ -508,13 +538,16 @@ GRAVCAL_TARGET_AVX2 inline void r_scan_avx2(const double* x, const double* y, co
   double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
   bool zero = false;
   std::size_t k;
+  std::int64_t rep = 0;
   if (want_w) {
     r_cumsums(x, y, z, 0, m, c, true, o);
-    k = r_scan_loop_avx2<false>(x, y, z, m, c, lo, hi, zero, o.ls);
+    k = r_scan_loop_avx2<false>(x, y, z, m, c, lo, hi, zero, o.ls, rep);
   } else {
-    k = r_scan_loop_avx2<true>(x, y, z, m, c, lo, hi, zero, o.ls);
+    k = r_scan_loop_avx2<true>(x, y, z, m, c, lo, hi, zero, o.ls, rep);
     r_cumsums(x, y, z, k, m, c, false, o);
   }
+  // the loop counted samples 4..k - 1; the first four and the tail here
+  o.repeats = rep + count_repeats(x, y, z, m < 4 ? m : 4) + count_repeats(x, y, z, m, k > 4 ? k : 4);
   for (std::size_t j = k; j < m; ++j) {
     for (int a = 0; a < 3; ++a) o.ls[a][j & 3] += col[a][j];
   }
