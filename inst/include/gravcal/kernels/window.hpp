@@ -469,14 +469,16 @@ GRAVCAL_TARGET_AVX2 inline std::size_t r_scan_loop_avx2(const double* x, const d
     c2 = c[2];
     c3 = c[3];
   }
-  alignas(32) double nrm[4];
+  // unaligned stores to the locals: 64-bit Windows' GCC does not promise
+  // a stack aligned to 32 bytes (GCC bug 54412)
+  double nrm[4];
   std::size_t k = 0;
   for (; k + 4 <= m; k += 4) {
     const __m256d a = _mm256_loadu_pd(x + k), b = _mm256_loadu_pd(y + k),
                   cc = _mm256_loadu_pd(z + k);
     if (Sums) {
       const __m256d sq = _mm256_add_pd(_mm256_mul_pd(a, a), _mm256_mul_pd(b, b));
-      _mm256_store_pd(nrm, _mm256_sqrt_pd(_mm256_add_pd(sq, _mm256_mul_pd(cc, cc))));
+      _mm256_storeu_pd(nrm, _mm256_sqrt_pd(_mm256_add_pd(sq, _mm256_mul_pd(cc, cc))));
       for (int j = 0; j < 4; ++j) {
         c0 += x[k + j];
         c1 += y[k + j];
@@ -505,8 +507,8 @@ GRAVCAL_TARGET_AVX2 inline std::size_t r_scan_loop_avx2(const double* x, const d
     }
   }
   {
-    alignas(32) std::int64_t r[4];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(r), rep);
+    std::int64_t r[4];
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(r), rep);
     repeats = (r[0] + r[1]) + (r[2] + r[3]);
   }
   if (Sums) {
