@@ -285,9 +285,17 @@ static void test_movisens() {
                 while (j < m - 1 && static_cast<double>(j + 1) < g) ++j;
                 double u = (g - static_cast<double>(j)) /
                            (static_cast<double>(j + 1) - static_cast<double>(j));
-                if (interp == 2) u = (u < 0 || u > 1) ? 0 : std::ceil(u - 0.5);
                 const double v0 = traw[a - 1 + j - 1] * 0.1, v1 = traw[a - 1 + j] * 0.1;
-                v = fused ? std::fma(u, v1 - v0, v0) : u * (v1 - v0) + v0;
+                if (interp == 2) {
+                  // u is then -0, 0 or 1, so u (v1 - v0) is exact and
+                  // fused or not is the same number (written unfused here:
+                  // mingw-w64's std::fma is not correctly rounded, e.g.
+                  // fma(1, 0.19999999999999998, 0.1) = 0.29999999999999993)
+                  u = (u < 0 || u > 1) ? 0 : std::ceil(u - 0.5);
+                  v = u * (v1 - v0) + v0;
+                } else {
+                  v = fused ? std::fma(u, v1 - v0, v0) : u * (v1 - v0) + v0;
+                }
               }
               want_t[static_cast<std::size_t>(from + q)] = v;
             }
