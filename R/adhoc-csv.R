@@ -167,7 +167,20 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
     }
     t <- as.numeric(as.POSIXct(stamps, format = fmt, tz = "UTC"))
     # GGIR spreads whole-second stamps that repeat over the second
-    # ("POSIX"): not reproduced
+    # ("POSIX"): not reproduced. What GGIR 3.3-9's read.myacc.csv() does,
+    # per block of lines, when the block's first 1000 stamps repeat one and
+    # sf is given: with b the ends of the runs of equal stamps (1 first,
+    # duplicates dropped, the block's last line last; so a first run of one
+    # line merges with the next) and L = diff(b) (the first "run" counted one
+    # short), in this order, each an addition to the stamps, with d =
+    # (0:(sf - 1)) * (1 / sf) (seq()'s products, not quotients): runs with
+    # L == sf get d (the first run from its second line on); a first run
+    # with L != sf gets seq(1 - b[2] / sf, 1 - 1 / sf, by = 1 / sf); a last
+    # run with L != sf gets d[1:L] (NA beyond sf); with more than four b,
+    # every run after the first with L != sf (the last one again) gets
+    # d[1:L], d[sf] repeated beyond sf. A streaming wrapper under
+    # GgirTimegapsOf could replay it holding the first 1000 lines and four
+    # runs.
     w <- t[!is.na(t)]
     if (unit == "POSIX" && all(w == floor(w)) && anyDuplicated(w)) {
       refuse("whole-second time stamps that repeat are spread over the second by GGIR")
