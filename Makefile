@@ -18,6 +18,7 @@ RSCRIPT ?= Rscript
 BUILD := _build
 LIB := $(BUILD)/lib
 SHARED_DATA ?= $(abspath ../shared/data)
+GGIR_CACHE := $(abspath tests/ggir-cache)
 VERSION := $(shell sed -n 's/^Version: *//p' DESCRIPTION)
 TARBALL := gravcal_$(VERSION).tar.gz
 
@@ -28,10 +29,10 @@ TARBALL := gravcal_$(VERSION).tar.gz
 # and printed fit are part of the suite.
 CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE \
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
-             GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true
+             GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -44,29 +45,67 @@ setup-test:
 # the package's translation units compiled in parallel, one per core (the
 # longest takes about a third of the serial time)
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
-install: setup
+# (installed once for all the targets that need it, again only when a file
+# of the package changed: $(BUILD)/install.stamp)
+PKG_SRC := DESCRIPTION NAMESPACE $(shell find R src inst vignettes -type f ! -name '*.o' ! -name '*.so' ! -name '*.dll' 2>/dev/null)
+install: $(BUILD)/install.stamp
+$(BUILD)/install.stamp: $(PKG_SRC) | setup
 	mkdir -p $(LIB)
 	MAKEFLAGS=-j$(JOBS) $(R) CMD INSTALL --preclean --no-multiarch -l $(LIB) . > $(BUILD)/install.log 2>&1 || (cat $(BUILD)/install.log; exit 1)
+	touch $@
 
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
 # make test: the tarball, then the sanitizer run (the whole suite under
-# ASan and UBSan, the longest step: 30 to 60 minutes) in the background,
-# installed from that tarball (so built in a directory of its own, not in
-# src/, where the steps beside it build), while the check and then the other
-# steps run one after another beside it on the second core; fails when
-# either side does. The sanitizer's output: $(BUILD)/sanitize-make.log.
+# ASan and UBSan, the longest step) in the background, installed from that
+# tarball (so built in a directory of its own, not in src/, where the steps
+# beside it build), while the check and then the other steps run one after
+# another beside it on the second core; fails when either side does. The
+# sanitizer's output: $(BUILD)/sanitize-make.log. Each step's wall time is
+# printed and kept in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the
+# identity tests comes from tests/ggir-cache where the same input, parameters,
+# GGIR version and platform were run before (tests/testthat/helper-ggir-cache.R;
+# a sixteenth of the entries is recomputed and compared on every run).
 TEST_REST := core cross-check flags-check valgrind fuzz-short test-slurm site
 test: setup-test
-	$(MAKE) tarball
-	@$(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) > $(BUILD)/sanitize-make.log 2>&1 & san=$$!; \
+	@rm -f $(BUILD)/times.txt; start=$$(date +%s); \
+	  bash tools/timed.sh tarball $(MAKE) tarball || exit 1; \
+	  bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) > $(BUILD)/sanitize-make.log 2>&1 & san=$$!; \
 	  echo "test: sanitize runs in the background (log: $(BUILD)/sanitize-make.log)"; \
-	  $(MAKE) check-run && $(MAKE) $(TEST_REST); rest=$$?; \
+	  ( bash tools/timed.sh check $(MAKE) check-run || exit 1; \
+	    for t in $(TEST_REST); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ); rest=$$?; \
 	  wait $$san; st=$$?; \
 	  if [ $$st -ne 0 ]; then tail -80 $(BUILD)/sanitize-make.log; echo "test: sanitize failed"; \
-	  else tail -2 $(BUILD)/sanitize-make.log; fi; \
+	  else tail -3 $(BUILD)/sanitize-make.log; fi; \
+	  echo "test: steps' wall times:"; cat $(BUILD)/times.txt; \
+	  echo "test: $$(( $$(date +%s) - start )) s in all"; \
 	  test $$rest -eq 0 && test $$st -eq 0
+
+# the R tests without the slow tier (GRAVCAL_TEST_TIER=quick: the tests that
+# call skip_if_quick()), from the installed package, for the edit-test loop:
+# a few minutes
+quick: install setup-test
+	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/run-tests.R
+
+# every cached GGIR result recomputed and compared with the cache (and the
+# missing ones added): the whole suite with GRAVCAL_GGIR_CACHE_MODE=verify,
+# GGIR run on every identity case as before the cache (about 20 minutes).
+# Not part of make test; run it before resolving and after a GGIR upgrade.
+test-ggir-cache: install setup-test
+	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_GGIR_CACHE_MODE=verify $(RSCRIPT) ../../tools/run-tests.R
+
+# the time of each test file and of the slowest tests, into
+# bench/results/test-profile.md (PROFILE_OUT)
+PROFILE_OUT ?= bench/results/test-profile.md
+profile-tests: install setup-test
+	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_OUT))
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the
@@ -115,7 +154,7 @@ flags-check: setup-test
 	R_MAKEVARS_USER=$(abspath $(BUILD)/native.mk) $(R) CMD INSTALL --preclean --no-multiarch \
 	  -l $(BUILD)/lib-native . > $(BUILD)/native-install.log 2>&1 || (tail -40 $(BUILD)/native-install.log; exit 1)
 	sh tools/fma-count.sh $(BUILD)/lib-native/gravcal/libs/gravcal.so
-	R_LIBS="$(abspath $(BUILD)/lib-native)$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) \
+	R_LIBS="$(abspath $(BUILD)/lib-native)$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) \
 	  $(RSCRIPT) tools/flags-check.R bits
 	$(MAKE) -C tests/cpp digest-flags DIGEST_FLAGS="$(FLAGS_NATIVE)"
 	R_MAKEVARS_USER=$(abspath $(BUILD)/clang-fast.mk) $(R) CMD INSTALL --preclean --no-multiarch \
@@ -139,8 +178,8 @@ sanitize-run:
 	if [ "$(SANITIZE_SRC)" = "." ]; then rm -f src/*.o src/*.so; fi
 	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
 	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
-	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true $(RSCRIPT) ../../tools/run-tests.R \
+	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" GRAVCAL_GGIR_CACHE_MODE=trust \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true $(RSCRIPT) ../../tools/run-tests.R \
 	  > ../../$(BUILD)/sanitize.log 2>&1 || (tail -60 ../../$(BUILD)/sanitize.log; exit 1)
 	@if grep -qE "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log; then \
 	  grep -E -A20 "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log | head -60; exit 1; fi

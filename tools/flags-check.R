@@ -18,7 +18,7 @@ if (!mode %in% c("bits", "refuse")) stop("usage: flags-check.R bits|refuse")
 # the test suite's helpers: run_both() (GGIR and gravcal on one file, with
 # GGIR's parameters), expect_same_as_ggir() (every number identical()),
 # shared_data()
-for (h in c("helper-ggir.R", "helper-data.R")) {
+for (h in c("helper-ggir-cache.R", "helper-ggir.R", "helper-data.R")) {
   source(file.path("tests", "testthat", h))
 }
 fp <- gravcal:::build_state$fp

@@ -7,6 +7,7 @@
 # x86-64 Linux, on R without long double: make test-noLD's R, and in the
 # arm64 chroot of make test-arm64).
 suppressPackageStartupMessages(library(gravcal))
+source(file.path("tests", "testthat", "helper-ggir-cache.R"))
 source(file.path("tests", "testthat", "helper-ggir.R"))
 out <- commandArgs(TRUE)[1]
 tf <- function(f) system.file("testfiles", f, package = "GGIRread")

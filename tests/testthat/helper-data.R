@@ -43,3 +43,12 @@ scrub_dir <- function(d) {
          fixed = TRUE)
   }
 }
+
+# The slow tier: tests that take tens of seconds each. make quick sets
+# GRAVCAL_TEST_TIER=quick and leaves them out; make test and R CMD check run
+# them all.
+skip_if_quick <- function() {
+  if (identical(Sys.getenv("GRAVCAL_TEST_TIER"), "quick")) {
+    testthat::skip("slow tier, left out by make quick (GRAVCAL_TEST_TIER=quick)")
+  }
+}

@@ -7,9 +7,11 @@ run_both <- function(file, params = list()) {
     utils::capture.output(out <- suppressWarnings(expr))
     out
   }
-  I <- quiet(GGIR::g.inspectfile(file, params_rawdata = pr))
-  R <- quiet(GGIR::g.calibrate(file, params_rawdata = pr,
-                               inspectfileobject = I, verbose = FALSE))
+  R <- ggir_cached("g.calibrate", file, list(params_rawdata = pr), {
+    I <- quiet(GGIR::g.inspectfile(file, params_rawdata = pr))
+    quiet(GGIR::g.calibrate(file, params_rawdata = pr,
+                            inspectfileobject = I, verbose = FALSE))
+  })
   G <- quiet(gravcal::g.calibrate(file, params_rawdata = pr, verbose = FALSE))
   list(ggir = R, gravcal = G)
 }

@@ -184,9 +184,12 @@ run_both_general <- function(f, general, rawdata = list()) {
     utils::capture.output(out <- suppressWarnings(expr))
     out
   }
-  I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
-  list(ggir = quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
-                                      inspectfileobject = I, verbose = FALSE)),
+  R <- ggir_cached("g.calibrate", f, list(params_rawdata = pr, params_general = pg), {
+    I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+    quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
+                            inspectfileobject = I, verbose = FALSE))
+  })
+  list(ggir = R,
        gravcal = quiet(g.calibrate(f, params_rawdata = pr, params_general = pg,
                                    verbose = FALSE)))
 }

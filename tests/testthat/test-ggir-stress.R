@@ -127,11 +127,12 @@ st_run_both <- function(file, params) {
     utils::capture.output(out <- suppressWarnings(expr))
     out
   }
-  R <- tryCatch(quiet({
-    I <- GGIR::g.inspectfile(file, params_rawdata = pr)
-    GGIR::g.calibrate(file, params_rawdata = pr, inspectfileobject = I,
-                      verbose = FALSE)
-  }), error = function(e) e)
+  R <- ggir_cached("g.calibrate", file, list(params_rawdata = pr),
+    tryCatch(quiet({
+      I <- GGIR::g.inspectfile(file, params_rawdata = pr)
+      GGIR::g.calibrate(file, params_rawdata = pr, inspectfileobject = I,
+                        verbose = FALSE)
+    }), error = function(e) e))
   G <- tryCatch(quiet(gravcal::g.calibrate(file, params_rawdata = pr,
                                            verbose = FALSE)),
                 error = function(e) e)
