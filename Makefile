@@ -57,30 +57,34 @@ $(BUILD)/install.stamp: $(PKG_SRC) | setup
 demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
-# make test: the tarball, then the sanitizer run (the whole suite under
-# ASan and UBSan, the longest step) in the background, installed from that
-# tarball (so built in a directory of its own, not in src/, where the steps
-# beside it build), while the check and then the other steps run one after
-# another beside it on the second core; fails when either side does. The
-# sanitizer's output: $(BUILD)/sanitize-make.log. Each step's wall time is
-# printed and kept in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the
-# identity tests comes from tests/ggir-cache where the same input, parameters,
-# GGIR version and platform were run before (tests/testthat/helper-ggir-cache.R;
-# a sixteenth of the entries is recomputed and compared on every run).
-TEST_REST := core cross-check flags-check valgrind fuzz-short test-slurm site
+# make test: the tarball, then two lanes side by side, one a core:
+# - lane A, in the background: the sanitizer run (the whole suite under ASan
+#   and UBSan), installed from the tarball (so built in a directory of its
+#   own, not in src/, where lane B builds), then the fuzzers (tests/fuzz);
+#   its output: $(BUILD)/lane-a.log;
+# - lane B: R CMD check, then the other steps one after another.
+# It fails when either lane does. Each step's wall time is printed and kept
+# in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the identity tests
+# comes from tests/ggir-cache where the same input, parameters, GGIR version
+# and platform were run before (tests/testthat/helper-ggir-cache.R; the
+# check recomputes a sixteenth of the entries and compares them).
+TEST_LANE_A := fuzz-short
+TEST_LANE_B := core cross-check flags-check valgrind test-slurm site
 test: setup-test
 	@rm -f $(BUILD)/times.txt; start=$$(date +%s); \
 	  bash tools/timed.sh tarball $(MAKE) tarball || exit 1; \
-	  bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) > $(BUILD)/sanitize-make.log 2>&1 & san=$$!; \
-	  echo "test: sanitize runs in the background (log: $(BUILD)/sanitize-make.log)"; \
+	  ( bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) || exit 1; \
+	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ) \
+	    > $(BUILD)/lane-a.log 2>&1 & lane_a=$$!; \
+	  echo "test: lane A (sanitize, then $(TEST_LANE_A)) runs in the background (log: $(BUILD)/lane-a.log)"; \
 	  ( bash tools/timed.sh check $(MAKE) check-run || exit 1; \
-	    for t in $(TEST_REST); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ); rest=$$?; \
-	  wait $$san; st=$$?; \
-	  if [ $$st -ne 0 ]; then tail -80 $(BUILD)/sanitize-make.log; echo "test: sanitize failed"; \
-	  else tail -3 $(BUILD)/sanitize-make.log; fi; \
+	    for t in $(TEST_LANE_B); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ); b=$$?; \
+	  wait $$lane_a; a=$$?; \
+	  if [ $$a -ne 0 ]; then tail -80 $(BUILD)/lane-a.log; echo "test: lane A failed"; \
+	  else grep -E "ASan/UBSan clean|expectations|^fuzz_" $(BUILD)/lane-a.log; fi; \
 	  echo "test: steps' wall times:"; cat $(BUILD)/times.txt; \
 	  echo "test: $$(( $$(date +%s) - start )) s in all"; \
-	  test $$rest -eq 0 && test $$st -eq 0
+	  test $$a -eq 0 && test $$b -eq 0
 
 # the R tests without the slow tier (GRAVCAL_TEST_TIER=quick: the tests that
 # call skip_if_quick()), from the installed package, for the edit-test loop:

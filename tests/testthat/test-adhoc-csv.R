@@ -25,6 +25,7 @@ expect_adhoc_same <- function(file, pr, full = TRUE, ...) {
 }
 
 test_that("g.calibrate() on ad hoc csv files is GGIR's, unit by unit and layout by layout", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   rec <- adhoc_rec()
@@ -76,6 +77,7 @@ test_that("ad hoc csv: text time stamps first, Kelvin, decimal commas", {
 })
 
 test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   # GGIR drops x = y = z = 0 rows (g.imputeTimegaps, impute = FALSE), here
@@ -89,6 +91,7 @@ test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
 })
 
 test_that("rmc.doresample: every block resampled from its time stamps, as GGIR does", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   # a device whose clock ran at 10.3 Hz for a nominal 10 Hz: time stamps
@@ -123,6 +126,7 @@ test_that("rmc.doresample: every block resampled from its time stamps, as GGIR d
 })
 
 test_that("rmc.doresample: samples equal read.myacc.csv's, block by block, grid ends included", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   # time stamps 0.1 s apart as text, from UNIX time 0: a block's (t_n -
@@ -397,6 +401,7 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
 })
 
 test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with gaps", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   f <- tempfile(fileext = ".csv")
@@ -439,6 +444,7 @@ test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with ga
 })
 
 test_that("text time in a zone with daylight saving: g.calibrate() is GGIR's across its changes", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   f <- tempfile(fileext = ".csv")

@@ -5,6 +5,7 @@
 # matters. The reference numbers are GGIR 3.3-9's own, computed here.
 
 test_that("g.calibrate() on an Axivity csv export is GGIR's, both readers", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   skip_if_not_installed("data.table")

@@ -363,6 +363,7 @@ test_that("compare_coefs() gives the differences, z values and mapping differenc
 })
 
 test_that("calibrate_files(coefs = ) applies another tool's coefficients to each recording", {
+  skip_if_quick()
   d <- snap_dir("coefs-cohort")
   raw <- file.path(d, "raw")
   dir.create(raw)

@@ -4,6 +4,7 @@
 # (tools/slurm-setup.sh, tools/test-slurm.R).
 
 test_that("a cohort under future.batchtools gives the sequential table", {
+  skip_if_quick()
   skip_if_not_installed("future.batchtools")
   dir <- tempfile("batchtools")
   dir.create(dir)

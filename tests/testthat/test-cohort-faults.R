@@ -171,6 +171,7 @@ test_that("a really full disk (a small tmpfs) loses nothing", {
 })
 
 test_that("two runs on one outdir: the second refuses, the first completes", {
+  skip_if_quick()
   skip_on_os("windows")  # fork
   dir <- fault_cohort()
   on.exit(unlink(dir, recursive = TRUE))

@@ -21,6 +21,7 @@ cohort_dir <- function() {
 }
 
 test_that("calibrate_files() calibrates a folder, one row per recording", {
+  skip_if_quick()
   dir <- cohort_dir()
   on.exit(unlink(dir, recursive = TRUE))
   out <- file.path(dir, "out")
@@ -86,6 +87,7 @@ test_that("calibrate_files() calibrates a folder, one row per recording", {
 })
 
 test_that("in parallel (multisession, 2 workers) the table is the same", {
+  skip_if_quick()
   skip_if_not_installed("future")
   skip_if_not_installed("future.apply")
   skip_on_os("windows")
@@ -101,6 +103,7 @@ test_that("in parallel (multisession, 2 workers) the table is the same", {
 })
 
 test_that("an interrupted run resumes without redoing finished recordings", {
+  skip_if_quick()
   skip_on_os("windows")  # fork
   dir <- cohort_dir()
   on.exit(unlink(dir, recursive = TRUE))
@@ -243,6 +246,7 @@ test_that("calibrate_files() and calibrate_cli() reject bad input clearly", {
 })
 
 test_that("calibrate_cli() calibrates files given on the command line", {
+  skip_if_quick()
   dir <- cohort_dir()
   on.exit(unlink(dir, recursive = TRUE))
   out <- file.path(dir, "cli")

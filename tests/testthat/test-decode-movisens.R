@@ -148,6 +148,7 @@ movisens_30h <- local({
 })
 
 test_that("g.calibrate matches GGIR on 30 hours of a Movisens recording", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("unisensR")
   d <- movisens_30h()
@@ -171,6 +172,7 @@ test_that("g.calibrate matches GGIR on 30 hours of a Movisens recording", {
 })
 
 test_that("damaged Movisens recordings: a cut acc.bin, no temp.bin, a bad unisens.xml", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("unisensR")
   src <- movisens_30h()

@@ -186,6 +186,7 @@ test_that("g.calibrate matches GGIR on GGIRread's Matrix files (interpolationTyp
 })
 
 test_that("g.calibrate matches GGIR on 30 hours written as a Matrix file (a real fit)", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   f <- tempfile(fileext = ".BIN")

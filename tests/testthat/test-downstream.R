@@ -118,6 +118,7 @@ Rcpp::List downstream_fit(Rcpp::NumericVector x, Rcpp::NumericVector y,
 '
 
 test_that("a program built against the installed headers gives the R functions' results to the bit", {
+  skip_if_quick()
   skip_if_not(has_compiler(), "no C++ compiler (R CMD config CXX17)")
   # the headers as installed, where LinkingTo and Rcpp::depends look
   inc <- system.file("include", "gravcal", "gravcal.hpp", package = "gravcal")

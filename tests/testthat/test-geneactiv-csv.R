@@ -42,6 +42,7 @@ test_that("a GENEActiv csv export is read as it is, its rate from the header", {
 })
 
 test_that("g.calibrate() refuses a GENEActiv csv export as GGIR does, and GGIR's advice gives GGIR's result", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   rec <- geneactiv_csv_rec(30, 10, 72)
   f <- tempfile(fileext = ".csv")

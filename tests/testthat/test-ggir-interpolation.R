@@ -103,6 +103,7 @@ test_that("frequency_tol: the decoder imputes where readAxivity does", {
 })
 
 test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   files <- c(cwa_testfile("ax3_testfile.cwa"), cwa_testfile("ax6_testfile.cwa"),
              cwa_testfile("ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa"))
@@ -219,6 +220,7 @@ test_that("a zone's offsets by calendar minute, as this R converts (R/zone.R)", 
 })
 
 test_that("desiredtz: across a change of UTC offset the decoder gives readAxivity's block times", {
+  skip_if_quick()
   skip_if_not_installed("GGIRread")
   # 30 hours across the end of daylight saving in Europe/Amsterdam (its
   # calendar 03:00 on 2023-10-29 is 02:00 UTC, not 01:00: readAxivity's
@@ -244,6 +246,7 @@ test_that("desiredtz: across a change of UTC offset the decoder gives readAxivit
 })
 
 test_that("desiredtz, configtz: across a change of UTC offset g.calibrate() gives GGIR's result", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   # the end of daylight saving in the session's zone (desiredtz = ""), with

@@ -367,6 +367,7 @@ test_that("duplicate filter: equal means and tied sds, GENEActiv .bin (exact sum
 })
 
 test_that("duplicate filter: ties decided by R's last bit (csv, 15 digits)", {
+  skip_if_quick()
   # As above on samples that are not multiples of 1/256 (15-digit
   # decimals): the means come from rounded cumulative sums and the sds of
   # shifted or permuted copies tie or not in their last bit, so GGIR's
@@ -417,6 +418,7 @@ test_that("duplicate filter: ties decided by R's last bit (csv, 15 digits)", {
 # --- 3. the temperature check (run-length code, R's sd near 0.01) --------
 
 test_that("temperature check: sd within rounding of 0.01, first values at 120", {
+  skip_if_quick()
   # Aims at GgirBlocks' temperature check: sd from the run-length code with
   # a proven bound, R's sd() only near temp_min_sd (r_sd_below()); and at
   # the mean of a block's first 10 used temperatures against 120. GGIR's
@@ -573,6 +575,7 @@ st_block_case <- function(sf, cs, fmt, blocks, full, seed, sf_g = sf,
 }
 
 test_that("block rules: idle-sleep zeros at block ends, whole-hour and dropped blocks (10, 12.5 Hz)", {
+  skip_if_quick()
   # Aims at GgirBlocks (the carry, GGIR's accidents) and at the decoders
   # writing into its buffer (writes end one sample past the current hour;
   # zeros dropped in place): csv (rows) and GENEActiv .bin (pages of 300).
@@ -597,6 +600,7 @@ test_that("block rules: idle-sleep zeros at block ends, whole-hour and dropped b
 })
 
 test_that("block rules at 12.5, 30, 50, 85.7 and 100 Hz (GENEActiv .bin, csv)", {
+  skip_if_quick()
   # The same edges where blocks, pages (300 samples), windows (10 sf
   # samples) and hours (3600 sf) fall differently: GGIR resamples a .bin
   # at 12.5 Hz to 12 (and stops after block 1) and at 85.7 Hz to 86, block
@@ -639,6 +643,7 @@ test_that("block rules at chunksize 1 and 0.1 (GENEActiv .bin)", {
 })
 
 test_that("rates whose hour is not a whole number in double (33.3, 64.1 Hz, csv)", {
+  skip_if_quick()
   # 3600 * 33.3 is 119879.99999999999 in double: GGIR's whole hours are
   # floor(LD / (3600 sf)) * 3600 sf, a number just below k * 119880; R's
   # `:` (with its fuzz) still takes k * 119880 rows for them, and GGIR's

@@ -66,6 +66,7 @@ test_that("g.calibrate matches GGIR on synthetic ActiGraph csv files", {
 })
 
 test_that("g.calibrate matches GGIR with temperature (ad hoc csv)", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   rec <- simulate_recording(hours = 26, sf = 20, seed = 42,
                             params = known_params(),
@@ -210,6 +211,7 @@ test_that("the temperature check decides as R's sd() at the threshold", {
 })
 
 test_that("g.calibrate matches GGIR where its rules compare window sds", {
+  skip_if_quick()
   # Compatible mode computes a window's sds in R's arithmetic only where
   # GGIR's rules can tell (Segmenter::lazy_r_sd()): at rest or near the
   # rest threshold, and when the duplicate filter could find an sd equal to
@@ -367,6 +369,7 @@ test_that("calibrate(method = 'ggir') gives a usable gravcal_fit", {
 })
 
 test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   # GGIR's part 2 draws its QC plots with png(), which an R built without
   # X11 and cairo (make test-noLD's) does not have
@@ -505,6 +508,7 @@ test_that("an ActiGraph csv with a time stamp column gives the same calibration"
 })
 
 test_that("a GENEActiv .bin at a rate that is not whole: GGIR's resampling, to the bit", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   # 12.5 Hz: GGIR's g.readaccfile interpolates each block onto 12 Hz (R's

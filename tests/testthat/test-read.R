@@ -85,6 +85,7 @@ test_that("ActiGraph .gt3x files read (read.gt3x's and GGIR's test files)", {
 })
 
 test_that("a .gt3x file streamed in blocks gives the samples of a whole read", {
+  skip_if_quick()
   skip_if_not_installed("read.gt3x")
   # read.gt3x's batches count stored seconds and leave out idle-sleep gaps;
   # the block reader must put the gaps back as zeros where a whole read
