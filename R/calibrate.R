@@ -152,6 +152,7 @@
 #' |---|---|---|
 #' | `"ok"` | calibrated | |
 #' | `"too_short"` | fewer samples than one window | check `sf` and the file |
+#' | `"all_zero"` | every sample is exactly 0 on all three axes (ActiGraph idle sleep, or a device that recorded nothing) | check the device and its download: there is nothing to calibrate |
 #' | `"no_rest"` | no window met the rest criterion | check units (g) and `sf` |
 #' | `"bins_incomplete"` | `selection = "paper"`: rest not seen in enough orientations | use a longer recording, the default selection, or lower `min_per_bin` / `min_distance` |
 #' | `"sphere_not_covered"` | rest not seen in enough orientations to determine even the offsets | use a longer recording |
@@ -206,7 +207,9 @@
 #' them), `"implausible"` (not applied: coefficients outside the ranges
 #' real devices show; not in compatible mode, which applies what GGIR
 #' applies), `"no_improvement"`, `"sphere_not_covered"`, `"no_rest"`,
-#' `"too_short"` and `"diverged"`, the last five with identity
+#' `"too_short"`, `"all_zero"` (gravcal's own mode: every sample is 0, the
+#' idle-sleep zeros GGIR's rule removes; compatible mode keeps GGIR's
+#' `"too_short"`) and `"diverged"`, the last six with identity
 #' coefficients.
 #'
 #' With `ggir_compat = TRUE` the numbers are GGIR's: coefficients, errors

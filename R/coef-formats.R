@@ -164,7 +164,7 @@ write_coefs <- function(fits, file, format = c("ggir", "actipy", "ukb",
       any(!nzchar(file))) {
     abort("`file` must be file paths, not ", describe(file), ".")
   }
-  cf <- as_coefs(fits, "fits")
+  cf <- as_coefs(fits, "fits", ggir = format == "ggir")
   if (format == "ggir") {
     if (length(file) != 1) {
       abort("`file` must be one path for format \"ggir\" (one csv file for ",
@@ -268,8 +268,9 @@ to_intercept <- function(r) {
 }
 
 # Any of the inputs the functions take, as rows of coefficients (with their
-# standard errors where there are some).
-as_coefs <- function(x, arg) {
+# standard errors where there are some). `ggir`: they are to be written to
+# GGIR's coefficient file (for the errors' words).
+as_coefs <- function(x, arg, ggir = FALSE) {
   if (inherits(x, "gravcal_fit") || is_ggir_result(x)) {
     nm <- if (is.null(x$file)) "recording" else basename(x$file)
     x <- stats::setNames(list(x), nm)
@@ -307,6 +308,8 @@ as_coefs <- function(x, arg) {
                       "t_y", "t_z")])
       }
       uses <- any(f$tempoffset != 0)
+      check_meantemp(f$tempoffset, f$meantemp, nms[i], "meantemp", arg,
+                     ggir = ggir)
       coefs_row(nms[i], "gravcal", diag(K), f$offset, f$tempoffset,
                 if (uses) f$meantemp else NA_real_,
                 if (identical(f$status, "ok")) "ok" else f$status, se,
@@ -314,6 +317,7 @@ as_coefs <- function(x, arg) {
     } else if (is_ggir_result(f)) {
       to <- if (length(f$tempoffset)) f$tempoffset else c(0, 0, 0)
       mt <- if (length(f$meantempcal)) f$meantempcal[1] else NA_real_
+      check_meantemp(to, mt, nms[i], "meantempcal", arg, ggir = ggir)
       coefs_row(nms[i], "ggir", f$scale, f$offset, to,
                 if (any(to != 0)) mt else NA_real_, arg = arg)
     } else {

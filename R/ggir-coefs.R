@@ -18,7 +18,10 @@
 #' the lightweight method has cross-axis terms GGIR cannot apply. When a
 #' fit has no temperature term, `meantempcal` is written as 0, because GGIR
 #' subtracts it from the temperature of files that have one (a missing value
-#' there would turn every sample into NA).
+#' there would turn every sample into NA). A fit with temperature offsets
+#' but no mean temperature (`meantemp`, or a `g.calibrate()` result's
+#' `meantempcal`) is an error: written as 0, GGIR would move every
+#' calibrated sample by `temperature.offset * meantemp`.
 #'
 #' @param fits A `gravcal_fit` from `calibrate(..., method = "ggir")` or
 #'   [fit_icp()], a `g.calibrate()` result, or a named list of either: the
@@ -116,6 +119,7 @@ ggir_coef_row <- function(f, name) {
     hours <- if (!is.null(g)) num1(g$nhoursused) else NA_real_
     use_temp <- isTRUE(f$use_temp) && any(to != 0)
     mt <- f$meantemp
+    check_meantemp(to, mt, name, "meantemp")
   } else if (is_ggir_result(f)) {
     scale <- f$scale
     offset <- f$offset
@@ -127,6 +131,7 @@ ggir_coef_row <- function(f, name) {
     hours <- num1(f$nhoursused)
     use_temp <- isTRUE(f$use.temp)
     mt <- num1(f$meantempcal)
+    check_meantemp(to, mt, name, "meantempcal")
   } else {
     abort("Element \"", name, "\" of `fits` is not a gravcal_fit or a ",
           "g.calibrate() result but ", describe(f), ".")
@@ -135,6 +140,8 @@ ggir_coef_row <- function(f, name) {
       length(offset) != 3 || length(to) != 3) {
     abort("The coefficients for \"", name, "\" are not 3 finite values each.")
   }
+  # no temperature term: GGIR subtracts meantempcal from the temperature of
+  # files that have one, so 0, never NA
   if (!length(mt) || !is.finite(mt[1])) mt <- 0
   mt <- as.numeric(mt[1])
   data.frame(filename = name,
@@ -146,4 +153,28 @@ ggir_coef_row <- function(f, name) {
              QCmessage = if (length(qc)) qc else "", n.10sec.windows = npts,
              n.hours.considered = hours, use.temperature = use_temp,
              row.names = NULL, stringsAsFactors = FALSE)
+}
+
+# Temperature offsets are centred on the mean temperature `mt` (the model's
+# `(T - meantemp) * tempoffset`): a fit that has offsets but no finite `mt`
+# cannot be written or converted, since a missing mean temperature taken as
+# 0 (GGIR reads it so) moves every calibrated sample by tempoffset *
+# meantemp. `field`: the fit's name for it; `ggir`: the message is about
+# GGIR's coefficient file (write_ggir_coefs()), else about coefficients in
+# general (as_coefs()).
+check_meantemp <- function(to, mt, name, field, arg = "fits", ggir = TRUE) {
+  if (length(to) && all(is.finite(to)) && any(to != 0) &&
+      !(length(mt) >= 1 && isTRUE(is.finite(as.numeric(mt[1]))))) {
+    abort("`", arg, "`: the fit for \"", name, "\" has temperature offsets ",
+          "but no `", field, "`: ", if (ggir) {
+            paste0("GGIR's coefficient file needs the mean temperature ",
+                   "they are centred on (its `meantempcal`); written as 0, ",
+                   "GGIR would move every calibrated sample by ",
+                   "temperature.offset * meantemp")
+          } else {
+            paste0("the coefficients need the mean temperature the offsets ",
+                   "are centred on (GGIR's `meantempcal`); taken as 0, every ",
+                   "calibrated sample would move by tempoffset * meantemp")
+          }, ". Give the fit its `", field, "`, or refit it.")
+  }
 }

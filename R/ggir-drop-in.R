@@ -358,6 +358,25 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
                             format_excluded(fit$excluded, fit$guards), ") [GGIR: ",
                             fit$QCmessage, "]")
     }
+    # GGIR's rule removes idle-sleep zeros (x = y = z = 0) before the
+    # windows: when they are all there is, the recording is empty, not short
+    # (compatible mode keeps GGIR's words)
+    n <- attr(res, "gravcal")$samples
+    zeros <- attr(res, "gravcal")$zeros
+    if (fit$status == "too_short" && length(zeros) == 1 && zeros > 0) {
+      if (zeros >= n) {
+        fit$status <- "all_zero"
+        fit$message <- sprintf(paste0(
+          "no data: all %.0f samples are exactly 0 on all three axes ",
+          "(ActiGraph idle sleep, or a device that recorded nothing); there ",
+          "is nothing to calibrate [GGIR: %s]"), n, fit$QCmessage)
+      } else {
+        fit$message <- sprintf(paste0(
+          "fewer distinct 10 s windows than the procedure needs: of %.0f ",
+          "samples, %.0f are exactly 0 on all three axes (removed as idle ",
+          "sleep) [GGIR: %s]"), n, zeros, fit$QCmessage)
+      }
+    }
   }
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)

@@ -188,7 +188,8 @@ ggir_result <- function(r, bsc_qc, input, verbose = FALSE, printsummary = FALSE)
   attr(out, "gravcal") <- list(icp = icp, meantemp = r$meantemp,
                                blocks = r$blocks, input = input,
                                temp.available = r$temp.available,
-                               windows = r$windows, excluded = r$excluded,
+                               windows = r$windows, samples = r$samples,
+                               zeros = r$zeros, excluded = r$excluded,
                                early = isTRUE(r$early))
   out
 }

@@ -77,9 +77,27 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
     finish_fit(f, rest)
   }
   if (nrow(w) == 0) {
+    # the samples exactly 0 on all three axes are skipped (skip_zero): when
+    # they are all there is, the recording is not short but empty
+    n <- attr(w, "samples")
+    zeros <- attr(w, "skipped_zero")
+    if (is.null(zeros)) zeros <- 0
+    if (n > 0 && zeros >= n) {
+      return(fail("all_zero", sprintf(paste0(
+        "no data: all %.0f samples are exactly 0 on all three axes (ActiGraph ",
+        "idle sleep, or a device that recorded nothing); there is nothing to ",
+        "calibrate"), n)))
+    }
+    if (zeros > 0) {
+      return(fail("too_short", sprintf(paste0(
+        "recording too short: of %.0f samples, %.0f are exactly 0 on all ",
+        "three axes (skipped as idle sleep) and the other %.0f are fewer ",
+        "than one %g s window at %g Hz"), n, zeros, n - zeros,
+        attr(w, "window"), attr(w, "sf"))))
+    }
     return(fail("too_short", sprintf(paste0(
-      "recording too short: %d samples, fewer than one %g s window at %g Hz"),
-      attr(w, "samples"), attr(w, "window"), attr(w, "sf"))))
+      "recording too short: %.0f samples, fewer than one %g s window at %g Hz"),
+      n, attr(w, "window"), attr(w, "sf"))))
   }
   if (nrow(rest) == 0 && sum(excluded) > 0) {
     return(fail("no_rest", sprintf(paste0(

@@ -14,11 +14,12 @@ gt3x_types <- c(activity = 0x00, battery = 0x02, metadata = 0x06,
 # (0-based from the start) get no record (idle sleep), `marker` seconds get a
 # one-byte idle record instead of their samples. format "activity": an old
 # NEO file with a packed activity.bin (firmware 2.5.0). `deflate`: zip method
-# 8, else stored. `last` overrides info.txt's Last Sample Time (seconds).
+# 8, else stored; `zip64`: sizes and offsets in zip64's structures (see
+# gt3x_write_zip()). `last` overrides info.txt's Last Sample Time (seconds).
 write_gt3x <- function(x, file, sf, start, format = c("log", "activity"),
                        record = c("activity2", "activity"), idle = integer(0),
                        marker = integer(0), scale = NULL, deflate = TRUE,
-                       last = NULL, serial = NULL) {
+                       last = NULL, serial = NULL, zip64 = FALSE) {
   format <- match.arg(format)
   record <- match.arg(record)
   x <- as.matrix(x)[, 1:3, drop = FALSE]
@@ -46,7 +47,7 @@ write_gt3x <- function(x, file, sf, start, format = c("log", "activity"),
   }
   entries <- list(info.txt = charToRaw(info))
   entries[[if (old) "activity.bin" else "log.bin"]] <- data
-  gt3x_write_zip(entries, file, deflate)
+  gt3x_write_zip(entries, file, deflate, zip64)
   invisible(file)
 }
 
@@ -184,31 +185,60 @@ gt3x_xor_rows <- function(m) {
   m[1, ]
 }
 
+# Little-endian bytes of 64-bit unsigned values (as doubles, below 2^53).
+gt3x_u64 <- function(v) {
+  v <- as.numeric(v)
+  as.vector(rbind(matrix(gt3x_u32(v %% 2^32), 4), matrix(gt3x_u32(v %/% 2^32), 4)))
+}
+
 # A zip of entries (raw vectors, or functions that write their bytes through
 # put()), stored or deflated (PKWARE APPNOTE). The deflate stream and CRC-32
 # come from a gzip file written by R's own zlib (RFC 1952: 10-byte header,
 # deflate data, CRC-32 and size trailer); data is copied in chunks.
-gt3x_write_zip <- function(entries, file, deflate = TRUE) {
+# `zip64`: every size, offset and count that zip64 can carry is written
+# there (APPNOTE 4.3.14, 4.3.15, 4.5.3): the 32-bit fields hold 0xFFFFFFFF
+# (0xFFFF for counts), the values stand in each header's zip64 extra field
+# (0x0001; the sizes in a local header, the sizes and the local header's
+# offset in the central directory), and a zip64 end of central directory
+# record and its locator come before the end record.
+gt3x_write_zip <- function(entries, file, deflate = TRUE, zip64 = FALSE) {
   out <- file(file, "wb")
   on.exit(close(out))
   central <- list()
   off <- 0
+  mark <- 2^32 - 1
+  version <- if (zip64) 45 else 20
   for (name in names(entries)) {
     e <- gt3x_entry(entries[[name]], deflate)
     nm <- charToRaw(name)
-    common <- c(gt3x_u16(c(20, 0, if (deflate) 8 else 0, 0, 33)), e$crc,
-                gt3x_u32(c(e$body_len, e$size)), gt3x_u16(c(length(nm), 0)))
-    writeBin(c(gt3x_u32(0x04034b50), common, nm), out)
+    local_extra <- if (zip64) c(gt3x_u16(c(1, 16)), gt3x_u64(c(e$size, e$body_len)))
+    central_extra <- if (zip64) c(gt3x_u16(c(1, 24)), gt3x_u64(c(e$size, e$body_len, off)))
+    common <- function(extra) {
+      c(gt3x_u16(c(version, 0, if (deflate) 8 else 0, 0, 33)), e$crc,
+        gt3x_u32(if (zip64) c(mark, mark) else c(e$body_len, e$size)),
+        gt3x_u16(c(length(nm), length(extra))))
+    }
+    writeBin(c(gt3x_u32(0x04034b50), common(local_extra), nm, local_extra), out)
     gt3x_copy(e$path, e$body_from, e$body_len, out)
     unlink(e$files)
-    central[[name]] <- c(gt3x_u32(0x02014b50), gt3x_u16(20), common,
-                         gt3x_u16(c(0, 0, 0)), gt3x_u32(c(0, off)), nm)
-    off <- off + 30 + length(nm) + e$body_len
+    central[[name]] <- c(gt3x_u32(0x02014b50), gt3x_u16(version), common(central_extra),
+                         gt3x_u16(c(0, 0, 0)), gt3x_u32(c(0, if (zip64) mark else off)), nm,
+                         central_extra)
+    off <- off + 30 + length(nm) + length(local_extra) + e$body_len
   }
   cd <- unlist(central, use.names = FALSE)
   writeBin(cd, out)
-  writeBin(c(gt3x_u32(0x06054b50), gt3x_u16(c(0, 0, length(entries), length(entries))),
-             gt3x_u32(c(length(cd), off)), gt3x_u16(0)), out)
+  n <- length(entries)
+  if (zip64) {
+    writeBin(c(gt3x_u32(0x06064b50), gt3x_u64(44), gt3x_u16(c(45, 45)), gt3x_u32(c(0, 0)),
+               gt3x_u64(c(n, n, length(cd), off))), out)
+    writeBin(c(gt3x_u32(0x07064b50), gt3x_u32(0), gt3x_u64(off + length(cd)), gt3x_u32(1)), out)
+    writeBin(c(gt3x_u32(0x06054b50), gt3x_u16(c(0, 0, 65535, 65535)),
+               gt3x_u32(c(mark, mark)), gt3x_u16(0)), out)
+  } else {
+    writeBin(c(gt3x_u32(0x06054b50), gt3x_u16(c(0, 0, n, n)),
+               gt3x_u32(c(length(cd), off)), gt3x_u16(0)), out)
+  }
   invisible(file)
 }
 

@@ -260,6 +260,7 @@ Rcpp::List outcome_list(const gravcal::GgirOutcome& r, const RHost& host) {
   out["blocks"] = r.blocks;
   out["windows"] = static_cast<double>(r.windows);
   out["samples"] = static_cast<double>(r.samples);
+  out["zeros"] = static_cast<double>(r.zeros);
   out["warnings"] = Rcpp::wrap(host.warnings);
   out["stopped"] = r.stopped;
   out["excluded"] = Rcpp::NumericVector::create(

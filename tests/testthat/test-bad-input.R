@@ -118,6 +118,55 @@ test_that("sf: zero, negative, NA, a vector, text are errors; 85.7 Hz works", {
   expect_equal(sum(w$n) / nrow(w), 428.5, tolerance = 1e-3)
 })
 
+test_that("a recording of zeros is all_zero, not too short, and says so", {
+  # idle-sleep zeros: 100 hours at 10 Hz, every sample 0 on all three axes
+  # (issue 44: reported as "3600000 samples, fewer than one 5 s window")
+  zeros <- data.frame(x = numeric(3.6e6), y = 0, z = 0)
+  unchanged(zeros, function(d) {
+    f <- calibrate(d, sf = 10)
+    expect_identity_fit(f, "all_zero")
+    expect_identical(f$message, paste0(
+      "no data: all 3600000 samples are exactly 0 on all three axes (ActiGraph ",
+      "idle sleep, or a device that recorded nothing); there is nothing to ",
+      "calibrate"))
+    g <- calibrate(d, sf = 10, method = "ggir")
+    expect_identity_fit(g, "all_zero")
+    expect_match(g$message, paste0(
+      "^no data: all 3600000 samples are exactly 0 on all three axes .*",
+      "\\[GGIR: recalibration not done because not enough data"))
+    # GGIR-compatible mode: GGIR's outcome and words, unchanged
+    gc <- calibrate(d, sf = 10, method = "ggir", ggir_compat = TRUE)
+    expect_identity_fit(gc, "too_short")
+    expect_identical(gc$QCmessage, gravcal:::ggir_messages[["no_data"]])
+    expect_match(gc$message, "^fewer distinct 10 s windows than the procedure needs \\[GGIR")
+  })
+  # a few samples that are not zero, fewer than a window: too short, and
+  # the message counts the zeros
+  few <- zeros
+  few$z[1:30] <- 1
+  f <- calibrate(few, sf = 10)
+  expect_identity_fit(f, "too_short")
+  expect_match(f$message, paste0(
+    "of 3600000 samples, 3599970 are exactly 0 on all three axes (skipped as ",
+    "idle sleep) and the other 30 are fewer than one 5 s window at 10 Hz"),
+    fixed = TRUE)
+  g <- calibrate(few, sf = 10, method = "ggir")
+  expect_identity_fit(g, "too_short")
+  expect_match(g$message, "of 3600000 samples, 3599970 are exactly 0 on all three axes",
+               fixed = TRUE)
+  # zeros kept as samples (skip_zero = FALSE) are windows of identical
+  # samples: no rest, as before
+  expect_identity_fit(calibrate(zeros[1:36000, ], sf = 10, skip_zero = FALSE), "no_rest")
+  # shorter than a window is still too short, zeros or not
+  expect_identity_fit(calibrate(zeros[1:20, ], sf = 10), "all_zero")
+  expect_identity_fit(calibrate(base[1:20, ], sf = 10), "too_short")
+  expect_snapshot({
+    calibrate(zeros[1:36000, ], sf = 10)$message
+    calibrate(zeros[1:36000, ], sf = 10, method = "ggir")$message
+    calibrate(few[1:36000, ], sf = 10)$message
+  })
+})
+
 test_that("unsorted or repeated time stamps do not change the windows", {
   # the samples' order is the stream's order; time stamps only label windows
   d <- rec

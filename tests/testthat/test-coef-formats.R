@@ -96,6 +96,63 @@ test_that("a conversion slip would be caught: centring matters by far more than 
                          apply_calibration(fx$rec, fit)), 0.01)
 })
 
+test_that("temperature offsets without meantemp are refused, never written as meantempcal 0", {
+  # GGIR applies (T - meantempcal) * temperature.offset: a mean temperature
+  # written as 0 would move every calibrated sample by temperature.offset *
+  # meantemp (issue 44)
+  fx <- coef_fixture()
+  expect_true(any(fx$fit$tempoffset != 0))
+  d <- snap_dir("coefs-meantemp")
+  out <- file.path(d, "coefs.csv")
+  msg <- paste0("`fits`: the fit for \"p01.bin\" has temperature offsets but ",
+                "no `meantemp`: GGIR's coefficient file needs the mean ",
+                "temperature they are centred on")
+  no_mt <- fx$fit
+  no_mt$meantemp <- NA_real_
+  expect_error(write_ggir_coefs(list(p01.bin = no_mt), out), msg, fixed = TRUE)
+  expect_error(write_coefs(list(p01.bin = no_mt), out, format = "ggir"), msg,
+               fixed = TRUE)
+  gone <- fx$fit
+  gone["meantemp"] <- list(NULL)
+  expect_null(gone$meantemp)
+  expect_error(write_ggir_coefs(list(p01.bin = gone), out), msg, fixed = TRUE)
+  expect_false(file.exists(out))
+  # a g.calibrate() result names it meantempcal
+  g <- fx$fit[["ggir"]]
+  expect_true(any(g$tempoffset != 0))
+  g["meantempcal"] <- list(NULL)
+  for (w in list(function() write_ggir_coefs(list(p01.bin = g), out),
+                 function() write_coefs(list(p01.bin = g), out, "ggir"))) {
+    expect_error(w(), paste0("the fit for \"p01.bin\" has temperature ",
+                             "offsets but no `meantempcal`: GGIR's"),
+                 fixed = TRUE)
+  }
+  expect_false(file.exists(out))
+  # the other tools' files need it as much
+  expect_error(write_coefs(list(p01 = no_mt), file.path(d, "p01.json"), "actipy"),
+               "has temperature offsets but no `meantemp`: the coefficients need",
+               fixed = TRUE)
+  # without temperature offsets: written as before, meantempcal 0
+  nt <- fx$fit_nt
+  expect_true(all(nt$tempoffset == 0))
+  expect_identical(nt$meantemp, NA_real_)
+  write_ggir_coefs(list(p01.bin = nt), out)
+  expect_identical(utils::read.csv(out)$meantempcal, 0L)
+  write_coefs(list(p01.bin = nt), out, "ggir")
+  expect_identical(utils::read.csv(out)$meantempcal, 0L)
+  nt["meantemp"] <- list(NULL)
+  write_ggir_coefs(list(p01.bin = nt), out)
+  expect_identical(utils::read.csv(out)$meantempcal, 0L)
+  # with it: written, and GGIR's formula on the file is gravcal's calibration
+  write_ggir_coefs(list(p01.bin = fx$fit), out)
+  cf <- utils::read.csv(out)
+  expect_equal(cf$meantempcal, fx$fit$meantemp, tolerance = 1e-14)
+  rec <- fx$rec
+  gx <- (rec$x + cf$offset.x) * cf$scale.x +
+    (rec$temperature - cf$meantempcal) * cf$temperature.offset.x
+  expect_lt(max(abs(gx - apply_calibration(rec, fx$fit)$x)), 1e-12)
+})
+
 test_that("GGIR's backup.cal.coef written by hand is read to its coefficients", {
   # columns as GGIR's g.calibrate() output / backup.cal.coef (the ones
   # write_ggir_coefs() documents); GGIR applies (v + offset) * scale +

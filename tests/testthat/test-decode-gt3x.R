@@ -376,3 +376,132 @@ test_that("files that are not .gt3x fail to open with the reason", {
   gravcal:::gt3x_write_zip(list(info.txt = charToRaw("Sample Rate: 30\r\n")), g)
   expect_error(read_native(g), "Start Date")
 })
+
+# ---- zip64 (issue 44) --------------------------------------------------------
+
+# The entries of a .gt3x (a zip), by name, as raw vectors (R's own unzip).
+zip_entries <- function(f) {
+  d <- tempfile("gt3x-entries")
+  on.exit(unlink(d, recursive = TRUE))
+  utils::unzip(f, exdir = d)
+  nm <- c("info.txt", "log.bin")
+  stats::setNames(lapply(file.path(d, nm), function(p) readBin(p, raw(), file.size(p))), nm)
+}
+
+# Where log.bin's zip64 extra field (id 0x0001) stands in a zip64 file from
+# gt3x_write_zip(zip64 = TRUE): 1-based byte of its id in the local header
+# and in the central directory; the values follow the id and the length (4
+# bytes): size, compressed size (and in the central directory the local
+# header's offset), 8 bytes each.
+zip64_fields <- function(bytes) {
+  at <- grepRaw(charToRaw("log.bin"), bytes, all = TRUE)
+  c(local = at[1] + 7L, central = at[2] + 7L)
+}
+
+u64_at <- function(bytes, at) sum(as.numeric(bytes[at + 0:7]) * 256^(0:7))
+put_u64 <- function(bytes, at, v) {
+  bytes[at + 0:7] <- gravcal:::gt3x_u64(v)
+  bytes
+}
+
+test_that("zip64 .gt3x files read as the zip files they were made from", {
+  # a real file's entries in zip64's structures (every size, offset and
+  # count 0xFFFFFFFF / 0xFFFF, the values in the zip64 extra fields and the
+  # zip64 end record), deflated and stored
+  f <- gt3x_real()[["tas"]]
+  orig <- read_recording(f)
+  e <- zip_entries(f)
+  for (deflate in c(TRUE, FALSE)) {
+    z <- tempfile(fileext = ".gt3x")
+    gravcal:::gt3x_write_zip(e, z, deflate = deflate, zip64 = TRUE)
+    bytes <- readBin(z, raw(), file.size(z))
+    expect_identical(bytes[grepRaw(charToRaw("log.bin"), bytes)[1] - 12:9],
+                     as.raw(c(0xFF, 0xFF, 0xFF, 0xFF)))  # the marker, not the size
+    r <- read_recording(z)
+    expect_identical(r$data$x, orig$data$x)
+    expect_identical(r$data$y, orig$data$y)
+    expect_identical(r$data$z, orig$data$z)
+    expect_identical(r$data$time, orig$data$time)
+    expect_identical(r$input$report, orig$input$report)
+    expect_false(r$input$report$truncated)
+    expect_identical(r$input$report$notes, character(0))
+    if (requireNamespace("read.gt3x", quietly = TRUE)) {  # zip64 as others read it
+      expect_same_samples(read_native(z, impute_zeroes = 1), ref_whole(z, TRUE))
+    }
+  }
+  # files written from the format documents, with and without zip64
+  for (deflate in c(TRUE, FALSE)) {
+    a <- synthetic(deflate = deflate)
+    b <- synthetic(deflate = deflate, zip64 = TRUE)
+    da <- read_native(a$file)
+    db <- read_native(b$file)
+    expect_identical(db$x, da$x)
+    expect_identical(db$time, da$time)
+    expect_identical(attr(db, "report"), attr(da, "report"))
+  }
+})
+
+test_that("damaged zip64 structures: a clear error, or the local headers read and a note", {
+  s <- synthetic(deflate = FALSE, zip64 = TRUE)
+  clean <- read_native(s$file)
+  bytes <- readBin(s$file, raw(), file.size(s$file))
+  at <- zip64_fields(bytes)
+  comp <- u64_at(bytes, at[["central"]] + 12)
+  expect_identical(comp, u64_at(bytes, at[["local"]] + 12))
+  read_bad <- function(b) read_native(write_bytes(b))
+  via_local <- function(b, note) {
+    d <- read_bad(b)
+    expect_identical(d$x, clean$x)
+    expect_identical(d$time, clean$time)
+    rep <- attr(d, "report")
+    expect_identical(rep$counters[["zip_directory_damaged"]], 1)
+    expect_false(rep$truncated)
+    expect_match(rep$notes[1], note)
+  }
+  # the zip64 extra field cut from the central directory (its id changed):
+  # read through the local headers; cut from both: an error naming it
+  bad <- bytes
+  bad[at[["central"]]] <- as.raw(0x99)
+  via_local(bad, "central directory's log.bin: .*no zip64 extra field")
+  bad[at[["local"]]] <- as.raw(0x99)
+  expect_error(read_bad(bad), "local header of log.bin at byte [0-9]+: .*no zip64 extra field")
+  # too short for the values marked 0xFFFFFFFF (16 and 24 bytes said 8)
+  bad <- bytes
+  bad[at + 2] <- as.raw(8)
+  expect_error(read_bad(bad), "log.bin.*zip64 extra field holds 8 bytes, too few")
+  # sizes that disagree between the central directory and the local header
+  bad <- put_u64(bytes, at[["central"]] + 12, comp + 1)
+  expect_error(read_bad(bad), paste0("inconsistent zip64 sizes of log.bin: ", comp,
+                                     " stored bytes .* ", comp + 1, " \\("))
+  # a size past the central directory: the directory is not used
+  bad <- put_u64(bytes, at[["central"]] + 12, 2^40)
+  via_local(bad, "run past the directory")
+  # a size out of any file's range, in both headers
+  bad <- put_u64(bytes, at[["central"]] + 12, 2^60)
+  via_local(bad, "out of range")
+  bad <- put_u64(bad, at[["local"]] + 12, 2^60)
+  expect_error(read_bad(bad), "local header of log.bin.*compressed size 1152921504606846976 is out of range")
+  # the zip64 end record's locator pointing nowhere: the local headers
+  loc <- grepRaw(as.raw(c(0x50, 0x4b, 0x06, 0x07)), bytes)
+  bad <- put_u64(bytes, loc + 8, 5)
+  via_local(bad, "zip64 end of central directory record not found at byte 5")
+  # the end record marks zip64 values but the locator is gone
+  bad <- bytes
+  bad[loc + 0:3] <- as.raw(0)
+  via_local(bad, "no zip64 locator precedes it")
+  # cut short: every whole second kept, as without zip64
+  act <- log_records(bytes)
+  act <- act[act$type == 0x1A, ]
+  d <- read_bad(bytes[seq_len(act$offset[250] + 50)])
+  expect_identical(d$x, clean$x[clean$time < act$time[250]])
+  expect_true(attr(d, "report")$truncated)
+  # every byte of the zip structures flipped: an error or samples, never a
+  # crash
+  cd <- grepRaw(as.raw(c(0x50, 0x4b, 0x01, 0x02)), bytes)
+  for (k in c(seq_len(act$offset[1] - 1), cd:length(bytes))) {
+    bad <- bytes
+    bad[k] <- xor(bad[k], as.raw(0xA5))
+    d <- tryCatch(read_bad(bad), error = function(e) conditionMessage(e))
+    expect_true(is.character(d) || is.data.frame(d))
+  }
+})

@@ -77,11 +77,21 @@ class EntryInflater {
 
 namespace gt3x {
 
-// zip (PKWARE APPNOTE 4.3.7, 4.3.12, 4.3.16)
+// zip (PKWARE APPNOTE 4.3.7, 4.3.12, 4.3.16; zip64: 4.3.14, 4.3.15, 4.5.3)
 constexpr std::uint32_t kLocalSig = 0x04034b50u;
 constexpr std::uint32_t kCentralSig = 0x02014b50u;
 constexpr std::uint32_t kEndSig = 0x06054b50u;
+constexpr std::uint32_t kZip64EndSig = 0x06064b50u;
+constexpr std::uint32_t kZip64LocatorSig = 0x07064b50u;
 constexpr std::size_t kLocalLen = 30, kCentralLen = 46, kEndLen = 22;
+constexpr std::size_t kZip64EndLen = 56, kZip64LocatorLen = 20;
+constexpr std::uint16_t kZip64Extra = 0x0001;  // zip64 extended information
+// zip64's marker: the field's value is in the zip64 structures
+constexpr std::uint32_t kMark32 = 0xFFFFFFFFu;
+constexpr std::uint16_t kMark16 = 0xFFFFu;
+// A zip64 size or offset above this (64 PiB) is damage; it keeps the sums of
+// sizes and offsets far from overflow.
+constexpr std::int64_t kMaxZip64 = std::int64_t{1} << 56;
 constexpr std::size_t kMaxComment = 65535;
 constexpr int kMaxEntries = 1000;          // entries looked at
 constexpr std::size_t kMaxName = 1024;     // entry name bytes kept
@@ -142,10 +152,16 @@ inline double decode_param_float(std::uint32_t v) {
 // One zip entry as the central directory (or its local header) gives it.
 struct ZipEntry {
   bool found = false;
+  bool zip64 = false;  // sizes or offset from its zip64 extra field
   std::uint16_t method = 0;
   std::uint16_t flags = 0;
   std::int64_t comp_size = 0, size = 0, local_offset = 0;
+  std::string name;
 };
+
+inline std::uint64_t le64(const unsigned char* p) {
+  return static_cast<std::uint64_t>(le32(p)) | (static_cast<std::uint64_t>(le32(p + 4)) << 32);
+}
 
 // A window [start, start + len) of a source, read sequentially.
 class WindowSource : public ByteSource {
@@ -183,10 +199,17 @@ namespace gt3x {
 // The entries a .gt3x needs, from the central directory; when the directory
 // is unreadable, from the local file headers read from byte 0 (a cut or
 // damaged end). Reads only fixed-size pieces; never sizes memory by a field.
+// `error`: why the directory or a local header could not be used (zip64
+// structures missing or inconsistent), for the decoder's message.
 struct ZipEntries {
   ZipEntry info, log, activity;
   bool from_local_headers = false;
+  std::string error;
 };
+
+inline bool wanted_entry(const std::string& name) {
+  return name == "info.txt" || name == "log.bin" || name == "activity.bin";
+}
 
 inline void keep_entry(ZipEntries& z, const std::string& name, const ZipEntry& e) {
   if (name == "info.txt" && !z.info.found) z.info = e;
@@ -206,8 +229,84 @@ inline ZipEntry zip_entry_at(const unsigned char* p) {
   return e;
 }
 
-// The end-of-central-directory record: searched in the last 64 KiB + 22.
-inline bool find_end_record(ByteSource& src, std::int64_t& cd_offset, int& n_entries) {
+// The fields of a header that hold zip64's marker (0xFFFFFFFF, the disk
+// number 0xFFFF): their values stand in its zip64 extra field, in this
+// order (APPNOTE 4.5.3).
+struct Zip64Marks {
+  bool size = false, comp = false, offset = false, disk = false;
+  bool any() const { return size || comp || offset || disk; }
+};
+
+// Reads the zip64 extra field (id 0x0001) among a header's `elen` bytes of
+// extra fields at byte `at`, and takes from it the values `m` marks: into
+// e.size, e.comp_size, e.local_offset and `disk`. In a local header both
+// sizes stand there when either is marked (APPNOTE 4.5.3); a field of 8
+// bytes where only one is marked is taken as that one. False, with `why`,
+// when the field is absent, too short or holds a value out of range. Reads
+// at most 28 bytes of the field.
+inline bool read_zip64_extra(ByteSource& src, std::int64_t at, std::size_t elen,
+                             const Zip64Marks& m, bool local, ZipEntry& e,
+                             std::uint32_t& disk, std::string& why) {
+  std::size_t pos = 0;
+  unsigned char h[4];
+  unsigned char d[28];
+  while (pos + 4 <= elen) {
+    if (!src.seek(at + static_cast<std::int64_t>(pos)) || read_full(src, h, 4) != 4) {
+      why = "its extra field cannot be read";
+      return false;
+    }
+    const std::size_t len = le16(h + 2);
+    if (pos + 4 + len > elen) break;  // a record past the extra field's end
+    if (le16(h) != kZip64Extra) {
+      pos += 4 + len;
+      continue;
+    }
+    const std::size_t k = std::min(len, sizeof d);
+    if (read_full(src, d, k) != k) {
+      why = "its zip64 extra field cannot be read";
+      return false;
+    }
+    const bool both = local && (m.size || m.comp) && k >= 16;
+    std::size_t q = 0;
+    int need = 0;
+    auto take = [&](std::int64_t& v, const char* what) {
+      ++need;
+      if (q + 8 > k) return false;
+      const std::uint64_t u = le64(d + q);
+      q += 8;
+      if (u > static_cast<std::uint64_t>(kMaxZip64)) {
+        why = std::string("its zip64 ") + what + " " + std::to_string(u) + " is out of range";
+        return false;
+      }
+      v = static_cast<std::int64_t>(u);
+      return true;
+    };
+    bool ok = true;
+    if (ok && (m.size || both)) ok = take(e.size, "size");
+    if (ok && (m.comp || both)) ok = take(e.comp_size, "compressed size");
+    if (ok && m.offset) ok = take(e.local_offset, "local header offset");
+    if (ok && m.disk) {
+      ++need;
+      ok = q + 4 <= k;
+      if (ok) disk = le32(d + q);
+    }
+    if (!ok && why.empty()) {
+      why = "its zip64 extra field holds " + std::to_string(k) + " bytes, too few for the " +
+            std::to_string(need) + " value(s) marked 0xFFFFFFFF / 0xFFFF in the header";
+    }
+    return ok;
+  }
+  why = "its header marks sizes or offsets as zip64's (0xFFFFFFFF / 0xFFFF) but it has no "
+        "zip64 extra field (0x0001) with their values";
+  return false;
+}
+
+// The end-of-central-directory record: searched in the last 64 KiB + 22;
+// with zip64 (its values marked 0xFFFF / 0xFFFFFFFF, or a zip64 locator just
+// before it) the directory's offset and entry count from the zip64 end
+// record the locator points to. False, with `why` for a damaged zip64 end.
+inline bool find_end_record(ByteSource& src, std::int64_t& cd_offset, int& n_entries,
+                            std::string& why) {
   const std::int64_t size = src.size();
   if (size < static_cast<std::int64_t>(kEndLen)) return false;
   const std::int64_t tail = std::min<std::int64_t>(size, kEndLen + kMaxComment);
@@ -217,8 +316,47 @@ inline bool find_end_record(ByteSource& src, std::int64_t& cd_offset, int& n_ent
     const unsigned char* p = buf.data() + i;
     if (le32(p) != kEndSig) continue;
     if (i + static_cast<std::int64_t>(kEndLen) + le16(p + 20) > tail) continue;
-    cd_offset = le32(p + 16);
-    n_entries = le16(p + 10);
+    const std::int64_t at = size - tail + i;  // the record's byte in the file
+    std::int64_t off = le32(p + 16);
+    std::int64_t n = le16(p + 10);
+    const bool marked = le16(p + 4) == kMark16 || le16(p + 6) == kMark16 || le16(p + 8) == kMark16 ||
+                        le16(p + 10) == kMark16 || le32(p + 12) == kMark32 || le32(p + 16) == kMark32;
+    unsigned char loc[kZip64LocatorLen];
+    const std::int64_t loc_at = at - static_cast<std::int64_t>(kZip64LocatorLen);
+    const bool has_loc = loc_at >= 0 && src.seek(loc_at) &&
+                         read_full(src, loc, kZip64LocatorLen) == kZip64LocatorLen &&
+                         le32(loc) == kZip64LocatorSig;
+    if (has_loc) {
+      const std::uint64_t rec = le64(loc + 8);
+      unsigned char r[kZip64EndLen];
+      const bool found = rec <= static_cast<std::uint64_t>(loc_at) &&
+                         static_cast<std::int64_t>(rec) + static_cast<std::int64_t>(kZip64EndLen) <= loc_at &&
+                         src.seek(static_cast<std::int64_t>(rec)) &&
+                         read_full(src, r, kZip64EndLen) == kZip64EndLen && le32(r) == kZip64EndSig;
+      if (found) {
+        if (le32(r + 16) != 0 || le32(r + 20) != 0) {
+          why = "zip64 end of central directory record on disk " + std::to_string(le32(r + 16)) +
+                " (split archives are not read)";
+          return false;
+        }
+        const std::uint64_t n64 = le64(r + 32), off64 = le64(r + 48);
+        n = static_cast<std::int64_t>(std::min<std::uint64_t>(n64, kMaxEntries + 1));
+        off = off64 < static_cast<std::uint64_t>(size) ? static_cast<std::int64_t>(off64) : size;
+      } else if (marked) {
+        why = "zip64 end of central directory record not found at byte " + std::to_string(rec) +
+              ", where its locator points";
+        return false;
+      }
+    } else if (marked) {
+      why = "the end of central directory record marks its values as zip64's (0xFFFF / "
+            "0xFFFFFFFF) but no zip64 locator precedes it";
+      return false;
+    }
+    cd_offset = off;
+    n_entries = static_cast<int>(n);
+    if (cd_offset >= size && (has_loc || marked)) {
+      why = "zip64 central directory offset beyond the file's " + std::to_string(size) + " bytes";
+    }
     return cd_offset < size;
   }
   return false;
@@ -227,24 +365,60 @@ inline bool find_end_record(ByteSource& src, std::int64_t& cd_offset, int& n_ent
 inline bool read_central_directory(ByteSource& src, ZipEntries& z) {
   std::int64_t off = 0;
   int n = 0;
-  if (!find_end_record(src, off, n) || !src.seek(off)) return false;
+  if (!find_end_record(src, off, n, z.error) || !src.seek(off)) return false;
+  const std::int64_t cd = off;
   unsigned char h[kCentralLen];
   char name[kMaxName];
   for (int i = 0; i < n && i < kMaxEntries; ++i) {
     if (read_full(src, h, kCentralLen) != kCentralLen || le32(h) != kCentralSig) return false;
-    const std::size_t nlen = le16(h + 28), skip = le16(h + 30) + static_cast<std::size_t>(le16(h + 32));
+    const std::size_t nlen = le16(h + 28), elen = le16(h + 30), clen = le16(h + 32);
     const std::size_t keep = std::min(nlen, kMaxName);
     if (read_full(src, reinterpret_cast<unsigned char*>(name), keep) != keep) return false;
-    off += static_cast<std::int64_t>(kCentralLen + nlen + skip);
     ZipEntry e = zip_entry_at(h + 8);
     e.local_offset = le32(h + 42);
-    keep_entry(z, std::string(name, keep), e);
+    e.name.assign(name, keep);
+    Zip64Marks m;
+    m.size = le32(h + 24) == kMark32;
+    m.comp = le32(h + 20) == kMark32;
+    m.offset = le32(h + 42) == kMark32;
+    m.disk = le16(h + 34) == kMark16;
+    if (m.any() && wanted_entry(e.name)) {
+      std::uint32_t disk = 0;
+      std::string why;
+      if (!read_zip64_extra(src, off + static_cast<std::int64_t>(kCentralLen + nlen), elen, m,
+                            false, e, disk, why)) {
+        z.error = "the central directory's " + e.name + ": " + why;
+        return false;
+      }
+      if (disk != 0) {
+        z.error = "the central directory's " + e.name + " starts on disk " + std::to_string(disk) +
+                  " (split archives are not read)";
+        return false;
+      }
+      if (e.local_offset >= cd) {
+        z.error = "the central directory's " + e.name + ": its local header offset " +
+                  std::to_string(e.local_offset) + " is not before the directory (byte " +
+                  std::to_string(cd) + ")";
+        return false;
+      }
+      if (e.local_offset + static_cast<std::int64_t>(kLocalLen) + e.comp_size > cd) {
+        z.error = "the central directory's " + e.name + ": its " + std::to_string(e.comp_size) +
+                  " stored bytes from byte " + std::to_string(e.local_offset) +
+                  " run past the directory (byte " + std::to_string(cd) + ")";
+        return false;
+      }
+      e.zip64 = true;
+    }
+    off += static_cast<std::int64_t>(kCentralLen + nlen + elen + clen);
+    keep_entry(z, e.name, e);
     if (!src.seek(off)) return false;
   }
   return z.info.found || z.log.found || z.activity.found;
 }
 
 // Walks the local file headers from byte 0 while their sizes are known.
+// A header whose sizes are zip64's (marked 0xFFFFFFFF) takes them from its
+// zip64 extra field; without one the walk stops there, with z.error.
 inline bool read_local_headers(ByteSource& src, ZipEntries& z) {
   std::int64_t off = 0;
   unsigned char h[kLocalLen];
@@ -256,9 +430,23 @@ inline bool read_local_headers(ByteSource& src, ZipEntries& z) {
     if (read_full(src, reinterpret_cast<unsigned char*>(name), keep) != keep) break;
     ZipEntry e = zip_entry_at(h + 6);
     e.local_offset = off;
+    e.name.assign(name, keep);
     const bool sizes_later = (e.flags & 0x08) != 0 && e.comp_size == 0;  // data descriptor
+    Zip64Marks m;
+    m.size = le32(h + 22) == kMark32;
+    m.comp = le32(h + 18) == kMark32;
+    if (!sizes_later && m.any()) {
+      std::uint32_t disk = 0;
+      std::string why;
+      if (!read_zip64_extra(src, off + static_cast<std::int64_t>(kLocalLen + nlen), elen, m, true,
+                            e, disk, why)) {
+        z.error = "the local header of " + e.name + " at byte " + std::to_string(off) + ": " + why;
+        break;
+      }
+      e.zip64 = true;
+    }
     if (sizes_later) e.comp_size = -1;
-    keep_entry(z, std::string(name, keep), e);
+    keep_entry(z, e.name, e);
     if (sizes_later) break;
     off += static_cast<std::int64_t>(kLocalLen + nlen + elen) + e.comp_size;
   }
@@ -266,14 +454,39 @@ inline bool read_local_headers(ByteSource& src, ZipEntries& z) {
   return z.info.found || z.log.found || z.activity.found;
 }
 
-// Where an entry's data starts (after its local header), or -1.
-inline std::int64_t entry_data_offset(ByteSource& src, const ZipEntry& e) {
+// Where an entry's data starts (after its local header), or -1 with `why`.
+// An entry the central directory gives with zip64 values must have a local
+// header whose sizes (its own zip64 ones when marked) are the same.
+inline std::int64_t entry_data_offset(ByteSource& src, const ZipEntry& e, std::string& why) {
   unsigned char h[kLocalLen];
   if (!src.seek(e.local_offset) || read_full(src, h, kLocalLen) != kLocalLen ||
       le32(h) != kLocalSig) {
+    why = "zip entry's local header not found at byte " + std::to_string(e.local_offset);
     return -1;
   }
-  return e.local_offset + static_cast<std::int64_t>(kLocalLen + le16(h + 26) + le16(h + 28));
+  const std::size_t nlen = le16(h + 26), elen = le16(h + 28);
+  const std::int64_t data = e.local_offset + static_cast<std::int64_t>(kLocalLen + nlen + elen);
+  ZipEntry l = zip_entry_at(h + 6);
+  if (e.zip64 && e.comp_size >= 0 && (l.flags & 0x08) == 0) {
+    Zip64Marks m;
+    m.size = le32(h + 22) == kMark32;
+    m.comp = le32(h + 18) == kMark32;
+    std::uint32_t disk = 0;
+    std::string w;
+    if (m.any() && !read_zip64_extra(src, e.local_offset + static_cast<std::int64_t>(kLocalLen + nlen),
+                                     elen, m, true, l, disk, w)) {
+      why = "the local header of " + e.name + " at byte " + std::to_string(e.local_offset) + ": " + w;
+      return -1;
+    }
+    if (l.comp_size != e.comp_size || l.size != e.size) {
+      why = "inconsistent zip64 sizes of " + e.name + ": " + std::to_string(l.comp_size) +
+            " stored bytes (" + std::to_string(l.size) + " inflated) in its local header, " +
+            std::to_string(e.comp_size) + " (" + std::to_string(e.size) +
+            ") in the central directory";
+      return -1;
+    }
+  }
+  return data;
 }
 
 // Days-from-civil arithmetic is not needed: ticks and Unix seconds are both
@@ -365,14 +578,20 @@ class Gt3xDecoder : public Decoder {
     info_.has_time = true;
     gt3x::ZipEntries z;
     if (!gt3x::read_central_directory(zip_, z)) {
+      const std::string cd_why = z.error;
       z = gt3x::ZipEntries();
       if (!gt3x::read_local_headers(zip_, z)) {
+        if (!z.error.empty()) {
+          return fail(z.error + (cd_why.empty() ? "" : "; and " + cd_why));
+        }
+        if (!cd_why.empty()) return fail(cd_why + ", and no readable local file header at byte 0");
         return fail("not a zip file (no readable central directory, no local file header at byte 0)");
       }
       report_.count("zip_directory_damaged");
-      report_.note("zip central directory unreadable: entries found from their local headers");
+      report_.note("zip central directory unreadable" + (cd_why.empty() ? "" : " (" + cd_why + ")") +
+                   ": entries found from their local headers");
     }
-    if (!z.info.found) return fail("no info.txt in the zip");
+    if (!z.info.found) return fail(z.error.empty() ? "no info.txt in the zip" : z.error);
     std::string text;
     if (!read_small_entry(z.info, text)) return false;
     gt3x::Info info;
@@ -380,7 +599,9 @@ class Gt3xDecoder : public Decoder {
     if (!take_info(info)) return false;
     const bool use_activity =
         z.activity.found && (old_ || !z.log.found);
-    if (!use_activity && !z.log.found) return fail("no log.bin or activity.bin in the zip");
+    if (!use_activity && !z.log.found) {
+      return fail(z.error.empty() ? "no log.bin or activity.bin in the zip" : z.error);
+    }
     old_ = use_activity;
     if (!open_entry(use_activity ? z.activity : z.log, data_)) return false;
     window_ = windows_.back().get();
@@ -430,8 +651,9 @@ class Gt3xDecoder : public Decoder {
 
   // A byte source for an entry's (inflated) bytes.
   bool open_entry(const gt3x::ZipEntry& e, ByteSource*& src) {
-    const std::int64_t at = gt3x::entry_data_offset(zip_, e);
-    if (at < 0) return fail("zip entry's local header not found at byte " + std::to_string(e.local_offset));
+    std::string why;
+    const std::int64_t at = gt3x::entry_data_offset(zip_, e, why);
+    if (at < 0) return fail(why);
     const std::int64_t len = e.comp_size >= 0 ? e.comp_size : std::max<std::int64_t>(0, zip_.size() - at);
     windows_.emplace_back(new gt3x::WindowSource(zip_, at, len));
     gt3x::WindowSource* w = windows_.back().get();

@@ -142,6 +142,7 @@ struct GgirOutcome {
   int blocks = 0;
   std::int64_t windows = 0;   // windows in the table
   std::int64_t samples = 0;   // samples read
+  std::int64_t zeros = 0;     // of which idle-sleep zeros, removed (GGIR's rule)
   bool stopped = false;       // interrupted
   // own mode: rest windows of the last table left out by the guards, by
   // reason (GgirWhy: norm, clipped, identical)
@@ -234,6 +235,7 @@ class GgirProcedure {
                   (cfg_.short_block_rows > 0 && static_cast<double>(b.rows) < cfg_.short_block_rows);
       if (present) {
         o.samples += b.rows;
+        o.zeros += b.zeros;
         const double two_hours = per_hour * 2 + 1;
         if (cfg_.compat && static_cast<double>(b.rows) < two_hours) {
           // GGIR: a short block is the last one; a short first block means
