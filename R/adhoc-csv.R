@@ -84,7 +84,7 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   if (p$rmc.dec == ",") opts$dec <- ","
   # the first data line: after the column-name line, if any (GGIR's test:
   # the first field of line rmc.firstrow.acc read as a number)
-  first <- readLines(file, n = p$rmc.firstrow.acc + 1, warn = FALSE)
+  first <- fread_lines(file, p$rmc.firstrow.acc + 1)
   if (length(first) < p$rmc.firstrow.acc) {
     abort("`rmc.firstrow.acc` = ", p$rmc.firstrow.acc, ", but \"", file, "\" has ",
           length(first), " lines.")
@@ -148,7 +148,7 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   unit <- p$rmc.unit.time
   if (unit %in% c("UNIXsec", "UNIXmsec")) return(list())
   zone <- attr(p, "tz") %||% p$rmc.configtz %||% p$rmc.desiredtz %||% tz
-  lines <- readLines(file, n = skip + 1000, warn = FALSE)
+  lines <- fread_lines(file, skip + 1000)
   lines <- lines[seq_along(lines) > skip]
   stamps <- vapply(lines, function(l) rmc_fields(l)[p$rmc.col.time], "", USE.NAMES = FALSE)
   refuse <- function(why) {
@@ -236,6 +236,49 @@ rmc_fread_datetime <- function(lines, col) {
   grepl("^[0-9]{4}-[0-9]{2}-[0-9]{2}[T ][0-9]{2}:[0-9]{2}:[0-9]{2}", rmc_fields(lines[1])[col])
 }
 
+# The first `n` lines of `file` (fewer when it has fewer) as
+# data.table::fread's `skip` counts lines, and so as GGIR's reads of an ad
+# hoc csv file count them (skip = rmc.firstrow.acc - 1 + its block's start;
+# the csv decoder skips its `skip` lines the same way): a line ends at
+# "\n", at "\r" and at the pairs "\r\n" and "\n\r". R's readLines() takes
+# "\n\r" for two line ends, the decoder's data lines end at "\n" only: a
+# stray carriage return in a free-text header line would otherwise move
+# every sample by a line.
+fread_lines <- function(file, n) {
+  if (n <= 0) return(character(0))
+  con <- gzfile(file, "rb")  # (reads an uncompressed file as it is)
+  on.exit(close(con))
+  b <- raw(0)
+  repeat {
+    more <- readBin(con, "raw", 65536)
+    b <- c(b, more)
+    if (!length(more) || sum(b == as.raw(10) | b == as.raw(13)) > n + 1) break
+  }
+  at <- which(b == as.raw(10) | b == as.raw(13))
+  lines <- character(0)
+  start <- 1L
+  k <- 1L
+  while (length(lines) < n && k <= length(at)) {
+    e <- at[k]
+    seg <- b[seq.int(start, length.out = e - start)]
+    lines <- c(lines, rawToChar(seg[seg != as.raw(0)]))
+    nxt <- e + 1L
+    # a pair of different line-end bytes is one line end
+    if (k < length(at) && at[k + 1L] == nxt && b[nxt] != b[e]) {
+      k <- k + 1L
+      nxt <- nxt + 1L
+    }
+    start <- nxt
+    k <- k + 1L
+  }
+  if (length(lines) < n && start <= length(b)) {
+    rest <- b[start:length(b)]
+    rest <- rest[rest != as.raw(0)]
+    if (length(rest)) lines <- c(lines, rawToChar(rest))
+  }
+  lines
+}
+
 # The fields of a line, split at the first of ';', tab or ',' it holds
 # (a line with ';' or tabs may hold decimal commas), blanks and double
 # quotes around them removed.
@@ -264,7 +307,7 @@ rmc_origin <- function(origin, tz) {
 rmc_header <- function(p, file) {
   if (!length(p$rmc.firstrow.header)) return(NULL)
   n <- if (length(p$rmc.header.length)) p$rmc.header.length else p$rmc.firstrow.acc - 1
-  lines <- readLines(file, n = p$rmc.firstrow.header - 1 + n, warn = FALSE)
+  lines <- fread_lines(file, p$rmc.firstrow.header - 1 + n)
   lines <- lines[seq_along(lines) >= p$rmc.firstrow.header]
   lines <- lines[nzchar(trimws(lines))]
   rows <- lapply(lines, function(l) {

@@ -1,5 +1,7 @@
-# Axivity's csv export (OMGUI): no header, one line per sample: time stamp
-# (UNIX seconds), x, y, z in g. GGIR 3.3-9 (g.inspectfile(),
+# Axivity's csv export (OMGUI, cwa-convert): one line per sample: time
+# stamp, x, y, z in g (AX6: and gyroscope columns), the time in UNIX
+# seconds or as text ("2024-03-04 09:00:00.040"); an optional header line
+# "Time,Accel-X (g), Accel-Y (g), Accel-Z (g)". GGIR 3.3-9 (g.inspectfile(),
 # g.readaccfile()) takes a csv file whose first line is not ActiGraph's and
 # whose lines have 4 or more fields for one of these; it finds the rate from
 # the time stamps of lines 2 to 100001 (samples over seconds, rounded down
@@ -8,59 +10,259 @@
 # point dropped). gravcal's csv decoder reads the lines and its resampler
 # (decode_ggir_resample.hpp) does the rest in GGIR-compatible mode; its own
 # reads keep the samples as stored.
+#
+# How GGIR reads the time column of a block (data.table::fread(), header =
+# FALSE): numbers are UNIX seconds (forced from UTC into its zone: configtz,
+# else desiredtz, "" the session's); text fread reads as ISO 8601
+# date-times ("2024-03-04 09:00:00.040", with "T", "Z" or an offset too) is
+# seconds as fread computes them (forced into configtz/desiredtz when one is
+# given); other text (slashes in the date, no seconds) goes through R's
+# as.POSIXct() in that zone, its first format of "%Y-%m-%d %H:%M:%OS",
+# "%Y/%m/%d %H:%M:%OS", "%Y-%m-%d %H:%M", "%Y/%m/%d %H:%M", ... that reads
+# every stamp. A header line is data to that read (GGIR stops:
+# "character string is not in a standard unambiguous format").
 
-# Whether `file` looks like an Axivity csv export: not ActiGraph's, a first
-# line of at least 4 comma-separated fields with numbers in fields 2 to 4
-# (so not a line of column names) and a number or date-time in field 1.
-is_axivity_csv <- function(file) {
-  if (is_actigraph_csv(file)) return(FALSE)
-  # the first line's bytes: a binary file named .csv is not text
+# The lines at the top of `file` (up to `n`, from its first `bytes` bytes),
+# or NULL when they are not text (a binary file named .csv).
+csv_head_lines <- function(file, n = 2, bytes = 1024) {
   con <- if (grepl("\\.gz$", file, ignore.case = TRUE)) gzfile(file, "rb") else file(file, "rb")
   on.exit(close(con))
-  b <- readBin(con, "raw", 512)
-  nl <- match(as.raw(10), b)
-  if (is.na(nl)) return(FALSE)
-  b <- b[seq_len(nl - 1)]
+  b <- readBin(con, "raw", bytes)
+  nl <- which(b == as.raw(10))
+  if (!length(nl)) return(NULL)
+  b <- b[seq_len(nl[min(n, length(nl))] - 1)]
   b <- b[b != as.raw(13)]
-  if (!length(b) || any(b < as.raw(32) | b >= as.raw(127))) return(FALSE)
-  f <- trimws(strsplit(rawToChar(b), ",", fixed = TRUE)[[1]])
-  if (length(f) < 4) return(FALSE)
-  num <- !is.na(suppressWarnings(as.numeric(f[1:4])))
-  all(num[2:4]) && (num[1] || grepl("^[0-9]{4}-[0-9]{2}-[0-9]{2}", f[1]))
+  if (any((b < as.raw(32) & b != as.raw(10)) | b >= as.raw(127))) return(NULL)
+  strsplit(rawToChar(b), "\n", fixed = TRUE)[[1]]
 }
 
-# The rate GGIR finds in an Axivity csv export: n / (t[n] - t[1]) over the
-# time stamps of lines 2 to 100001, rounded down to a multiple of 5.
+# A data line of an Axivity export: at least 4 comma-separated fields,
+# numbers in fields 2 to 4 and a time stamp (anything) in field 1. (GGIR
+# takes any csv of 4 or more columns that is not ActiGraph's for one.)
+axivity_data_line <- function(line) {
+  f <- trimws(strsplit(line, ",", fixed = TRUE)[[1]])
+  length(f) >= 4 && nzchar(f[1]) && !anyNA(suppressWarnings(as.numeric(f[2:4])))
+}
+
+# OMGUI's header line: "Time,Accel-X (g), Accel-Y (g), Accel-Z (g)" (and
+# gyroscope columns).
+axivity_header_line <- function(line) {
+  f <- trimws(strsplit(line, ",", fixed = TRUE)[[1]])
+  length(f) >= 4 && tolower(f[1]) == "time" &&
+    all(grepl("^accel-[xyz]", f[2:4], ignore.case = TRUE))
+}
+
+# Whether `file` looks like an Axivity csv export: not ActiGraph's, a first
+# line that is a data line (not column names), or OMGUI's header line and
+# a data line after it.
+is_axivity_csv <- function(file) {
+  if (is_actigraph_csv(file)) return(FALSE)
+  lines <- csv_head_lines(file)
+  if (!length(lines)) return(FALSE)
+  if (axivity_data_line(lines[1])) return(TRUE)
+  length(lines) >= 2 && axivity_header_line(lines[1]) && axivity_data_line(lines[2])
+}
+
+# Whether the export starts with OMGUI's header line.
+axivity_csv_header <- function(file) {
+  lines <- csv_head_lines(file, 1)
+  length(lines) == 1 && axivity_header_line(lines[1])
+}
+
+# The rate GGIR finds in an Axivity csv export (g.inspectfile()): the first
+# column of lines 2 to 100001 (read.csv() takes line 1 for column names),
+# text read by as.POSIXct() in the session's zone; n / (t[n] - t[1]),
+# rounded down to a multiple of 5.
 axivity_csv_sf <- function(file) {
   t <- utils::read.csv(file, nrows = 1e5)[[1]]
   if (!is.numeric(t)) {
-    abort("\"", file, "\" is an Axivity csv export with text time stamps; gravcal reads ",
-          "those with UNIX time stamps (OMGUI's export option), as GGIR advises.")
+    t <- tryCatch(as.numeric(as.POSIXct(t, origin = "1970-01-01")), error = function(e) NULL)
+    if (is.null(t)) {
+      abort("The time stamps of the Axivity csv export \"", file, "\" are in no format R's ",
+            "as.POSIXct() reads (GGIR's g.inspectfile() stops on them too).")
+    }
   }
   sf <- floor((length(t) / (t[length(t)] - t[1])) / 5) * 5
-  if (!isTRUE(sf > 0)) {
+  if (!isTRUE(sf > 0 && is.finite(sf))) {
     abort("The sampling frequency of the Axivity csv export \"", file, "\" is unknown: give `sf`.")
   }
   sf
 }
 
+# The formats R's as.POSIXct() tries on text, in its order.
+r_time_formats <- c("%Y-%m-%d %H:%M:%OS", "%Y/%m/%d %H:%M:%OS", "%Y-%m-%d %H:%M",
+                    "%Y/%m/%d %H:%M", "%Y-%m-%d", "%Y/%m/%d")
+
+# How GGIR's block read takes the export's time column, from its first data
+# lines (after `skip`): list(kind = "unix" (numbers), "iso" (fread's
+# date-times) or "text" (R's as.POSIXct(), `format` the one it chooses),
+# first = the first stamp in seconds (UTC)). An error naming the file for
+# other columns.
+axivity_csv_time <- function(file, skip = 0) {
+  lines <- fread_lines(file, skip + 1000)
+  lines <- lines[seq_along(lines) > skip]
+  lines <- lines[nzchar(trimws(lines))]
+  stamps <- vapply(lines, function(l) trimws(strsplit(l, ",", fixed = TRUE)[[1]][1]), "",
+                   USE.NAMES = FALSE)
+  stamps <- gsub("^\"|\"$", "", stamps)
+  if (!length(stamps)) abort("The Axivity csv export \"", file, "\" has no data lines.")
+  col <- if (requireNamespace("data.table", quietly = TRUE)) {
+    tryCatch(data.table::fread(text = lines, header = FALSE, showProgress = FALSE,
+                               data.table = FALSE)[[1]], error = function(e) NULL)
+  }
+  num <- suppressWarnings(as.numeric(stamps))
+  if (is.numeric(col) || (is.null(col) && !anyNA(num))) {
+    return(list(kind = "unix", first = num[1]))
+  }
+  iso <- "^[0-9]{4}-[0-9]{1,2}-[0-9]{1,2}[ T][0-9]{1,2}:[0-9]{1,2}:[0-9]"
+  if (inherits(col, "POSIXct") || (is.null(col) && all(grepl(iso, stamps)))) {
+    first <- if (inherits(col, "POSIXct")) as.numeric(col[1]) else
+      as.numeric(as.POSIXct(stamps[1], tz = "UTC"))
+    return(list(kind = "iso", first = first))
+  }
+  if (is.character(col) || is.null(col)) {
+    for (f in r_time_formats) {
+      if (all(!is.na(strptime(stamps, f, tz = "UTC")))) {
+        return(list(kind = "text", format = f,
+                    first = as.numeric(as.POSIXct(stamps[1], format = f, tz = "UTC"))))
+      }
+    }
+  }
+  abort("The time stamps of the Axivity csv export \"", file, "\" (\"", stamps[1], "\") are ",
+        "neither UNIX seconds nor a date-time GGIR reads: its reader stops on them.")
+}
+
+# The last line of `file` that holds text (NA when there is none).
+file_last_line <- function(file) {
+  if (grepl("\\.gz$", file, ignore.case = TRUE)) {
+    con <- gzfile(file, "rb")
+    on.exit(close(con))
+    tail <- raw(0)
+    repeat {
+      b <- readBin(con, "raw", 2^20)
+      if (!length(b)) break
+      tail <- c(tail, b)
+      if (length(tail) > 8192) tail <- tail[(length(tail) - 8191):length(tail)]
+    }
+  } else {
+    size <- file.size(file)
+    con <- file(file, "rb")
+    on.exit(close(con))
+    if (size > 8192) seek(con, size - 8192)
+    tail <- readBin(con, "raw", 8192)
+  }
+  tail <- tail[tail != as.raw(0)]
+  lines <- strsplit(rawToChar(tail), "\r?\n")[[1]]
+  lines <- lines[nzchar(trimws(lines))]
+  if (length(lines)) lines[length(lines)] else NA_character_
+}
+
+# GGIR's time zone for the export's time (configtz, else desiredtz; ""
+# the session's), in GGIR-compatible reads: decoder options, or an error
+# naming the parameter (`zone_arg`) where gravcal does not reproduce it.
+# Numbers (UNIX seconds) and fread's date-times are forced into the zone
+# (lubridate::force_tz(); fread's date-times only when a zone is given): a
+# fixed offset moves every stamp of the recording by the same whole
+# seconds, which leaves the resampling, and so GGIR's result, to the bit as
+# it is (times of 2004 to 2038 share one floating-point exponent), but an
+# offset that changes during the recording moves some stamps and not
+# others: refused. Other text is read by as.POSIXct() in the zone, as the
+# csv decoder reads it (its offset, or R/zone.R's table of them where it
+# changes; a block of GGIR's reading that starts at a time that exists
+# twice or not at all there is refused after the read,
+# ggir_check_zone_read()).
+axivity_csv_zone <- function(file, time, zone, zone_arg) {
+  if (time$kind == "iso" && !nzchar(zone)) return(list())
+  zone_name <- if (nzchar(zone)) paste0("`", zone_arg, "` = \"", zone, "\"") else
+    "the session's time zone (GGIR's when desiredtz and configtz are \"\")"
+  if (time$kind == "text") {
+    if (!is.null(zone_table(zone))) return(c(list(time_utc_offset = 0), zone_options(zone)))
+    fmt <- "%Y-%m-%d %H:%M:%S"
+    at <- time$first
+    off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+    if (is.na(off)) abort(zone_name, ": R cannot convert the recording's times in this zone.")
+    return(list(time_utc_offset = off))
+  }
+  if (is.null(zone_table(zone))) {
+    # a zone of one offset from 2000 to 2063: the stamps forced into it by
+    # it (fread's date-times; for UNIX seconds a constant that changes
+    # nothing, not applied)
+    if (time$kind == "unix") return(list())
+    fmt <- "%Y-%m-%d %H:%M:%S"
+    at <- time$first
+    off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+    return(if (is.na(off)) list() else list(time_utc_offset = off))
+  }
+  # a zone whose offset changes: the recording's span (from its first and
+  # last stamps, a day either side) must see one offset
+  last <- file_last_line(file)
+  t1 <- axivity_stamp_seconds(trimws(strsplit(last, ",", fixed = TRUE)[[1]][1]), time)
+  span <- range(c(time$first, t1), na.rm = TRUE)
+  at <- seq(span[1] - 86400, span[2] + 86400, by = 1800)
+  fmt <- "%Y-%m-%d %H:%M:%S"
+  off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+  if (anyNA(off) || any(off != off[1])) {
+    abort(zone_name, ": the Axivity csv export \"", basename(file), "\" spans a change of UTC ",
+          "offset in that zone (daylight saving), into which GGIR forces its ",
+          if (time$kind == "unix") "UNIX" else "ISO 8601", " time stamps, moving those after ",
+          "it; gravcal does not reproduce that. Give a zone without a change there (\"UTC\", ",
+          "or a fixed offset such as \"Etc/GMT-1\").")
+  }
+  if (time$kind == "unix") list() else list(time_utc_offset = off[1])
+}
+
+# A stamp of the kind `time` in seconds (UTC), for the recording's span.
+axivity_stamp_seconds <- function(stamp, time) {
+  stamp <- gsub("^\"|\"$", "", stamp)
+  if (time$kind == "unix") return(suppressWarnings(as.numeric(stamp)))
+  if (requireNamespace("data.table", quietly = TRUE)) {
+    v <- tryCatch(data.table::fread(text = paste0(stamp, ",0,0,0"), header = FALSE,
+                                    showProgress = FALSE, data.table = FALSE)[[1]],
+                  error = function(e) NULL)
+    if (inherits(v, "POSIXct")) return(as.numeric(v))
+  }
+  as.numeric(as.POSIXct(stamp, tz = "UTC", tryFormats = r_time_formats, optional = TRUE))
+}
+
 # The csv decoder's layout for an Axivity csv export (time stamp, x, y, z),
-# and its rate: `sf` when given, else GGIR's.
-axivity_csv_layout <- function(file, sf = NULL) {
+# and its rate: `sf` when given, else GGIR's. `compat`: GGIR's reading
+# (its zone `zone`, named `zone_arg` in errors; a header line refused, as
+# GGIR's reader stops on it); else gravcal's own (text time read as UTC).
+axivity_csv_layout <- function(file, sf = NULL, compat = FALSE, zone = "",
+                               zone_arg = "desiredtz") {
+  header <- axivity_csv_header(file)
+  if (header && compat) {
+    abort("\"", file, "\" is an Axivity csv export with a header line (\"Time,Accel-X (g), ...\"): ",
+          "GGIR 3.3-9 reads that line as data and stops (\"character string is not in a ",
+          "standard unambiguous format\"). Remove the line for GGIR's result; calibrate() and ",
+          "read_recording() read the file as it is.")
+  }
+  skip <- as.numeric(header)
+  time <- axivity_csv_time(file, skip)
   if (is.null(sf)) sf <- axivity_csv_sf(file)
   check_sf(sf)
-  list(sf = sf, opts = list(sf = as.numeric(sf), grid_sf = as.numeric(sf), skip = 0,
-                            col_time = 1, time_div = 1, col_x = 2, col_y = 3, col_z = 4))
+  opts <- list(sf = as.numeric(sf), grid_sf = as.numeric(sf), skip = skip,
+               col_time = 1, col_x = 2, col_y = 3, col_z = 4)
+  opts <- c(opts, switch(time$kind,
+    unix = list(time_div = 1),
+    iso = list(time_iso = 1),
+    text = list(time_format = time$format)))
+  if (compat) {
+    z <- axivity_csv_zone(file, time, zone %||% "", zone_arg)
+    opts[names(z)] <- z
+  }
+  list(sf = sf, opts = opts, time = time)
 }
 
 # The file block by block through data.table::fread() and GGIRread's
-# resampling (reader = "reference").
+# resampling (reader = "reference"), the time column as GGIR's reader takes
+# it in the session's zone (desiredtz and configtz "").
 source_axivity_csv <- function(file, sf, chunksize) {
   if (!requireNamespace("data.table", quietly = TRUE)) {
     abort("Reading Axivity csv files with reader = \"reference\" needs the data.table package.")
   }
   need_ggirread("Axivity csv")
-  sf <- axivity_csv_layout(file, sf)$sf
+  sf <- axivity_csv_layout(file, sf, compat = TRUE)$sf
   B <- format_block_units("axivity_csv", sf, chunksize)
   list(format = "axivity_csv", sf = sf, temperature = FALSE,
        read = function(i) {
@@ -68,7 +270,9 @@ source_axivity_csv <- function(file, sf, chunksize) {
                                          showProgress = FALSE, data.table = FALSE),
                        error = function(e) NULL)
          if (is.null(d) || nrow(d) < 2 || ncol(d) < 4) return(NULL)
-         t <- as.numeric(d[[1]])
+         t <- d[[1]]
+         if (is.character(t)) t <- as.POSIXct(t, tz = "", origin = "1970-01-01")
+         t <- as.numeric(t)
          grid <- seq(t[1], t[length(t)], by = 1 / sf)
          grid <- grid[-length(grid)]
          a <- GGIRread::resample(as.matrix(d[, 2:4]), t, grid, nrow(d), 1L)

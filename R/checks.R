@@ -52,11 +52,11 @@ check_sf <- function(sf) {
 # `own_rate`, R/formats.R) must be that rate: the file's rate is the one
 # used, so another would silently change nothing the user asked for. The
 # same rate rounded to whole Hz agrees too (GGIR rounds GENEActiv's rate).
-check_sf_agrees <- function(sf, file_sf, format, file) {
+check_sf_agrees <- function(sf, file_sf, format, file, arg = "sf") {
   if (is.null(sf) || !isTRUE(format_entry(format)$own_rate)) return(invisible())
   if (isTRUE(sf == file_sf || round(sf) == round(file_sf))) return(invisible())
-  abort("`sf` = ", format(sf), " Hz, but \"", basename(file), "\" records its ",
-        "own rate, ", format(file_sf), " Hz, which is the one used; leave `sf` ",
+  abort("`", arg, "` = ", format(sf), " Hz, but \"", basename(file), "\" records its ",
+        "own rate, ", format(file_sf), " Hz, which is the one used; leave `", arg, "` ",
         "out or give ", format(file_sf), ".")
 }
 

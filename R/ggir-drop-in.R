@@ -34,7 +34,9 @@
 #' the reading are skipped, so an error in one of those does not stop it
 #' either. A missing (`NA`) or infinite sample in a data frame is left out
 #' of its window (in GGIR's cumulative sums it would empty the rest of its
-#' block). For a data frame, `rmc.noise` sets
+#' block); one read from a file (GGIRread's resampling gives `NaN` where
+#' time stamps repeat, as whole-second ones do) enters the sums as in GGIR.
+#' For a data frame, `rmc.noise` sets
 #' the rest threshold as for an ad hoc csv file (`1.2 * rmc.noise`).
 #'
 #' Unlike GGIR's, this function does not need `inspectfileobject` (it finds
@@ -43,8 +45,11 @@
 #' optional `temperature`), read in the blocks GGIR uses for csv files, with
 #' the sampling rate given as `sf = ` in `...` (or from a `time` column).
 #'
-#' Formats: ActiGraph csv exports, Axivity csv exports (OMGUI, UNIX time
-#' stamps; resampled block by block as GGIR does, linearly), csv files with
+#' Formats: ActiGraph csv exports, Axivity csv exports (OMGUI: UNIX time
+#' stamps, or text ones read as GGIR reads them, ISO 8601 date-times as
+#' `data.table::fread()` computes them and other text as `as.POSIXct()`
+#' does; resampled block by block as GGIR does, linearly; OMGUI's optional
+#' header line, on which GGIR's reader stops, is refused), csv files with
 #' `x`, `y`, `z` columns, ad hoc csv files (below), `.rds` data frames, ActiGraph `.gt3x`, Axivity `.cwa`, GENEActiv
 #' `.bin`, Parmay Matrix `.bin` and Movisens recordings (the unisens folder or,
 #' as GGIR takes it, its `acc.bin`; at 64 Hz, the rate GGIR assumes for them:
@@ -72,6 +77,7 @@
 #' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Movisens (its temperature); Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa` (the zone of its block times) | honoured, across changes of UTC offset (daylight saving) too, by the zone rules of the R it runs in; an error naming it only where a block of GGIR's reading starts or ends at a calendar time that exists twice or not at all in that zone, and with `reader = "reference"` where the offset changes |
+#' | `desiredtz`, `configtz` | Axivity csv (the zone GGIR reads or forces its time stamps in) | honoured: text that is not ISO 8601 as `as.POSIXct()` reads it in the zone, across changes of offset too; UNIX and ISO 8601 stamps, which GGIR forces into the zone, an error naming it where the recording spans a change of UTC offset there |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
 #' | other `rmc.*` | ad hoc csv | see "Ad hoc csv files" |
 #'
@@ -102,7 +108,9 @@
 #'   `printsummary = FALSE`, `interpolationType = 1`, `frequency_tol = 0.1`,
 #'   `desiredtz = ""`).
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
-#'   `sf` is used.
+#'   `sf` is used. One that names another format than the file's (its
+#'   `monc`, `dformc`), decimal commas for a csv export, or no `sf` is an
+#'   error saying so.
 #' @param verbose Print progress (the blocks read) as GGIR does.
 #' @param ... Legacy arguments that override the parameter lists, as in
 #'   GGIR (any parameter of the lists by name, e.g. `chunksize`,
@@ -140,8 +148,10 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     abort("`inspectfileobject` must be a list (GGIR's g.inspectfile() result), ",
           "not ", describe(inspectfileobject), ".")
   }
+  sf_arg <- "sf"
   if (is.null(sf) && length(inspectfileobject) && !is.null(inspectfileobject$sf)) {
     sf <- inspectfileobject$sf
+    sf_arg <- "inspectfileobject$sf"
     check_number(sf, "inspectfileobject$sf", min = 0, min_inclusive = FALSE)
   }
   if (is.null(sf) && length(pr$rmc.sf)) sf <- pr$rmc.sf
@@ -159,15 +169,19 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
       "rmc.configtz"
     } else if (nzchar(pr$desiredtz %||% "") || is.null(pr$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
   }
+  if (length(inspectfileobject) && is.character(datafile)) {
+    ggir_check_inspect(inspectfileobject, datafile, adhoc = !is.null(rmc))
+  }
   # the zone of a .cwa file's calendar times (readAxivity's configtz, else
   # desiredtz): offsets that change (daylight saving) move block times
   tz <- if (length(pr$configtz)) pr$configtz else pr$desiredtz
   tz_arg <- if (length(pr$configtz)) "configtz" else "desiredtz"
   read_opts <- list(interpolation = pr$interpolationType,
-                    frequency_tol = pr$frequency_tol, zone = tz %||% "")
+                    frequency_tol = pr$frequency_tol, zone = tz %||% "", zone_arg = tz_arg)
   open <- function() {
     open_source(datafile, sf = sf, chunksize = pr$chunksize,
-                reader = pr$reader, compat = TRUE, read_opts = read_opts, rmc = rmc)
+                reader = pr$reader, compat = TRUE, read_opts = read_opts, rmc = rmc,
+                sf_arg = sf_arg)
   }
   src <- open()
   if (is.null(src$native)) ggir_check_tz(src, datafile, pr$desiredtz, pr$configtz)
@@ -192,6 +206,61 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   }
   attr(out, "gravcal") <- NULL
   invisible(out)
+}
+
+# The format GGIR's g.inspectfile() result `I` names by its monitor and
+# data format codes (monc, dformc; GGIR's MONITOR and FORMAT), as the
+# registry's name (R/formats.R); NA for a pair gravcal has none for, NULL
+# when `I` has no such codes.
+ggir_inspect_format <- function(I) {
+  mon <- I$monc
+  dform <- I$dformc
+  if (!is.numeric(mon) || !is.numeric(dform) || length(mon) != 1 || length(dform) != 1) {
+    return(NULL)
+  }
+  if (isTRUE(mon == 6)) mon <- 3  # Verisense: read as ActiGraph
+  switch(paste(mon, dform),
+         "3 2" = "actigraph_csv", "4 2" = "axivity_csv", "2 2" = "geneactiv_csv",
+         "3 6" = "gt3x", "4 4" = "cwa", "2 1" = "geneactiv", "5 1" = "movisens",
+         "7 1" = "parmay", "0 5" = "adhoc_csv", NA_character_)
+}
+
+# g.calibrate() follows an `inspectfileobject` (GGIR's g.inspectfile()
+# result) where GGIR's g.calibrate() would: its sf (used as the rate), and
+# its format, which decides GGIR's reader. One that gravcal cannot honour
+# is an error naming what, never a quiet "not enough data": a format other
+# than the one gravcal reads the file as (the object of another file, or
+# rmc.firstrow.acc given on one side only), decimal commas in a csv export
+# read with decimal points, no sf (GGIR's g.calibrate() then returns
+# nothing).
+ggir_check_inspect <- function(I, datafile, adhoc) {
+  claimed <- ggir_inspect_format(I)
+  if (!is.null(claimed)) {
+    file <- unisens_acc(datafile)
+    check_file(file, "datafile")
+    actual <- if (adhoc) "adhoc_csv" else tryCatch(file_format(file, "datafile"),
+                                                   error = function(e) NA_character_)
+    if (!identical(claimed, actual)) {
+      what <- if (is.na(claimed)) "a format gravcal does not read" else format_entry(claimed)$label
+      abort("`inspectfileobject` (monc = ", I$monc, ", dformc = ", I$dformc, ": ", what,
+            ") does not describe \"", basename(datafile), "\", which gravcal reads as ",
+            if (is.na(actual)) "no format it knows" else format_entry(actual)$label,
+            if (adhoc) " (rmc.firstrow.acc is given)",
+            "; GGIR would read it with the reader the object names. Give ",
+            "GGIR::g.inspectfile()'s result for this file with the same parameters, or ",
+            "leave `inspectfileobject` out.")
+    }
+    if (claimed %in% c("actigraph_csv", "axivity_csv") && identical(I$decn, ",")) {
+      abort("`inspectfileobject$decn` = \",\": GGIR would read the values of \"",
+            basename(datafile), "\" with decimal commas; gravcal reads this csv export ",
+            "with decimal points.")
+    }
+  }
+  if (is.null(I$sf)) {
+    abort("`inspectfileobject` has no `sf`: GGIR's g.calibrate() returns nothing for it. ",
+          "Give GGIR::g.inspectfile()'s result for this file, or leave `inspectfileobject` out.")
+  }
+  invisible()
 }
 
 # g.calibrate()'s parameters (ggir-params.R) from GGIR's params_rawdata and
@@ -235,7 +304,9 @@ ggir_params <- function(params_rawdata, params_general, dots) {
 # that depends on R's conversions before it, which gravcal does not know:
 # an error naming the parameter.
 ggir_check_zone_read <- function(src, tz, arg) {
-  if (!isTRUE(src$format %in% c("cwa", "adhoc_csv")) || is.null(src$report)) return(invisible())
+  if (!isTRUE(src$format %in% c("cwa", "adhoc_csv", "axivity_csv")) || is.null(src$report)) {
+    return(invisible())
+  }
   n <- src$report()$counters["zone_ambiguous"]
   if (isTRUE(n > 0)) {
     abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",

@@ -109,6 +109,10 @@ ggir_run <- function(src, compat = TRUE,
                        temperature = isTRUE(src$temperature), lazy = lazy,
                        guards = guards, reading = reading,
                        check_hours = check_hours)
+  # a non-finite sample read from a file enters R's cumulative sums as in
+  # GGIR (GGIRread's resampling of repeated time stamps gives NaN); one in
+  # a data frame (which GGIR does not take) is left out of its window
+  opts$nonfinite_in_sums <- as.numeric(!identical(src$format, "data.frame"))
   # the adaptive budget's rule, called by the core after a converged fit
   # that meets GGIR's error target (GgirHost::enough())
   if (!is.null(on_fit)) opts$on_fit <- on_fit

@@ -7,8 +7,9 @@
 #'   `time` column;
 #' * `.csv`, `.csv.gz`: an ActiGraph csv export (ActiLife's 10-line header,
 #'   with or without time stamps; `sf` from the header), an Axivity csv
-#'   export (no header; UNIX time stamp, x, y, z; `sf` as GGIR finds it from
-#'   the time stamps, the samples as stored), a GENEActiv csv export (its
+#'   export (time stamp, x, y, z, the time in UNIX seconds or text, read as
+#'   UTC; OMGUI's optional header line; `sf` as GGIR finds it from the time
+#'   stamps, the samples as stored), a GENEActiv csv export (its
 #'   header's rate; x, y, z and temperature, the time stamps not read), or a
 #'   header line with
 #'   columns `x`, `y`, `z` and optionally `time` and `temperature`; `sf` from

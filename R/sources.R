@@ -19,7 +19,7 @@
 # rmc.firstrow.acc the file is read as an ad hoc csv file (R/adhoc-csv.R).
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
                         reader = "native", compat = TRUE, read_opts = list(),
-                        rmc = NULL) {
+                        rmc = NULL, sf_arg = "sf") {
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -57,7 +57,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
       format_entry(format)$source(datafile, sf, chunksize, arg, layout = layout)
   }
   if (!is.null(layout$serial)) src$info$serial <- layout$serial
-  check_sf_agrees(sf, src$sf, format, datafile)
+  check_sf_agrees(sf, src$sf, format, datafile, sf_arg)
   src$filename <- ggir_file_name(datafile)
   if (is.null(src$pump)) src <- reference_source(src)
   if (!is.null(shown)) src$format <- shown
@@ -125,6 +125,14 @@ check_source_read <- function(src, samples) {
           " of it hold samples (", format(r$skipped), " skipped",
           if (length(r$notes)) paste0("; first: ", r$notes[1]), ").")
   }
+  # lines read whose time stamps could not be, so that GGIR's resampling
+  # (which needs them) had nothing to give
+  bad <- unname(r$counters["bad_timestamps"])
+  if (isTRUE(bad > 0)) {
+    abort("Cannot read \"", src$filename, "\": none of its time stamps could be read (",
+          format(bad), " unreadable", if (length(r$notes)) paste0("; first: ", r$notes[1]),
+          "), and GGIR's resampling of it needs them.")
+  }
 }
 
 # The decoder's reason a file could not be opened, in the package's words
@@ -146,6 +154,7 @@ native_open_error <- function(file, format, why, arg) {
 source_native <- function(file, format, sf, chunksize, compat, arg,
                           read_opts = list(), extra = NULL) {
   opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
+  opts$zone_arg <- NULL
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
   if (format == "movisens") opts$block_samples <- movisens_block(file)
@@ -153,9 +162,11 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   # a zone with daylight saving (rmc_time_opts())
   if (format == "adhoc_csv" && !is.null(sf)) opts$block_lines <- format_block_units(format, sf, chunksize)
   if (format == "axivity_csv") {
-    lay <- axivity_csv_layout(file, sf)
+    lay <- axivity_csv_layout(file, sf, compat = isTRUE(compat), zone = read_opts$zone %||% "",
+                              zone_arg = read_opts$zone_arg %||% "desiredtz")
     sf <- lay$sf
     opts[names(lay$opts)] <- lay$opts
+    opts$block_lines <- format_block_units(format, sf, chunksize)
   }
   # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
   # it back as zeros where it was, as a whole read does

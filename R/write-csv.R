@@ -129,16 +129,30 @@ write_plain_csv <- function(d, file, sep = ",", dec = ".") {
   invisible(file)
 }
 
-# Writes samples x, y, z (in g) as Axivity's csv export (OMGUI, UNIX time
-# stamps): no header, lines "time,x,y,z" with the time in seconds (3
-# decimals) of sample i at `start` + i / `true_sf` (a device's clock runs a
-# little off its nominal rate) and `digits` decimals.
+# Writes samples x, y, z (in g) as Axivity's csv export (OMGUI,
+# cwa-convert): lines "time,x,y,z", the time of sample i at `start` + i /
+# `true_sf` (a device's clock runs a little off its nominal rate), `digits`
+# decimals of g. `stamps`: "unix" (seconds since 1970 with 3 decimals) or
+# text: `time_format` (a format() of the whole second, UTC), then
+# `decimals` digits of its fraction after a point (0: none), then `suffix`
+# ("Z", "+01:00"); `header`: OMGUI's header line first.
 write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
-                              digits = 4) {
+                              digits = 4, stamps = c("unix", "text"),
+                              time_format = "%Y-%m-%d %H:%M:%S", decimals = 3,
+                              suffix = "", header = FALSE) {
+  stamps <- match.arg(stamps)
   s <- as_samples(x)
   t <- as.numeric(as.POSIXct(start, tz = "UTC")) + (seq_len(s$n) - 1) / true_sf
-  data.table::fwrite(list(sprintf("%.3f", t), round(s$x, digits), round(s$y, digits),
-                          round(s$z, digits)), file, col.names = FALSE, quote = FALSE)
+  tcol <- if (stamps == "unix") sprintf("%.3f", t) else {
+    # the fraction from the time rounded to the last decimal written
+    k <- round(t * 10^decimals)
+    whole <- k %/% 10^decimals
+    paste0(format(.POSIXct(whole, tz = "UTC"), time_format),
+           if (decimals > 0) sprintf(".%0*.0f", decimals, k %% 10^decimals), suffix)
+  }
+  if (header) writeLines("Time,Accel-X (g), Accel-Y (g), Accel-Z (g)", file)
+  data.table::fwrite(list(tcol, round(s$x, digits), round(s$y, digits), round(s$z, digits)),
+                     file, col.names = FALSE, quote = FALSE, append = header)
   invisible(file)
 }
 

@@ -194,6 +194,8 @@ gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
   c.compat = num(o, "compat") != 0;
   c.temperature = num(o, "temperature") != 0;
   c.lazy = num(o, "lazy") != 0;
+  c.nonfinite_in_sums = o.containsElementNamed("nonfinite_in_sums") &&
+                        num(o, "nonfinite_in_sums") != 0;
   c.r_long_double = gravcal_glue::r_long_double();
   c.min_rest = static_cast<int>(num(o, "min_rest"));
   c.error_digits = static_cast<int>(num(o, "error_digits"));

@@ -15,7 +15,9 @@
 // * the plain shape (scan_plain_number + plain_value) against parse_number,
 //   every number of up to 6 digits and random longer ones;
 // * the date-time parser that keeps the last date and second against a
-//   fresh one for each stamp;
+//   fresh one for each stamp; fread's ISO 8601 date-times (FreadDateTime),
+//   kept text against fresh, and the lines skipped as fread's skip counts
+//   them, across refills of small buffers;
 // * a decoder reading lines in place against one reading every line through
 //   the general parser (option fast = 0), bit for bit, on files of several
 //   layouts, with damage, CRLF and small buffers.
@@ -451,6 +453,69 @@ static void test_files(std::mt19937_64& rng) {
   std::printf("csv files: %d decodings in place and line by line compared\n", files);
 }
 
+// LineReader::skip_fread_lines() counts line ends as fread's skip does
+// ("\n", "\r", "\r\n" and "\n\r" one each), whatever the buffer's size
+// (a pair split by a refill): where each count of lines ends.
+static void test_fread_skip() {
+  const std::string text = "a\rb\r\nc\n\rd\r\re\n\nf\ng,1\n";
+  // the byte after k lines by that count: a b c d "" e "" f g,1
+  const std::int64_t ends[] = {2, 5, 8, 10, 11, 13, 14, 16, 20};
+  for (std::size_t buffer : {64, 65, 66, 67, 68, 1024}) {
+    // padded so that a small buffer's refills fall inside the text
+    const std::size_t pad = buffer - 4;
+    const std::string padded = std::string(pad, 'x') + text;
+    for (int k = 1; k <= 9; ++k) {
+      gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(padded.data()), padded.size());
+      csv::LineReader lr(src, buffer);
+      CHECK(lr.skip_fread_lines(k) == k, "skip " + std::to_string(k));
+      CHECK(lr.offset() == static_cast<std::int64_t>(pad) + ends[k - 1],
+            "after " + std::to_string(k) + " lines, buffer " + std::to_string(buffer));
+    }
+  }
+  gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(text.data()), text.size());
+  csv::LineReader lr(src);
+  CHECK(lr.skip_fread_lines(20) == 9, "lines at the end of the input");
+}
+
+// FreadDateTime: fread's value of ISO 8601 date-times, with the minute's
+// text kept from stamp to stamp (as a fresh parser gives).
+static void test_fread_datetime() {
+  struct Case {
+    const char* s;
+    double want;  // seconds since 1970; NaN: not taken
+  } cases[] = {
+      {"2024-03-04 09:17:00.04", 1709543820.04},
+      {"2024-03-04T09:17:00.040Z", 1709543820.04},
+      {"2024-03-04 09:17:00.040+01:00", 1709540220.04},
+      {"2024-03-04 09:17:00 +0130", 1709538420.0},
+      {"2024-03-04 09:17:00-05:30", 1709561820.0 - 1800.0},  // fread: -5 h, +30 min
+      {"2024-3-4 9:7:5", 1709543225.0},
+      {"2024-02-30 09:17:00", NAN},
+      {"2024-03-04 24:00:00", NAN},
+      {"2024-03-04 09:17:60", NAN},
+      {"2024-03-04 09:17", NAN},
+      {"2024-03-04", NAN},
+      {"2024/03/04 09:17:00", NAN},
+      {"2024-03-04 09:17:00.5 Z", NAN},
+  };
+  csv::FreadDateTime kept;
+  for (const Case& c : cases) {
+    const char* b = c.s;
+    const char* e = c.s + std::strlen(c.s);
+    double t = 0, u = 0;
+    csv::FreadDateTime fresh;
+    const bool ok = kept.parse(b, e, csv::kFreadMultiply, t);
+    const bool ok2 = fresh.parse(b, e, csv::kFreadMultiply, u);
+    CHECK(ok == !std::isnan(c.want), std::string(c.s) + " (taken)");
+    CHECK(ok == ok2, std::string(c.s) + " (kept text)");
+    if (ok && ok2) {
+      CHECK(same_bits(t, u), std::string(c.s) + " (kept text: bits)");
+      CHECK(std::fabs(t - c.want) < 1e-6, std::string(c.s) + " (value)");
+    }
+  }
+}
+
+
 // `--quick` (make valgrind: memcheck, not the numbers, is the point there;
 // `make test` runs the whole set natively): numbers of up to 4 digits
 // exhaustively instead of 6, a tenth of the random ones.
@@ -482,6 +547,8 @@ int main(int argc, char** argv) {
   test_long_numbers(rng, scale);
   test_stamps(rng, scale);
   test_files(rng);
+  test_fread_skip();
+  test_fread_datetime();
   // the two fread rules are told apart by the inputs above (with x87's or
   // quad's long double; where long double is double they may agree)
   std::printf("csv: fread's rules 1 and 2 differ on %ld numbers\n", rules_differ);

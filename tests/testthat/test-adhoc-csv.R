@@ -62,6 +62,40 @@ test_that("g.calibrate() on ad hoc csv files is GGIR's, unit by unit and layout 
   expect_adhoc_same(f, c(pr, noise))
 })
 
+test_that("ad hoc csv in mg with one decimal after free-text header lines: GGIR's lines, GGIR's result", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # GGIR skips rmc.firstrow.acc - 1 lines (and each block's start) with
+  # data.table::fread(skip = ), which ends a line at "\n", "\r", "\r\n"
+  # or "\n\r": a free-text line with a stray carriage return counts as
+  # two. gravcal counts them alike (R/adhoc-csv.R fread_lines(), the csv
+  # decoder's skip); counting "\n" only lost the first sample and moved
+  # every window by one.
+  rec <- adhoc_rec(seed = 18)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  noise <- list(rmc.noise = 0.013 / 1.2)
+  layouts <- list(
+    # "Recorded by ...\r" "exported ..." "Study notes" then the column
+    # names: rmc.firstrow.acc = 4 by the writer's count is the names line
+    # by fread's, and GGIR (its first field not a number) starts a line later
+    stray_cr = c("Recorded by a simulated device\rexported 2024-03-04", "Study notes"),
+    # free text with commas and quotes, Windows line ends ("\r\n"), the
+    # names on line 3 and the samples from line 4
+    crlf = c("\"Study, site 1\",left wrist\r", "free text, more text\r"),
+    # a line ending "\r\r\n" (two line ends for fread and for R)
+    double_cr = c("Recorded by a simulated device\r\r", "free text"))
+  for (nm in names(layouts)) {
+    pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, unit = "mg", header = layouts[[nm]])
+    expect_equal(pr$rmc.firstrow.acc, 4)
+    b <- expect_adhoc_same(f, c(pr, noise))
+    expect_gt(b$ggir$npoints, 1000)
+    expect_true(b$ggir$use.temp)
+  }
+  # the values are mg with one decimal
+  expect_true(any(grepl("^-?[0-9]+[.][0-9],", gravcal:::fread_lines(f, 20)[-(1:4)])))
+})
+
 test_that("ad hoc csv: text time stamps first, Kelvin, decimal commas", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")

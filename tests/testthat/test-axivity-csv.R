@@ -57,13 +57,211 @@ test_that("an Axivity csv export read whole keeps its samples and times; other c
   t <- as.numeric(r$data$time)
   # the file's time stamps (written to the millisecond), not a grid
   expect_lt(abs((t[100] - t[1]) - 99 / 10.5), 1e-3)
-  # text time stamps are refused with a reason
-  writeLines(c("2024-01-01 00:00:00.000,0,0,1", "2024-01-01 00:00:00.100,0,0,1"), f)
+  # text time stamps (OMGUI's), with and without its header line: the same
+  # samples, the stamps read (UTC)
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.5, digits = 4, stamps = "text")
   expect_identical(gravcal:::file_format(f), "axivity_csv")
-  expect_error(read_recording(f), "text time stamps")
+  r2 <- read_recording(f)
+  expect_identical(r2$sf, 10)
+  expect_identical(r2$data$x, r$data$x)
+  expect_identical(round(as.numeric(r2$data$time), 3), round(t, 3))
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.5, digits = 4, stamps = "text", header = TRUE)
+  expect_identical(gravcal:::file_format(f), "axivity_csv")
+  r3 <- read_recording(f)
+  expect_identical(r3$data$x, r$data$x)
+  expect_identical(r3$data$time, r2$data$time)
+  # stamps in no format R or fread reads: an error naming the file
+  writeLines(paste0("04.01.2024 00:00:0", 0:9, ",0,0,1"), f)
+  expect_error(read_recording(f), "neither UNIX seconds nor a date-time GGIR reads")
   # a header of column names, or three fields, is not an Axivity export
   writeLines(c("time,x,y,z", "1,0,0,1"), f)
   expect_identical(gravcal:::file_format(f), "csv")
   writeLines(c("0,0,1", "0,0,1"), f)
   expect_identical(gravcal:::file_format(f), "csv")
+})
+
+# Text time stamps, as GGIR 3.3-9 reads them: its block reader
+# (data.table::fread(), header = FALSE) takes ISO 8601 date-times
+# ("2024-03-04 09:00:00.040", "Z" or an offset after it) as fread computes
+# them, other text (slashes) through as.POSIXct(); g.inspectfile() finds the
+# rate from the stamps in the session's zone. Stamps of whole seconds repeat
+# for every sample of a second: GGIRread's resampling then gives NaN at
+# each block's start, which empties the rest of the block in GGIR's
+# cumulative sums, and GGIR calibrates on almost nothing; gravcal the same.
+test_that("g.calibrate() on Axivity csv exports with text time stamps is GGIR's, format by format", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  skip_if_not_installed("data.table")
+  # OMGUI's stamps on 30 hours (three of GGIR's blocks), the others on 13
+  # (two blocks: GGIR's run costs time)
+  recs <- list(long = simulate_recording(hours = 30, sf = 10, seed = 23, params = known_params(),
+                                         temperature = FALSE),
+               short = simulate_recording(hours = 13, sf = 10, seed = 26,
+                                          params = known_params(), temperature = FALSE))
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  styles <- list(
+    omgui = list(),                                        # 2024-03-04 09:00:00.040
+    zulu = list(suffix = "Z", decimals = 2),               # ...09:00:00.04Z
+    offset = list(suffix = "+01:00"),                      # ...09:00:00.040+01:00
+    slashes = list(time_format = "%Y/%m/%d %H:%M:%S"),     # as.POSIXct()'s path
+    seconds = list(decimals = 0))                          # 2024-03-04 09:00:00
+  pr <- GGIR::load_params()$params_rawdata
+  quiet <- function(expr) {
+    out <- NULL
+    utils::capture.output(out <- suppressWarnings(expr))
+    out
+  }
+  for (nm in names(styles)) {
+    rec <- recs[[if (nm == "omgui") "long" else "short"]]
+    do.call(gravcal:::write_axivity_csv,
+            c(list(rec, f, true_sf = 10.03, start = "2024-03-04 09:00:00", stamps = "text"),
+              styles[[nm]]))
+    expect_identical(gravcal:::file_format(f), "axivity_csv")
+    b <- run_both(f)
+    expect_same_as_ggir(b)
+    for (k in setdiff(names(b$ggir), "bsc_qc")) {
+      expect_identical(b$gravcal[[k]], b$ggir[[k]], label = paste(nm, k))
+    }
+    if (nm == "seconds") {
+      expect_identical(b$ggir$QCmessage, gravcal:::ggir_messages[["no_data"]])
+    } else {
+      expect_gt(b$ggir$npoints, 1000)
+    }
+    if (nm == "omgui") {
+      # given GGIR's inspectfileobject (the issue: "not enough data" before),
+      # and through fread and GGIRread::resample (reader = "reference")
+      I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pr))
+      G <- quiet(gravcal::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
+                                      verbose = FALSE))
+      G2 <- quiet(gravcal::g.calibrate(f, params_rawdata = pr, verbose = FALSE,
+                                       reader = "reference"))
+      for (k in setdiff(names(b$ggir), "bsc_qc")) {
+        expect_identical(G[[k]], b$ggir[[k]], label = paste("inspectfileobject", k))
+        expect_identical(G2[[k]], b$ggir[[k]], label = paste("reference", k))
+      }
+    }
+  }
+})
+
+test_that("fread's date-times: the csv decoder's value of every millisecond is fread's", {
+  skip_if_not_installed("data.table")
+  # each millisecond of a minute, with and without an offset, against
+  # fread's own POSIXct values
+  s <- expand.grid(ms = 0:999, sec = c(0, 7, 31, 59))
+  stamp <- sprintf("2024-03-04 09:17:%02d.%03d", s$sec, s$ms)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  for (suffix in c("", "Z", "+0130", "-05:30", " +02")) {
+    txt <- paste0(stamp, suffix)
+    writeLines(paste0(txt, ",0.5,0.25,1"), f)
+    ref <- as.numeric(data.table::fread(f, header = FALSE, data.table = FALSE)[[1]])
+    expect_false(anyNA(ref))
+    lay <- gravcal:::axivity_csv_layout(f, sf = 10, compat = TRUE)
+    expect_identical(lay$time$kind, "iso")
+    # the decoder as GGIR's reads take it (fread's rule for the seconds),
+    # without the resampling
+    opts <- lay$opts[setdiff(names(lay$opts), "grid_sf")]
+    d <- gravcal:::native_read_all(f, "adhoc_csv", c(list(compat = 1), opts))
+    expect_identical(d$time, ref, label = paste0("suffix \"", suffix, "\""))
+  }
+})
+
+test_that("an Axivity csv export with OMGUI's header line: GGIR stops, so g.calibrate() refuses it", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  rec <- simulate_recording(hours = 2, sf = 10, seed = 24, temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, stamps = "text", header = TRUE)
+  pr <- GGIR::load_params()$params_rawdata
+  I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr))
+  expect_error(suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
+                                                  verbose = FALSE)),
+               "standard unambiguous format")
+  expect_error(gravcal::g.calibrate(f, verbose = FALSE),
+               "Axivity csv export with a header line", fixed = TRUE)
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = I, verbose = FALSE),
+               "GGIR 3.3-9 reads that line as data and stops", fixed = TRUE)
+  # gravcal's own methods read it
+  expect_s3_class(calibrate(f), "gravcal_fit")
+})
+
+test_that("g.calibrate() refuses an inspectfileobject it cannot honour, naming why", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  rec <- simulate_recording(hours = 1, sf = 10, seed = 25, temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, stamps = "text")
+  I <- suppressWarnings(GGIR::g.inspectfile(f))
+  expect_identical(gravcal:::ggir_inspect_format(I), "axivity_csv")
+  # another format's object (an ActiGraph csv export's codes)
+  I2 <- utils::modifyList(I, list(monc = 3L, monn = "actigraph"))
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = I2, verbose = FALSE),
+               paste0("`inspectfileobject` (monc = 3, dformc = 2: an ActiGraph csv export) ",
+                      "does not describe \"", basename(f), "\", which gravcal reads as an ",
+                      "Axivity csv export"), fixed = TRUE)
+  # the ad hoc csv reader named on one side only
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = I, verbose = FALSE,
+                                    rmc.firstrow.acc = 1, rmc.sf = 10),
+               "(rmc.firstrow.acc is given)", fixed = TRUE)
+  # decimal commas, and no sf
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = utils::modifyList(I, list(decn = ",")),
+                                    verbose = FALSE),
+               "`inspectfileobject$decn` = \",\"", fixed = TRUE)
+  I3 <- I
+  I3$sf <- NULL
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = I3, verbose = FALSE),
+               "`inspectfileobject` has no `sf`", fixed = TRUE)
+  # a rate that is not the file's own (.cwa): the error names the object's sf
+  cwa <- system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread")
+  skip_if(!nzchar(cwa), "GGIRread's test .cwa file is missing")
+  Icwa <- suppressWarnings(GGIR::g.inspectfile(cwa))
+  expect_error(gravcal::g.calibrate(cwa, inspectfileobject = utils::modifyList(Icwa, list(sf = 37)),
+                                    verbose = FALSE),
+               "`inspectfileobject$sf` = 37 Hz", fixed = TRUE)
+  # stamps no reader takes: an error, not GGIR's quiet "not enough data"
+  writeLines(sprintf("04.03.2024 09:%02d:%02d,0,0,1", (0:999) %/% 60, (0:999) %% 60), f)
+  expect_error(gravcal::g.calibrate(f, inspectfileobject = I, verbose = FALSE),
+               "neither UNIX seconds nor a date-time GGIR reads", fixed = TRUE)
+})
+
+test_that("desiredtz across daylight saving: text stamps GGIR's; UNIX and ISO 8601 stamps refused", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  skip_if(is.null(gravcal:::zone_table("Europe/Amsterdam")),
+          "this R has no daylight saving rules for Europe/Amsterdam")
+  # 13 hours across Europe/Amsterdam's change of 2024-03-31 (01:00 UTC)
+  rec <- simulate_recording(hours = 13, sf = 10, seed = 27, params = known_params(),
+                            temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pl <- GGIR::load_params()
+  pg <- utils::modifyList(pl$params_general, list(desiredtz = "Europe/Amsterdam"))
+  quiet <- function(expr) {
+    out <- NULL
+    utils::capture.output(out <- suppressWarnings(expr))
+    out
+  }
+  # text GGIR reads with as.POSIXct() in the zone: its result, which the
+  # zone changes
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, start = "2024-03-30 20:00:00",
+                              stamps = "text", time_format = "%Y/%m/%d %H:%M:%S")
+  I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pl$params_rawdata, params_general = pg))
+  R <- quiet(GGIR::g.calibrate(f, params_rawdata = pl$params_rawdata, params_general = pg,
+                               inspectfileobject = I, verbose = FALSE))
+  G <- quiet(gravcal::g.calibrate(f, params_rawdata = pl$params_rawdata, params_general = pg,
+                                  verbose = FALSE))
+  k <- setdiff(names(R), "bsc_qc")
+  expect_true(identical(G[k], R[k]), label = "identical(gravcal[-bsc_qc], GGIR[-bsc_qc])")
+  expect_gt(R$npoints, 1000)
+  G0 <- quiet(gravcal::g.calibrate(f, params_rawdata = pl$params_rawdata, verbose = FALSE))
+  expect_false(identical(G0$spheredata, G$spheredata))
+  # ISO 8601 and UNIX stamps, which GGIR forces into the zone: refused
+  for (st in c("text", "unix")) {
+    gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, start = "2024-03-30 20:00:00", stamps = st)
+    expect_error(gravcal::g.calibrate(f, params_general = pg, verbose = FALSE),
+                 "`desiredtz` = \"Europe/Amsterdam\": the Axivity csv export", fixed = TRUE)
+  }
 })

@@ -28,7 +28,9 @@
 // start_time + i / sf, unless time_format is given: text read by that
 // strptime() format (%Y %y %m %d %H %M %S %OS %T and literal characters;
 // time_utc_offset seconds subtracted: a zone of fixed offset), for GGIR's
-// gap imputation), time_offset (seconds added to numeric time), dec
+// gap imputation, or time_iso = 1: ISO 8601 text as data.table::fread reads
+// it into date-times, less time_utc_offset (csv_text::FreadDateTime; an
+// Axivity csv export's text time)), time_offset (seconds added to numeric time), dec
 // ("," for decimal commas), sf (required), and the units: acc_div (1000
 // for mg), acc_scale, bit (1 unsigned, 2 signed) with bit_pow (2^bitrate)
 // and bit_range, temp_unit (1 K, 2 F). Values are converted as GGIR's
@@ -142,11 +144,12 @@ class CsvDecoder : public Decoder {
       time_div_ = opts.num("time_div", 0);
       time_offset_ = opts.num("time_offset", 0);
       time_fmt_ = opts.str("time_format", "");
+      time_iso_ = opts.num("time_iso", 0) != 0;
       time_utc_offset_ = opts.num("time_utc_offset", 0);
       zone_ = ZoneTable(opts);
       block_lines_ = static_cast<std::int64_t>(opts.num("block_lines", 0));
       // text time: not read (start_time + i / sf) unless a format is given
-      if (!(time_div_ > 0) && time_fmt_.empty()) col_time_ = -1;
+      if (!(time_div_ > 0) && time_fmt_.empty() && !time_iso_) col_time_ = -1;
       time_text_ = false;
       info_.start_time = opts.num("start_time", std::numeric_limits<double>::quiet_NaN());
       adhoc_dec_ = opts.str("dec", ".") == "," ? ',' : '.';
@@ -468,13 +471,11 @@ class CsvDecoder : public Decoder {
   // from the data lines, the columns as the options give them.
   bool open_adhoc() {
     info_.format = adhoc_format_;
-    csv_text::Line ln;
-    for (std::int64_t i = 0; i < adhoc_skip_; ++i) {
-      if (!lines_.next(ln)) {
-        return fail(lines_.read_failed() ? "the file cannot be read"
-                                         : "the file ends before its data (line " +
-                                               std::to_string(adhoc_skip_ + 1) + ")");
-      }
+    // the lines before the data as GGIR's reads skip them (fread's count)
+    if (lines_.skip_fread_lines(adhoc_skip_) < adhoc_skip_) {
+      return fail(lines_.read_failed() ? "the file cannot be read"
+                                       : "the file ends before its data (line " +
+                                             std::to_string(adhoc_skip_ + 1) + ")");
     }
     const auto v = peek_lines();
     if (v.empty()) return fail("no data lines after line " + std::to_string(adhoc_skip_));
@@ -536,6 +537,13 @@ class CsvDecoder : public Decoder {
   }
 
   bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
+    if (adhoc_ && time_iso_) {
+      // as fread reads it, less a fixed offset (a zone GGIR forces it into)
+      frac_digits = 9;
+      if (!iso_.parse(f.b, f.e, number_rule_, t)) return false;
+      if (time_utc_offset_ != 0) t = t - time_utc_offset_;
+      return true;
+    }
     if (adhoc_ && !time_fmt_.empty()) {
       frac_digits = 9;  // taken as it is (no spreading of coarse stamps)
       return parse_formatted(f.b, f.e, t);
@@ -715,7 +723,8 @@ class CsvDecoder : public Decoder {
     }
     if (col_x_ < 0 || col_y_ < 0 || col_z_ < 0) return;
     // numeric time (time_of()'s plain number) is parsed in place too
-    number_time_ = col_time_ >= 0 && !time_text_ && !(adhoc_ && !time_fmt_.empty()) && zone_.empty();
+    number_time_ = col_time_ >= 0 && !time_text_ && !(adhoc_ && (!time_fmt_.empty() || time_iso_)) &&
+                   zone_.empty();
     if (number_time_) role_[col_time_] = kTimeNumber;
     plain_ = nfields_ == 3 && role_[0] == kX && role_[1] == kY && role_[2] == kZ ? 2 : 1;
     decimals_ = &csv_text::decimals(number_rule_);
@@ -1015,6 +1024,8 @@ class CsvDecoder : public Decoder {
   char adhoc_dec_ = '.';
   double time_div_ = 0, time_offset_ = 0;
   std::string time_fmt_;  // text time stamps' strptime() format ("": not read)
+  bool time_iso_ = false;  // text time stamps read as fread reads ISO 8601 date-times
+  csv_text::FreadDateTime iso_;
   double time_utc_offset_ = 0;
   ZoneTable zone_;  // a zone whose offset changes (options tz_*), else time_utc_offset_
   std::int64_t block_lines_ = 0;  // lines in one of GGIR's blocks (option block_lines)

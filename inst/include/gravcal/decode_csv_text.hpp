@@ -584,6 +584,128 @@ class DateTimeParser {
   std::int64_t second_days_ = 0, second_whole_ = 0;
 };
 
+// An integer as data.table::fread reads the parts of a date-time: an
+// optional sign, any leading zeros, then at most 10 digits of a value at
+// most 2^31 - 1; at least one character after the sign. Moves p past it.
+inline bool fread_int32(const char*& p, const char* e, std::int64_t& v) {
+  const char* q = p;
+  const bool neg = q < e && *q == '-';
+  if (q < e && (*q == '-' || *q == '+')) ++q;
+  const char* const start = q;
+  while (q < e && *q == '0') ++q;
+  std::int64_t acc = 0;
+  int nd = 0;
+  for (; q < e && is_digit(*q); ++q, ++nd) {
+    if (nd == 10) return false;
+    acc = acc * 10 + (*q - '0');
+  }
+  if (q == start || acc > 2147483647) return false;
+  v = neg ? -acc : acc;
+  p = q;
+  return true;
+}
+
+// A date-time as data.table::fread reads it into a POSIXct column
+// (data.table 1.13.0 on, its default tz = "UTC"): the date as
+// [+-]year-month-day (each part an fread integer, the day valid for the
+// month), ' ' or 'T', hour (0-23) ':' minute (0-59) ':' seconds (an fread
+// number, 0 to below 60, by `rule`), then nothing (taken as UTC), 'Z', or
+// an optional blank and an offset: +hh:mm or +hh (fread takes minutes after
+// the colon as they are, so -05:30 moves the time by -5 h and +30 min),
+// +hhmm, and +h, +hhh (hours). The value is the whole seconds of the
+// calendar less the offset, exact, plus the seconds: one rounding, as
+// fread's 86400 * days + 3600 * (hour - offset hours) + 60 * (minute -
+// offset minutes) + seconds. A file's stamps share their date and minute
+// for many lines: the text up to the seconds is kept with its value, so
+// the next stamp with the same start parses its seconds only.
+class FreadDateTime {
+ public:
+  bool parse(const char* b, const char* e, int rule, double& t) {
+    const std::size_t n = static_cast<std::size_t>(e - b);
+    const char* p;
+    std::int64_t minute_secs;
+    if (prefix_len_ > 0 && n > prefix_len_ && std::memcmp(b, prefix_, prefix_len_) == 0) {
+      p = b + prefix_len_;
+      minute_secs = prefix_secs_;
+    } else {
+      p = b;
+      if (!calendar_minute(p, e, minute_secs)) return false;
+      const std::size_t len = static_cast<std::size_t>(p - b);
+      if (len <= kMaxPrefix) {
+        std::memcpy(prefix_, b, len);
+        prefix_len_ = len;
+        prefix_secs_ = minute_secs;
+      }
+    }
+    // the seconds: [+-]digits[.digits][(e|E)[+-]digits], as fread scans them
+    const char* s = p;
+    if (p < e && (*p == '-' || *p == '+')) ++p;
+    while (p < e && is_digit(*p)) ++p;
+    if (p < e && *p == '.') {
+      ++p;
+      while (p < e && is_digit(*p)) ++p;
+    }
+    if (p < e && (*p == 'e' || *p == 'E')) {
+      const char* x = p + 1;
+      if (x < e && (*x == '-' || *x == '+')) ++x;
+      int nd = 0;
+      while (x < e && is_digit(*x) && nd < 3) { ++x; ++nd; }
+      if (nd == 0) return false;
+      p = x;
+    }
+    double sec;
+    if (p == s || !parse_number(s, p, '.', rule, sec) || sec < 0 || sec >= 60) return false;
+    std::int64_t zone_secs = 0;
+    if (p < e && *p == 'Z') {
+      ++p;
+    } else if (p < e) {
+      if (*p == ' ') ++p;
+      if (p >= e || (*p != '+' && *p != '-')) return false;
+      const char* const start = p;
+      std::int64_t hh, mm = 0;
+      if (!fread_int32(p, e, hh)) return false;
+      const std::ptrdiff_t len = p - start;
+      if (len == 5 && hh != 0) {
+        if (hh > 2400 || hh < -2400) return false;
+        mm = hh % 100;
+        hh /= 100;
+      } else if (len == 3) {
+        if (hh > 24 || hh < -24) return false;
+        if (p < e && *p == ':') {
+          ++p;
+          if (!fread_int32(p, e, mm)) return false;
+        }
+      }
+      zone_secs = 3600 * hh + 60 * mm;
+    }
+    if (p != e) return false;
+    t = static_cast<double>(minute_secs - zone_secs) + sec;
+    return true;
+  }
+
+ private:
+  // "<date>[ T]hh:mm:" as seconds since 1970 (the calendar read as UTC).
+  static bool calendar_minute(const char*& p, const char* e, std::int64_t& secs) {
+    std::int64_t y, m, d, hh, mi;
+    if (!fread_int32(p, e, y) || y < 1 || p >= e || *p++ != '-') return false;
+    if (!fread_int32(p, e, m) || m < 1 || m > 12 || p >= e || *p++ != '-') return false;
+    if (!fread_int32(p, e, d) || d < 1 ||
+        d > days_in_month(y, static_cast<unsigned>(m))) return false;
+    if (p >= e || (*p != ' ' && *p != 'T')) return false;
+    ++p;
+    if (!fread_int32(p, e, hh) || hh < 0 || hh > 23 || p >= e || *p++ != ':') return false;
+    if (!fread_int32(p, e, mi) || mi < 0 || mi > 59 || p >= e || *p++ != ':') return false;
+    secs = days_from_civil(y, static_cast<unsigned>(m), static_cast<unsigned>(d)) * 86400 +
+           hh * 3600 + mi * 60;
+    return true;
+  }
+
+  static constexpr std::size_t kMaxPrefix = 40;
+  char prefix_[kMaxPrefix];
+  std::size_t prefix_len_ = 0;
+  std::int64_t prefix_secs_ = 0;
+};
+
 // One line of the input (without its line end), where it was, and how it
 // ended.
 struct Line {
@@ -666,6 +788,31 @@ class LineReader {
     p = buf_.data() + beg_;
     n = end_ - beg_;
   }
+  // Skips k lines as data.table::fread's `skip` counts them: a line ends at
+  // '\n', at '\r' and at the pairs "\r\n" and "\n\r" (next() ends lines at
+  // '\n' only). Returns the lines skipped (fewer at the end of the input).
+  std::int64_t skip_fread_lines(std::int64_t k) {
+    std::int64_t done = 0;
+    while (done < k) {
+      const char* p;
+      std::size_t n;
+      peek(p, n);
+      if (n == 0) break;
+      std::size_t i = 0;
+      for (; i < n && done < k; ++i) {
+        const char c = p[i];
+        if (c != '\n' && c != '\r') continue;
+        const char other = c == '\n' ? '\r' : '\n';
+        if (i + 1 == n && !eof_ && i > 0) break;  // its pair may follow: read on first
+        if (i + 1 < n && p[i + 1] == other) ++i;
+        ++done;
+      }
+      consume(i, 0);
+    }
+    line_ += done;
+    return done;
+  }
+
   // Starts again at byte `pos` of the source (whose line number is `line`).
   bool rewind(std::int64_t pos, std::int64_t line) {
     if (!src_.seek(pos)) return false;

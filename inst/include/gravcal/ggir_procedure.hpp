@@ -51,6 +51,11 @@ struct GgirConfig {
   double short_block_rows = 0.0;  // a block with fewer rows is the last (0: none)
   bool temperature = true;     // use the source's temperature if it has one
   bool lazy = true;            // compatible mode: R's sds only where seen
+  bool nonfinite_in_sums = false;  // compatible mode: a non-finite sample
+                                   // enters R's cumulative sums (GGIR's
+                                   // readers' samples: its NaN empties the
+                                   // rest of its block); else left out of
+                                   // its window (samples in memory)
   bool r_long_double = true;   // R's accumulator (its LDOUBLE) is long
                                // double; false: double (an R without long
                                // double, capabilities("long.double") FALSE)
@@ -163,6 +168,7 @@ class GgirProcedure {
     if (cfg_.compat) {
       buffer_.assign(3 * (static_cast<std::size_t>(std::ceil(L_)) + 1), 0.0);
       seg_.use_r_arithmetic(buffer_.data(), buffer_.size(), cfg_.r_long_double);
+      seg_.keep_nonfinite(cfg_.nonfinite_in_sums);
     }
     if (cfg_.compat && cfg_.lazy) {
       held_.assign(buffer_.size(), 0.0);

@@ -114,6 +114,17 @@ class Segmenter {
     return true;
   }
 
+  // R's arithmetic: a sample with a non-finite x, y or z enters R's
+  // cumulative sums (GGIR's rule for the samples its readers give; on), or
+  // is left out of its window (off, the default). See
+  // RExactStatsT::keep_nonfinite().
+  void keep_nonfinite(bool on) {
+    r_.stats().keep_nonfinite(on);
+    lazy_.stats().keep_nonfinite(on);
+    r_d_.stats().keep_nonfinite(on);
+    lazy_d_.stats().keep_nonfinite(on);
+  }
+
   // Push a chunk of n samples. t may be null (no temperature). sink(stats) is
   // called once for every window given out, in order.
   template <class Sink>

@@ -163,12 +163,18 @@ class RExactStatsT {
   }
   std::size_t per_axis() const { return cap_; }
 
+  // A non-finite x, y or z is left out of its window, unless
+  // keep_nonfinite() is on: then it enters R's cumulative sums as in GGIR's
+  // (a NaN read from a file: the means of its window and of every later
+  // window up to restart() are NaN, the sds of its window too).
+  void keep_nonfinite(bool on) { keep_nonfinite_ = on; }
+
   void add(double xi, double yi, double zi, double ti) {
     if (std::isfinite(ti)) {
       csum_[4] += ti;
       ++c_.n_temp;
     }
-    if (!WindowCounts::finite(xi, yi, zi)) {
+    if (!keep_nonfinite_ && !WindowCounts::finite(xi, yi, zi)) {
       ++c_.n_invalid;
       return;
     }
@@ -309,6 +315,7 @@ class RExactStatsT {
   WindowCounts c_;
   bool whole_ = false;     // the open window came whole: its sds in wsd_
   double wsd_[3] = {0.0, 0.0, 0.0};
+  bool keep_nonfinite_ = false;  // non-finite samples enter the sums (GGIR's)
 };
 
 // The state of LazyRStats, which the caller keeps (the core allocates
