@@ -205,7 +205,7 @@ check: setup-test
 	$(MAKE) check-run
 tarball:
 	mkdir -p $(BUILD)
-	cd $(BUILD) && $(R) CMD build --no-manual .. > build.log 2>&1 || (cat build.log; exit 1)
+	cd $(BUILD) && MAKEFLAGS=-j$(JOBS) $(R) CMD build --no-manual .. > build.log 2>&1 || (cat build.log; exit 1)
 check-run:
 	cd $(BUILD) && env $(CHECK_ENV) $(R) CMD check --as-cran --no-manual $(TARBALL) > check.log 2>&1 || true
 	bash tools/check-result.sh $(BUILD)/gravcal.Rcheck

@@ -63,6 +63,7 @@ test_that("g.calibrate() on ad hoc csv files is GGIR's, unit by unit and layout 
 })
 
 test_that("ad hoc csv in mg with one decimal after free-text header lines: GGIR's lines, GGIR's result", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   # GGIR skips rmc.firstrow.acc - 1 lines (and each block's start) with

@@ -89,6 +89,7 @@ test_that("an Axivity csv export read whole keeps its samples and times; other c
 # each block's start, which empties the rest of the block in GGIR's
 # cumulative sums, and GGIR calibrates on almost nothing; gravcal the same.
 test_that("g.calibrate() on Axivity csv exports with text time stamps is GGIR's, format by format", {
+  skip_if_quick()
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   skip_if_not_installed("data.table")
@@ -227,6 +228,7 @@ test_that("g.calibrate() refuses an inspectfileobject it cannot honour, naming w
                "neither UNIX seconds nor a date-time GGIR reads", fixed = TRUE)
 })
 
+  skip_if_quick()
 test_that("desiredtz across daylight saving: text stamps GGIR's; UNIX and ISO 8601 stamps refused", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
