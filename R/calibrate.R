@@ -151,6 +151,7 @@
 #' | status | meaning | what to do |
 #' |---|---|---|
 #' | `"ok"` | calibrated | |
+#' | `"high_error"` | calibrated, coefficients kept, but the calibration points are still 10 mg or more off 1 g on average after the fit (`error_after`; GGIR's threshold) | inspect the points with `plot()`: some may not be rest |
 #' | `"too_short"` | fewer samples than one window | check `sf` and the file |
 #' | `"all_zero"` | every sample is exactly 0 on all three axes (ActiGraph idle sleep, or a device that recorded nothing) | check the device and its download: there is nothing to calibrate |
 #' | `"no_rest"` | no window met the rest criterion | check units (g) and `sf` |

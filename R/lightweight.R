@@ -129,7 +129,7 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
     fit$input <- attr(w, "input")
     fit$file <- file
     fit <- add_guards(fit, excluded, excluded_windows, guards)
-    return(finish_fit(fit, rest))
+    return(judge_error(finish_fit(fit, rest)))
   }
   # the paper's procedure: the bins that a 0.3 g novelty threshold cannot
   # fill are filled with smaller thresholds, keeping the points already
@@ -154,7 +154,28 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
   fit$input <- attr(w, "input")
   fit$file <- file
   fit <- add_guards(fit, excluded, excluded_windows, guards)
-  finish_fit(fit, rest)
+  judge_error(finish_fit(fit, rest))
+}
+
+# The lightweight method's judgement of its error after calibration, GGIR's
+# rule (ggir_constants$max_error): a fit whose calibration points stay 10 mg
+# or more off the sphere on average (mean | |v| - 1 |, `error_after`) is
+# "high_error", its coefficients kept, as the GGIR method keeps them. At
+# rest, points are 10 s means whose noise is well under 1 mg, so 10 mg left
+# after the fit means the points are not all rest or the model does not fit.
+judge_error <- function(fit) {
+  e <- fit$error_after
+  if (identical(fit$status, "ok") && length(e) == 1 && is.finite(e) &&
+      e >= ggir_constants$max_error) {
+    fit$status <- "high_error"
+    fit$message <- paste0(if (nzchar(fit$message)) paste0(fit$message, "; "),
+      sprintf(paste0(
+      "the calibration points are still %.1f mg off 1 g on average after ",
+      "the fit (%.0f mg or more): some may not be rest, or the model may ",
+      "not fit the device; inspect them with plot()"), 1000 * e,
+      1000 * ggir_constants$max_error))
+  }
+  fit
 }
 
 # The rest windows that are never calibration points, and why: "identical"

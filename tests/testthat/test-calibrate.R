@@ -217,7 +217,10 @@ test_that("a rest window whose norm is far from 1 g is never a point", {
   bad$y[1:50] <- 0.04
   bad$z[1:50] <- 0.03
   off <- calibrate(bad, sf = 10, selection = "paper", max_norm_error = Inf, max_identical = 1)
-  expect_equal(off$status, "ok")
+  # the glitch is 0.93 g off the sphere among 18 points: the fit's points
+  # stay tens of mg off after calibration, which its status says
+  expect_equal(off$status, "high_error")
+  expect_gt(off$error_after, 0.01)
   expect_equal(off$points$row[1], 1L)
   expect_equal(off$points$mean_norm[1], sqrt(0.05^2 + 0.04^2 + 0.03^2))
   expect_equal(off$excluded, c(norm = 0L, clipped = 0L, identical = 0L))
@@ -315,4 +318,35 @@ test_that("the clipping guard takes the full scale from a device file", {
                     selection = "paper", max_identical = 1)
   expect_equal(wide$excluded, c(norm = 0L, clipped = 0L, identical = 0L))
   expect_equal(wide$status, "implausible")
+})
+
+test_that("a lightweight fit whose points stay 10 mg or more off the sphere is high_error, never ok", {
+  # issue 44: near-rest that is not rest left the lightweight method at tens
+  # of mg after calibration with status "ok". Here every half hour the norm
+  # is 5 % low, then 5 % high: no calibration can bring both to 1 g.
+  rec <- simulate_recording(hours = 24, sf = 10, seed = 2)
+  fit0 <- calibrate(rec, sf = 10)
+  expect_identical(fit0$status, "ok")
+  expect_lt(fit0$error_after, 0.01)
+  half_hour <- floor((seq_len(nrow(rec)) - 1) / (10 * 1800))
+  k <- ifelse(half_hour %% 2 == 0, 0.95, 1.05)
+  rec[, c("x", "y", "z")] <- rec[, c("x", "y", "z")] * k
+  for (sel in c("cells", "paper")) {
+    fit <- calibrate(rec, sf = 10, selection = sel)
+    expect_gte(fit$error_after, 0.01)
+    expect_identical(fit$status, "high_error", label = sel)
+    expect_match(fit$message, sprintf("still %.1f mg off 1 g", 1000 * fit$error_after),
+                 fixed = TRUE)
+    # the coefficients are kept, as the GGIR method keeps them
+    expect_false(isTRUE(all.equal(unname(fit$K), diag(3))))
+  }
+  # the threshold is GGIR's, on error_after; a fit of another status is left
+  f <- fit0
+  f$error_after <- 0.01
+  expect_identical(gravcal:::judge_error(f)$status, "high_error")
+  f$error_after <- 0.00999
+  expect_identical(gravcal:::judge_error(f)$status, "ok")
+  f$status <- "implausible"
+  f$error_after <- 0.5
+  expect_identical(gravcal:::judge_error(f)$status, "implausible")
 })

@@ -124,7 +124,10 @@ test_that("the model is the one the rest points determine, and says so", {
   # from its offset: scale and offset, or offset only
   flat <- band_recording(c(-0.35, 0.35), p, seed = 2)
   ff <- calibrate(flat, sf = 10)
-  expect_identical(ff$status, "ok")
+  # offsets alone leave the undetermined 1-2 % of scale and cross-axis
+  # terms: the points stay 12 mg off the sphere, which the status says
+  expect_identical(ff$status, "high_error")
+  expect_match(ff$message, "still 1[0-9].[0-9] mg off 1 g")
   expect_lt(length(ff$model), 9L)
   expect_match(ff$message, "not determined by the rest points")
   expect_true(all(ff$se[ff$model] <= 0.01))
