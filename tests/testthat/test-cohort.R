@@ -119,6 +119,18 @@ test_that("an interrupted run resumes without redoing finished recordings", {
          difftime(Sys.time(), t0, units = "secs") < 120) Sys.sleep(0.05)
   tools::pskill(job$pid, tools::SIGKILL)
   suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
+  # on a loaded machine the killed process can outlive the collection (a
+  # CI rehearsal saw its lock still held): wait until it is gone or a
+  # zombie, as lock_stale() reads it, before asking for the lock
+  gone <- function(pid) {
+    st <- file.path("/proc", pid, "stat")
+    if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
+    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
+                                      error = function(e) ""), collapse = ""))
+  }
+  t1 <- Sys.time()
+  while (!gone(job$pid) && difftime(Sys.time(), t1, units = "secs") < 60) Sys.sleep(0.05)
+  expect_true(gone(job$pid))
   saved <- list.files(store, pattern = "rds$", full.names = TRUE)
   expect_gte(length(saved), 2)
   expect_lt(length(saved), 5)  # stopped before the end
@@ -372,6 +384,18 @@ test_that("an interrupted run of recordings in subfolders resumes", {
          difftime(Sys.time(), t0, units = "secs") < 60) Sys.sleep(0.05)
   tools::pskill(job$pid, tools::SIGKILL)
   suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
+  # on a loaded machine the killed process can outlive the collection (a
+  # CI rehearsal saw its lock still held): wait until it is gone or a
+  # zombie, as lock_stale() reads it, before asking for the lock
+  gone <- function(pid) {
+    st <- file.path("/proc", pid, "stat")
+    if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
+    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
+                                      error = function(e) ""), collapse = ""))
+  }
+  t1 <- Sys.time()
+  while (!gone(job$pid) && difftime(Sys.time(), t1, units = "secs") < 60) Sys.sleep(0.05)
+  expect_true(gone(job$pid))
   saved <- list.files(store, pattern = "rds$", full.names = TRUE)
   expect_length(saved, 2)
   # both recordings named p01.rds have their own saved result
