@@ -20,6 +20,24 @@ cohort_dir <- function() {
   dir
 }
 
+# Kill a forked calibrate_files() run and wait until its process is gone
+# or a zombie, as lock_stale() reads it (60 s at most): on a loaded machine
+# the killed process can outlive the collection (a CI rehearsal saw its lock
+# still held). TRUE when it is gone.
+kill_run <- function(job) {
+  tools::pskill(job$pid, tools::SIGKILL)
+  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
+  gone <- function() {
+    st <- file.path("/proc", job$pid, "stat")
+    if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
+    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
+                                      error = function(e) ""), collapse = ""))
+  }
+  t0 <- Sys.time()
+  while (!gone() && difftime(Sys.time(), t0, units = "secs") < 60) Sys.sleep(0.05)
+  gone()
+}
+
 test_that("calibrate_files() calibrates a folder, one row per recording", {
   skip_if_quick()
   dir <- cohort_dir()
@@ -117,20 +135,7 @@ test_that("an interrupted run resumes without redoing finished recordings", {
   t0 <- Sys.time()
   while (length(list.files(store, pattern = "rds$")) < 2 &&
          difftime(Sys.time(), t0, units = "secs") < 120) Sys.sleep(0.05)
-  tools::pskill(job$pid, tools::SIGKILL)
-  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
-  # on a loaded machine the killed process can outlive the collection (a
-  # CI rehearsal saw its lock still held): wait until it is gone or a
-  # zombie, as lock_stale() reads it, before asking for the lock
-  gone <- function(pid) {
-    st <- file.path("/proc", pid, "stat")
-    if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
-    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
-                                      error = function(e) ""), collapse = ""))
-  }
-  t1 <- Sys.time()
-  while (!gone(job$pid) && difftime(Sys.time(), t1, units = "secs") < 60) Sys.sleep(0.05)
-  expect_true(gone(job$pid))
+  expect_true(kill_run(job))
   saved <- list.files(store, pattern = "rds$", full.names = TRUE)
   expect_gte(length(saved), 2)
   expect_lt(length(saved), 5)  # stopped before the end
@@ -382,20 +387,7 @@ test_that("an interrupted run of recordings in subfolders resumes", {
   t0 <- Sys.time()
   while (length(list.files(store, pattern = "rds$")) < 2 &&
          difftime(Sys.time(), t0, units = "secs") < 60) Sys.sleep(0.05)
-  tools::pskill(job$pid, tools::SIGKILL)
-  suppressWarnings(parallel::mccollect(job, wait = TRUE, timeout = 5))
-  # on a loaded machine the killed process can outlive the collection (a
-  # CI rehearsal saw its lock still held): wait until it is gone or a
-  # zombie, as lock_stale() reads it, before asking for the lock
-  gone <- function(pid) {
-    st <- file.path("/proc", pid, "stat")
-    if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
-    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
-                                      error = function(e) ""), collapse = ""))
-  }
-  t1 <- Sys.time()
-  while (!gone(job$pid) && difftime(Sys.time(), t1, units = "secs") < 60) Sys.sleep(0.05)
-  expect_true(gone(job$pid))
+  expect_true(kill_run(job))
   saved <- list.files(store, pattern = "rds$", full.names = TRUE)
   expect_length(saved, 2)
   # both recordings named p01.rds have their own saved result
