@@ -49,6 +49,10 @@ gc_crc32 <- function(bytes) {
     .Call(`_gravcal_gc_crc32`, bytes)
 }
 
+gc_ggir_block_epochs <- function(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear) {
+    .Call(`_gravcal_gc_ggir_block_epochs`, x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear)
+}
+
 gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace) {
     .Call(`_gravcal_gc_fit_icp`, x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace)
 }

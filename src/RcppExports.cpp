@@ -141,6 +141,25 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_ggir_block_epochs
+Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, Rcpp::Nullable<Rcpp::NumericVector> light, const Rcpp::List& cal, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear);
+RcppExport SEXP _gravcal_gc_ggir_block_epochs(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP lightSEXP, SEXP calSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temperature(temperatureSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type light(lightSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type cal(calSEXP);
+    Rcpp::traits::input_parameter< double >::type sf(sfSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type windowsizes(windowsizesSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::CharacterVector& >::type metrics(metricsSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type nonwear(nonwearSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_block_epochs(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fit_icp
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
 RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
@@ -342,6 +361,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
+    {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 10},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
     {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},

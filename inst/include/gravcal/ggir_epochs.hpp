@@ -1,0 +1,554 @@
+// gravcal: GGIR part 1's epoch signals for one block, as g.getmeta()
+// computes them (GGIR 3.3-9: g.getmeta, g.applymetrics,
+// detect_nonwear_clipping), to the bit.
+//
+// g.getmeta() reads a recording in blocks of about 24 hours, keeps the
+// whole long epochs (15 min) of each, applies the calibration, and computes
+// per block: short-epoch metrics (5 s: ENMO, anglez, ...), and per long
+// epoch non-wear and clipping scores and the means of the norm, the
+// temperature and the light. Its arithmetic decides bits in ways that this
+// header repeats (the reasons are GGIR's R code; the order of operations
+// is R's):
+// - calibration: scale(data, center = -offset, scale = 1 / scale), that is
+//   (v + offset) / (1 / scale), then + (T - meantempcal) / (1 / tempoffset);
+// - epoch means: a cumulative sum over the whole block (R's cumsum(), in
+//   R's long double accumulator rounded to double after each addition),
+//   read at round(seq(1, n + 1, by = sf * epoch)), differenced, divided by
+//   the index difference. So a mean depends on where its block starts;
+// - angles: every floor(sf / 10)-th sample, a running median of about 5 s
+//   (zoo::rollmedian with zero fill), zeros near the head and tail of the
+//   block replaced, values repeated back to the full rate (the raw signal
+//   when the repeated length exceeds the block's), then atan(z / sqrt(x^2
+//   + y^2)) / (pi / 180);
+// - non-wear and clipping per long epoch, with R's sd() and the index
+//   arithmetic of R's `:` and seq() on fractional bounds;
+// - R's sequences (`:`, seq()) index with truncation, 0 dropped, beyond the
+//   end NA (left out by the max/min/sd with na.rm).
+// Rounding (round(x, 4)) and the text round trip of metashort are R's own,
+// applied by the caller in R. Header-only, standard headers only.
+#ifndef GRAVCAL_GGIR_EPOCHS_HPP
+#define GRAVCAL_GGIR_EPOCHS_HPP
+
+#include "fp_contract.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "r_arith.hpp"
+
+namespace gravcal {
+namespace ggir_part1 {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// R's `from:to` on doubles (seq_colon): n = floor(|to - from| + 1 +
+// FLT_EPSILON) values from, from +- 1, ... (integers when from is one).
+struct RColon {
+  double from = 0;
+  std::int64_t n = 0;
+  bool down = false;
+  double at(std::int64_t k) const {
+    return down ? from - static_cast<double>(k) : from + static_cast<double>(k);
+  }
+};
+
+inline RColon r_colon(double from, double to) {
+  RColon c;
+  c.from = from;
+  c.down = from > to;
+  const double r = std::fabs(to - from);
+  c.n = static_cast<std::int64_t>(r + 1 + FLT_EPSILON);
+  return c;
+}
+
+// R's seq(from, to, by = by) for finite doubles with from <= to, by > 0,
+// from and to not both integer-typed (the double branch of seq.default):
+// n = as.integer((to - from) / by + 1e-10); from + k by, capped at to. A
+// single `from` when (to - from) / max(|to|, |from|) < 100 eps.
+inline std::vector<double> r_seq_by(double from, double to, double by) {
+  const double del = to - from;
+  std::vector<double> out;
+  if (del == 0 && to == 0) {
+    out.push_back(to);
+    return out;
+  }
+  const double n = del / by;
+  if (!std::isfinite(n) || n < 0) throw std::runtime_error("seq(): invalid (to - from) / by");
+  if (n > 2147483647.0) throw std::runtime_error("seq(): 'by' is much too small");
+  if (std::fabs(del) / std::max(std::fabs(to), std::fabs(from)) < 100 * DBL_EPSILON) {
+    out.push_back(from);
+    return out;
+  }
+  const std::int64_t k = static_cast<std::int64_t>(n + 1e-10);
+  out.resize(static_cast<std::size_t>(k) + 1);
+  for (std::int64_t i = 0; i <= k; ++i) {
+    const double v = from + static_cast<double>(i) * by;
+    out[static_cast<std::size_t>(i)] = std::min(v, to);
+  }
+  return out;
+}
+
+// R's round(x) (digits 0): to the nearest integer, ties to even.
+inline double r_round0(double x) { return std::nearbyint(x); }
+
+// R's cumsum(c(0, x)) with R's accumulator Acc: out[0] = 0, out[i + 1] the
+// sum of x[0..i] rounded to double.
+template <class Acc>
+void r_cumsum0(const double* x, std::size_t n, std::vector<double>& out) {
+  out.resize(n + 1);
+  Acc s = 0;
+  out[0] = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    s += x[i];
+    out[i + 1] = static_cast<double>(s);
+  }
+}
+
+// GGIR's averagePerEpoch() (mean = true) and sumPerEpoch() (mean = false)
+// of x[0..n) for epochs of `by` samples (sf * epoch length, maybe not
+// whole).
+template <class Acc>
+std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
+  std::vector<double> cs;
+  r_cumsum0<Acc>(x, n, cs);
+  const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
+  std::vector<double> out;
+  if (sel.size() < 2) return out;
+  out.resize(sel.size() - 1);
+  double prev = r_round0(sel[0]);
+  for (std::size_t i = 1; i < sel.size(); ++i) {
+    const double cur = r_round0(sel[i]);
+    // 1-based indices into cs (whole numbers within 1..n + 1)
+    const double d = cs[static_cast<std::size_t>(cur) - 1] - cs[static_cast<std::size_t>(prev) - 1];
+    out[i - 1] = mean ? d / std::fabs(cur - prev) : d;
+    prev = cur;
+  }
+  return out;
+}
+
+// The calibration as g.getmeta applies it, in place: v = (v + offset) /
+// inv_scale (inv_scale = 1 / scale, computed by R), then, with a
+// temperature, + (t - meantemp) / inv_tempoffset.
+struct Calibration {
+  double offset[3] = {0, 0, 0};
+  double inv_scale[3] = {1, 1, 1};
+  bool temp = false;  // apply the temperature term
+  double meantemp = 0;
+  double inv_tempoffset[3] = {1, 1, 1};
+};
+
+inline void apply_calibration(const Calibration& c, double* x, double* y, double* z,
+                              const double* t, std::size_t n) {
+  double* v[3] = {x, y, z};
+  for (int a = 0; a < 3; ++a) {
+    double* p = v[a];
+    const double o = c.offset[a], s = c.inv_scale[a];
+    for (std::size_t i = 0; i < n; ++i) p[i] = (p[i] + o) / s;
+    if (c.temp && t != nullptr) {
+      const double m = c.meantemp, to = c.inv_tempoffset[a];
+      for (std::size_t i = 0; i < n; ++i) p[i] = p[i] + (t[i] - m) / to;
+    }
+  }
+}
+
+// sqrt(x^2 + y^2 + z^2) in R's order.
+inline double r_norm(double x, double y, double z) {
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+// A running median of odd width k over v (zoo::rollmedian(v, k, fill = 0),
+// centred): out[i] = the median of v[i - m .. i + m] for m <= i < N - m, 0
+// elsewhere; a window holding NaN gives NaN (zoo then uses median(),
+// whose result is NA). Sorted window, insert and erase by binary search.
+inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vector<double>& out) {
+  const std::size_t N = v.size();
+  out.assign(N, 0.0);
+  if (k == 0 || k > N) {
+    // zoo: rollapply of median over windows that never fit: all fill
+    return;
+  }
+  const std::size_t m = k / 2;
+  std::vector<double> win;
+  win.reserve(k);
+  std::size_t nans = 0;
+  auto add = [&](double a) {
+    if (std::isnan(a)) {
+      ++nans;
+      return;
+    }
+    win.insert(std::upper_bound(win.begin(), win.end(), a), a);
+  };
+  auto drop = [&](double a) {
+    if (std::isnan(a)) {
+      --nans;
+      return;
+    }
+    auto it = std::lower_bound(win.begin(), win.end(), a);
+    win.erase(it);
+  };
+  for (std::size_t i = 0; i < k; ++i) add(v[i]);
+  for (std::size_t c = m;; ++c) {
+    out[c] = nans ? kNaN : win[m];
+    if (c + m + 1 >= N) break;
+    drop(v[c - m]);
+    add(v[c + m + 1]);
+  }
+}
+
+// GGIR's rollmed(): the smoothed axis used for the angles and the
+// roll_med_acc metrics, for one axis of a block.
+inline void ggir_rollmed(const double* x, std::size_t LX, double sf, std::vector<double>& out) {
+  const double fl = std::floor(sf / 10);
+  const std::size_t step = static_cast<std::size_t>(std::max(fl, 1.0));
+  const double newsf = step > 1 ? 10.0 : sf;
+  double winsi = r_round0(newsf * 5);
+  if (r_round0(winsi / 2) == winsi / 2) winsi = winsi + 1;
+  if (std::fmod(winsi, 2.0) == 0) winsi = winsi + 1;
+  std::vector<double> sub;
+  sub.reserve(LX / step + 1);
+  for (std::size_t i = 0; i < LX; i += step) sub.push_back(x[i]);
+  std::vector<double> xm;
+  rolling_median(sub, static_cast<std::size_t>(winsi), xm);
+  const std::size_t LN0 = xm.size();
+  // the head: zeros among the first S2check values take the first value
+  // there that is not zero (NA when there is none)
+  double S2check = std::max(sf * 60, 1000.0);
+  {
+    const RColon c = r_colon(1, S2check);
+    const std::size_t lim = static_cast<std::size_t>(std::min<double>(static_cast<double>(c.n), static_cast<double>(LN0)));
+    double first = kNaN;
+    for (std::size_t i = 0; i < lim; ++i) {
+      if (!std::isnan(xm[i]) && xm[i] != 0) {
+        first = xm[i];
+        break;
+      }
+    }
+    for (std::size_t i = 0; i < lim; ++i) {
+      if (xm[i] == 0) xm[i] = first;
+    }
+  }
+  // the tail: xm[(LN - S2check):LN], zeros there take the first value of
+  // the tail that is not zero (NA when there is none)
+  if (LN0 >= 1) {
+    S2check = std::min(static_cast<double>(LN0) - 1, S2check);
+    const RColon c = r_colon(static_cast<double>(LN0) - S2check, static_cast<double>(LN0));
+    std::vector<std::size_t> idx;
+    idx.reserve(static_cast<std::size_t>(c.n));
+    for (std::int64_t k = 0; k < c.n; ++k) {
+      const double d = c.at(k);
+      const std::int64_t j = static_cast<std::int64_t>(d);  // R truncates
+      if (j >= 1 && j <= static_cast<std::int64_t>(LN0)) idx.push_back(static_cast<std::size_t>(j - 1));
+    }
+    double lastvalue = kNaN;
+    for (std::size_t j : idx) {
+      if (!std::isnan(xm[j]) && xm[j] != 0) {
+        lastvalue = xm[j];
+        break;
+      }
+    }
+    for (std::size_t j : idx) {
+      if (xm[j] == 0) xm[j] = lastvalue;
+    }
+  }
+  const std::size_t LN = LN0 * step;
+  if (LN > LX) {
+    out.assign(x, x + LX);  // GGIR's fallback: the raw axis
+    return;
+  }
+  out.resize(LX);
+  for (std::size_t i = 0; i < LN; ++i) out[i] = xm[i / step];
+  for (std::size_t i = LN; i < LX; ++i) out[i] = LN ? xm[LN0 - 1] : kNaN;
+}
+
+// After rollmed() of the three axes: when any value of any axis is NA, each
+// axis's NA values take that axis's last value that is not NA.
+inline void fill_na_last(std::vector<double>* ax[3]) {
+  bool any = false;
+  for (int a = 0; a < 3 && !any; ++a) {
+    for (double v : *ax[a]) {
+      if (std::isnan(v)) {
+        any = true;
+        break;
+      }
+    }
+  }
+  if (!any) return;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double>& v = *ax[a];
+    double last = kNaN;
+    for (std::size_t i = v.size(); i-- > 0;) {
+      if (!std::isnan(v[i])) {
+        last = v[i];
+        break;
+      }
+    }
+    for (double& e : v) {
+      if (std::isnan(e)) e = last;
+    }
+  }
+}
+
+// Non-wear and clipping per long epoch (GGIR's medium epoch, ws2),
+// detect_nonwear_clipping() for approaches "2013" and "2023" without a
+// wear column.
+struct NonwearConfig {
+  double sf = 0;
+  double ws2 = 900;   // seconds
+  double ws = 3600;   // seconds
+  double clipthres = 7.5;
+  double sdcriter = 0.013;
+  double racriter = 0.15;
+  bool approach_2023 = true;
+  bool r_long_double = true;
+};
+
+struct NonwearResult {
+  std::vector<double> nonwear;   // NWav
+  std::vector<double> clipping;  // CWav
+  std::int64_t epochs = 0;       // nmin
+};
+
+// Values of one axis at R's indices (1-based, truncated), keeping those
+// within 1..n (R's NA beyond the end, left out by na.rm); 0 dropped.
+// A negative index would be R's exclusion: GGIR's sequences give none for
+// blocks of at least one window `ws`.
+template <class F>
+inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
+  for (std::int64_t k = 0; k < c.n; ++k) {
+    const double d = c.at(k);
+    if (d < 0) throw std::runtime_error("negative index in GGIR's non-wear window");
+    const std::int64_t j = static_cast<std::int64_t>(d);
+    if (j >= 1 && j <= static_cast<std::int64_t>(n)) f(static_cast<std::size_t>(j - 1));
+  }
+}
+
+template <class Acc>
+NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, const NonwearConfig& cf) {
+  NonwearResult r;
+  const double M = cf.ws2 * cf.sf;  // MediumEpochSize
+  const double L = cf.ws * cf.sf;   // LongEpochSize
+  const std::int64_t N = static_cast<std::int64_t>(std::floor(static_cast<double>(nrow) / M));
+  r.epochs = N;
+  if (N <= 0) return r;
+  std::vector<double> nwlog(static_cast<std::size_t>(N) * 3, 0.0);
+  r.nonwear.assign(static_cast<std::size_t>(N), 0.0);
+  r.clipping.assign(static_cast<std::size_t>(N), 0.0);
+  const double minimumEpochCount = ((L / M) / 2) + 1;
+  const double stride = std::ceil(cf.sf / 5);
+  std::vector<double> vals;
+  for (std::int64_t h = 1; h <= N; ++h) {
+    const double hd = static_cast<double>(h);
+    const double clipstart = (((hd - 1) * M) + M * 0.5) - M * 0.5;
+    const double clipend = (((hd - 1) * M) + M * 0.5) + M * 0.5;
+    double nwstart = 0, nwend = 0;
+    std::int64_t flag_from = h, flag_to = h;
+    if (!cf.approach_2023) {
+      if (hd <= minimumEpochCount) {
+        nwstart = 1;
+        nwend = L;
+      } else if (hd >= (static_cast<double>(N) - minimumEpochCount)) {
+        nwstart = (static_cast<double>(N) - minimumEpochCount) * M;
+        nwend = static_cast<double>(N) * M;
+      } else {
+        nwstart = (((hd - 1) * M) + M * 0.5) - L * 0.5;
+        nwend = (((hd - 1) * M) + M * 0.5) + L * 0.5;
+      }
+    } else {
+      // h:(h + L / M - 1), those beyond N left out
+      const RColon fc = r_colon(hd, hd + L / M - 1);
+      flag_from = h;
+      flag_to = h;
+      if (fc.n > 0) {
+        const double lastv = fc.at(fc.n - 1);
+        flag_to = static_cast<std::int64_t>(std::min(lastv, static_cast<double>(N)));
+      }
+      nwstart = hd * M - M;
+      nwend = nwstart + L;
+      if (nwend > static_cast<double>(nrow)) nwend = static_cast<double>(nrow);
+    }
+    double cmax = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double* v = xyz[a];
+      // clipping: values beyond clipthres in (1 + clipstart):clipend
+      const RColon cc = r_colon(1 + clipstart, clipend);
+      double count = 0;
+      bool extreme = false;
+      at_r_indices(cc, nrow, [&](std::size_t j) {
+        const double av = std::fabs(v[j]);
+        if (av > cf.clipthres) {
+          count += 1;
+          if (av > cf.clipthres * 1.5) extreme = true;
+        }
+      });
+      if (count > 0 && extreme) count = M;
+      cmax = a == 0 ? count / M : std::max(cmax, count / M);
+      // non-wear: range, then sd, of the window's values
+      vals.clear();
+      if (!cf.approach_2023) {
+        at_r_indices(r_colon(1 + nwstart, nwend), nrow, [&](std::size_t j) { vals.push_back(v[j]); });
+      } else {
+        const std::vector<double> s = r_seq_by(1 + nwstart, nwend, stride);
+        for (double d : s) {
+          const std::int64_t j = static_cast<std::int64_t>(d);
+          if (j >= 1 && j <= static_cast<std::int64_t>(nrow)) vals.push_back(v[static_cast<std::size_t>(j - 1)]);
+        }
+      }
+      double mx = -std::numeric_limits<double>::infinity();
+      double mn = std::numeric_limits<double>::infinity();
+      for (double e : vals) {
+        if (std::isnan(e)) continue;
+        if (e > mx) mx = e;
+        if (e < mn) mn = e;
+      }
+      const double absrange = std::fabs(mx - mn);
+      if (absrange < cf.racriter) {
+        const RMeanSd ms = r_mean_sd<Acc>([&](auto&& f) {
+          for (double e : vals) f(e);
+        });
+        if (ms.sd < cf.sdcriter) {
+          for (std::int64_t g = flag_from; g <= flag_to; ++g) {
+            nwlog[static_cast<std::size_t>(g - 1) * 3 + static_cast<std::size_t>(a)] = 1;
+          }
+        }
+      }
+    }
+    // R's max(c(...)) of the three clipping fractions
+    r.clipping[static_cast<std::size_t>(h - 1)] = cmax;
+    const std::size_t b = static_cast<std::size_t>(h - 1) * 3;
+    r.nonwear[static_cast<std::size_t>(h - 1)] = nwlog[b] + nwlog[b + 1] + nwlog[b + 2];
+  }
+  // an isolated 1 between two scores above 1 becomes 2
+  for (std::size_t i = 1; i + 1 < r.nonwear.size(); ++i) {
+    if (r.nonwear[i] == 1 && r.nonwear[i - 1] > 1 && r.nonwear[i + 1] > 1) r.nonwear[i] = 2;
+  }
+  return r;
+}
+
+// GGIR's lightpeak: for li in 1:(n / M), max(light[((li - 1) M):(li M)])
+// (index 0 dropped, so the first epoch has M values and the others M + 1).
+inline std::vector<double> light_peaks(const double* light, std::size_t n, double M) {
+  std::vector<double> out;
+  const RColon loop = r_colon(1, static_cast<double>(n) / M);
+  if (static_cast<double>(n) / M < 1) return out;
+  out.resize(static_cast<std::size_t>(loop.n), 0.0);
+  for (std::int64_t k = 0; k < loop.n; ++k) {
+    const double li = loop.at(k);
+    double mx = -std::numeric_limits<double>::infinity();
+    bool na = false;
+    at_r_indices(r_colon((li - 1) * M, li * M), n, [&](std::size_t j) {
+      if (std::isnan(light[j])) na = true;
+      else if (light[j] > mx) mx = light[j];
+    });
+    // indices beyond the end are NA in R, and max() without na.rm is NA
+    const RColon c = r_colon((li - 1) * M, li * M);
+    if (static_cast<std::int64_t>(c.at(c.n - 1)) > static_cast<std::int64_t>(n)) na = true;
+    out[static_cast<std::size_t>(k)] = na ? kNaN : mx;
+  }
+  return out;
+}
+
+
+// The short-epoch metrics of g.applymetrics() that need no filter, for a
+// block of calibrated samples: "roll_med_acc_x" (and y, z),
+// "dev_roll_med_acc_x" (y, z), "angle_x" (y, z), "ENMO", "MAD", "EN",
+// "ENMOa". Each asked name gets its epoch means (unrounded), in the order
+// asked. Unknown names are an error (the filtered metrics are
+// ggir_filters.hpp's).
+template <class Acc>
+std::vector<std::vector<double>> short_metrics(const double* x, const double* y, const double* z,
+                                               std::size_t n, double sf, double ws3,
+                                               const std::vector<std::string>& names) {
+  const double by = sf * ws3;
+  std::vector<std::vector<double>> out(names.size());
+  std::vector<double> sig(n);
+  std::vector<double> rm[3];
+  bool have_rm = false;
+  auto need_rm = [&]() {
+    if (have_rm) return;
+    const double* v[3] = {x, y, z};
+    for (int a = 0; a < 3; ++a) ggir_rollmed(v[a], n, sf, rm[a]);
+    std::vector<double>* p[3] = {&rm[0], &rm[1], &rm[2]};
+    fill_na_last(p);
+    have_rm = true;
+  };
+  std::vector<double> en;
+  auto need_en = [&]() {
+    if (!en.empty() || n == 0) return;
+    en.resize(n);
+    for (std::size_t i = 0; i < n; ++i) en[i] = r_norm(x[i], y[i], z[i]);
+  };
+  const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string& nm = names[k];
+    int axis = -1;
+    if (nm.size() > 2 && nm[nm.size() - 2] == '_') {
+      const char c = nm.back();
+      axis = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
+    }
+    const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
+    if (base == "roll_med_acc" && axis >= 0) {
+      need_rm();
+      out[k] = per_epoch<Acc>(rm[axis].data(), n, by, true);
+    } else if (base == "dev_roll_med_acc" && axis >= 0) {
+      need_rm();
+      const double* v = axis == 0 ? x : axis == 1 ? y : z;
+      for (std::size_t i = 0; i < n; ++i) sig[i] = std::fabs(v[i] - rm[axis][i]);
+      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+    } else if (base == "angle" && axis >= 0) {
+      need_rm();
+      const std::vector<double>& a = rm[axis];
+      const std::vector<double>& b = rm[(axis + 1) % 3];
+      const std::vector<double>& c = rm[(axis + 2) % 3];
+      // GGIR's order: angle_x: atan(x / sqrt(y^2 + z^2)); angle_y: y over
+      // x, z; angle_z: z over x, y
+      const std::vector<double>& p = axis == 1 ? c : b;  // first in the sum
+      const std::vector<double>& q = axis == 1 ? b : c;
+      for (std::size_t i = 0; i < n; ++i) {
+        sig[i] = std::atan(a[i] / (std::sqrt(p[i] * p[i] + q[i] * q[i]))) / deg;
+      }
+      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+    } else if (nm == "ENMO") {
+      need_en();
+      for (std::size_t i = 0; i < n; ++i) {
+        const double e = en[i] - 1;
+        sig[i] = e < 0 ? 0 : e;
+      }
+      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+    } else if (nm == "EN") {
+      need_en();
+      out[k] = per_epoch<Acc>(en.data(), n, by, true);
+    } else if (nm == "ENMOa") {
+      need_en();
+      for (std::size_t i = 0; i < n; ++i) sig[i] = std::fabs(en[i] - 1);
+      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+    } else if (nm == "MAD") {
+      need_en();
+      // rep(epoch means, each = sf * ws3) (each truncated to an integer),
+      // recycled against EN as R's `-` recycles
+      const std::vector<double> means = per_epoch<Acc>(en.data(), n, by, true);
+      const std::size_t each = static_cast<std::size_t>(by);
+      const std::size_t m = means.size() * each;
+      const std::size_t len = (n == 0 || m == 0) ? 0 : std::max(n, m);
+      std::vector<double> mad(len);
+      for (std::size_t i = 0; i < len; ++i) {
+        mad[i] = std::fabs(en[i % n] - means[(i % m) / each]);
+      }
+      out[k] = per_epoch<Acc>(mad.data(), len, by, true);
+    } else {
+      throw std::runtime_error("unknown GGIR metric: " + nm);
+    }
+  }
+  return out;
+}
+
+}  // namespace ggir_part1
+}  // namespace gravcal
+
+#endif  // GRAVCAL_GGIR_EPOCHS_HPP
