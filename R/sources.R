@@ -17,9 +17,13 @@
 
 # `rmc`: GGIR's rmc.* parameters (their checked values, rmc_values()); with
 # rmc.firstrow.acc the file is read as an ad hoc csv file (R/adhoc-csv.R).
+# `part`: whose blocks, g.calibrate()'s ("calibrate", about 12 hours at
+# chunksize 1) or g.getmeta()'s ("getmeta", about 24 hours: every format's
+# block at twice the chunksize, Movisens's a whole day).
 open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
                         reader = "native", compat = TRUE, read_opts = list(),
-                        rmc = NULL, sf_arg = "sf") {
+                        rmc = NULL, sf_arg = "sf", part = "calibrate") {
+  if (identical(part, "getmeta")) chunksize <- 2 * chunksize
   if (is.data.frame(datafile) || is.matrix(datafile)) {
     return(source_frame(datafile, sf, chunksize, arg))
   }
@@ -49,7 +53,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   src <- NULL
   if (reader == "native" && format_has_decoder(format)) {
     src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
-                         extra = layout$opts)
+                         extra = layout$opts, part = part)
   }
   if (is.null(src)) {
     check_reference_opts(read_opts, format)
@@ -152,12 +156,12 @@ native_open_error <- function(file, format, why, arg) {
 # `segment()` streams units straight into a segmenter, without R vectors.
 # `extra`: more options for the decoder (an ad hoc csv file's layout).
 source_native <- function(file, format, sf, chunksize, compat, arg,
-                          read_opts = list(), extra = NULL) {
+                          read_opts = list(), extra = NULL, part = "calibrate") {
   opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
   opts$zone_arg <- NULL
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
-  if (format == "movisens") opts$block_samples <- movisens_block(file)
+  if (format == "movisens") opts$block_samples <- movisens_block(file, part)
   # GGIR's block of lines: where its first line's text time is ambiguous in
   # a zone with daylight saving (rmc_time_opts())
   if (format == "adhoc_csv" && !is.null(sf)) opts$block_lines <- format_block_units(format, sf, chunksize)
@@ -187,7 +191,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
   check_sf(sf)
-  B <- format_block_units(format, sf, chunksize)
+  B <- if (format == "movisens") movisens_block(file, part) else format_block_units(format, sf, chunksize)
   # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
   # pages hold for the last one; after its resampling of a rate that rounds
   # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
@@ -361,7 +365,9 @@ source_parmay <- function(file) {
 
 # GGIR's block of a Movisens recording, in samples: sf * 60 * 1440 / 2 with
 # its sf, which g.inspectfile sets to 64 whatever unisens.xml says.
-movisens_block <- function(file = NULL) 64 * 60 * 1440 / 2
+movisens_block <- function(file = NULL, part = "calibrate") {
+  if (identical(part, "getmeta")) 64 * 60 * 1440 else 64 * 60 * 1440 / 2
+}
 
 # The number attributes of a Movisens recording's unisens.xml (sampleRate,
 # lsbValue, baseline) as R's as.numeric() reads them, which is how unisensR

@@ -1,0 +1,446 @@
+# GGIR part 1 after calibration: g.getmeta()'s calibrated epoch signals,
+# read by gravcal's decoders and computed by its core
+# (inst/include/gravcal/ggir_epochs.hpp), block by block as GGIR does.
+
+#' Calibrated epoch signals as GGIR's g.getmeta, on gravcal's core
+#'
+#' A drop-in replacement for `GGIR::g.getmeta()` (GGIR 3.3-9): same
+#' arguments, same returned list `M`. It reads the recording in GGIR's
+#' blocks of about 24 hours (`chunksize` scales them), starts at the next
+#' whole long epoch (15 minutes), keeps the whole long epochs of each block
+#' (the rest carries into the next), applies the calibration as GGIR
+#' applies it (`offset`, `scale`, `tempoffset` around `meantempcal`), and
+#' computes per short epoch (5 s) the metrics asked for in `params_metrics`
+#' and per long epoch the non-wear and clipping scores and the mean norm,
+#' temperature and light. Every number is GGIR's to the bit: the epoch means
+#' are R's block-wide cumulative sums, the angles GGIR's running median of
+#' the block, the values rounded to 4 decimals and passed through R's text
+#' as GGIR passes them.
+#'
+#' The file is read once, by gravcal's decoders, in the blocks GGIR's
+#' readers give; the per-sample work is C++.
+#'
+#' @section What this version covers:
+#' Formats: Axivity `.cwa`, GENEActiv `.bin`. Metrics: `do.enmo`,
+#' `do.anglex`, `do.angley`, `do.anglez`, `do.en`, `do.enmoa`, `do.mad`,
+#' `do.roll_med_acc_x/y/z`, `do.dev_roll_med_acc_x/y/z`. Non-wear:
+#' `nonwear_approach` "2013" and "2023". Anything else GGIR's g.getmeta()
+#' would compute (a filtered metric, `myfun`, another format) is an error
+#' naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
+#' wall-clock times and memory); GGIR shrinks its blocks when its own R
+#' session holds over 4000 MB, which gravcal's reading never makes it do.
+#'
+#' @param datafile Path of the recording.
+#' @param params_metrics,params_rawdata,params_general,params_cleaning
+#'   GGIR's parameter lists (as from `GGIR::load_params()`); missing entries
+#'   take GGIR 3.3-9's defaults.
+#' @param daylimit Stop after this many blocks (GGIR's; `FALSE`: none).
+#' @param offset,scale,tempoffset,meantempcal The calibration, as
+#'   [g.calibrate()] returns it (`meantempcal`: its `meantempcal`).
+#' @param myfun Not supported yet: an error when given.
+#' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
+#'   `sf` must agree with the file.
+#' @param verbose Print the blocks read, as GGIR does.
+#' @param ... GGIR's legacy arguments: any parameter of the lists by name.
+#' @return GGIR's list `M`: `filecorrupt`, `filetooshort`,
+#'   `NFilePagesSkipped`, `metalong`, `metashort`, `wday`, `wdayname`,
+#'   `windowsizes`, `bsc_qc`, `QClog`.
+#' @seealso [g.calibrate()], [epoch_signals()].
+#' @export
+g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
+                      params_general = c(), params_cleaning = c(), daylimit = FALSE,
+                      offset = c(0, 0, 0), scale = c(1, 1, 1), tempoffset = c(0, 0, 0),
+                      meantempcal = c(), myfun = c(), inspectfileobject = c(),
+                      verbose = TRUE, ...) {
+  p <- meta_params(params_metrics, params_rawdata, params_general, params_cleaning,
+                   list(...))
+  check_flag(verbose, "verbose")
+  if (length(myfun)) {
+    abort("`myfun`: an external function per block is not supported by gravcal's ",
+          "g.getmeta() yet; use GGIR::g.getmeta() for it.")
+  }
+  cal <- meta_calibration(offset, scale, tempoffset, meantempcal)
+  check_fp_build("`g.getmeta()`")
+  tz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  tz_arg <- if (length(p$configtz)) "configtz" else "desiredtz"
+  read_opts <- list(interpolation = p$interpolationType, frequency_tol = p$frequency_tol,
+                    zone = tz %||% "", zone_arg = tz_arg)
+  sf <- NULL
+  if (length(inspectfileobject)) {
+    if (!is.list(inspectfileobject)) {
+      abort("`inspectfileobject` must be a list (GGIR's g.inspectfile() result), not ",
+            describe(inspectfileobject), ".")
+    }
+    ggir_check_inspect(inspectfileobject, datafile, adhoc = FALSE)
+    sf <- inspectfileobject$sf
+  }
+  src <- open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native",
+                     compat = TRUE, read_opts = read_opts, part = "getmeta")
+  if (!src$format %in% meta_formats || is.null(src$native)) {
+    abort("gravcal's g.getmeta() does not read ", format_entry(src$format)$label %||% src$format,
+          " yet (it reads ", paste(vapply(meta_formats, function(f) format_entry(f)$label, ""),
+                                    collapse = " and "),
+          "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
+  }
+  on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
+  meta_run(src, p, cal, daylimit, verbose)
+}
+
+# The formats g.getmeta() reads so far.
+meta_formats <- c("cwa", "geneactiv")
+
+# The metrics of g.applymetrics() in the order GGIR computes them (its
+# result's names), with their do.* parameter; `core`: computed by
+# ggir_epochs.hpp (the others need filters: not yet).
+meta_metric_table <- function() {
+  data.frame(
+    name = c("BFX", "BFY", "BFZ", "BFEN", "ZCX", "ZCY", "ZCZ", "LFX", "LFY", "LFZ", "LFEN",
+             "LFENMO", "HFX", "HFY", "HFZ", "HFEN", "HFENplus",
+             "roll_med_acc_x", "roll_med_acc_y", "roll_med_acc_z",
+             "dev_roll_med_acc_x", "dev_roll_med_acc_y", "dev_roll_med_acc_z",
+             "angle_x", "angle_y", "angle_z", "ENMO", "MAD", "EN", "ENMOa"),
+    core = c(rep(FALSE, 17), rep(TRUE, 13)),
+    stringsAsFactors = FALSE)
+}
+
+# GGIR 3.3-9's defaults (load_params()) of the parameters g.getmeta() reads.
+meta_defaults <- function() {
+  do <- c("do.anglex", "do.angley", "do.anglez", "do.zcx", "do.zcy", "do.zcz", "do.enmo",
+          "do.lfenmo", "do.en", "do.mad", "do.enmoa", "do.roll_med_acc_x",
+          "do.roll_med_acc_y", "do.roll_med_acc_z", "do.dev_roll_med_acc_x",
+          "do.dev_roll_med_acc_y", "do.dev_roll_med_acc_z", "do.bfen", "do.hfen",
+          "do.hfenplus", "do.lfen", "do.lfx", "do.lfy", "do.lfz", "do.hfx", "do.hfy",
+          "do.hfz", "do.bfx", "do.bfy", "do.bfz", "do.brondcounts", "do.neishabouricounts")
+  metrics <- stats::setNames(as.list(do %in% c("do.anglez", "do.enmo")), do)
+  list(metrics = c(metrics, list(hb = 15, lb = 0.2, n = 4, zc.lb = 0.25, zc.hb = 3,
+                                 zc.sb = 0.01, zc.order = 2, zc.scale = 1,
+                                 actilife_LFE = FALSE)),
+       rawdata = list(chunksize = 1, dynrange = NULL, nonwear_range_threshold = 150,
+                      imputeTimegaps = TRUE, interpolationType = 1, frequency_tol = 0.1),
+       general = list(windowsizes = c(5, 900, 3600), desiredtz = "", configtz = NULL),
+       cleaning = list(nonwear_approach = "2023"))
+}
+
+# GGIR's parameters for g.getmeta(): the lists (missing entries from
+# GGIR's defaults), then the legacy arguments in `dots` by name. The ones
+# that change M and are not honoured are an error naming them.
+meta_params <- function(params_metrics, params_rawdata, params_general, params_cleaning,
+                        dots) {
+  if (length(dots) && (is.null(names(dots)) || any(names(dots) == ""))) {
+    abort("All arguments in `...` must be named.")
+  }
+  d <- meta_defaults()
+  lists <- list(metrics = params_metrics, rawdata = params_rawdata,
+                general = params_general, cleaning = params_cleaning)
+  p <- list()
+  for (k in names(lists)) {
+    v <- lists[[k]]
+    if (length(v) && !is.list(v)) {
+      abort("`params_", k, "` must be a list (as from GGIR::load_params()), not ",
+            describe(v), ".")
+    }
+    p[names(d[[k]])] <- d[[k]]
+    for (nm in names(v)) p[nm] <- list(v[[nm]])
+  }
+  for (nm in names(dots)) p[nm] <- list(dots[[nm]])
+  do <- grep("^do[.]", names(d$metrics), value = TRUE)
+  for (nm in do) check_flag(p[[nm]], nm)
+  tab <- meta_metric_table()
+  dov <- meta_do_name(tab$name)
+  asked <- vapply(dov, function(nm) isTRUE(p[[nm]]), TRUE)
+  # a filtered metric is computed when any of its family is asked
+  filt <- unique(dov[!tab$core & asked])
+  if (length(filt)) {
+    abort("`", filt[1], "` = TRUE: gravcal's g.getmeta() does not compute the filtered ",
+          "metrics (BFEN, HFEN, LFENMO, zero crossings, ...) yet; use GGIR::g.getmeta().")
+  }
+  for (nm in c("do.brondcounts", "do.neishabouricounts")) {
+    if (isTRUE(p[[nm]])) {
+      abort("`", nm, "` = TRUE: not supported by gravcal's g.getmeta(); use GGIR::g.getmeta().")
+    }
+  }
+  ws <- p$windowsizes
+  if (!is.numeric(ws) || length(ws) != 3 || anyNA(ws) || any(ws <= 0)) {
+    abort("`windowsizes` must be 3 positive numbers of seconds, not ", describe(ws), ".")
+  }
+  if (ws[3] < ws[2] || ws[2] < ws[1]) {
+    abort("`windowsizes` must be increasing (short, long, non-wear window), not ",
+          paste(ws, collapse = ", "), ".")
+  }
+  check_number(p$chunksize, "chunksize", min = 0, min_inclusive = FALSE)
+  check_number(p$nonwear_range_threshold, "nonwear_range_threshold", min = 0)
+  if (length(p$dynrange)) check_number(p$dynrange, "dynrange", min = 0, min_inclusive = FALSE)
+  if (!identical(p$nonwear_approach, "2013") && !identical(p$nonwear_approach, "2023")) {
+    abort("`nonwear_approach` must be \"2013\" or \"2023\", not ", describe(p$nonwear_approach), ".")
+  }
+  if (!isTRUE(p$interpolationType %in% c(1, 2))) {
+    abort("`interpolationType` must be 1 (linear) or 2 (nearest neighbour), not ",
+          describe(p$interpolationType), ".")
+  }
+  check_flag(p$imputeTimegaps, "imputeTimegaps")
+  p
+}
+
+# do.<name> of a metric of g.applymetrics()'s result (GGIR's rule: lower
+# case, "angle_" as "angle").
+meta_do_name <- function(name) sub("angle_", "angle", paste0("do.", tolower(name)), fixed = TRUE)
+
+# The calibration as g.getmeta() applies it, for the core.
+meta_calibration <- function(offset, scale, tempoffset, meantempcal) {
+  chk <- function(v, arg) {
+    if (!is.numeric(v) || length(v) != 3 || anyNA(v)) {
+      abort("`", arg, "` must be 3 numbers (x, y, z), not ", describe(v), ".")
+    }
+    as.double(v)
+  }
+  offset <- chk(offset, "offset")
+  scale <- chk(scale, "scale")
+  tempoffset <- chk(tempoffset, "tempoffset")
+  out <- list(offset = offset, inv_scale = 1 / scale)
+  if (length(meantempcal)) {
+    if (!is.numeric(meantempcal) || length(meantempcal) != 1 || is.na(meantempcal)) {
+      abort("`meantempcal` must be one number (degrees C) or empty, not ",
+            describe(meantempcal), ".")
+    }
+    out$meantemp <- as.double(meantempcal)
+    out$inv_tempoffset <- 1 / tempoffset
+  }
+  out
+}
+
+# GGIR's clipping threshold, non-wear criteria and block size
+# (get_nw_clip_block_params()) for the source.
+meta_nonwear <- function(src, p) {
+  dynrange <- p$dynrange
+  clipthres <- if (length(dynrange)) dynrange - 0.5 else 7.5
+  list(clipthres = clipthres, sdcriter = 0.013,
+       racriter = p$nonwear_range_threshold / 1000,
+       approach = p$nonwear_approach)
+}
+
+# One of GGIR's blocks from a native decoder: every sample of `units` units
+# (the pump's rule: until the units are read and the last write left room),
+# as a list of columns (x, y, z, and time, temperature, light where the
+# format has them).
+meta_read_block <- function(h, units, capacity = 2^20) {
+  parts <- list()
+  left <- units
+  repeat {
+    b <- gc_decoder_read(h$ptr, left, capacity, TRUE, TRUE)
+    n <- b$n
+    if (n > 0) {
+      keep <- seq_len(n)
+      parts[[length(parts) + 1]] <- lapply(b[c("x", "y", "z", "temperature", "time", "light")],
+                                           function(v) if (!is.null(v)) v[keep])
+    }
+    left <- left - b$units
+    if (n == 0 && b$units == 0) break
+    if (left <= 0 && n < capacity) break
+    if (isTRUE(b$done)) break
+  }
+  if (!length(parts)) return(NULL)
+  cols <- c("time", "x", "y", "z", "temperature", "light")
+  out <- lapply(stats::setNames(cols, cols), function(nm) {
+    v <- lapply(parts, `[[`, nm)
+    if (is.null(v[[1]])) NULL else unlist(v, use.names = FALSE)
+  })
+  out[!vapply(out, is.null, TRUE)]
+}
+
+# Rows `i` of a block (a list of equal-length columns).
+meta_rows <- function(d, i) lapply(d, function(v) v[i])
+meta_nrow <- function(d) if (length(d)) length(d$x) else 0L
+meta_bind <- function(a, b) {
+  if (!meta_nrow(a)) return(b)
+  nm <- union(names(a), names(b))
+  stats::setNames(lapply(nm, function(k) c(a[[k]], b[[k]])), nm)
+}
+
+# g.getmeta()'s loop over the blocks of an open native source.
+meta_run <- function(src, p, cal, daylimit, verbose) {
+  sf <- src$sf
+  ws3 <- p$windowsizes[1]
+  ws2 <- p$windowsizes[2]
+  ws <- p$windowsizes[3]
+  nwc <- meta_nonwear(src, p)
+  tab <- meta_metric_table()
+  asked <- tab$name[vapply(meta_do_name(tab$name), function(nm) isTRUE(p[[nm]]), TRUE)]
+  metnames <- sub("angle_", "angle", asked, fixed = TRUE)
+  short <- list()   # per metric, the blocks' rounded epoch values
+  long <- list()
+  filetooshort <- filecorrupt <- FALSE
+  S <- list()
+  starttime <- NULL
+  wday <- wdayname <- NULL
+  light.available <- use.temp <- FALSE
+  metricnames_long <- NULL
+  short_rows <- if (src$format == "geneactiv") src$units * 300 else 0
+  i <- 1
+  LD <- 2
+  QClog <- NULL
+  while (LD > 1) {
+    if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
+    data <- meta_read_block(src$native, src$units)
+    nr <- meta_nrow(data)
+    isLastBlock <- FALSE
+    if (nr == 0) {
+      isLastBlock <- TRUE
+      if (i == 1) {
+        warning("\nFile empty, possibly corrupt.\n", call. = FALSE)
+        filetooshort <- filecorrupt <- TRUE
+      }
+      data <- NULL
+    } else if (nr < sf * ws * 2 + 1) {
+      isLastBlock <- TRUE
+      if (i == 1) {
+        data <- NULL
+        filetooshort <- TRUE
+      }
+    } else if (nr < short_rows) {
+      isLastBlock <- TRUE
+    }
+    if (!is.null(data)) {
+      if (i == 1) {
+        light.available <- "light" %in% names(data)
+        use.temp <- "temperature" %in% names(data)
+        if (use.temp && mean(data$temperature[1:10], na.rm = TRUE) > 50) {
+          warning("temperature value is unreaslistically high (> 50 Celcius) and will not be used.",
+                  call. = FALSE)
+          use.temp <- FALSE
+        }
+        metricnames_long <- c("timestamp", "nonwearscore", "clippingscore",
+                              if (light.available) c("lightmean", "lightpeak"),
+                              if (use.temp) "temperaturemean", "EN")
+      }
+      if (meta_nrow(S) > 0) {
+        if (!is.null(data$time) && !is.null(S$time)) {
+          gap <- as.numeric(data$time[1] - S$time[length(S$time)])
+          if (gap > 3600 * sf) {
+            abort("Time gap observed of more than 1 hour between data chunks for ",
+                  basename(src$filename), " (GGIR's g.getmeta() stops here too).")
+          } else if (gap > 3 / sf && gap <= 60 * sf) {
+            last <- length(S$x)
+            v <- c(S$x[last], S$y[last], S$z[last])
+            v <- v / sqrt(sum(v^2))
+            S$x[last] <- v[1]
+            S$y[last] <- v[2]
+            S$z[last] <- v[3]
+            S <- meta_bind(S, meta_rows(S, rep(last, round(gap * sf))))
+          }
+        }
+        data <- meta_bind(S, data)
+      }
+      if (i == 1) {
+        sw <- meta_start(data, src, p, sf, ws2)
+        starttime <- sw$starttime
+        wday <- sw$wday
+        wdayname <- sw$wdayname
+        if (sw$shift > 1) data <- meta_rows(data, -seq_len(sw$shift))
+      }
+      LD <- meta_nrow(data)
+      if (LD < ws * sf && i == 1) {
+        warning("\nWarning data too short for doing non-wear detection 3\n", call. = FALSE)
+        isLastBlock <- TRUE
+        LD <- 0
+      }
+      if (LD >= ws * sf) {
+        use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
+        S <- if ((LD - use) > 1) meta_rows(data, (use + 1):LD) else list()
+        data <- meta_rows(data, 1:use)
+        r <- gc_ggir_block_epochs(
+          data$x, data$y, data$z, if (use.temp) data$temperature,
+          if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc)
+        for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
+        blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
+        if (light.available) {
+          blk$lightmean <- round(r$lightmean, 4)
+          blk$lightpeak <- round(r$lightpeak, 4)
+        }
+        if (use.temp) blk$temperaturemean <- round(r$temperature, 4)
+        blk$EN <- round(r$en, 4)
+        long[[length(long) + 1]] <- blk
+      }
+    } else {
+      LD <- 0
+    }
+    if (isLastBlock) LD <- 0
+    if (ceiling(daylimit) != FALSE && i == ceiling(daylimit)) {
+      LD <- 0
+      if (verbose) cat(paste0("\nstopped reading data because this analysis is limited to ",
+                              ceiling(daylimit), " days\n"))
+    }
+    i <- i + 1
+  }
+  rep <- src$report()
+  if (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0)) {
+    warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
+            unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
+            "reproduced (M$QClog is NULL).", call. = FALSE)
+  }
+  meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
+              filetooshort, filecorrupt, p, ws3, ws2, QClog)
+}
+
+# The first block's start: GGIR's get_starttime_weekday_truncdata(), which
+# starts the analysis at the next whole long epoch (the start's seconds
+# rounded up to the next minute).
+meta_start <- function(data, src, p, sf, ws2) {
+  if (is.null(data$time)) {
+    abort("\"", basename(src$filename), "\" has no time stamps to start from.")
+  }
+  start_meas <- ws2 / 60
+  st <- as.POSIXlt(data$time[1], tz = p$desiredtz, origin = "1970-01-01")
+  wday <- st$wday + 1
+  wdayname <- c("Sunday", "Monday", "Tuesday", "Wednesday", "Thursday", "Friday",
+                "Saturday")[wday]
+  secshift <- 60 - st$sec
+  if (secshift == 60) {
+    secshift <- 0
+  } else {
+    st$min <- st$min + 1
+  }
+  minshift <- start_meas - (st$min %% start_meas)
+  if (minshift == start_meas) minshift <- 0
+  shift <- floor((minshift * 60 * sf) + (secshift * sf))
+  st$min <- st$min + minshift
+  st$sec <- 0
+  list(starttime = st, wday = wday, wdayname = wdayname, shift = shift)
+}
+
+# GGIR's M from the blocks' values: the columns as GGIR's character
+# matrices hold them (R's text of each number, read back), time stamps in
+# desiredtz.
+meta_result <- function(short, long, metnames, metricnames_long, starttime, wday, wdayname,
+                        filetooshort, filecorrupt, p, ws3, ws2, QClog) {
+  via_text <- function(v) as.numeric(as.character(v))
+  bsc_qc <- data.frame(time = format(Sys.time()), size = gc()[2, 2], stringsAsFactors = FALSE)
+  if (filecorrupt || filetooshort) {
+    return(invisible(list(filecorrupt = filecorrupt, filetooshort = TRUE,
+                          NFilePagesSkipped = 0, metalong = c(), metashort = c(),
+                          wday = c(), wdayname = c(), windowsizes = c(),
+                          bsc_qc = bsc_qc, QClog = QClog)))
+  }
+  n_short <- if (length(short)) length(unlist(short[[1]], use.names = FALSE)) else 0
+  if (!length(short)) n_short <- 0
+  stamp <- function(n, by, min_rows) {
+    if (n <= min_rows) return(rep(" ", n))
+    t0 <- round(as.numeric(starttime))
+    tt <- seq(t0, t0 + (n - 1) * by, by = by)
+    strftime(as.POSIXlt(tt, origin = "1970-01-01", tz = p$desiredtz),
+             format = "%Y-%m-%dT%H:%M:%S%z")
+  }
+  ms <- data.frame(timestamp = stamp(n_short, ws3, 1), stringsAsFactors = FALSE)
+  for (k in seq_along(metnames)) {
+    ms[[metnames[k]]] <- via_text(unlist(short[[k]], use.names = FALSE))
+  }
+  cols_long <- metricnames_long[-1]
+  n_long <- sum(vapply(long, function(b) length(b$nonwearscore), 0))
+  ml <- data.frame(timestamp = stamp(n_long, ws2, 2), stringsAsFactors = FALSE)
+  for (nm in cols_long) {
+    ml[[nm]] <- via_text(unlist(lapply(long, `[[`, nm), use.names = FALSE))
+  }
+  invisible(list(filecorrupt = filecorrupt, filetooshort = filetooshort,
+                 NFilePagesSkipped = 0, metalong = ml, metashort = ms, wday = wday,
+                 wdayname = wdayname, windowsizes = p$windowsizes, bsc_qc = bsc_qc,
+                 QClog = QClog))
+}
