@@ -160,6 +160,36 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_ggir_filter
+Rcpp::NumericVector gc_ggir_filter(const Rcpp::NumericVector& b, const Rcpp::NumericVector& a, const Rcpp::NumericVector& x, bool conv_fused, bool rec_fused);
+RcppExport SEXP _gravcal_gc_ggir_filter(SEXP bSEXP, SEXP aSEXP, SEXP xSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type b(bSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type a(aSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
+    Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_filter(b, a, x, conv_fused, rec_fused));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_ggir_filtered_signal
+Rcpp::NumericVector gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const std::string& metric, const Rcpp::List& coefs, bool conv_fused, bool rec_fused);
+RcppExport SEXP _gravcal_gc_ggir_filtered_signal(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP metricSEXP, SEXP coefsSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< const std::string& >::type metric(metricSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type coefs(coefsSEXP);
+    Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
+    Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_filtered_signal(x, y, z, metric, coefs, conv_fused, rec_fused));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_fit_icp
 Rcpp::List gc_fit_icp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temp, bool use_temp, const std::string& rule, int max_iter, double tol, double max_weight, bool trace);
 RcppExport SEXP _gravcal_gc_fit_icp(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP tempSEXP, SEXP use_tempSEXP, SEXP ruleSEXP, SEXP max_iterSEXP, SEXP tolSEXP, SEXP max_weightSEXP, SEXP traceSEXP) {
@@ -362,6 +392,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
     {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 10},
+    {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
+    {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 7},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
     {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},
