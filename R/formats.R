@@ -13,6 +13,9 @@
 # * detect: for formats that share an extension, whether a file is this one
 #   (a file is the first format of its extension whose detector says yes or
 #   that has none);
+# * local_clock: TRUE where GGIR's reader takes the file's clock times for
+#   times in configtz (else desiredtz) and the native decoder gives them as
+#   UTC (g.getmeta() moves them: meta_zone_shift());
 # * own_rate: TRUE for a device format whose file records its sampling
 #   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
@@ -117,7 +120,7 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
-    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE,
+    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = TRUE,
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),

@@ -21,12 +21,13 @@
 #' readers give; the per-sample work is C++.
 #'
 #' @section What this version covers:
-#' Formats: Axivity `.cwa`, GENEActiv `.bin`. Metrics: `do.enmo`,
-#' `do.anglex`, `do.angley`, `do.anglez`, `do.en`, `do.enmoa`, `do.mad`,
-#' `do.roll_med_acc_x/y/z`, `do.dev_roll_med_acc_x/y/z`. Non-wear:
-#' `nonwear_approach` "2013" and "2023". Anything else GGIR's g.getmeta()
-#' would compute (a filtered metric, `myfun`, another format) is an error
-#' naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
+#' Formats: Axivity `.cwa`, GENEActiv `.bin`. Metrics: every `do.*` of
+#' `params_metrics` but `do.brondcounts` (GGIR stops on it too) and
+#' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
+#' LFEN, the per-axis filtered signals and zero crossings) need the signal
+#' package, as GGIR does. Non-wear: `nonwear_approach` "2013" and "2023".
+#' Anything else GGIR's g.getmeta() would compute (`myfun`, another
+#' format) is an error naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
 #' wall-clock times and memory); GGIR shrinks its blocks when its own R
 #' session holds over 4000 MB, which gravcal's reading never makes it do.
 #'
@@ -90,8 +91,8 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
 meta_formats <- c("cwa", "geneactiv")
 
 # The metrics of g.applymetrics() in the order GGIR computes them (its
-# result's names), with their do.* parameter; `core`: computed by
-# ggir_epochs.hpp (the others need filters: not yet).
+# result's names); `filtered`: a Butterworth filter's (ggir_filters.hpp,
+# coefficients from the signal package).
 meta_metric_table <- function() {
   data.frame(
     name = c("BFX", "BFY", "BFZ", "BFEN", "ZCX", "ZCY", "ZCZ", "LFX", "LFY", "LFZ", "LFEN",
@@ -99,7 +100,7 @@ meta_metric_table <- function() {
              "roll_med_acc_x", "roll_med_acc_y", "roll_med_acc_z",
              "dev_roll_med_acc_x", "dev_roll_med_acc_y", "dev_roll_med_acc_z",
              "angle_x", "angle_y", "angle_z", "ENMO", "MAD", "EN", "ENMOa"),
-    core = c(rep(FALSE, 17), rep(TRUE, 13)),
+    filtered = c(rep(TRUE, 17), rep(FALSE, 13)),
     stringsAsFactors = FALSE)
 }
 
@@ -148,11 +149,12 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
   tab <- meta_metric_table()
   dov <- meta_do_name(tab$name)
   asked <- vapply(dov, function(nm) isTRUE(p[[nm]]), TRUE)
-  # a filtered metric is computed when any of its family is asked
-  filt <- unique(dov[!tab$core & asked])
-  if (length(filt)) {
-    abort("`", filt[1], "` = TRUE: gravcal's g.getmeta() does not compute the filtered ",
-          "metrics (BFEN, HFEN, LFENMO, zero crossings, ...) yet; use GGIR::g.getmeta().")
+  if (any(tab$filtered & asked) && !requireNamespace("signal", quietly = TRUE)) {
+    abort("`", dov[tab$filtered & asked][1], "` = TRUE needs the signal package ",
+          "(GGIR's Butterworth filters): install.packages(\"signal\").")
+  }
+  for (nm in c("n", "lb", "hb", "zc.lb", "zc.hb", "zc.sb", "zc.order")) {
+    check_number(p[[nm]], nm, min = 0, min_inclusive = FALSE)
   }
   for (nm in c("do.brondcounts", "do.neishabouricounts")) {
     if (isTRUE(p[[nm]])) {
@@ -266,6 +268,13 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
   tab <- meta_metric_table()
   asked <- tab$name[vapply(meta_do_name(tab$name), function(nm) isTRUE(p[[nm]]), TRUE)]
   metnames <- sub("angle_", "angle", asked, fixed = TRUE)
+  filters <- NULL
+  fused <- list(conv = FALSE, rec = FALSE)
+  if (any(asked %in% tab$name[tab$filtered])) {
+    filters <- ggir_filter_coefs(sf, n = p$n, lb = p$lb, hb = p$hb, zc.lb = p$zc.lb,
+                                 zc.hb = p$zc.hb, zc.sb = p$zc.sb, zc.order = p$zc.order)
+    fused <- stats_filter_fused()
+  }
   short <- list()   # per metric, the blocks' rounded epoch values
   long <- list()
   filetooshort <- filecorrupt <- FALSE
@@ -274,13 +283,17 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
   wday <- wdayname <- NULL
   light.available <- use.temp <- FALSE
   metricnames_long <- NULL
-  short_rows <- if (src$format == "geneactiv") src$units * 300 else 0
+  short_rows <- src$short_rows %||% 0
+  zone <- if (length(p$configtz)) p$configtz else p$desiredtz
   i <- 1
   LD <- 2
   QClog <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     data <- meta_read_block(src$native, src$units)
+    if (isTRUE(format_entry(src$format)$local_clock) && !is.null(data$time)) {
+      data$time <- meta_zone_shift(data$time, zone)
+    }
     nr <- meta_nrow(data)
     isLastBlock <- FALSE
     if (nr == 0) {
@@ -349,7 +362,8 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
         data <- meta_rows(data, 1:use)
         r <- gc_ggir_block_epochs(
           data$x, data$y, data$z, if (use.temp) data$temperature,
-          if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc)
+          if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc,
+          filters, fused$conv, fused$rec)
         for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
         if (light.available) {
@@ -379,6 +393,24 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
   }
   meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
               filetooshort, filecorrupt, p, ws3, ws2, QClog)
+}
+
+# A block's time stamps, from a decoder that reads the file's clock as UTC,
+# as GGIR's reader gives them when it reads that clock in `zone`: moved by
+# the zone's offset at the block's first time (GGIRread converts each
+# block's first time in the zone and counts the samples from there). A
+# whole number of seconds added to times in one binade: the same bits as
+# GGIR's sums.
+meta_zone_shift <- function(time, zone) {
+  if (!length(time) || identical(zone, "UTC") || identical(zone, "GMT")) return(time)
+  t1 <- floor(time[1])
+  wall <- format(as.POSIXct(t1, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+  local <- as.numeric(as.POSIXct(wall, tz = zone))
+  if (is.na(local)) {
+    abort("The recording's clock time ", wall, " does not exist in the time zone \"", zone,
+          "\" (`configtz`/`desiredtz`).")
+  }
+  time + (local - t1)
 }
 
 # The first block's start: GGIR's get_starttime_weekday_truncdata(), which

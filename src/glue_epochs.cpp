@@ -42,7 +42,9 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
                                 const Rcpp::List& cal, double sf,
                                 const Rcpp::NumericVector& windowsizes,
                                 const Rcpp::CharacterVector& metrics,
-                                const Rcpp::List& nonwear) {
+                                const Rcpp::List& nonwear,
+                                Rcpp::Nullable<Rcpp::List> filters, bool conv_fused,
+                                bool rec_fused) {
   namespace p1 = gravcal::ggir_part1;
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
@@ -81,13 +83,38 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
   if (appr != "2013" && appr != "2023") Rcpp::stop("nonwear approach must be \"2013\" or \"2023\"");
   nw.approach_2023 = appr == "2023";
   const bool ld = gravcal_glue::r_long_double();
+  gravcal::GgirFilterCoefs fc;
+  std::vector<Rcpp::NumericVector> keep_coefs;
+  const bool have_f = filters.isNotNull();
+  if (have_f) {
+    const Rcpp::List fl(filters.get());
+    auto arma = [&](const char* nm) {
+      const Rcpp::List co = fl[nm];
+      keep_coefs.push_back(Rcpp::NumericVector(co["b"]));
+      keep_coefs.push_back(Rcpp::NumericVector(co["a"]));
+      const Rcpp::NumericVector& b = keep_coefs[keep_coefs.size() - 2];
+      const Rcpp::NumericVector& a = keep_coefs.back();
+      return gravcal::ArmaCoefs{b.begin(), static_cast<std::size_t>(b.size()), a.begin(),
+                                static_cast<std::size_t>(a.size())};
+    };
+    keep_coefs.reserve(8);
+    fc.band = arma("band");
+    fc.low = arma("low");
+    fc.high = arma("high");
+    fc.zc = arma("zc");
+    fc.zc_sb = Rcpp::as<double>(fl["zc_sb"]);
+  }
+  gravcal::RFilterArith arith;
+  arith.conv_fused = conv_fused;
+  arith.rec_fused = rec_fused;
   Rcpp::List shorts(metrics.size());
   Rcpp::List out;
   try {
     gravcal::with_r_acc(ld, [&](auto acc) {
       using Acc = decltype(acc);
       const std::vector<std::vector<double>> s =
-          p1::short_metrics<Acc>(cx.data(), cy.data(), cz.data(), un, sf, windowsizes[0], names);
+          p1::short_metrics<Acc>(cx.data(), cy.data(), cz.data(), un, sf, windowsizes[0], names,
+                                have_f ? &fc : nullptr, arith);
       for (std::size_t k = 0; k < s.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(s[k]);
       shorts.names() = metrics;
       const double* xyz[3] = {cx.data(), cy.data(), cz.data()};

@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "ggir_filters.hpp"
 #include "r_arith.hpp"
 
 namespace gravcal {
@@ -458,13 +459,16 @@ inline std::vector<double> light_peaks(const double* light, std::size_t n, doubl
 // The short-epoch metrics of g.applymetrics() that need no filter, for a
 // block of calibrated samples: "roll_med_acc_x" (and y, z),
 // "dev_roll_med_acc_x" (y, z), "angle_x" (y, z), "ENMO", "MAD", "EN",
-// "ENMOa". Each asked name gets its epoch means (unrounded), in the order
-// asked. Unknown names are an error (the filtered metrics are
-// ggir_filters.hpp's).
+// "ENMOa"; with filter coefficients `fc`, also the filtered metrics of
+// ggir_filters.hpp ("BFEN", "LFENMO", "ZCX", ...: zero crossings summed
+// per epoch, the others averaged). Each asked name gets its epoch values
+// (unrounded), in the order asked. Unknown names are an error.
 template <class Acc>
 std::vector<std::vector<double>> short_metrics(const double* x, const double* y, const double* z,
                                                std::size_t n, double sf, double ws3,
-                                               const std::vector<std::string>& names) {
+                                               const std::vector<std::string>& names,
+                                               const GgirFilterCoefs* fc = nullptr,
+                                               RFilterArith arith = {}) {
   const double by = sf * ws3;
   std::vector<std::vector<double>> out(names.size());
   std::vector<double> sig(n);
@@ -485,8 +489,22 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
     for (std::size_t i = 0; i < n; ++i) en[i] = r_norm(x[i], y[i], z[i]);
   };
   const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
+  std::vector<double> work;
   for (std::size_t k = 0; k < names.size(); ++k) {
     const std::string& nm = names[k];
+    FilteredMetric fm;
+    if (filtered_metric_from_name(nm.c_str(), &fm)) {
+      if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
+      work.resize(3 * n);
+      const SignalStatus st = ggir_filtered_signal(fm, x, y, z, n, *fc, sig.data(), work.data(), arith);
+      if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
+      if (st == SignalStatus::replacement_length)
+        throw std::runtime_error("number of items to replace is not a multiple of replacement length");
+      if (st == SignalStatus::too_short) throw std::runtime_error("GGIR's zero crossings need at least 2 samples");
+      const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY || fm == FilteredMetric::ZCZ;
+      out[k] = per_epoch<Acc>(sig.data(), n, by, !zc);
+      continue;
+    }
     int axis = -1;
     if (nm.size() > 2 && nm[nm.size() - 2] == '_') {
       const char c = nm.back();

@@ -1,0 +1,135 @@
+# gravcal::g.getmeta() against GGIR 3.3-9's g.getmeta() on the same file and
+# parameters: identical() on every element of M but bsc_qc (GGIR's wall
+# clock and memory). References: GGIR::g.getmeta() itself, run here (its
+# results cached in tests/ggir-cache by input bytes, parameters and
+# platform; helper-ggir-cache.R).
+
+meta_quiet <- function(expr) {
+  out <- NULL
+  utils::capture.output(out <- suppressWarnings(expr))
+  out
+}
+
+# GGIR's and gravcal's M for `file` with the same arguments (a list:
+# params_metrics, params_rawdata, params_general, params_cleaning, offset,
+# scale, tempoffset, meantempcal, daylimit; missing lists are GGIR's
+# defaults).
+meta_both <- function(file, args = list()) {
+  skip_if_not_installed("GGIR")
+  defaults <- GGIR::load_params()
+  for (k in c("metrics", "rawdata", "general", "cleaning")) {
+    nm <- paste0("params_", k)
+    args[[nm]] <- utils::modifyList(defaults[[nm]], args[[nm]] %||% list())
+  }
+  R <- ggir_cached("g.getmeta", file, args, {
+    I <- meta_quiet(GGIR::g.inspectfile(file, params_rawdata = args$params_rawdata,
+                                        params_general = args$params_general))
+    meta_quiet(do.call(GGIR::g.getmeta, c(list(datafile = file, inspectfileobject = I,
+                                               verbose = FALSE), args)))
+  })
+  G <- meta_quiet(do.call(gravcal::g.getmeta, c(list(datafile = file, verbose = FALSE), args)))
+  list(ggir = R, gravcal = G)
+}
+
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
+expect_same_meta <- function(b) {
+  R <- b$ggir
+  G <- b$gravcal
+  expect_identical(names(G), names(R))
+  for (nm in setdiff(names(R), "bsc_qc")) {
+    expect_identical(G[[nm]], R[[nm]], label = paste0("gravcal's M$", nm),
+                     expected.label = paste0("GGIR's M$", nm))
+  }
+  expect_true(is.data.frame(G$bsc_qc))
+}
+
+# A recording of `hours` written as a device file, with stretches at rest on
+# a table (flat, 1 mg noise: GGIR's non-wear) and a few clipped samples.
+meta_recording <- function(format, sf, hours, seed = 7, start = "2024-03-04 09:07:23") {
+  rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
+                            start = as.POSIXct(start, tz = "UTC"),
+                            tempoffset = c(0.001, -0.002, 0.0005))
+  n <- nrow(rec)
+  withr::with_seed(seed, {
+    for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
+      i <- round(s[1] * n):round(s[2] * n)
+      rec$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
+      rec$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
+      rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
+    }
+  })
+  rec$x[round(0.8 * n) + 0:40] <- 7.9
+  f <- tempfile(fileext = if (format == "cwa") ".cwa" else ".bin")
+  if (format == "cwa") {
+    gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = sf,
+                        start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  } else {
+    gravcal:::write_geneactiv_bin(rec, f, sf = sf, start = start)
+  }
+  f
+}
+
+cal_args <- list(offset = c(0.01, -0.02, 0.005), scale = c(1.01, 0.99, 1.002),
+                 tempoffset = c(0.001, -0.002, 0.0005), meantempcal = 24)
+
+test_that("g.getmeta() is GGIR's on a .cwa recording: defaults, calibrated", {
+  f <- meta_recording("cwa", 25, 30)
+  b <- meta_both(f, cal_args)
+  expect_same_meta(b)
+  # the recording has what the comparison should see: two blocks, non-wear
+  # from the flat stretches, a clipped epoch, the temperature column
+  M <- b$gravcal
+  expect_gt(nrow(M$metashort), 30 * 720 * 0.9)
+  expect_true(any(M$metalong$nonwearscore >= 2))
+  expect_true(any(M$metalong$clippingscore > 0))
+  expect_true(all(c("temperaturemean", "lightmean", "lightpeak") %in% names(M$metalong)))
+  expect_identical(names(M$metashort), c("timestamp", "anglez", "ENMO"))
+})
+
+test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter blocks", {
+  skip_if_quick()
+  skip_if_not_installed("signal")
+  f <- meta_recording("cwa", 25, 30, seed = 8)
+  pm <- GGIR::load_params()$params_metrics
+  for (k in grep("^do[.]", names(pm), value = TRUE)) {
+    pm[[k]] <- !k %in% c("do.brondcounts", "do.neishabouricounts")
+  }
+  b <- meta_both(f, c(cal_args, list(params_metrics = pm,
+                                     params_cleaning = list(nonwear_approach = "2013"),
+                                     params_rawdata = list(chunksize = 0.3))))
+  expect_same_meta(b)
+  expect_identical(ncol(b$gravcal$metashort), 31L)
+})
+
+test_that("g.getmeta() is GGIR's on a GENEActiv .bin recording, in a zone with an offset", {
+  f <- meta_recording("bin", 50, 28, seed = 9, start = "2024-06-04 22:59:58")
+  b <- meta_both(f, c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam"),
+                                     params_rawdata = list(nonwear_range_threshold = 100))))
+  expect_same_meta(b)
+  expect_match(b$gravcal$metashort$timestamp[1], "\\+0200$")
+})
+
+test_that("g.getmeta() is GGIR's without calibration, for a daylimit, and on a file too short", {
+  f <- meta_recording("cwa", 25, 30, seed = 10)
+  expect_same_meta(meta_both(f, list(daylimit = 1)))
+  short <- meta_recording("cwa", 25, 1.5, seed = 11)
+  b <- meta_both(short, cal_args)
+  expect_same_meta(b)
+  expect_true(b$gravcal$filetooshort)
+})
+
+test_that("g.getmeta() refuses what it does not compute, naming it", {
+  f <- meta_recording("cwa", 25, 3, seed = 12)
+  expect_error(gravcal::g.getmeta(f, myfun = list(FUN = mean), verbose = FALSE), "myfun")
+  expect_error(gravcal::g.getmeta(f, do.neishabouricounts = TRUE, verbose = FALSE),
+               "do.neishabouricounts")
+  expect_error(gravcal::g.getmeta(f, windowsizes = c(5, 900), verbose = FALSE), "windowsizes")
+  expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
+               "nonwear_approach")
+  expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
+  gt3x <- system.file("extdata", "TAS1H30182785_2019-09-17.gt3x", package = "read.gt3x")
+  if (nzchar(gt3x)) {
+    expect_error(gravcal::g.getmeta(gt3x, verbose = FALSE), "does not read an ActiGraph .gt3x")
+  }
+})
