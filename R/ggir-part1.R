@@ -87,6 +87,21 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   meta_run(src, p, cal, daylimit, verbose)
 }
 
+# The reader of GGIR's blocks for meta_run(): a native decoder's, or slices
+# of samples in memory (`units` rows a block).
+meta_reader <- function(src) {
+  if (!is.null(src$native)) return(function() meta_read_block(src$native, src$units))
+  s <- src$samples
+  from <- 0
+  function() {
+    n <- length(s$x)
+    if (from >= n) return(NULL)
+    i <- (from + 1):min(n, from + src$units)
+    from <<- max(i)
+    meta_rows(s[!vapply(s, is.null, TRUE)], i)
+  }
+}
+
 # The formats g.getmeta() reads so far.
 meta_formats <- c("cwa", "geneactiv")
 
@@ -259,7 +274,8 @@ meta_bind <- function(a, b) {
 }
 
 # g.getmeta()'s loop over the blocks of an open native source.
-meta_run <- function(src, p, cal, daylimit, verbose) {
+meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
+  read_block <- meta_reader(src)
   sf <- src$sf
   ws3 <- p$windowsizes[1]
   ws2 <- p$windowsizes[2]
@@ -290,7 +306,7 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
   QClog <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
-    data <- meta_read_block(src$native, src$units)
+    data <- read_block()
     if (isTRUE(format_entry(src$format)$local_clock) && !is.null(data$time)) {
       data$time <- meta_zone_shift(data$time, zone)
     }
@@ -360,6 +376,7 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
         use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
         S <- if ((LD - use) > 1) meta_rows(data, (use + 1):LD) else list()
         data <- meta_rows(data, 1:use)
+        if (!is.null(model)) data <- model(data)
         r <- gc_ggir_block_epochs(
           data$x, data$y, data$z, if (use.temp) data$temperature,
           if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc,
@@ -385,7 +402,7 @@ meta_run <- function(src, p, cal, daylimit, verbose) {
     }
     i <- i + 1
   }
-  rep <- src$report()
+  rep <- if (!is.null(src$report)) src$report() else list()
   if (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0)) {
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
             unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",

@@ -1,0 +1,188 @@
+# epoch_signals(): the calibrated epoch signals of a recording (GGIR part
+# 1's metrics), from a device file or samples in memory, with a gravcal fit
+# or GGIR's coefficients.
+
+#' Calibrated epoch signals: ENMO, angles, non-wear, clipping
+#'
+#' Applies a calibration to a recording and computes the epoch signals that
+#' GGIR's part 1 computes (`g.getmeta()`): per short epoch (5 s) ENMO and
+#' anglez by default, or any of GGIR's metrics; per long epoch (15 min) the
+#' non-wear and clipping scores and the mean norm, temperature and light. The
+#' arithmetic is GGIR's, block by block (about 24 hours), so that the
+#' numbers are those [g.getmeta()] returns for the same coefficients; the
+#' time stamps are date-times rather than GGIR's text.
+#'
+#' @param x A device file (the formats [g.getmeta()] reads), or a data
+#'   frame of raw samples in g (`x`, `y`, `z`, optional `temperature`,
+#'   `light`) with a `time` column (POSIXct or seconds since 1970) or
+#'   `start`.
+#' @param fit The calibration: a `gravcal_fit` (any method; cross-axis terms
+#'   are applied as the fit's model), a [g.calibrate()] result, or `NULL`
+#'   (none).
+#' @param sf Sampling rate in Hz, for a data frame without one (attribute
+#'   `sf` or its time stamps tell it otherwise).
+#' @param metrics GGIR's metric names for the short epochs (`"ENMO"`,
+#'   `"anglez"`, `"anglex"`, `"angley"`, `"EN"`, `"ENMOa"`, `"MAD"`,
+#'   `"BFEN"`, `"HFEN"`, `"HFENplus"`, `"LFENMO"`, `"LFEN"`, `"ZCX"`, ...);
+#'   filtered ones need the signal package.
+#' @param windowsizes Short, long and non-wear window in seconds (GGIR's).
+#' @param start For a data frame without a `time` column: the time of its
+#'   first sample (POSIXct).
+#' @param tz The time zone of the time stamps (GGIR's `desiredtz`).
+#' @param ... More of GGIR's parameters, by name (for example
+#'   `nonwear_approach`, `nonwear_range_threshold`, `dynrange`, `hb`,
+#'   `chunksize`).
+#' @return A `gravcal_epochs` object: a list with `short` (a data frame:
+#'   `time` and one column per metric) and `long` (`time`, `nonwearscore`,
+#'   `clippingscore`, `lightmean`, `lightpeak`, `temperaturemean` where the
+#'   recording has them, `EN`), and `windowsizes`, `sf`, `file`.
+#' @seealso [g.getmeta()] for GGIR's list.
+#' @export
+#' @examples
+#' rec <- simulate_recording(hours = 4, sf = 10, seed = 1)
+#' ep <- epoch_signals(rec, fit = calibrate(rec, sf = 10))
+#' head(ep$short)
+#' plot(ep)
+epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"),
+                          windowsizes = c(5, 900, 3600), start = NULL, tz = "UTC", ...) {
+  if (!is.character(metrics) || !length(metrics) || anyNA(metrics)) {
+    abort("`metrics` must be GGIR metric names, not ", describe(metrics), ".")
+  }
+  tab <- meta_metric_table()
+  known <- sub("angle_", "angle", tab$name, fixed = TRUE)
+  bad <- setdiff(metrics, known)
+  if (length(bad)) {
+    abort("`metrics`: unknown ", paste0("\"", bad, "\"", collapse = ", "), "; GGIR's are ",
+          paste(known, collapse = ", "), ".")
+  }
+  if (!(is.character(tz) && length(tz) == 1 && !is.na(tz))) {
+    abort("`tz` must be a time zone name, not ", describe(tz), ".")
+  }
+  dots <- list(...)
+  do <- stats::setNames(as.list(known %in% metrics), meta_do_name(tab$name))
+  p <- meta_params(do, list(), list(windowsizes = windowsizes, desiredtz = tz), list(), dots)
+  cal <- meta_calibration(c(0, 0, 0), c(1, 1, 1), c(0, 0, 0), c())
+  model <- NULL
+  if (!is.null(fit)) {
+    if (inherits(fit, "gravcal_fit") && any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0)) {
+      model <- function(d) {
+        df <- data.frame(x = d$x, y = d$y, z = d$z)
+        if (!is.null(d$temperature)) df$temperature <- d$temperature
+        y <- apply_calibration(df, fit)
+        d$x <- y$x
+        d$y <- y$y
+        d$z <- y$z
+        d
+      }
+    } else {
+      row <- ggir_coef_row(fit, "fit")
+      cal <- meta_calibration(unlist(row[c("offset.x", "offset.y", "offset.z")]),
+                              unlist(row[c("scale.x", "scale.y", "scale.z")]),
+                              unlist(row[c("temperature.offset.x", "temperature.offset.y",
+                                           "temperature.offset.z")]),
+                              if (isTRUE(row$use.temperature)) row$meantempcal)
+    }
+  }
+  if (is.character(x)) {
+    src <- open_source(x, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
+                       read_opts = list(interpolation = p$interpolationType,
+                                        frequency_tol = p$frequency_tol, zone = tz,
+                                        zone_arg = "tz"),
+                       arg = "x", part = "getmeta")
+    if (!src$format %in% meta_formats || is.null(src$native)) {
+      abort("epoch_signals() does not read ", format_entry(src$format)$label %||% src$format,
+            " yet; read it with read_recording() and give the samples.")
+    }
+    on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
+  } else {
+    src <- epochs_frame_source(x, sf, start, p$chunksize)
+  }
+  M <- meta_run(src, p, cal, FALSE, FALSE, model = model)
+  epochs_result(M, src, p, tz)
+}
+
+# Samples in memory as a source for meta_run(): blocks of GGIR's csv size.
+epochs_frame_source <- function(x, sf, start, chunksize) {
+  s <- as_samples(x, "x")
+  if (is.null(sf)) sf <- attr(x, "sf")
+  if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
+  if (is.null(sf)) abort("The sampling frequency of `x` is unknown: give `sf`.")
+  check_sf(sf)
+  time <- if (!is.null(s$time)) time_seconds(s$time) else NULL
+  if (is.null(time)) {
+    if (!(inherits(start, "POSIXct") && length(start) == 1 && !is.na(start))) {
+      abort("`x` has no `time` column: give `start`, the time of its first sample (POSIXct).")
+    }
+    time <- as.numeric(start) + (seq_len(s$n) - 1) / sf
+  }
+  light <- if (is.data.frame(x) && "light" %in% names(x)) as.double(x$light)
+  list(format = "data.frame", sf = sf, filename = NA_character_,
+       units = format_block_units("csv", sf, 2 * chunksize),
+       samples = list(time = time, x = s$x, y = s$y, z = s$z,
+                      temperature = s$temperature, light = light))
+}
+
+# gravcal_epochs from g.getmeta()'s M.
+epochs_result <- function(M, src, p, tz) {
+  if (isTRUE(M$filetooshort) || !is.data.frame(M$metashort)) {
+    abort("The recording is too short for epoch signals: GGIR's part 1 needs at least ",
+          format(2 * p$windowsizes[3] / 3600), " hours.")
+  }
+  st <- function(txt) as.POSIXct(txt, format = "%Y-%m-%dT%H:%M:%S%z", tz = tz)
+  short <- M$metashort
+  long <- M$metalong
+  names(short)[1] <- names(long)[1] <- "time"
+  short$time <- st(short$time)
+  long$time <- st(long$time)
+  structure(list(short = short, long = long, windowsizes = p$windowsizes, sf = src$sf,
+                 file = src$filename),
+            class = "gravcal_epochs")
+}
+
+#' @export
+print.gravcal_epochs <- function(x, ...) {
+  days <- nrow(x$long) * x$windowsizes[2] / 86400
+  cat("<gravcal_epochs> ", format(nrow(x$short)), " epochs of ", format(x$windowsizes[1]),
+      " s (", format(round(days, 2)), " days from ", format(x$short$time[1]), ")\n", sep = "")
+  cat("  short: ", paste(names(x$short)[-1], collapse = ", "), "\n", sep = "")
+  cat("  long:  ", paste(names(x$long)[-1], collapse = ", "), "\n", sep = "")
+  if ("ENMO" %in% names(x$short)) {
+    cat("  mean ENMO ", format(round(1000 * mean(x$short$ENMO, na.rm = TRUE), 1)),
+        " mg; non-wear ", format(round(100 * mean(x$long$nonwearscore >= 2), 1)),
+        " % of long epochs\n", sep = "")
+  }
+  invisible(x)
+}
+
+#' Plot a day of epoch signals
+#'
+#' ENMO (mg) and, where computed, anglez over one day, with the long epochs
+#' scored as non-wear shaded.
+#' @param x A `gravcal_epochs` object ([epoch_signals()]).
+#' @param day Which day (1 = the first 24 hours).
+#' @param ... Passed to [graphics::plot()].
+#' @return `x`, invisibly.
+#' @export
+plot.gravcal_epochs <- function(x, day = 1, ...) {
+  check_number(day, "day", min = 1, integer = TRUE)
+  t0 <- x$short$time[1] + (day - 1) * 86400
+  s <- x$short[x$short$time >= t0 & x$short$time < t0 + 86400, , drop = FALSE]
+  if (!nrow(s)) abort("`day` = ", day, ": the recording has no epochs on that day.")
+  l <- x$long[x$long$time >= t0 & x$long$time < t0 + 86400, , drop = FALSE]
+  panels <- intersect(c("ENMO", "anglez"), names(s))
+  if (!length(panels)) panels <- names(s)[2]
+  op <- graphics::par(mfrow = c(length(panels), 1), mar = c(3, 4, 1.5, 1))
+  on.exit(graphics::par(op))
+  for (m in panels) {
+    v <- if (m == "ENMO") 1000 * s[[m]] else s[[m]]
+    graphics::plot(s$time, v, type = "l", xlab = "", ylab = if (m == "ENMO") "ENMO (mg)" else m,
+                   main = if (m == panels[1]) paste("Day", day) else "", ...)
+    nw <- l$time[l$nonwearscore >= 2]
+    if (length(nw)) {
+      usr <- graphics::par("usr")
+      graphics::rect(nw, usr[3], nw + x$windowsizes[2], usr[4], col = grDevices::adjustcolor("grey", 0.4),
+                     border = NA)
+    }
+  }
+  invisible(x)
+}

@@ -1,0 +1,58 @@
+# epoch_signals(): GGIR part 1's epoch signals of a calibrated recording.
+# References: gravcal::g.getmeta() (itself identical to GGIR's, see
+# test-ggir-getmeta.R) and the metric's definition computed here in R.
+
+test_that("epoch_signals() of a file with g.calibrate()'s coefficients is g.getmeta()'s M", {
+  rec <- simulate_recording(hours = 27, sf = 25, seed = 21,
+                            start = as.POSIXct("2024-05-01 10:02:11", tz = "UTC"))
+  f <- tempfile(fileext = ".cwa")
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = 25,
+                      start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  C <- gravcal::g.calibrate(f, verbose = FALSE)
+  ep <- epoch_signals(f, fit = C, metrics = c("ENMO", "anglez", "MAD"))
+  M <- gravcal::g.getmeta(f, offset = C$offset, scale = C$scale, tempoffset = C$tempoffset,
+                          meantempcal = C$meantempcal, do.mad = TRUE, verbose = FALSE)
+  expect_s3_class(ep, "gravcal_epochs")
+  for (m in c("ENMO", "anglez", "MAD")) expect_identical(ep$short[[m]], M$metashort[[m]])
+  for (m in names(M$metalong)[-1]) expect_identical(ep$long[[m]], M$metalong[[m]])
+  expect_identical(format(ep$short$time, "%Y-%m-%dT%H:%M:%S%z"), M$metashort$timestamp)
+  expect_identical(format(ep$short$time[1]), "2024-05-01 10:15:00")
+  expect_output(print(ep), "epochs of 5 s")
+})
+
+test_that("epoch_signals() of samples in memory: ENMO by its definition, a fit's model applied", {
+  rec <- simulate_recording(hours = 3, sf = 10, seed = 22,
+                            start = as.POSIXct("2024-01-01 00:00:00", tz = "UTC"))
+  ep <- epoch_signals(rec, metrics = c("ENMO", "EN"))
+  # GGIR's ENMO: the mean of max(|a| - 1, 0) over 5 s (50 samples), to 4 decimals
+  enmo <- pmax(sqrt(rec$x^2 + rec$y^2 + rec$z^2) - 1, 0)
+  ref <- round(colMeans(matrix(enmo, nrow = 50)), 4)
+  # (the cumulative sum's rounding may move a value across a rounding edge
+  # of the 4th decimal, by one unit there)
+  d <- abs(ep$short$ENMO - ref[seq_len(nrow(ep$short))])
+  expect_lte(max(d), 1e-4 + 1e-12)
+  expect_gt(mean(d == 0), 0.99)
+  expect_identical(nrow(ep$short), 3L * 720L)
+  expect_identical(nrow(ep$long), 12L)
+  # a lightweight fit with cross-axis terms: its model, as apply_calibration() applies it
+  fit <- calibrate(rec, sf = 10)
+  a <- epoch_signals(rec, fit = fit, metrics = "ENMO")
+  b <- epoch_signals(apply_calibration(rec, fit), metrics = "ENMO")
+  expect_identical(a$short, b$short)
+  expect_false(identical(a$short$ENMO, ep$short$ENMO))
+  p <- tempfile(fileext = ".png")
+  grDevices::png(p)
+  expect_invisible(plot(a))
+  grDevices::dev.off()
+  expect_true(file.size(p) > 0)
+})
+
+test_that("epoch_signals() says what is wrong with its arguments", {
+  rec <- simulate_recording(hours = 3, sf = 10, seed = 23)
+  expect_error(epoch_signals(rec, metrics = "ENMOX"), "unknown \"ENMOX\"")
+  xyz <- rec[, c("x", "y", "z")]
+  expect_error(epoch_signals(xyz, sf = 10), "give `start`")
+  expect_error(epoch_signals(rec, tz = 3), "`tz`")
+  short <- simulate_recording(hours = 1, sf = 10, seed = 24)
+  expect_error(epoch_signals(short), "too short")
+})
