@@ -341,9 +341,15 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     }
   }
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
-  lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
-                           file = if (is.character(x)) basename(x),
-                           timed = !is.character(x) &&
-                             "time" %in% tolower(names(x)),
-                           max_identical = max_identical)
+  fit <- lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
+                                  file = if (is.character(x)) basename(x),
+                                  timed = !is.character(x) &&
+                                    "time" %in% tolower(names(x)),
+                                  max_identical = max_identical)
+  # a stuck temperature sensor: the rest windows' temperature does not vary
+  # (see ?plausible_bounds)
+  fit$temperature_check <- temperature_check(
+    fit_hours(fit), TRUE,
+    temps = if (is.data.frame(fit$windows)) fit$windows$temperature else NA_real_)
+  fit
 }

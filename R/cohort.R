@@ -263,6 +263,8 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
       fits[[i]] <- g
     }
   }
+  # whether each recording's temperature varies (the fit's own check)
+  tab <- add_temperature_flat(tab, fits)
   # each fit judged against the bounds and its device's other recordings
   judged <- cohort_plausibility(tab)
   tab <- place_plausibility(judged$tab)
@@ -286,6 +288,21 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   attr(tab, "fits") <- fits
   attr(tab, "devices") <- judged$devices
   tab
+}
+
+# Column `temperature_flat` after `meantempcal`: TRUE when the recording
+# has a temperature that does not vary (the fit's temperature_check(),
+# gravcal's own modes), FALSE when it varies, NA when not known (no
+# temperature, not calibrated, GGIR-compatible mode).
+add_temperature_flat <- function(tab, fits) {
+  flat <- vapply(fits, function(f) {
+    v <- if (is.null(f)) NULL else f$temperature_check$flat
+    if (length(v) == 1 && !is.na(v)) as.logical(v) else NA
+  }, NA)
+  tab$temperature_flat <- unname(flat)
+  at <- match("meantempcal", names(tab))
+  rest <- setdiff(names(tab), "temperature_flat")
+  tab[c(rest[seq_len(at)], "temperature_flat", rest[-seq_len(at)])]
 }
 
 # The plausibility columns right after `pooled`.

@@ -416,6 +416,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
                         })
   ex <- attr(res, "gravcal")$excluded
   early <- isTRUE(attr(res, "gravcal")$early)
+  temp_warn <- attr(res, "gravcal")$temperature_warnings
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!compat) {
     fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
@@ -451,10 +452,18 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   }
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
-  ggir_over_time_fit(fit, over, a, src$sf, early,
-                     hours_total = if (!is.character(x)) {
-                       NROW(x) / src$sf / 3600
-                     })
+  fit <- ggir_over_time_fit(fit, over, a, src$sf, early,
+                            hours_total = if (!is.character(x)) {
+                              NROW(x) / src$sf / 3600
+                            })
+  # a stuck temperature sensor (gravcal's own mode; the procedure's verdict
+  # that the temperature does not vary, see ?plausible_bounds)
+  if (!compat) {
+    fit$temperature_check <- temperature_check(
+      fit_hours(fit), isTRUE(src$temperature),
+      flat = any(grepl("does not vary", temp_warn, fixed = TRUE)))
+  }
+  fit
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.
