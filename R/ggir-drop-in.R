@@ -456,12 +456,22 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
                             hours_total = if (!is.character(x)) {
                               NROW(x) / src$sf / 3600
                             })
-  # a stuck temperature sensor (gravcal's own mode; the procedure's verdict
-  # that the temperature does not vary, see ?plausible_bounds)
+  # a stuck temperature sensor (gravcal's own mode, see ?plausible_bounds):
+  # where the procedure left the temperature out because a block's does not
+  # vary, the rest windows of the whole recording say whether it ever does
+  # (a second pass of the segmenter, only then)
   if (!compat) {
+    temps <- NULL
+    if (isTRUE(src$temperature) && any(grepl("does not vary", temp_warn, fixed = TRUE))) {
+      temps <- tryCatch({
+        w <- rest_windows(x, sf = src$sf, method = "ggir", reader = a$reader,
+                          rmc = if (is.character(x)) a$rmc)
+        w$temperature[w$rest]
+      }, error = function(e) NA_real_)
+    }
     fit$temperature_check <- temperature_check(
-      fit_hours(fit), isTRUE(src$temperature),
-      flat = any(grepl("does not vary", temp_warn, fixed = TRUE)))
+      fit_hours(fit), isTRUE(src$temperature), temps = temps,
+      flat = if (is.null(temps)) FALSE)
   }
   fit
 }
