@@ -33,17 +33,45 @@
 #' left out, to have a history), `z` (a coefficient disagrees with its
 #' device's reference when it differs by more than `z` times the combined
 #' uncertainty: the recording's standard error, the reference's and the
-#' device's robust spread, or the cohort's when larger), `attenuation` (the smallest common change of
+#' device's robust spread, or the cohort's when larger, and by at least the
+#' coefficient's `practical_min`, below), `attenuation` (the smallest common change of
 #' the three scales called a firmware-style attenuation, relative to the
 #' device's reference), `attenuation_absolute` (the same, relative to 1, for
-#' a device without history or whose history shows it) and `agreement` (the
+#' a device without history or whose history shows it), `agreement` (the
 #' three scales changed by the same factor: the smallest change at least
-#' this fraction of the largest, all in one direction).
+#' this fraction of the largest, all in one direction), `min_reference`
+#' (a device's reference is computed again without the recordings a first
+#' judgement flags, when at least this many remain; the second
+#' judgement's flags are the result), `temperature_flat_sd` (a temperature
+#' whose standard deviation over the rest windows is below this, in degrees
+#' C, does not vary: GGIR's rule for leaving the temperature term out) and
+#' `temperature_stuck_hours` (such a temperature over a recording of at
+#' least this many hours is a stuck sensor by itself; a shorter one is,
+#' when another recording of the same device has a temperature that
+#' varies).
+#'
+#' **Practical minimum.** `practical_min` is the smallest difference from
+#' the device's reference that makes a `"device_outlier"`, whatever its
+#' z: a change that moves a user's results. It is chosen from the change
+#' of a day's ENMO (mean of `max(|a| - 1, 0)`) that a change of one
+#' coefficient causes (`bench/enmo-sensitivity.R`): on a real free-living
+#' day (20.7 h, ENMO 15 mg) a change of one axis' offset moves ENMO by 1 mg
+#' at 6.2 mg on average over the axes and directions (3.5 mg on the most
+#' sensitive), a scale's at 0.56 % (0.37 %); on simulated days at 10 mg and
+#' 0.5 %. The minimum is 5 mg for offsets (compared at the device's
+#' reference temperature) and 0.5 % of the reference for scales; 0.005 for
+#' cross-axis terms (a term's change moves a calibrated axis by at most
+#' what a scale change as large does); 1 mg per degree C for temperature
+#' offsets, whose change `t` moves the signal by `t (T - meantemp)`: on a
+#' real wrist recording `|T - meantemp|` is below 3.8 degrees C nine tenths
+#' of the time, so 1 mg per degree C stays within the offsets' 5 mg.
 #'
 #' @return A data frame, one row per coefficient group (`scale`, `cross`,
 #'   `offset`, `temperature_offset`), with columns `coefficient`, `unit`,
-#'   `flag_lower`, `flag_upper`, `refuse_lower`, `refuse_upper` and
-#'   `source`; attribute `history` (a list, see above).
+#'   `flag_lower`, `flag_upper`, `refuse_lower`, `refuse_upper`,
+#'   `practical_min` (scales: a fraction of the reference; the others in
+#'   `unit`), `source` and `practical_source`; attribute `history` (a list,
+#'   see above).
 #' @references
 #' van Hees VT et al. (2014). Autocalibration of accelerometer data for
 #' free-living physical activity assessment using local gravity and
