@@ -57,7 +57,7 @@
 #' coefficient causes (`bench/enmo-sensitivity.R`): on a real free-living
 #' day (20.7 h, ENMO 15 mg) a change of one axis' offset moves ENMO by 1 mg
 #' at 6.2 mg on average over the axes and directions (3.5 mg on the most
-#' sensitive), a scale's at 0.56 % (0.37 %); on simulated days at 10 mg and
+#' sensitive), a scale's at 0.56 % (0.37 %); on simulated days at 12 mg and
 #' 0.5 %. The minimum is 5 mg for offsets (compared at the device's
 #' reference temperature) and 0.5 % of the reference for scales; 0.005 for
 #' cross-axis terms (a term's change moves a calibrated axis by at most
