@@ -297,7 +297,15 @@
 #'     the coefficients are the identity;
 #'   * for the lightweight method from [calibrate()]: `excluded`,
 #'     `excluded_windows` and `guards`; for the GGIR method in gravcal's own
-#'     mode: `excluded` and `guards` (see Details).
+#'     mode: `excluded` and `guards` (see Details);
+#'   * in gravcal's own modes (both methods), `temperature_check`: the
+#'     temperature sensor, a list with `available`, `flat` (the rest
+#'     windows' temperature does not vary: sd below 0.01 degrees C), `sd`,
+#'     `value`, `hours` and `stuck` (flat over 12 h or more: a stuck sensor,
+#'     flagged `"temperature_stuck"` by `print()` and [calibrate_files()];
+#'     see [plausible_bounds()]) and `note`. For the GGIR method the rest
+#'     windows are read again only when the procedure left the temperature
+#'     out because it does not vary.
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]
 #' @export
 #' @examples
@@ -341,9 +349,15 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     }
   }
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))
-  lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
-                           file = if (is.character(x)) basename(x),
-                           timed = !is.character(x) &&
-                             "time" %in% tolower(names(x)),
-                           max_identical = max_identical)
+  fit <- lightweight_from_windows(w, args, choice, max_norm_error, range_g, call,
+                                  file = if (is.character(x)) basename(x),
+                                  timed = !is.character(x) &&
+                                    "time" %in% tolower(names(x)),
+                                  max_identical = max_identical)
+  # a stuck temperature sensor: the rest windows' temperature does not vary
+  # (see ?plausible_bounds)
+  fit$temperature_check <- temperature_check(
+    fit_hours(fit), TRUE,
+    temps = if (is.data.frame(fit$windows)) fit$windows$temperature else NA_real_)
+  fit
 }

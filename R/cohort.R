@@ -60,8 +60,10 @@
 #' bounds of [plausible_bounds()] and against its device's other recordings
 #' (by the `serial` column; pooled rows are not part of a device's
 #' history). A device with at least 3 calibrated recordings has a
-#' reference: the median of each coefficient over its recordings (those
-#' without a firmware-style attenuation when at least 3 remain), with a
+#' reference: the median of each coefficient over its recordings (first
+#' those without a firmware-style attenuation when at least 3 remain; then,
+#' for the judgement that counts, those the first judgement did not flag,
+#' when at least 2 remain), with a
 #' robust spread (the median absolute deviation, scaled to a standard
 #' deviation; the median of all devices' spreads in the cohort when that
 #' is larger, so that a device whose few recordings happen to agree is not
@@ -71,17 +73,26 @@
 #' temperature, the median of its recordings' (`o + (T_ref - m) K^-1 t`).
 #' A recording's coefficient disagrees with the reference when
 #' it differs by more than 4 times the combined uncertainty (its standard
-#' error, the reference's and the spread). Column `plausibility` says
+#' error, the reference's and the spread) and by at least the coefficient's
+#' practical minimum (`practical_min` of [plausible_bounds()]: 5 mg for
+#' offsets, 0.5 % for scales, 1 mg per degree C for temperature offsets,
+#' changes that move a day's ENMO by about 1 mg). Column `plausibility` says
 #' `"attenuated"` (all three scales changed by one common factor, at least
 #' 0.02 from the device's reference or 0.03 from 1, beyond their uncertainty:
 #' what a firmware fault that attenuates the raw signal does, as in
 #' ActiGraph's notice 16CPAN03), `"out_of_bounds"` (beyond omconvert's
-#' bounds, or not applied because beyond gravcal's), `"device_outlier"`
+#' bounds, or not applied because beyond gravcal's), `"temperature_stuck"`
+#' (the recording's temperature does not vary, column `temperature_flat`,
+#' over 12 h or more, or while another recording of the device has a
+#' temperature that varies: a stuck sensor, whose recording is calibrated
+#' without a temperature term; gravcal's own modes), `"device_outlier"`
 #' (disagrees with its device's reference) or `"ok"`, in that order of
 #' precedence; `NA` for a recording not calibrated. `plausibility_note`
 #' says why, with the device's reference values. The devices' references
 #' are in `attr(, "devices")` (one row per device with a history: `serial`,
-#' `recordings`, `reference_recordings`, `reference_temp`, `ref.<coefficient>`,
+#' `recordings`, `reference_recordings`, `reference_files` and
+#' `left_out_files` (the recordings its reference used and those it left
+#' out, separated by `"; "`), `reference_temp`, `ref.<coefficient>`,
 #' `spread.<coefficient>`), and each fit in `attr(, "fits")` carries its
 #' flag (`fit$plausibility`), which `print()` shows. GGIR's coefficient file
 #' is unchanged.
@@ -148,6 +159,9 @@
 #'   fitted: 9, 6 or 3 for the lightweight method, which fits what the
 #'   recording determines; 6 or 9 for the GGIR method; 0 when not
 #'   calibrated) and `points` (calibration points used); `meantempcal`;
+#'   `temperature_flat` (TRUE when the recording has a temperature that does
+#'   not vary, see [plausible_bounds()]; FALSE when it varies; NA without a
+#'   temperature or in GGIR-compatible mode);
 #'   `error_before_mg`, `error_after_mg` (on the rest points used); `format`,
 #'   `serial` (the device's serial number from the file's header, NA
 #'   where there is none), `pooled` (see `pool`), `plausibility` and
@@ -263,6 +277,8 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
       fits[[i]] <- g
     }
   }
+  # whether each recording's temperature varies (the fit's own check)
+  tab <- add_temperature_flat(tab, fits)
   # each fit judged against the bounds and its device's other recordings
   judged <- cohort_plausibility(tab)
   tab <- place_plausibility(judged$tab)
@@ -286,6 +302,21 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   attr(tab, "fits") <- fits
   attr(tab, "devices") <- judged$devices
   tab
+}
+
+# Column `temperature_flat` after `meantempcal`: TRUE when the recording
+# has a temperature that does not vary (the fit's temperature_check(),
+# gravcal's own modes), FALSE when it varies, NA when not known (no
+# temperature, not calibrated, GGIR-compatible mode).
+add_temperature_flat <- function(tab, fits) {
+  flat <- vapply(fits, function(f) {
+    v <- if (is.null(f)) NULL else f$temperature_check$flat
+    if (length(v) == 1 && !is.na(v)) as.logical(v) else NA
+  }, NA)
+  tab$temperature_flat <- unname(flat)
+  at <- match("meantempcal", names(tab))
+  rest <- setdiff(names(tab), "temperature_flat")
+  tab[c(rest[seq_len(at)], "temperature_flat", rest[-seq_len(at)])]
 }
 
 # The plausibility columns right after `pooled`.

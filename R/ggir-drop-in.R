@@ -416,6 +416,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
                         })
   ex <- attr(res, "gravcal")$excluded
   early <- isTRUE(attr(res, "gravcal")$early)
+  temp_warn <- attr(res, "gravcal")$temperature_warnings
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!compat) {
     fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
@@ -451,10 +452,28 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   }
   if (!is.null(fit$input) && is.numeric(src$sf)) fit$input$sf <- src$sf
   if (is.character(x)) fit$file <- basename(x)
-  ggir_over_time_fit(fit, over, a, src$sf, early,
-                     hours_total = if (!is.character(x)) {
-                       NROW(x) / src$sf / 3600
-                     })
+  fit <- ggir_over_time_fit(fit, over, a, src$sf, early,
+                            hours_total = if (!is.character(x)) {
+                              NROW(x) / src$sf / 3600
+                            })
+  # a stuck temperature sensor (gravcal's own mode, see ?plausible_bounds):
+  # where the procedure left the temperature out because a block's does not
+  # vary, the rest windows of the whole recording say whether it ever does
+  # (a second pass of the segmenter, only then)
+  if (!compat) {
+    temps <- NULL
+    if (isTRUE(src$temperature) && any(grepl("does not vary", temp_warn, fixed = TRUE))) {
+      temps <- tryCatch({
+        w <- rest_windows(x, sf = src$sf, method = "ggir", reader = a$reader,
+                          rmc = if (is.character(x)) a$rmc)
+        w$temperature[w$rest]
+      }, error = function(e) NA_real_)
+    }
+    fit$temperature_check <- temperature_check(
+      fit_hours(fit), isTRUE(src$temperature), temps = temps,
+      flat = if (is.null(temps)) FALSE)
+  }
+  fit
 }
 
 # GGIR's result as a gravcal_fit, with a status code beside GGIR's message.

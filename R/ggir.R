@@ -194,7 +194,8 @@ ggir_result <- function(r, bsc_qc, input, verbose = FALSE, printsummary = FALSE)
                                temp.available = r$temp.available,
                                windows = r$windows, samples = r$samples,
                                zeros = r$zeros, excluded = r$excluded,
-                               early = isTRUE(r$early))
+                               early = isTRUE(r$early),
+                               temperature_warnings = as.character(r$warnings))
   out
 }
 

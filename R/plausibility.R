@@ -33,17 +33,45 @@
 #' left out, to have a history), `z` (a coefficient disagrees with its
 #' device's reference when it differs by more than `z` times the combined
 #' uncertainty: the recording's standard error, the reference's and the
-#' device's robust spread, or the cohort's when larger), `attenuation` (the smallest common change of
+#' device's robust spread, or the cohort's when larger, and by at least the
+#' coefficient's `practical_min`, below), `attenuation` (the smallest common change of
 #' the three scales called a firmware-style attenuation, relative to the
 #' device's reference), `attenuation_absolute` (the same, relative to 1, for
-#' a device without history or whose history shows it) and `agreement` (the
+#' a device without history or whose history shows it), `agreement` (the
 #' three scales changed by the same factor: the smallest change at least
-#' this fraction of the largest, all in one direction).
+#' this fraction of the largest, all in one direction), `min_reference`
+#' (a device's reference is computed again without the recordings a first
+#' judgement flags, when at least this many remain; the second
+#' judgement's flags are the result), `temperature_flat_sd` (a temperature
+#' whose standard deviation over the rest windows is below this, in degrees
+#' C, does not vary: GGIR's rule for leaving the temperature term out) and
+#' `temperature_stuck_hours` (such a temperature over a recording of at
+#' least this many hours is a stuck sensor by itself; a shorter one is,
+#' when another recording of the same device has a temperature that
+#' varies).
+#'
+#' **Practical minimum.** `practical_min` is the smallest difference from
+#' the device's reference that makes a `"device_outlier"`, whatever its
+#' z: a change that moves a user's results. It is chosen from the change
+#' of a day's ENMO (mean of `max(|a| - 1, 0)`) that a change of one
+#' coefficient causes (`bench/enmo-sensitivity.R`): on a real free-living
+#' day (20.7 h, ENMO 15 mg) a change of one axis' offset moves ENMO by 1 mg
+#' at 6.2 mg on average over the axes and directions (3.5 mg on the most
+#' sensitive), a scale's at 0.56 % (0.37 %); on simulated days at 12 mg and
+#' 0.5 %. The minimum is 5 mg for offsets (compared at the device's
+#' reference temperature) and 0.5 % of the reference for scales; 0.005 for
+#' cross-axis terms (a term's change moves a calibrated axis by at most
+#' what a scale change as large does); 1 mg per degree C for temperature
+#' offsets, whose change `t` moves the signal by `t (T - meantemp)`: on a
+#' real wrist recording `|T - meantemp|` is below 3.8 degrees C nine tenths
+#' of the time, so 1 mg per degree C stays within the offsets' 5 mg.
 #'
 #' @return A data frame, one row per coefficient group (`scale`, `cross`,
 #'   `offset`, `temperature_offset`), with columns `coefficient`, `unit`,
-#'   `flag_lower`, `flag_upper`, `refuse_lower`, `refuse_upper` and
-#'   `source`; attribute `history` (a list, see above).
+#'   `flag_lower`, `flag_upper`, `refuse_lower`, `refuse_upper`,
+#'   `practical_min` (scales: a fraction of the reference; the others in
+#'   `unit`), `source` and `practical_source`; attribute `history` (a list,
+#'   see above).
 #' @references
 #' van Hees VT et al. (2014). Autocalibration of accelerometer data for
 #' free-living physical activity assessment using local gravity and
@@ -64,11 +92,17 @@ plausible_bounds <- function() {
     flag_upper = c(1.2, 0.1, 0.41, 0.02),
     refuse_lower = c(0.7, -0.2, -0.6, -0.05),
     refuse_upper = c(1.3, 0.2, 0.6, 0.05),
+    practical_min = c(0.005, 0.005, 0.005, 0.001),
     source = c(
       "flag: omconvert (|scale - 1| <= 0.2); refuse: gravcal, far beyond van Hees et al. (2014) Table 2",
       "flag: gravcal, twice Farago et al. (2024)'s simulated range; refuse: gravcal",
       "flag: omconvert (0.41 g); refuse: gravcal, far beyond van Hees et al. (2014) Table 2",
       "flag: omconvert (0.02 g per degree C); refuse: gravcal, far beyond van Hees et al. (2014) Table 2"),
+    practical_source = c(
+      "0.5 % of the device's reference: moves a day's ENMO by about 1 mg (bench/enmo-sensitivity.R)",
+      "0.005: a cross-axis term moves a calibrated axis by at most what a scale change as large does",
+      "5 mg: moves a day's ENMO by about 1 mg (bench/enmo-sensitivity.R)",
+      "1 mg per degree C: at most a 5 mg offset over the wrist's usual 4 degrees C from its mean (bench/enmo-sensitivity.R)"),
     stringsAsFactors = FALSE)
   attr(b, "history") <- history_rules
   b
@@ -76,7 +110,9 @@ plausible_bounds <- function() {
 
 # The device-history rules (documented in ?plausible_bounds).
 history_rules <- list(min_recordings = 3L, z = 4, attenuation = 0.02,
-                      attenuation_absolute = 0.03, agreement = 0.5)
+                      attenuation_absolute = 0.03, agreement = 0.5,
+                      min_reference = 2L, temperature_flat_sd = 0.01,
+                      temperature_stuck_hours = 12)
 
 # The refusal bounds as guard_fit() and the GGIR method's own mode read them.
 plausible <- local({
@@ -136,7 +172,42 @@ fit_plausibility <- function(fit) {
   if (!is.null(a)) {
     return(list(flag = "attenuated", note = a))
   }
+  tc <- fit$temperature_check
+  if (isTRUE(tc$stuck)) {
+    return(list(flag = "temperature_stuck", note = tc$note))
+  }
   list(flag = "ok", note = "")
+}
+
+# The temperature sensor of a fit in gravcal's own modes (both methods):
+# list(available, flat, sd, value, hours, stuck, note). `available`: the
+# recording has a temperature; `flat`: it does not vary (sd below
+# history_rules$temperature_flat_sd, GGIR's rule for leaving the
+# temperature term out); `stuck`: flat over a recording of at least
+# history_rules$temperature_stuck_hours (see ?plausible_bounds). For the
+# lightweight method `temps` are the rest windows' temperatures; for the
+# GGIR method `flat` is the procedure's own verdict (its block's samples'
+# sd below 0.01) and `temps` NULL.
+temperature_check <- function(hours, available, temps = NULL, flat = NULL) {
+  rules <- history_rules
+  sdv <- NA_real_
+  value <- NA_real_
+  if (!is.null(temps)) {
+    temps <- temps[is.finite(temps)]
+    available <- available && length(temps) > 0
+    if (length(temps) >= 2) {
+      sdv <- stats::sd(temps)
+      value <- stats::median(temps)
+      flat <- sdv < rules$temperature_flat_sd
+    } else {
+      flat <- NA
+    }
+  }
+  flat <- if (available) isTRUE(flat) else NA
+  stuck <- isTRUE(flat) && isTRUE(hours >= rules$temperature_stuck_hours)
+  list(available = available, flat = flat, sd = sdv, value = value,
+       hours = hours, stuck = stuck,
+       note = if (stuck) temperature_stuck_note(hours, value) else "")
 }
 
 # The temperature at which a device's recordings (rows `rows` of a cohort
@@ -207,13 +278,13 @@ attenuation_signature <- function(s, se, ref, u_ref, min_change) {
 # The device-history judgement of a cohort table (calibrate_files()):
 # the table with columns `plausibility` and `plausibility_note`, and the
 # devices' reference values (attribute "devices" of the result). See
-# calibrate_files()'s documentation.
+# calibrate_files()'s documentation. Two passes: every recording is judged
+# against its device's reference; then each reference is computed again
+# without the recordings the first pass flagged, and every recording is
+# judged again against it (the second pass's flags are the result).
 cohort_plausibility <- function(tab) {
   rules <- history_rules
   n <- nrow(tab)
-  flag <- rep(NA_character_, n)
-  note <- rep("", n)
-  add <- function(i, s) note[i] <<- ifelse(nzchar(note[i]), paste0(note[i], "; ", s), s)
   cols <- c(paste0("scale.", c("x", "y", "z")), paste0("cross.", c("xy", "xz", "yz")),
             paste0("offset.", c("x", "y", "z")),
             paste0("temperature.offset.", c("x", "y", "z")))
@@ -224,10 +295,6 @@ cohort_plausibility <- function(tab) {
   raw <- co
   applied <- tab$status %in% c("ok", "high_error")
   refused <- tab$status == "implausible"
-  flag[applied] <- "ok"
-  flag[refused] <- "out_of_bounds"
-  note[refused] <- paste0("coefficients beyond the bounds at which gravcal ",
-                          "refuses them (plausible_bounds()); not applied")
   bounds <- lapply(seq_len(n), function(i) {
     if (applied[i]) beyond_flag_bounds(raw[i, ]) else character(0)
   })
@@ -235,11 +302,12 @@ cohort_plausibility <- function(tab) {
   scales <- cols[1:3]
   serial <- tab$serial
   key <- ifelse(is.na(serial), paste0("\r", seq_len(n)), serial)
-  devices <- list()
-  att <- rep(FALSE, n)
-  outlier <- rep(FALSE, n)
-  # first, each device's reference; then every recording judged against it
+  files <- if (is.null(tab$file)) as.character(seq_len(n)) else tab$file
+  stuck <- temperature_stuck_notes(tab, applied, pooled, key)
+  # each device's history (its recordings, offsets restated at one
+  # temperature, the attenuation signature relative to 1)
   hists <- list()
+  other <- list()
   for (k in unique(key[applied])) {
     idx <- which(key == k & applied)
     hist <- idx[!pooled[idx]]
@@ -258,61 +326,51 @@ cohort_plausibility <- function(tab) {
                             c(0, 0, 0), rules$attenuation_absolute)
     })
     abs_att <- !vapply(abs_note, is.null, NA)
-    if (any(pooled[idx])) add(idx[pooled[idx]], "pooled: not judged against the device's history")
+    h <- list(key = k, serial = serial[idx[1]], idx = idx, hist = hist,
+              tref = tref, abs_note = abs_note, abs_att = abs_att)
     if (length(hist) < rules$min_recordings) {
-      for (j in which(abs_att)) add(hist[j], abs_note[[j]])
-      att[hist[abs_att]] <- TRUE
-      if (!is.na(serial[idx[1]])) {
-        add(hist, sprintf(paste0("no device history (%d calibrated ",
-                                 "recording(s) of device %s, %d needed)"),
-                          length(hist), serial[idx[1]], rules$min_recordings))
-      }
-      next
+      other[[length(other) + 1]] <- h
+    } else {
+      hists[[length(hists) + 1]] <- h
     }
-    # the reference: the device's recordings without the attenuation
-    # signature when there are enough of them, else all (the whole device
-    # shows it)
-    use <- if (sum(!abs_att) >= rules$min_recordings) hist[!abs_att] else hist
-    hists[[length(hists) + 1]] <- list(
-      serial = serial[idx[1]], hist = hist, use = use, abs_att = abs_att,
-      tref = tref,
-      abs_note = abs_note,
-      ref = apply(co[use, , drop = FALSE], 2, stats::median),
-      spread = apply(co[use, , drop = FALSE], 2, stats::mad),
-      # uncertainty of the median: 1.2533 times that of the mean
-      u_ref = 1.2533 * apply(se[use, , drop = FALSE], 2, function(v) {
-        v <- v[is.finite(v)]
-        if (length(v)) stats::median(v) else NA_real_
-      }) / sqrt(length(use)))
+  }
+  # a device's reference from the recordings `use`: the median of each
+  # coefficient, their robust spread, the median's uncertainty
+  reference <- function(use) {
+    list(use = use,
+         ref = apply(co[use, , drop = FALSE], 2, stats::median),
+         spread = apply(co[use, , drop = FALSE], 2, stats::mad),
+         # uncertainty of the median: 1.2533 times that of the mean
+         u_ref = 1.2533 * apply(se[use, , drop = FALSE], 2, function(v) {
+           v <- v[is.finite(v)]
+           if (length(v)) stats::median(v) else NA_real_
+         }) / sqrt(length(use)))
   }
   # the spread between a device's recordings: its own, or the median of
   # all devices' when larger (a device whose few recordings happen to agree
   # does not set a tighter rule than the cohort shows)
-  cohort_spread <- if (length(hists)) {
-    apply(do.call(rbind, lapply(hists, `[[`, "spread")), 2, stats::median,
+  cohort_spread <- function(refs) {
+    if (!length(refs)) return(NULL)
+    apply(do.call(rbind, lapply(refs, `[[`, "spread")), 2, stats::median,
           na.rm = TRUE)
   }
-  for (h in hists) {
-    ref <- h$ref
-    spread <- pmax(h$spread, cohort_spread, na.rm = TRUE)
-    u_ref <- h$u_ref
+  # one pass: each device's recordings judged against reference `R`; a
+  # list of (kind, note) per recording of `hist`, kind "attenuated",
+  # "device_outlier" or NA
+  judge <- function(h, R, cspread) {
+    ref <- R$ref
+    spread <- pmax(R$spread, cspread, na.rm = TRUE)
+    u_ref <- R$u_ref
+    use <- R$use
     hist <- h$hist
-    use <- h$use
     abs_att <- h$abs_att
-    devices[[length(devices) + 1]] <- data.frame(
-      serial = h$serial, recordings = length(hist),
-      reference_recordings = length(use),
-      reference_temp = h$tref,
-      t(stats::setNames(ref, paste0("ref.", cols))),
-      t(stats::setNames(spread, paste0("spread.", cols))),
-      check.names = FALSE)
     refnote <- sprintf("device %s reference (median of %d recordings): scale %s, offset %s g%s",
                        h$serial, length(use),
                        paste(sprintf("%.4f", ref[scales]), collapse = " "),
                        paste(sprintf("%.4f", ref[paste0("offset.", c("x", "y", "z"))]),
                              collapse = " "),
                        if (is.finite(h$tref)) sprintf(" at %.1f degrees C", h$tref) else "")
-    for (j in seq_along(hist)) {
+    lapply(seq_along(hist), function(j) {
       i <- hist[j]
       # relative to the device's reference where it has a history of its
       # own, else (the whole device shows it) relative to 1
@@ -323,22 +381,88 @@ cohort_plausibility <- function(tab) {
       }
       if (!is.null(a)) a <- paste0(a, " (", refnote, ")")
       if (is.null(a) && abs_att[j]) a <- h$abs_note[[j]]
-      if (!is.null(a)) {
-        att[i] <- TRUE
-        add(i, a)
-        next
-      }
+      if (!is.null(a)) return(list(kind = "attenuated", note = a))
+      # statistically (beyond z combined uncertainties) and practically
+      # (at least the coefficient's practical minimum) different
       u <- sqrt(se[i, ]^2 + u_ref^2 + spread^2)
       z <- (co[i, ] - ref) / u
-      z <- z[is.finite(z)]
-      if (any(abs(z) > rules$z)) {
-        outlier[i] <- TRUE
-        worst <- order(-abs(z))[seq_len(min(3, sum(abs(z) > rules$z)))]
-        add(i, sprintf("disagrees with its device's other recordings: %s (%s)",
-                       paste(sprintf("%s %s (z = %.1f)", names(z)[worst],
-                                     format(signif(co[i, names(z)[worst]], 4)),
-                                     z[worst]), collapse = ", "), refnote))
-      }
+      d <- practical_change(co[i, ], ref)
+      out <- is.finite(z) & abs(z) > rules$z & is.finite(d$size) & d$size >= d$min
+      if (!any(out)) return(list(kind = NA_character_, note = ""))
+      cand <- which(out)
+      worst <- cand[order(-abs(z[cand]))][seq_len(min(3, length(cand)))]
+      list(kind = "device_outlier", note = sprintf(
+        "disagrees with its device's other recordings: %s (%s)",
+        paste(sprintf("%s %s (%s, z = %.1f)", names(z)[worst],
+                      format(signif(co[i, worst], 4)), d$text[worst], z[worst]),
+              collapse = ", "), refnote))
+    })
+  }
+  # pass 1: the reference of the recordings without the attenuation
+  # signature when there are enough of them, else all (the whole device
+  # shows it)
+  refs1 <- lapply(hists, function(h) {
+    reference(if (sum(!h$abs_att) >= rules$min_recordings) h$hist[!h$abs_att] else h$hist)
+  })
+  cs1 <- cohort_spread(refs1)
+  pass1 <- lapply(seq_along(hists), function(d) judge(hists[[d]], refs1[[d]], cs1))
+  # pass 2: each reference without the recordings pass 1 flagged (any
+  # flag), when at least min_reference remain
+  flagged1 <- function(d) {
+    h <- hists[[d]]
+    vapply(seq_along(h$hist), function(j) {
+      i <- h$hist[j]
+      !is.na(pass1[[d]][[j]]$kind) || length(bounds[[i]]) > 0 || nzchar(stuck[i])
+    }, NA)
+  }
+  refs2 <- lapply(seq_along(hists), function(d) {
+    h <- hists[[d]]
+    keep <- h$hist[!flagged1(d)]
+    if (length(keep) >= rules$min_reference) reference(keep) else refs1[[d]]
+  })
+  cs2 <- cohort_spread(refs2)
+  pass2 <- lapply(seq_along(hists), function(d) judge(hists[[d]], refs2[[d]], cs2))
+
+  flag <- rep(NA_character_, n)
+  note <- rep("", n)
+  add <- function(i, s) note[i] <<- ifelse(nzchar(note[i]), paste0(note[i], "; ", s), s)
+  flag[applied] <- "ok"
+  flag[refused] <- "out_of_bounds"
+  note[refused] <- paste0("coefficients beyond the bounds at which gravcal ",
+                          "refuses them (plausible_bounds()); not applied")
+  att <- rep(FALSE, n)
+  outlier <- rep(FALSE, n)
+  for (h in other) {
+    if (any(pooled[h$idx])) add(h$idx[pooled[h$idx]], "pooled: not judged against the device's history")
+    for (j in which(h$abs_att)) add(h$hist[j], h$abs_note[[j]])
+    att[h$hist[h$abs_att]] <- TRUE
+    if (!is.na(h$serial)) {
+      add(h$hist, sprintf(paste0("no device history (%d calibrated ",
+                                 "recording(s) of device %s, %d needed)"),
+                          length(h$hist), h$serial, rules$min_recordings))
+    }
+  }
+  devices <- list()
+  for (d in seq_along(hists)) {
+    h <- hists[[d]]
+    R <- refs2[[d]]
+    if (any(pooled[h$idx])) add(h$idx[pooled[h$idx]], "pooled: not judged against the device's history")
+    left <- setdiff(h$hist, R$use)
+    devices[[length(devices) + 1]] <- data.frame(
+      serial = h$serial, recordings = length(h$hist),
+      reference_recordings = length(R$use),
+      reference_files = paste(files[R$use], collapse = "; "),
+      left_out_files = paste(files[left], collapse = "; "),
+      reference_temp = h$tref,
+      t(stats::setNames(R$ref, paste0("ref.", cols))),
+      t(stats::setNames(pmax(R$spread, cs2, na.rm = TRUE), paste0("spread.", cols))),
+      check.names = FALSE, stringsAsFactors = FALSE)
+    for (j in seq_along(h$hist)) {
+      i <- h$hist[j]
+      v <- pass2[[d]][[j]]
+      if (is.na(v$kind)) next
+      if (v$kind == "attenuated") att[i] <- TRUE else outlier[i] <- TRUE
+      add(i, v$note)
     }
   }
   for (i in which(applied)) {
@@ -346,12 +470,78 @@ cohort_plausibility <- function(tab) {
       add(i, paste0("beyond omconvert's bounds (plausible_bounds()): ",
                     paste(bounds[[i]], collapse = ", ")))
     }
+    if (nzchar(stuck[i])) add(i, stuck[i])
   }
   flag[outlier] <- "device_outlier"
+  flag[applied & nzchar(stuck)] <- "temperature_stuck"
   flag[applied & lengths(bounds) > 0] <- "out_of_bounds"
   flag[att] <- "attenuated"
   tab$plausibility <- flag
   tab$plausibility_note <- note
   devs <- if (length(devices)) do.call(rbind, devices) else NULL
   list(tab = tab, devices = devs)
+}
+
+# How far a recording's coefficients `co` lie from the reference `ref`
+# in the units of their practical minimum (plausible_bounds()'s
+# `practical_min`): list(size, min, text), one element per coefficient.
+# Scales are compared relative to the reference (a fraction), the others
+# as differences.
+practical_change <- function(co, ref) {
+  b <- plausible_bounds()
+  nm <- names(co)
+  group <- coefficient_group(nm)
+  rel <- group == "scale"
+  size <- ifelse(rel, abs(co / ref - 1), abs(co - ref))
+  d <- ifelse(rel, co / ref - 1, co - ref)
+  text <- ifelse(group == "scale", sprintf("%+.2f %%", 100 * d),
+          ifelse(group == "offset", sprintf("%+.1f mg", 1000 * d),
+          ifelse(group == "temperature_offset",
+                 sprintf("%+.2f mg per degree C", 1000 * d),
+                 sprintf("%+.4f", d))))
+  list(size = stats::setNames(size, nm),
+       min = b$practical_min[match(group, b$coefficient)], text = text)
+}
+
+# The coefficient group (a row of plausible_bounds()) of cohort table names.
+coefficient_group <- function(nm) {
+  ifelse(startsWith(nm, "scale."), "scale",
+  ifelse(startsWith(nm, "cross."), "cross",
+  ifelse(startsWith(nm, "offset."), "offset", "temperature_offset")))
+}
+
+# A stuck temperature sensor (see ?plausible_bounds, attribute history):
+# for each row of a cohort table, the note that flags it, or "". Reads the
+# column `temperature_flat` (TRUE: the recording has a temperature that does
+# not vary; absent or NA: not known) and `hours`.
+temperature_stuck_notes <- function(tab, applied, pooled, key) {
+  n <- nrow(tab)
+  out <- rep("", n)
+  if (!"temperature_flat" %in% names(tab)) return(out)
+  flat <- tab$temperature_flat %in% TRUE
+  varies <- tab$temperature_flat %in% FALSE
+  hours <- if ("hours" %in% names(tab)) tab$hours else rep(NA_real_, n)
+  for (i in which(applied & flat & !pooled)) {
+    others <- which(key == key[i] & applied & !pooled & varies)
+    others <- setdiff(others, i)
+    long <- isTRUE(hours[i] >= history_rules$temperature_stuck_hours)
+    if (!long && !length(others)) next
+    out[i] <- temperature_stuck_note(hours[i], NA_real_, if (length(others)) {
+      sprintf("while %d other recording(s) of device %s vary", length(others),
+              tab$serial[i])
+    })
+  }
+  out
+}
+
+# The note of a stuck temperature sensor.
+temperature_stuck_note <- function(hours, value, history = NULL) {
+  paste0("temperature stuck: the temperature ",
+         if (is.finite(value)) sprintf("reads %.2f degrees C", value) else
+           "does not vary",
+         sprintf(" (sd < %g degrees C)", history_rules$temperature_flat_sd),
+         if (is.finite(hours)) sprintf(" over %.1f h", hours),
+         if (!is.null(history)) paste0(" ", history),
+         "; a working sensor follows the skin and the room by degrees. The ",
+         "calibration has no temperature term")
 }

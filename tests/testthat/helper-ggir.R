@@ -1,10 +1,23 @@
+# GGIR 3.3-9's g.calibrate(), g.inspectfile(), read.myacc.csv() and
+# g.getstarttime() set options(warn = -1) and set it back (to 0) only when
+# they get that far: one that stops in between leaves warnings switched off
+# for the rest of the session, and every later expect_snapshot() then
+# records no warning (evaluate drops warnings while warn < 0). A call of
+# GGIR's that may stop goes through keep_warn(), which restores the
+# session's `warn` whatever happens.
+keep_warn <- function(expr) {
+  op <- options(warn = getOption("warn"))
+  on.exit(options(op), add = TRUE)
+  expr
+}
+
 # Run GGIR's g.calibrate and gravcal's on the same file, quietly.
 run_both <- function(file, params = list()) {
   pr <- GGIR::load_params()$params_rawdata
   pr <- utils::modifyList(pr, params)
   quiet <- function(expr) {
     out <- NULL
-    utils::capture.output(out <- suppressWarnings(expr))
+    keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
     out
   }
   R <- ggir_cached("g.calibrate", file, list(params_rawdata = pr), {

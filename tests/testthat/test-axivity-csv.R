@@ -110,7 +110,7 @@ test_that("g.calibrate() on Axivity csv exports with text time stamps is GGIR's,
   pr <- GGIR::load_params()$params_rawdata
   quiet <- function(expr) {
     out <- NULL
-    utils::capture.output(out <- suppressWarnings(expr))
+    keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
     out
   }
   for (nm in names(styles)) {
@@ -177,9 +177,13 @@ test_that("an Axivity csv export with OMGUI's header line: GGIR stops, so g.cali
   gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, stamps = "text", header = TRUE)
   pr <- GGIR::load_params()$params_rawdata
   I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr))
-  expect_error(suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
-                                                  verbose = FALSE)),
+  # GGIR stops with the session's warnings switched off (options(warn =
+  # -1)); keep_warn() restores them, so later snapshots record warnings
+  warn <- getOption("warn")
+  expect_error(keep_warn(suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
+                                                            verbose = FALSE))),
                "standard unambiguous format")
+  expect_identical(getOption("warn"), warn)
   expect_error(gravcal::g.calibrate(f, verbose = FALSE),
                "Axivity csv export with a header line", fixed = TRUE)
   expect_error(gravcal::g.calibrate(f, inspectfileobject = I, verbose = FALSE),
@@ -243,7 +247,7 @@ test_that("desiredtz across daylight saving: text stamps GGIR's; UNIX and ISO 86
   pg <- utils::modifyList(pl$params_general, list(desiredtz = "Europe/Amsterdam"))
   quiet <- function(expr) {
     out <- NULL
-    utils::capture.output(out <- suppressWarnings(expr))
+    keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
     out
   }
   # text GGIR reads with as.POSIXct() in the zone: its result, which the

@@ -49,7 +49,7 @@ test_that("g.calibrate() refuses a GENEActiv csv export as GGIR does, and GGIR's
   on.exit(unlink(f))
   gravcal:::write_geneactiv_csv(rec, f, sf = 10)
   # GGIR detects the written file as a GENEActiv csv export, and stops
-  expect_error(suppressWarnings(GGIR::g.inspectfile(f)), "GENEActiv csv reading functionality is deprecated",
+  expect_error(keep_warn(suppressWarnings(GGIR::g.inspectfile(f))), "GENEActiv csv reading functionality is deprecated",
                fixed = TRUE)
   expect_error(g.calibrate(f, verbose = FALSE),
                "is a GENEActiv csv export, which GGIR does not read", fixed = TRUE)

@@ -182,7 +182,7 @@ run_both_general <- function(f, general, rawdata = list()) {
   pg <- utils::modifyList(GGIR::load_params()$params_general, general)
   quiet <- function(expr) {
     out <- NULL
-    utils::capture.output(out <- suppressWarnings(expr))
+    keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
     out
   }
   R <- ggir_cached("g.calibrate", f, list(params_rawdata = pr, params_general = pg), {

@@ -124,7 +124,7 @@ st_run_both <- function(file, params) {
   pr <- utils::modifyList(GGIR::load_params()$params_rawdata, params)
   quiet <- function(expr) {
     out <- NULL
-    utils::capture.output(out <- suppressWarnings(expr))
+    keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
     out
   }
   R <- ggir_cached("g.calibrate", file, list(params_rawdata = pr),

@@ -57,10 +57,11 @@ test_that("a recording that disagrees with its device's others is a device outli
   expect_identical(j$tab$plausibility, c("ok", "ok", "device_outlier", "ok", "ok"))
   expect_match(j$tab$plausibility_note[3], "offset.x")
   expect_match(j$tab$plausibility_note[3], "device 1234 reference")
-  # the device's reference: the median, which the outlier does not move
+  # the device's reference: the median of the recordings not flagged
   expect_identical(j$devices$serial, "1234")
   expect_equal(j$devices$recordings, 5)
-  expect_equal(j$devices$ref.offset.x, stats::median(co[, 4]))
+  expect_equal(j$devices$ref.offset.x, stats::median(co[-3, 4]))
+  expect_identical(j$devices$left_out_files, "r03.cwa")
   expect_lt(abs(j$devices$ref.offset.x - p[4]), 0.003)
   # within its uncertainty it is not: the same shift with standard errors
   # of 0.01
@@ -89,10 +90,11 @@ test_that("a device's offsets are compared at one temperature", {
   expect_identical(j$tab$plausibility, rep("ok", 5))
   expect_equal(j$devices$reference_temp, 28)
   expect_lt(abs(j$devices$ref.offset.x - p[4]), 0.001)
-  # a recording whose offset moved by 4 mg is found at one temperature;
-  # as each fit states them, the temperature's spread of the offsets
-  # (5 mg on y between 22 and 34 degrees C) hides it
-  tab$offset.y[3] <- tab$offset.y[3] + 0.004
+  # a recording whose offset moved by 8 mg (beyond the practical minimum
+  # of 5 mg) is found at one temperature; as each fit states them, the
+  # temperature's spread of the offsets (5 mg on y between 22 and 34
+  # degrees C) hides it
+  tab$offset.y[3] <- tab$offset.y[3] + 0.008
   j <- gravcal:::cohort_plausibility(tab)
   expect_identical(j$tab$plausibility, c("ok", "ok", "device_outlier", "ok", "ok"))
   expect_match(j$tab$plausibility_note[3], "offset.y", fixed = TRUE)
@@ -234,4 +236,228 @@ test_that("print() of a fit beyond omconvert's bounds says so", {
   fit <- calibrate(rec, sf = 10, method = "lightweight")
   expect_identical(fit$status, "ok")
   expect_output(print(fit), "plausibility: out_of_bounds - beyond omconvert's bounds")
+})
+
+# A cohort table with temperature offsets: `co` 9 columns (scale, offset,
+# temperature offset), one standard error per group.
+cohort_tab_t <- function(co, se, serial, meantemp = 28) {
+  cols <- c("scale.x", "scale.y", "scale.z", "offset.x", "offset.y", "offset.z",
+            "temperature.offset.x", "temperature.offset.y", "temperature.offset.z")
+  co <- matrix(co, ncol = 9, dimnames = list(NULL, cols))
+  se <- matrix(rep(se, each = nrow(co)), nrow(co), 9,
+               dimnames = list(NULL, paste0(cols, ".se")))
+  data.frame(file = sprintf("r%02d.cwa", seq_len(nrow(co))), status = "ok", co, se,
+             meantempcal = meantemp, serial = serial, pooled = FALSE,
+             stringsAsFactors = FALSE, check.names = FALSE)
+}
+
+test_that("plausible_bounds() states a practical minimum change per coefficient", {
+  b <- plausible_bounds()
+  # bench/results/enmo-sensitivity.md: the changes that move a day's ENMO
+  # by about 1 mg (5 mg offsets, 0.5 % scales; 1 mg per degree C = 5 mg
+  # over the wrist's usual 4 degrees C from its mean)
+  expect_equal(b$practical_min, c(0.005, 0.005, 0.005, 0.001))
+  expect_true(all(nzchar(b$practical_source)))
+  h <- attr(b, "history")
+  expect_equal(h[c("min_reference", "temperature_flat_sd", "temperature_stuck_hours")],
+               list(min_reference = 2L, temperature_flat_sd = 0.01,
+                    temperature_stuck_hours = 12))
+})
+
+test_that("a device outlier needs a change of practical size, not only a large z", {
+  set.seed(41)
+  # 8 devices of 3-4 recordings that agree within a device to 0.5 mg and
+  # 0.03 % (fits of 26 h), standard errors 0.2 mg and 0.02 %
+  n <- rep(c(3, 4), 4)
+  co <- do.call(rbind, lapply(n, function(k) {
+    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02),
+           stats::rnorm(3, sd = 0.0005))
+    t(replicate(k, p + c(stats::rnorm(3, sd = 0.0003), stats::rnorm(3, sd = 0.0005),
+                         stats::rnorm(3, sd = 0.00002))))
+  }))
+  serial <- rep(sprintf("S%d", 1:8), n)
+  se <- c(0.0002, 0.0002, 0.0002, 0.0002, 0.0002, 0.0002, 0.00001, 0.00001, 0.00001)
+  tab <- cohort_tab_t(co, se, serial)
+  expect_identical(unique(gravcal:::cohort_plausibility(tab)$tab$plausibility), "ok")
+  # recording 2 of S1: offset.y 3.5 mg and temperature.offset.z 0.24 mg per
+  # degree C from its device's others (the issue's clean recording);
+  # recording 6 of S2: offset.x 50 mg (a jump)
+  tab$offset.y[2] <- stats::median(tab$offset.y[c(1, 3)]) + 0.0035
+  tab$temperature.offset.z[2] <- stats::median(tab$temperature.offset.z[c(1, 3)]) + 0.00024
+  tab$offset.x[6] <- tab$offset.x[6] + 0.05
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility[2], "ok")
+  expect_identical(j$tab$plausibility[6], "device_outlier")
+  expect_match(j$tab$plausibility_note[6], "offset.x .*\\(\\+(49|50)[.][0-9] mg, z = ")
+  expect_identical(sum(j$tab$plausibility != "ok"), 1L)
+  # statistically, recording 2 does differ (z above 4 for both): only the
+  # practical minimum keeps it unflagged
+  d <- j$devices[j$devices$serial == "S1", ]
+  zof <- function(col) {
+    u <- sqrt(tab[[paste0(col, ".se")]][2]^2 +
+                (1.2533 * tab[[paste0(col, ".se")]][2] / sqrt(d$reference_recordings))^2 +
+                d[[paste0("spread.", col)]]^2)
+    (tab[[col]][2] - d[[paste0("ref.", col)]]) / u
+  }
+  expect_gt(zof("offset.y"), 4)
+  expect_gt(zof("temperature.offset.z"), 4)
+  # twice as large, beyond the practical minimum (7 mg, 0.48 mg per degree
+  # C stays below 1): flagged for the offset only
+  tab$offset.y[2] <- tab$offset.y[2] + 0.0035
+  tab$temperature.offset.z[2] <- tab$temperature.offset.z[2] + 0.00024
+  j2 <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j2$tab$plausibility[2], "device_outlier")
+  expect_match(j2$tab$plausibility_note[2], "offset.y")
+  expect_no_match(j2$tab$plausibility_note[2], "temperature.offset.z")
+  # a temperature offset 1.5 mg per degree C off, and a scale 0.7 % off
+  tab$temperature.offset.x[9] <- tab$temperature.offset.x[9] + 0.0015
+  tab$scale.z[12] <- tab$scale.z[12] * 1.007
+  tab$scale.y[13] <- tab$scale.y[13] * 1.003  # 0.3 %: below the minimum
+  j3 <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j3$tab$plausibility[c(9, 12, 13)], c("device_outlier", "device_outlier", "ok"))
+  expect_match(j3$tab$plausibility_note[9], "temperature.offset.x .*\\+1[.][45][0-9] mg per degree C")
+  expect_match(j3$tab$plausibility_note[12], "scale.z .*\\+0[.]7[0-9] %")
+})
+
+test_that("the issue's cohort: recordings 1.5 mg and 0.1 % apart are not flagged, faults are", {
+  set.seed(44)
+  n <- rep(c(3, 4), 4)
+  co <- do.call(rbind, lapply(n, function(k) {
+    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02),
+           stats::rnorm(3, sd = 0.0005))
+    t(replicate(k, p + c(p[1:3] * stats::rnorm(3, sd = 0.001), stats::rnorm(3, sd = 0.0015),
+                         stats::rnorm(3, sd = 0.00005))))
+  }))
+  serial <- rep(sprintf("S%d", 1:8), n)
+  tab <- cohort_tab_t(co, c(rep(0.0003, 6), rep(0.00003, 3)), serial)
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(unique(j$tab$plausibility), "ok")
+  # faults: a 50 mg offset jump (4), an attenuated recording (11: the raw
+  # signal x 0.95, scales / 0.95), an implausible gain (20: refused)
+  tab$offset.x[4] <- tab$offset.x[4] + 0.05
+  tab[11, c("scale.x", "scale.y", "scale.z")] <- tab[11, c("scale.x", "scale.y", "scale.z")] / 0.95
+  tab$status[20] <- "implausible"
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility[c(4, 11, 20)],
+                   c("device_outlier", "attenuated", "out_of_bounds"))
+  expect_identical(sum(j$tab$plausibility != "ok"), 3L)
+})
+
+test_that("a device's reference leaves out the recordings the run flags", {
+  set.seed(45)
+  p <- c(1.01, 0.99, 1.005, 0.02, -0.01, 0.015)
+  co <- device_rows(p, 4, 0.0005)
+  co[2, 1:3] <- co[2, 1:3] / 0.95      # attenuated
+  co[4, 4] <- co[4, 4] + 0.03          # an offset jump of 30 mg
+  # a second device, clean
+  co <- rbind(co, device_rows(c(1, 1.01, 0.995, -0.01, 0.01, 0), 3, 0.0005))
+  tab <- cohort_tab(co, 0.0005, rep(c("A", "B"), c(4, 3)))
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility,
+                   c("ok", "attenuated", "ok", "device_outlier", "ok", "ok", "ok"))
+  a <- j$devices[j$devices$serial == "A", ]
+  expect_identical(a$reference_files, "r01.cwa; r03.cwa")
+  expect_identical(a$left_out_files, "r02.cwa; r04.cwa")
+  expect_equal(a$reference_recordings, 2)
+  expect_equal(a$ref.offset.x, mean(co[c(1, 3), 4]))
+  expect_equal(a$ref.scale.y, mean(co[c(1, 3), 2]))
+  # the note names the reference of 2 recordings
+  expect_match(j$tab$plausibility_note[4], "median of 2 recordings")
+  b <- j$devices[j$devices$serial == "B", ]
+  expect_identical(b$reference_files, "r05.cwa; r06.cwa; r07.cwa")
+  expect_identical(b$left_out_files, "")
+  # a device of 3 with 2 flagged keeps all 3 in its reference (fewer than
+  # min_reference would remain)
+  co3 <- device_rows(p, 3, 0.0005)
+  co3[1, 4] <- co3[1, 4] + 0.03
+  co3[2, 5] <- co3[2, 5] - 0.03
+  j3 <- gravcal:::cohort_plausibility(cohort_tab(co3, 0.0005, "C"))
+  expect_identical(j3$tab$plausibility, c("device_outlier", "device_outlier", "ok"))
+  expect_identical(j3$devices$reference_files, "r01.cwa; r02.cwa; r03.cwa")
+})
+
+test_that("a temperature that does not vary is a stuck sensor: alone over 12 h, or against the device", {
+  set.seed(46)
+  co <- device_rows(c(1.01, 0.99, 1.005, 0.02, -0.01, 0.015), 4, 0.0005)
+  tab <- cohort_tab(co, 0.0005, "T1")
+  tab$hours <- c(26, 26, 26, 6)
+  tab$temperature_flat <- c(FALSE, TRUE, FALSE, TRUE)
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility, c("ok", "temperature_stuck", "ok", "temperature_stuck"))
+  expect_match(j$tab$plausibility_note[2], "temperature stuck: the temperature does not vary (sd < 0.01 degrees C) over 26.0 h",
+               fixed = TRUE)
+  expect_match(j$tab$plausibility_note[4], "over 6.0 h while 2 other recording(s) of device T1 vary",
+               fixed = TRUE)
+  # left out of the device's reference
+  expect_identical(j$devices$reference_files, "r01.cwa; r03.cwa")
+  # 6 h without a device whose temperature is seen to vary: not flagged;
+  # 26 h alone (no serial): flagged
+  tab2 <- tab
+  tab2$temperature_flat <- c(NA, NA, NA, TRUE)
+  expect_identical(gravcal:::cohort_plausibility(tab2)$tab$plausibility, rep("ok", 4))
+  tab3 <- tab[2, ]
+  tab3$serial <- NA_character_
+  expect_identical(gravcal:::cohort_plausibility(tab3)$tab$plausibility, "temperature_stuck")
+  # a table without the column (GGIR-compatible mode, older tables)
+  expect_identical(gravcal:::cohort_plausibility(tab[setdiff(names(tab), "temperature_flat")])$tab$plausibility,
+                   rep("ok", 4))
+})
+
+test_that("calibrate() in gravcal's own modes flags a stuck temperature sensor; GGIR-compatible mode does not look", {
+  rec <- simulate_recording(hours = 13, sf = 10, seed = 47, tempoffset = c(0.001, -0.0005, 0.0008))
+  stuck <- rec
+  stuck$temperature <- stuck$temperature[1]
+  for (m in c("lightweight", "ggir")) {
+    f <- suppressWarnings(calibrate(stuck, sf = 10, method = m))
+    expect_identical(f$status, "ok")
+    expect_true(f$temperature_check$stuck, label = m)
+    expect_identical(unname(f$tempoffset), c(0, 0, 0))
+    expect_output(print(f), "plausibility: temperature_stuck - temperature stuck: the temperature ")
+    if (m == "lightweight") {
+      expect_match(f$temperature_check$note, sprintf("reads %.2f degrees C", rec$temperature[1]),
+                   fixed = TRUE)
+    }
+    # the same recording with its temperature: not stuck, temperature term fitted
+    g <- calibrate(rec, sf = 10, method = m)
+    expect_false(g$temperature_check$stuck)
+    expect_false(g$temperature_check$flat)
+    expect_true(any(g$tempoffset != 0))
+    expect_no_match(paste(capture.output(print(g)), collapse = "\n"), "temperature_stuck")
+    # 6 h: flat, but too short to say alone
+    s6 <- stuck[seq_len(6 * 3600 * 10), ]
+    f6 <- suppressWarnings(calibrate(s6, sf = 10, method = m))
+    expect_true(f6$temperature_check$flat)
+    expect_false(f6$temperature_check$stuck)
+  }
+  # no temperature: nothing to judge
+  nt <- calibrate(rec[c("time", "x", "y", "z")], sf = 10)
+  expect_false(nt$temperature_check$available)
+  expect_false(nt$temperature_check$stuck)
+  # GGIR-compatible mode keeps GGIR's outcome and adds no check
+  fc <- suppressWarnings(calibrate(stuck, sf = 10, method = "ggir", ggir_compat = TRUE))
+  expect_null(fc$temperature_check)
+})
+
+test_that("calibrate_files() flags a stuck temperature sensor, both methods", {
+  skip_if_quick()
+  dir <- tempfile("stuck")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  p <- c(1.01, 0.99, 1.005, 0, 0, 0, 0.02, -0.015, 0.01)
+  for (k in 1:3) {
+    rec <- simulate_recording(hours = 13, sf = 12.5, params = p, seed = 60 + k,
+                              tempoffset = c(0.001, -0.0005, 0.0008))
+    temp <- rec$temperature
+    if (k == 3) temp[] <- temp[1]
+    gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file.path(dir, sprintf("r%d.cwa", k)),
+                        sf = 12.5, packed = FALSE, temperature = temp, device_id = 77)
+  }
+  for (m in c("ggir", "lightweight")) {
+    res <- suppressWarnings(calibrate_files(dir, method = m, outdir = file.path(dir, paste0("out-", m))))
+    expect_identical(res$status, rep("ok", 3))
+    expect_identical(res$temperature_flat, c(FALSE, FALSE, TRUE))
+    expect_identical(res$plausibility, c("ok", "ok", "temperature_stuck"), label = m)
+    expect_match(res$plausibility_note[3], "temperature stuck")
+    expect_identical(attr(res, "fits")[[3]]$plausibility$flag, "temperature_stuck")
+  }
 })
