@@ -34,14 +34,16 @@ native_open <- function(file, format, options = list(), arg = "file") {
 native_format_name <- function(format) format_entry(format)$label %||% format
 
 # The next block of at most `max_units` format units (NULL: no limit) and
-# `capacity` samples, as list(cols = list(x, y, z, temperature, time), from
-# = 0, to = n, units, done).
+# `capacity` samples, as list(cols = list(x, y, z, temperature, time,
+# light), from = 0, to = n, units, done). temperature, time and light are
+# NULL unless asked for and the format has them (light: .cwa and GENEActiv
+# .bin; h$info$light).
 native_block <- function(h, max_units = NULL, capacity = 1e6,
-                         temperature = TRUE, time = FALSE) {
+                         temperature = TRUE, time = FALSE, light = TRUE) {
   b <- gc_decoder_read(h$ptr, if (is.null(max_units)) -1 else max_units,
-                       capacity, temperature, time)
+                       capacity, temperature, time, light)
   list(cols = list(x = b$x, y = b$y, z = b$z, temperature = b$temperature,
-                   time = b$time),
+                   time = b$time, light = b$light),
        from = 0, to = b$n, units = b$units, done = b$done)
 }
 
@@ -49,22 +51,24 @@ native_block <- function(h, max_units = NULL, capacity = 1e6,
 # decode.hpp).
 native_report <- function(h) gc_decoder_report(h$ptr)
 
-# A whole file as a data frame (x, y, z, and temperature and time where the
-# file has them), with attributes `sf`, `info` and `report`. For tests and
-# read_recording(); calibration streams instead.
+# A whole file as a data frame (x, y, z, and temperature, time and light
+# where the file has them and they are asked for), with attributes `sf`,
+# `info` and `report`. For tests and read_recording(); calibration streams
+# instead.
 native_read_all <- function(file, format, options = list(), time = TRUE,
-                            chunk = 65536, arg = "file") {
+                            chunk = 65536, arg = "file", light = TRUE) {
   h <- native_open(file, format, options, arg)
   on.exit(gc_decoder_close(h$ptr))
-  native_samples(h, time, chunk)
+  native_samples(h, time, chunk, light)
 }
 
 # Every sample of an open decoder `h`, through the pump (`chunk` samples a
 # write), as native_read_all() gives them.
-native_samples <- function(h, time = TRUE, chunk = 65536) {
+native_samples <- function(h, time = TRUE, chunk = 65536, light = TRUE) {
   d <- as.data.frame(gc_pump(gc_source_decoder(h$ptr), "samples",
                              list(time = as.numeric(time && isTRUE(h$info$time)),
-                                  chunk = chunk)))
+                                  chunk = chunk,
+                                  light = as.numeric(light && isTRUE(h$info$light)))))
   attr(d, "sf") <- h$info$sf
   attr(d, "info") <- h$info
   attr(d, "report") <- native_report(h)
