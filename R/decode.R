@@ -19,7 +19,35 @@ decoder_open <- function(file, format, options = list()) {
     nums <- unisens_r_numbers(file)
     options[names(nums)] <- nums
   }
+  if (format == "geneactiv") {
+    lo <- geneactiv_light_header(file)
+    lo <- lo[setdiff(names(lo), names(options))]
+    options[names(lo)] <- lo
+  }
   gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
+}
+
+# What GGIRread 1.2.0's readGENEActiv() reads from a GENEActiv header for its
+# light column, read as it reads it: among the file's first 69 lines
+# (readLines()), the first with "Lux", the first with "Volts" (as.numeric()
+# once "Lux:", "Volts:" are taken out; NA where there is none) and whether
+# the first with "Device Model" ends in "1.1" once "Device Model:" and
+# blanks are taken out. As options light_lux, light_volts, light_model11
+# for the decoder (decode_geneactiv.hpp); nothing when the file's first
+# 64 kB cannot be read as lines (the decoder reads the header itself).
+geneactiv_light_header <- function(file) {
+  b <- tryCatch(suppressWarnings(readBin(file, raw(), 65536)), error = function(e) raw(0))
+  if (!length(b)) return(list())
+  con <- rawConnection(b)
+  on.exit(close(con))
+  tryCatch(suppressWarnings({
+    fh <- readLines(con, 69)
+    first <- function(key) fh[grep(key, fh)[1]]
+    model <- gsub(" ", "", gsub("Device Model:", "", first("Device Model")))
+    list(light_lux = as.numeric(gsub("Lux:", "", first("Lux"))),
+         light_volts = as.numeric(gsub("Volts:", "", first("Volts"))),
+         light_model11 = as.numeric(grepl("1\\.1$", model)))
+  }), error = function(e) list())
 }
 
 # Open `file` with the native decoder of `format`; `options` is a named list
