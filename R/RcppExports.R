@@ -29,8 +29,8 @@ gc_decoder_open <- function(path, format, options) {
     .Call(`_gravcal_gc_decoder_open`, path, format, options)
 }
 
-gc_decoder_read <- function(ptr, max_units, capacity, want_temperature, want_time) {
-    .Call(`_gravcal_gc_decoder_read`, ptr, max_units, capacity, want_temperature, want_time)
+gc_decoder_read <- function(ptr, max_units, capacity, want_temperature, want_time, want_light) {
+    .Call(`_gravcal_gc_decoder_read`, ptr, max_units, capacity, want_temperature, want_time, want_light)
 }
 
 gc_decoder_report <- function(ptr) {

@@ -51,8 +51,11 @@
 #'   is the file's for UNIX or ActivPAL time stamps, else the first stamp
 #'   plus the sample index over `sf`.
 #' @return A list with `data` (a data frame with `x`, `y`, `z` and, where the
-#'   file has them, `time` and `temperature`), `sf` and `input` (for the
-#'   native reader: the samples read and what was skipped, and why).
+#'   file has them, `time` and `temperature`; with the native reader, `light`
+#'   for `.cwa` and GENEActiv `.bin` files, the device's light value as
+#'   GGIRread gives it: an Axivity block's raw 10-bit sensor value,
+#'   GENEActiv's lux), `sf` and `input` (for the native reader: the samples
+#'   read and what was skipped, and why).
 #' @export
 #' @examples
 #' rec <- read_recording(gravcal_example())

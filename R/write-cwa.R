@@ -11,7 +11,9 @@ cwa_chunk_blocks <- 8192  # blocks built at once (bounds the writer's memory)
 # (POSIXct or seconds since 1970 UTC). `packed`: AX3 3 x 10-bit + exponent
 # (120 samples a block), else 16-bit (80; 40 with `ax6`, gyroscope 0).
 # `temperature` in degrees C: one value, or one a sample (each block takes
-# its first sample's). `time`: optional time of each sample, to place blocks
+# its first sample's). `light`: the light sensor's raw value (0 to 1023),
+# one value, one a block, or one a sample (each block takes its first
+# sample's). `time`: optional time of each sample, to place blocks
 # (gaps, jumps); a block starts at its first sample's time. `fractional`:
 # blocks carry a fraction of a second (deviceFractional's top bit).
 # `append = TRUE` adds the blocks to the end of an existing file written by
@@ -33,6 +35,7 @@ write_cwa <- function(x, file, sf = 100, start = 1.7e9, packed = TRUE,
   first <- (seq_len(nb) - 1) * spb + 1
   t0 <- if (is.null(time)) as.numeric(start) + (first - 1) / sf else as.numeric(time)[first]
   temp <- if (length(temperature) == n) temperature[first] else rep_len(temperature, nb)
+  lux <- if (length(light) == n) light[first] else rep_len(light, nb)
   con <- file(file, if (append) "ab" else "wb")
   on.exit(close(con))
   if (!append) writeBin(cwa_header(device_id, session, rate_byte, ax6), con)
@@ -40,7 +43,7 @@ write_cwa <- function(x, file, sf = 100, start = 1.7e9, packed = TRUE,
     bl <- b0:min(nb, b0 + cwa_chunk_blocks - 1)
     rows <- ((bl[1] - 1) * spb + 1):min(n, bl[length(bl)] * spb)
     w <- cwa_words(x[rows, , drop = FALSE], bl + block0, spb, t0[bl], temp[bl], sf,
-                   packed, ax6, light, rate_byte, scale_code, fractional,
+                   packed, ax6, lux[bl], rate_byte, scale_code, fractional,
                    device_id, session)
     writeBin(as.integer(w), con, size = 2, endian = "little")  # 16-bit words
   }

@@ -11,13 +11,19 @@
 # is the header's "Time Zone:" text. `append = TRUE` adds pages to the end
 # of a file written by this function (no header), numbered from `page0`;
 # `pages_total` is the header's page count for a file written in pieces.
+# `light`: the 10-bit light value of each sample (0 to 1023; NULL: 0),
+# written with status bits `status` (0 to 3); `model`: the header's "Device
+# Model:" value; `volts_line`, `lux_line`: its "Volts:" and "Lux:" lines
+# (whole lines: a test may misspell them, the header keeps its 59 lines).
 # Test-only; not exported.
 write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
                                 gain = c(25600, 25600, 25600),
                                 offset = c(0, 0, 0), pages_per_write = 2000,
                                 eol = "\n", page_sf = NULL,
                                 time_zone = "GMT +00:00", serial = "000000",
-                                append = FALSE, page0 = 0, pages_total = NULL) {
+                                append = FALSE, page0 = 0, pages_total = NULL,
+                                light = NULL, status = 0, model = "1.1",
+                                volts_line = "Volts:300", lux_line = "Lux:800") {
   s <- as_samples(x)
   pages <- s$n %/% 300
   if (pages < 1) abort("`x` has fewer than 300 samples, one GENEActiv page.")
@@ -26,7 +32,10 @@ write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
   t0 <- as.numeric(as.POSIXct(start, tz = "UTC"))
   page_t <- t0 + cumsum(c(0, 300 / page_sf[-pages]))
   hdr <- ga_header(t0, sf, if (is.null(pages_total)) pages else pages_total,
-                   gain, offset, time_zone, serial)
+                   gain, offset, time_zone, serial, model, volts_line, lux_line)
+  lt <- if (is.null(light)) integer(s$n) else as.integer(rep_len(light, s$n))
+  if (anyNA(lt) || any(lt < 0 | lt > 1023)) abort("`light` must be in 0..1023.")
+  lt <- lt * 4L + as.integer(rep_len(status, s$n))
   con <- file(file, if (append) "ab" else "wb")
   on.exit(close(con))
   if (!append) writeLines(hdr, con, sep = eol)
@@ -37,7 +46,7 @@ write_geneactiv_bin <- function(x, file, sf, start = "2024-01-01 00:00:00",
     to <- p1 * 300
     lines <- ga_hex_lines(lut, ga_counts(s$x[from:to], gain[1], offset[1]),
                           ga_counts(s$y[from:to], gain[2], offset[2]),
-                          ga_counts(s$z[from:to], gain[3], offset[3]))
+                          ga_counts(s$z[from:to], gain[3], offset[3]), lt[from:to])
     np <- p1 - p0
     temp <- if (is.null(s$temperature)) rep(20, np) else
       colMeans(matrix(s$temperature[from:to], 300))
@@ -61,10 +70,11 @@ ga_stamp <- function(t) {
          ":", sprintf("%03d", as.integer(ms %% 1000)))
 }
 
-ga_header <- function(t0, sf, pages, gain, offset, time_zone, serial) {
+ga_header <- function(t0, sf, pages, gain, offset, time_zone, serial,
+                      model = "1.1", volts_line = "Volts:300", lux_line = "Lux:800") {
   st <- ga_stamp(t0)
   c("Device Identity", paste0("Device Unique Serial Code:", serial),
-    "Device Type:GENEActiv", "Device Model:1.1",
+    "Device Type:GENEActiv", paste0("Device Model:", model),
     "Device Firmware Version:Ver1.30 date 05Aug11",
     paste0("Calibration Date:", st), "",
     "Device Capabilities", "Accelerometer Range:-8 to 8",
@@ -83,7 +93,7 @@ ga_header <- function(t0, sf, pages, gain, offset, time_zone, serial) {
     "Handedness Code:", "Subject Notes:", "", "Calibration Data",
     paste0(c("x gain:", "x offset:", "y gain:", "y offset:", "z gain:",
              "z offset:"), c(rbind(round(gain), round(offset)))),
-    "Volts:300", "Lux:800", "", "Memory Status",
+    volts_line, lux_line, "", "Memory Status",
     paste0("Number of Pages:", pages), "")
 }
 
@@ -101,12 +111,12 @@ ga_hex_lut <- function() {
   rbind(d[v %/% 256 + 1], d[(v %/% 16) %% 16 + 1], d[v %% 16 + 1])
 }
 
-# One 3600-digit line per page: x, y, z digits of each sample, then "000"
-# (no light, no button).
-ga_hex_lines <- function(lut, cx, cy, cz) {
+# One 3600-digit line per page: x, y, z digits of each sample, then those of
+# its light and status bits `ls` (light * 4 + status; 0: "000").
+ga_hex_lines <- function(lut, cx, cy, cz, ls = integer(length(cx))) {
   n <- length(cx)
   m <- matrix(as.raw(48L), 12L, n)
-  m[1:9, ] <- lut[, rbind(cx, cy, cz) + 1L]
+  m[1:12, ] <- lut[, rbind(cx, cy, cz, ls) + 1L]
   dim(m) <- c(3600L, n %/% 300L)
   vapply(seq_len(ncol(m)), function(j) rawToChar(m[, j]), "")
 }

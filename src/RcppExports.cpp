@@ -89,8 +89,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_decoder_read
-Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity, bool want_temperature, bool want_time);
-RcppExport SEXP _gravcal_gc_decoder_read(SEXP ptrSEXP, SEXP max_unitsSEXP, SEXP capacitySEXP, SEXP want_temperatureSEXP, SEXP want_timeSEXP) {
+Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity, bool want_temperature, bool want_time, bool want_light);
+RcppExport SEXP _gravcal_gc_decoder_read(SEXP ptrSEXP, SEXP max_unitsSEXP, SEXP capacitySEXP, SEXP want_temperatureSEXP, SEXP want_timeSEXP, SEXP want_lightSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
@@ -98,7 +98,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type capacity(capacitySEXP);
     Rcpp::traits::input_parameter< bool >::type want_temperature(want_temperatureSEXP);
     Rcpp::traits::input_parameter< bool >::type want_time(want_timeSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_decoder_read(ptr, max_units, capacity, want_temperature, want_time));
+    Rcpp::traits::input_parameter< bool >::type want_light(want_lightSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_read(ptr, max_units, capacity, want_temperature, want_time, want_light));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -389,7 +390,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_fp_probe_unpinned", (DL_FUNC) &_gravcal_gc_fp_probe_unpinned, 2},
     {"_gravcal_gc_file_kind", (DL_FUNC) &_gravcal_gc_file_kind, 1},
     {"_gravcal_gc_decoder_open", (DL_FUNC) &_gravcal_gc_decoder_open, 3},
-    {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 5},
+    {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 6},
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},

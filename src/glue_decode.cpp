@@ -89,7 +89,8 @@ Rcpp::List info_list(const gravcal::DeviceInfo& d) {
       Rcpp::Named("serial") = d.serial, Rcpp::Named("sf") = d.sf,
       Rcpp::Named("start_time") = d.start_time,
       Rcpp::Named("temperature") = d.has_temperature,
-      Rcpp::Named("time") = d.has_time, Rcpp::Named("range_g") = d.range_g);
+      Rcpp::Named("time") = d.has_time, Rcpp::Named("light") = d.has_light,
+      Rcpp::Named("range_g") = d.range_g);
 }
 
 }  // namespace
@@ -125,18 +126,19 @@ Rcpp::List gc_decoder_open(const std::string& path, const std::string& format,
 }
 
 // The next block: at most `max_units` format units (negative: no limit) and
-// at most `capacity` samples. Returns list(x, y, z, temperature, time, n,
-// units, done); the vectors have length `capacity` and hold n samples
-// (temperature and time are NULL unless asked for and given by the file).
+// at most `capacity` samples. Returns list(x, y, z, temperature, time,
+// light, n, units, done); the vectors have length `capacity` and hold n
+// samples (temperature, time and light are NULL unless asked for and given
+// by the file).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity,
-                           bool want_temperature, bool want_time) {
+                           bool want_temperature, bool want_time, bool want_light) {
   OpenFile* f = get(ptr);
   if (!(capacity >= 1) || capacity > 1e9) Rcpp::stop("capacity must be in [1, 1e9]");
   const R_xlen_t cap = static_cast<R_xlen_t>(capacity);
   const gravcal::DeviceInfo& d = f->decoder->info();
   Rcpp::NumericVector x(Rcpp::no_init(cap)), y(Rcpp::no_init(cap)), z(Rcpp::no_init(cap));
-  Rcpp::NumericVector t, tm;
+  Rcpp::NumericVector t, tm, li;
   gravcal::SampleBuffer out;
   out.x = x.begin();
   out.y = y.begin();
@@ -149,6 +151,10 @@ Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity,
     tm = Rcpp::NumericVector(Rcpp::no_init(cap));
     out.time = tm.begin();
   }
+  if (want_light && d.has_light) {
+    li = Rcpp::NumericVector(Rcpp::no_init(cap));
+    out.light = li.begin();
+  }
   out.capacity = static_cast<std::size_t>(cap);
   const std::int64_t units = f->decoder->read(
       out, max_units < 0 ? -1 : static_cast<std::int64_t>(max_units));
@@ -156,6 +162,7 @@ Rcpp::List gc_decoder_read(SEXP ptr, double max_units, double capacity,
       Rcpp::Named("x") = x, Rcpp::Named("y") = y, Rcpp::Named("z") = z,
       Rcpp::Named("temperature") = out.t ? Rcpp::RObject(t) : Rcpp::RObject(R_NilValue),
       Rcpp::Named("time") = out.time ? Rcpp::RObject(tm) : Rcpp::RObject(R_NilValue),
+      Rcpp::Named("light") = out.light ? Rcpp::RObject(li) : Rcpp::RObject(R_NilValue),
       Rcpp::Named("n") = static_cast<double>(out.n),
       Rcpp::Named("units") = static_cast<double>(units),
       Rcpp::Named("done") = f->decoder->done());

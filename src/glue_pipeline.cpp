@@ -110,17 +110,21 @@ Rcpp::List run_blocks(gravcal::Source& src, const Rcpp::List& o) {
   return out;
 }
 
-// Every sample of the source into R vectors.
+// Every sample of the source into R vectors: x, y, z, temperature (when the
+// source has it), time (option time), light (option light, default 1, when
+// the source has it).
 Rcpp::List run_samples(gravcal::Source& src, const Rcpp::List& o) {
   const double chunk = o.containsElementNamed("chunk") ? num(o, "chunk") : 65536.0;
   if (!(chunk >= 1 && chunk <= 1e8)) Rcpp::stop("chunk must be in [1, 1e8]");
+  const bool light = (!o.containsElementNamed("light") || num(o, "light") != 0) && src.has_light();
   gravcal::CollectStage stage(src.has_temperature(), num(o, "time") != 0,
-                              static_cast<std::size_t>(chunk));
+                              static_cast<std::size_t>(chunk), light);
   gravcal::pump(src, stage, -1, [](const gravcal::WindowStats&) {}, interrupt_tick);
-  const char* names[5] = {"x", "y", "z", "temperature", "time"};
-  const bool on[5] = {true, true, true, stage.temperature(), num(o, "time") != 0};
+  using C = gravcal::CollectStage;
+  const char* names[C::kColumns] = {"x", "y", "z", "temperature", "time", "light"};
+  const bool on[C::kColumns] = {true, true, true, stage.temperature(), num(o, "time") != 0, light};
   Rcpp::List out;
-  for (int c = 0; c < 5; ++c) {
+  for (int c = 0; c < C::kColumns; ++c) {
     if (!on[c]) continue;
     out[names[c]] = Rcpp::NumericVector(stage.col[c].begin(), stage.col[c].end());
     std::vector<double>().swap(stage.col[c]);

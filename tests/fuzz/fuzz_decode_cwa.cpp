@@ -50,7 +50,7 @@ bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t windo
     if (dec.error().empty()) __builtin_trap();
     return false;
   }
-  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap), li(cap);
   int idle = 0;
   while (!dec.done() && r.v.size() / 5 < max_out) {
     gravcal::SampleBuffer out;
@@ -59,12 +59,15 @@ bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t windo
     out.z = z.data();
     out.t = t.data();
     out.time = tm.data();
+    out.light = li.data();
     out.capacity = cap;
     const std::int64_t u = dec.read(out, window);
     if (out.n > cap || u < 0) __builtin_trap();
     if (!compat && window >= 0 && u > window) __builtin_trap();
     r.units += u;
     for (std::size_t i = 0; i < out.n; ++i) {
+      // light: a block's 10-bit value
+      if (!(li[i] >= 0 && li[i] <= 1023 && li[i] == static_cast<int>(li[i]))) __builtin_trap();
       const double s[5] = {x[i], y[i], z[i], t[i], tm[i]};
       r.v.insert(r.v.end(), s, s + 5);
     }

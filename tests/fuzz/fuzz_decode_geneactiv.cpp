@@ -48,7 +48,7 @@ static std::uint64_t decode_all(const std::vector<unsigned char>& bytes, std::ui
   };
   const std::int64_t max_units = (mode & 4) ? -1 : 1 + ((mode >> 3) & 3);
   const std::size_t cap = (mode & 32) ? 7 : 600;
-  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap), li(cap);
   std::int64_t samples = 0, units = 0;
   for (int calls = 0; !dec.done(); ++calls) {
     gravcal::SampleBuffer out;
@@ -57,6 +57,7 @@ static std::uint64_t decode_all(const std::vector<unsigned char>& bytes, std::ui
     out.z = z.data();
     out.t = t.data();
     out.time = tm.data();
+    out.light = (mode & 64) ? li.data() : nullptr;  // light asked or not
     out.capacity = cap;
     const std::int64_t u = dec.read(out, max_units);
     CHECK(!(out.n > cap || u < 0 || (max_units >= 0 && u > max_units)));
@@ -96,6 +97,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (mode & 1) bytes.assign(kHeader, kHeader + sizeof kHeader - 1);
   bytes.insert(bytes.end(), in.p, in.p + in.n);
   const std::uint64_t h = decode_all(bytes, mode);
+  // light asked or not (mode bit 64): the other columns are the same
+  CHECK(decode_all(bytes, mode ^ 64) == h);
   // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
   if (gravcal::use_avx2()) {
     gravcal::set_avx2(false);

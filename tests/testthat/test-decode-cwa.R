@@ -26,7 +26,7 @@ ref_windows <- function(f, B) {
       header = header)), error = function(e) NULL)
     if (is.null(P) || is.null(P$data)) break
     header <- P$header
-    out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time")]
+    out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time", "light")]
     s <- s + B
   }
   d <- do.call(rbind, out)
@@ -36,7 +36,8 @@ ref_windows <- function(f, B) {
   d
 }
 
-# The native decoder, read(out, B) after read(out, B), `cap` samples at a time.
+# The native decoder, read(out, B) after read(out, B), `cap` samples at a
+# time; light too (native_block()'s default), as readAxivity gives it.
 nat_windows <- function(f, B, cap = B * 120 + 1000, compat = 1) {
   h <- native_open(f, "cwa", list(compat = compat))
   on.exit(gc_decoder_close(h$ptr))
@@ -62,14 +63,28 @@ strip <- function(d) {
 }
 
 # A synthetic recording and its file; samples stay within +-2 g so the
-# packed 10-bit form holds them exactly at 1/256 g.
-synth <- function(blocks = 60, sf = 100, ...) {
+# packed 10-bit form holds them exactly at 1/256 g. Light changes from
+# block to block over the whole 10-bit range (`light`: one a block).
+synth_light <- function(blocks) (seq_len(blocks) * 97 + 5) %% 1024
+synth <- function(blocks = 60, sf = 100, light = synth_light(blocks), ...) {
   n <- 120 * blocks
   tt <- seq_len(n) / sf
   x <- cbind(sin(tt), 0.9 * cos(tt), 0.3 + 0.1 * sin(3 * tt))
   f <- tempfile(fileext = ".cwa")
-  write_cwa(x, f, sf = sf, start = 1.7e9 + 0.25, temperature = 20 + tt / 1000, ...)
-  list(x = x, file = f, bytes = readBin(f, raw(), file.size(f)))
+  write_cwa(x, f, sf = sf, start = 1.7e9 + 0.25, temperature = 20 + tt / 1000,
+            light = light, ...)
+  list(x = x, file = f, bytes = readBin(f, raw(), file.size(f)), light = light)
+}
+
+# The light word's low 10 bits of every data block of a file (cwa.h: bytes
+# 18-19 of a block), read from its bytes.
+block_light <- function(f) {
+  b <- readBin(f, raw(), file.size(f))
+  nb <- (length(b) - 1024) %/% 512
+  vapply(seq_len(nb) - 1, function(k) {
+    bitwAnd(readBin(b[block_at(k) + 19:20], integer(), size = 2, signed = FALSE,
+                    endian = "little"), 1023L)
+  }, 0L)
 }
 
 block_at <- function(k) 1024 + 512 * k  # byte offset of data block k (0-based)
@@ -110,8 +125,9 @@ test_that("compat = 1 gives GGIR's readAxivity windows to the bit (GGIRread's fi
              "ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa")
   for (name in files) {
     f <- ggirread_file(name)
-    # B = round(12 * 3600 * sf / 80) = 54000 at 100 Hz (GGIR); 37: windows
-    for (B in c(54000, 37)) {
+    # B = round(12 * 3600 * sf / 80) = 54000 at 100 Hz (g.calibrate); 37, 9:
+    # windows inside the file (light compared too: ref_windows())
+    for (B in c(54000, 37, 9)) {
       ref <- ref_windows(f, B)
       nat <- nat_windows(f, B)
       expect_gt(nrow(ref), 11000)
@@ -254,7 +270,8 @@ test_that("a jump in time is a reported gap; compat imputes it as readAxivity do
   after <- (25 * 120 + 1):n
   tm[after] <- tm[after] + 100
   f <- tempfile(fileext = ".cwa")
-  write_cwa(x, f, sf = 100, time = tm)
+  # light changes from block to block: the imputed span takes block 24's
+  write_cwa(x, f, sf = 100, time = tm, light = synth_light(60))
   d <- native_read_all(f, "cwa", list(compat = 0))
   r <- attr(d, "report")
   expect_identical(nrow(d), as.integer(n))
@@ -313,4 +330,57 @@ test_that("a gap over 3 days is not imputed in compat mode (readAxivity stops th
   expect_lt(nrow(d), n)
   expect_gt(nrow(d), n - 130)
   expect_identical(d$time[d$time > 1.7e9 + 86400][1], tm[10 * 120 + 1])
+})
+
+test_that("light: each block's 10-bit value, in both modes; none when not asked", {
+  # GGIRread's files: compat = 0 gives every sample its block's value, read
+  # from the file's bytes (bytes 18-19 of a block, low 10 bits: 283 to 435
+  # on ax3_testfile.cwa; 16 on ax6_testfile.cwa, whose upper bits hold the
+  # gyroscope range)
+  for (name in c("ax3_testfile.cwa", "ax6_testfile.cwa",
+                 "ax3_testfile_corrupt_blocks_0_13_14_142_143_144.cwa")) {
+    f <- ggirread_file(name)
+    raw <- raw_blocks(f)
+    expect_identical(raw$light, as.numeric(block_light(f)[raw$block + 1]), label = name)
+  }
+  expect_identical(range(raw_blocks(ggirread_file("ax3_testfile.cwa"))$light), c(283, 435))
+  # the whole-file compat read (GGIR's g.getmeta block: round(24 * 3600 *
+  # sf / 80) = 108000 blocks at 100 Hz) is readAxivity's light
+  f <- ggirread_file("ax3_testfile.cwa")
+  expect_identical(nat_windows(f, 108000)$light, ref_windows(f, 108000)$light)
+  # synthetic: the values written, one a block
+  s <- synth(blocks = 20)
+  d <- native_read_all(s$file, "cwa", list(compat = 0))
+  expect_identical(d$light, rep(as.numeric(s$light), each = 120))
+  expect_true(attr(d, "info")$light)
+  # not asked: no column, nothing else changes
+  for (compat in 0:1) {
+    a <- native_read_all(s$file, "cwa", list(compat = compat))
+    b <- native_read_all(s$file, "cwa", list(compat = compat), light = FALSE)
+    expect_identical(names(b), c("x", "y", "z", "temperature", "time"))
+    expect_identical(strip(b), strip(a)[names(b)])
+    h <- native_open(s$file, "cwa", list(compat = compat))
+    blk <- native_block(h, 7, 7 * 120, TRUE, TRUE, light = FALSE)
+    gc_decoder_close(h$ptr)
+    expect_null(blk$cols$light)
+  }
+})
+
+test_that("light on damaged copies: readAxivity's, several block sizes", {
+  # every damaged copy GGIRread reads (compat = 1: ref_windows() has light);
+  # compat = 0: the clean file's light less the blocks lost
+  s <- synth(blocks = 60)
+  cases <- damage_cases(s)
+  clean <- raw_blocks(s$file)
+  for (case in c("corrupt", "checksum", "first", "last3", "seqgap")) {
+    g <- with_bytes(cases[[case]])
+    for (B in c(108000, 17, 5)) {
+      nat <- nat_windows(g, B)
+      ref <- ref_windows(g, B)
+      expect_identical(nat$light, ref$light, label = paste(case, B))
+    }
+    got <- raw_blocks(g)
+    expect_identical(got$light, clean$light[paste(clean$block, clean$time) %in%
+                                              paste(got$block, got$time)], label = case)
+  }
 })

@@ -3,7 +3,9 @@
 # desiredtz = "", configtz = ""), on GGIRread's real test file and on files
 # written by write_geneactiv_bin() from the format description.
 
-cols <- c("x", "y", "z", "temperature", "time")
+# every column readGENEActiv gives (light: GGIRread 1.2.0's lux, see
+# decode_geneactiv.hpp) is compared
+cols <- c("x", "y", "z", "temperature", "time", "light")
 
 ga_real <- function() {
   skip_if_not_installed("GGIRread")
@@ -38,11 +40,18 @@ ga_sim <- function(n, sf, seed = 1) {
              temperature = 25 + 3 * sin(t / 100))
 }
 
+# Light over the whole 10-bit range, with status bits: sample i's light and
+# status.
+ga_light <- function(n) (seq_len(n) * 37 + seq_len(n) %/% 300) %% 1024
+ga_status <- function(n) seq_len(n) %% 4
+
 ga_write <- function(pages, sf = 100, eol = "\r\n", ...) {
   f <- tempfile(fileext = ".bin")
-  gravcal:::write_geneactiv_bin(ga_sim(pages * 300, sf), f, sf = sf, eol = eol,
+  n <- pages * 300
+  gravcal:::write_geneactiv_bin(ga_sim(n, sf), f, sf = sf, eol = eol,
                                 gain = c(25875, 25734, 25538),
-                                offset = c(439, -662, -3056), ...)
+                                offset = c(439, -662, -3056),
+                                light = ga_light(n), status = ga_status(n), ...)
   f
 }
 
@@ -323,7 +332,8 @@ test_that("a file cut short keeps every whole sample and says so", {
   expect_identical(attr(d, "report")$skipped, 1)
   # inside page 10's hex line after r digits: whole samples kept, and a tail
   # of 10 or 11 digits (x, y, z whole) as the reference keeps it
-  for (r in c(1200, 1205, 1210, 3599)) {
+  # (10 or 11 digits: the light of that sample from its 1 or 2 light digits)
+  for (r in c(1200, 1205, 1210, 1211, 3599)) {
     g <- cut(line10 - 1 + r)
     d <- ga_read(g)
     rep <- attr(d, "report")
@@ -331,7 +341,9 @@ test_that("a file cut short keeps every whole sample and says so", {
     expect_identical(rep$counters[["truncated_page"]], 1)
     expect_same(d, ga_ref(g))
     expect_identical(nrow(d), as.integer(2700 + r %/% 12 + (r %% 12 >= 10)))
-    expect_same(d, clean[seq_len(nrow(d)), ])
+    expect_same(d, clean[seq_len(nrow(d)), ], setdiff(cols, "light"))
+    whole <- 2700 + r %/% 12  # a cut sample's light is from its digits
+    expect_identical(d$light[seq_len(whole)], clean$light[seq_len(whole)])
   }
   # cut at a page boundary, or before the last CRLF: nothing lost
   expect_identical(nrow(ga_read(cut(starts[11] - 1))), 3000L)
@@ -387,4 +399,112 @@ test_that("a block gives every sample of its pages when the buffer fills inside 
     gravcal:::gc_decoder_close(h$ptr)
     expect_identical(vapply(res, `[[`, 0, "rows"), c(219, 219, 219, 43) * 300)
   }
+})
+
+test_that("light is readGENEActiv's: the hex digits over 4, times Lux / Volts", {
+  # the real file (GENEActiv 1.1, Lux:800, Volts:300): from its bytes, page
+  # 1's light is each sample's last 3 hex digits, over 4 (integer), times
+  # 800 / 300
+  f <- ga_real()
+  d <- ga_read(f)
+  hex <- suppressWarnings(readLines(f, 69))[69]
+  l12 <- strtoi(substring(hex, seq(10, 3600, 12), seq(12, 3600, 12)), 16L)
+  expect_identical(d$light[1:300], (l12 %/% 4) * (800 / 300))
+  expect_gt(length(unique(d$light)), 10)
+  expect_true(attr(d, "info")$light)
+  # synthetic: every 10-bit value and status bits; a model other than 1.1
+  # maps the value as GGIRread does; Lux and Volts as the header gives them,
+  # NA (every light NA) where a line is missing; compared with readGENEActiv
+  # as GGIR calls it, whole and in blocks inside the file
+  n <- 12 * 300
+  l <- ga_light(n)
+  map <- ifelse(l < 256, l, ifelse(l < 512, (l - 128) * 2,
+                                   ifelse(l < 768, (l - 320) * 4, (l - 656) * 16)))
+  headers <- list(
+    list(model = "1.1", lux_line = "Lux:800", volts_line = "Volts:300",
+         want = l * (800 / 300)),
+    list(model = "1.2", lux_line = "Lux:800", volts_line = "Volts:300",
+         want = map * (800 / 300)),
+    list(model = " 1.1   ", lux_line = "Lux: 1000 ", volts_line = "Volts:250",
+         want = l * (1000 / 250)),
+    list(model = "1.1", lux_line = "Lx:800", volts_line = "Volts:300",
+         want = rep(NA_real_, n)),
+    list(model = "1.1", lux_line = "Lux:800", volts_line = "Volts:0",
+         want = l * (800 / 0)))
+  for (hd in headers) {
+    g <- ga_write(12, model = hd$model, lux_line = hd$lux_line, volts_line = hd$volts_line)
+    lab <- paste(hd$model, hd$lux_line, hd$volts_line)
+    d <- ga_read(g)
+    expect_identical(d$light, hd$want, label = lab)
+    expect_same(d, ga_ref(g))
+    expect_blocks(g, 5)
+    expect_identical(ga_read(g, compat = 0)$light, hd$want, label = lab)
+    # the decoder's own reading of the header (without R's options) agrees
+    h <- gravcal:::gc_decoder_open(g, "geneactiv", list(resample = 0))
+    own <- gravcal:::native_samples(h)
+    gravcal:::gc_decoder_close(h$ptr)
+    expect_identical(own$light, hd$want, label = lab)
+  }
+  # light = FALSE: no column, nothing else changes
+  g <- ga_write(3)
+  a <- gravcal:::native_read_all(g, "geneactiv", list(resample = 0))
+  b <- gravcal:::native_read_all(g, "geneactiv", list(resample = 0), light = FALSE)
+  expect_identical(names(b), cols[1:5])
+  expect_same(b, a, cols[1:5])
+})
+
+# GGIR's blocks of a GENEActiv file through g.readaccfile (readGENEActiv,
+# then, at a rate that is not whole, GGIRread::resample() of every column,
+# light too) and the compatible decoder (resampling on), B pages a block.
+expect_ggir_blocks <- function(f, B) {
+  pr <- GGIR::load_params()
+  I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pr$params_rawdata))
+  fq <- list(filetooshort = FALSE, filecorrupt = FALSE,
+             filedoesnotholdday = FALSE, NFilePagesSkipped = 0)
+  h <- gravcal:::native_open(f, "geneactiv", list(compat = 1))
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  expect_identical(h$info$sf, I$sf)
+  prev <- c()
+  k <- 1
+  repeat {
+    g <- NULL
+    utils::capture.output(type = "message", g <- GGIR:::g.readaccfile(
+      f, blocksize = B, blocknumber = k, filequality = fq, ws = 1,
+      PreviousEndPage = prev, inspectfileobject = I,
+      params_rawdata = pr$params_rawdata, params_general = pr$params_general))
+    b <- gravcal:::native_block(h, B, B * 600, TRUE, TRUE)
+    n <- b$to
+    ref <- g$P$data
+    if (is.null(ref) || !nrow(ref)) break
+    expect_identical(as.integer(n), nrow(ref), label = paste("rows of block", k))
+    for (v in cols) {
+      expect_identical(b$cols[[v]][seq_len(n)], ref[[v]], label = paste(v, "block", k, "B", B))
+    }
+    if (isTRUE(g$isLastBlock)) break
+    prev <- g$endpage
+    k <- k + 1
+  }
+  k
+}
+
+test_that("at a rate that is not whole, light is resampled as GGIR resamples it", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  # the real file at 85.7 Hz onto 86 Hz: GGIR's block (round(14512 * (sf /
+  # 50)) pages: g.getmeta's, 24874) and blocks inside the file
+  f <- ga_real()
+  for (B in c(24874, 5, 3)) expect_gt(expect_ggir_blocks(f, B), if (B < 17) 2 else 0)
+  # synthetic at 85.7 Hz, light over the whole range
+  g <- ga_write(12, sf = 85.7)
+  for (B in c(5, 4)) expect_ggir_blocks(g, B)
+  # a copy cut inside page 10's hex line after 1211 digits (the last
+  # sample's light from 2 digits): GGIR's blocks still, light too
+  bytes <- readBin(g, "raw", file.size(g))
+  starts <- gregexpr("Recorded Data", rawToChar(bytes), fixed = TRUE)[[1]]
+  cut <- tempfile(fileext = ".bin")
+  writeBin(bytes[seq_len(starts[11] - 2 - 3600 - 1 + 1211)], cut)
+  for (B in c(4, 3)) expect_ggir_blocks(cut, B)
+  d <- gravcal:::native_read_all(g, "geneactiv", list(compat = 1))
+  expect_false(anyNA(d$light))
+  expect_gt(stats::sd(d$light), 100)
 })

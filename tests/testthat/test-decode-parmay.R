@@ -211,3 +211,14 @@ test_that("g.calibrate matches GGIR on 30 hours written as a Matrix file (a real
   fit <- calibrate(f)
   expect_identical(fit$input$report$skipped, 1)
 })
+
+test_that("no light: GGIRread's readParmayMatrix() gives none, nor does the decoder", {
+  f <- mtx_files()[1]
+  expect_false("light" %in% names(GGIRread::readParmayMatrix(f)$data))
+  d <- mtx_read(f)
+  expect_false(attr(d, "info")$light)
+  expect_false("light" %in% names(d))
+  h <- gravcal:::native_open(f, "parmay")
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  expect_null(gravcal:::native_block(h, 10, 1e5, TRUE, TRUE, light = TRUE)$cols$light)
+})

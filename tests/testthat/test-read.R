@@ -52,6 +52,12 @@ test_that("the devices' own files read: Axivity, GENEActiv, ActiGraph", {
   expect_identical(nrow(nat$data), 145L * 120L)
   expect_identical(nat$data$x * 256, round(nat$data$x * 256))
   expect_identical(nat$input$report$skipped, 0)
+  # and light, each sample its block's raw value (283 to 435 in this file's
+  # blocks: test-decode-cwa.R reads them from its bytes); the reference
+  # reader gives no light column
+  expect_identical(names(nat$data), c("x", "y", "z", "temperature", "time", "light"))
+  expect_identical(range(nat$data$light), c(283, 435))
+  expect_false("light" %in% names(rec$data))
   bin <- system.file("testfiles", "GENEActiv_testfile.bin", package = "GGIRread")
   ref <- GGIRread::readGENEActiv(bin, start = 1, end = 1e6)
   rec <- read_recording(bin, reader = "reference")
@@ -64,6 +70,8 @@ test_that("the devices' own files read: Axivity, GENEActiv, ActiGraph", {
   expect_identical(rec$sf, ref$header$SampleRate)
   expect_equal(rec$data$z, ref$data.out$z, tolerance = 1e-7)
   expect_equal(rec$data$temperature, ref$data.out$temperature, tolerance = 1e-7)
+  # light in lux as readGENEActiv gives it, to the bit
+  expect_identical(rec$data$light, ref$data.out$light)
   # windows from the file streamed block by block = from the data read whole
   w1 <- rest_windows(bin, progress = FALSE)
   w2 <- rest_windows(rec$data, sf = rec$sf)

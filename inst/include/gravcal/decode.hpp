@@ -207,6 +207,9 @@ struct DeviceInfo {
   double start_time = std::numeric_limits<double>::quiet_NaN();  // s since 1970 UTC
   bool has_temperature = false;
   bool has_time = false;  // the decoder gives a time stamp per sample
+  // the decoder gives a light value per sample (SampleBuffer::light): .cwa
+  // and GENEActiv .bin; its units are the format decoder's (see there)
+  bool has_light = false;
   double range_g = std::numeric_limits<double>::quiet_NaN();  // +- full scale, g
 };
 
@@ -248,27 +251,41 @@ class Report {
   std::int64_t notes_total = 0;
 };
 
-// Arrays owned by the caller, each of `capacity` doubles; t and time may be
-// null (then not written). The decoder appends at n.
+// Arrays owned by the caller, each of `capacity` doubles; t, time and light
+// may be null (then not written). The decoder appends at n.
+//
+// light is asked for by a caller that wants it and whose decoder says it has
+// it (DeviceInfo::has_light); a null light costs the decoder nothing. A
+// decoder without light never writes it (its caller leaves the column out),
+// so put() does not touch it: the decoders with light write it themselves.
 struct SampleBuffer {
   double* x = nullptr;
   double* y = nullptr;
   double* z = nullptr;
-  double* t = nullptr;     // temperature, degrees C
-  double* time = nullptr;  // seconds since 1970-01-01 UTC
+  double* t = nullptr;      // temperature, degrees C
+  double* time = nullptr;   // seconds since 1970-01-01 UTC
+  double* light = nullptr;  // the device's light value (DeviceInfo::has_light)
   std::size_t capacity = 0;
   std::size_t n = 0;
   bool full() const { return n >= capacity; }
   std::size_t room() const { return capacity - n; }
   // A buffer over consecutive columns of `cap` values at `base`: x, y, z,
-  // then temperature and time when asked (base holds 3 to 5 columns).
-  static SampleBuffer columns(double* base, std::size_t cap, bool temperature, bool with_time) {
+  // then temperature, time and light when asked (base holds 3 to 6 columns).
+  static SampleBuffer columns(double* base, std::size_t cap, bool temperature, bool with_time,
+                              bool with_light = false) {
     SampleBuffer b;
-    b.x = base;
-    b.y = b.x + cap;
-    b.z = b.y + cap;
-    b.t = temperature ? b.z + cap : nullptr;
-    b.time = with_time ? (temperature ? b.t : b.z) + cap : nullptr;
+    double* next = base;
+    auto take = [&]() {
+      double* c = next;
+      next += cap;
+      return c;
+    };
+    b.x = take();
+    b.y = take();
+    b.z = take();
+    b.t = temperature ? take() : nullptr;
+    b.time = with_time ? take() : nullptr;
+    b.light = with_light ? take() : nullptr;
     b.capacity = cap;
     return b;
   }

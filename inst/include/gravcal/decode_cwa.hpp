@@ -54,6 +54,12 @@
 //    conversion is UTC (GGIR's configtz = "" on a UTC machine). Seconds 60,
 //    61 roll over and 62, 63 count as 0, as as.POSIXct parses them.
 // In both modes temperature is (raw & 0x3ff) * 75 / 256 - 50 (GGIRread) and
+// light (when asked: SampleBuffer::light) is the low 10 bits of the block's
+// lightScale word, the light sensor's raw value (cwa.h's "raw units", not
+// lux) as GGIRread gives it; every sample of a block, and in compat = 1
+// every grid point of a block's span, imputed ones too, takes its block's
+// value, as readAxivity fills its light column (and temperature). With
+// light null, nothing is done for it. In both modes
 // blocks with a zero rate byte (old firmware) carry their rate in the
 // timestampOffset field and have no checksum (as GGIRread reads them).
 //
@@ -135,6 +141,7 @@ struct Header {
   bool packed = true;
   int axes = 3;              // from numAxesBPS
   int scale_code = 0;        // lightScale >> 13
+  int light = 0;             // lightScale & 0x3ff: the light sensor's raw value
   int offset26 = 0;          // timestampOffset (signed)
   unsigned ts_offset = 0;    // deviceFractional
   double temperature = 0;
@@ -167,6 +174,7 @@ inline Status parse_header(const unsigned char* b, Header& h) {
   h.coded = le32(b + 14);
   const unsigned light_scale = le16(b + 18);
   h.scale_code = static_cast<int>(light_scale >> 13);
+  h.light = static_cast<int>(light_scale & 0x3ffu);
   h.temperature = (le16(b + 20) & 0x3ffu) * 75.0 / 256.0 - 50.0;
   h.offset26 = static_cast<std::int16_t>(le16(b + 26));
   h.count = le16(b + 28);
@@ -380,6 +388,7 @@ inline bool CwaDecoder::open() {
   info_.range_g = static_cast<double>(16 >> (h[36] >> 6));
   info_.has_temperature = true;
   info_.has_time = true;
+  info_.has_light = true;
   const std::int64_t size = src_.size();
   if (size >= 0) {
     n_blocks_ = (size - static_cast<std::int64_t>(cwa::header_bytes)) /
@@ -573,6 +582,7 @@ inline std::int64_t CwaDecoder::read_raw(SampleBuffer& out, std::int64_t max_uni
     cwa::scale_columns(raw_.bytes, raw_.h, cwa::own_params(raw_.h), 1.0 / 256, raw_next_, n,
                        out.x + out.n, out.y + out.n, out.z + out.n);
     if (out.t != nullptr) std::fill(out.t + out.n, out.t + out.n + n, raw_.h.temperature);
+    if (out.light != nullptr) std::fill(out.light + out.n, out.light + out.n + n, raw_.h.light);
     if (out.time != nullptr) {
       for (int k = 0; k < n; ++k) out.time[out.n + k] = raw_.start + (raw_next_ + k) * dt;
     }
@@ -895,6 +905,8 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     given = nearest_ || fused_ ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
                      : kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
   }
+  // light: the block's value on every point of its span, as temperature
+  if (out.light != nullptr) std::fill(out.light + out.n, out.light + out.n + given, p.h.light);
   pos_ += given;
   out.n += static_cast<std::size_t>(given);
   report_.samples += given;

@@ -54,6 +54,23 @@
 //   or time_backwards); a lone wrong sequence number is counted and mended
 //   (bad_sequence). None of this changes compat 1 times.
 //
+// Light (when asked: SampleBuffer::light; the same in both modes) is what
+// readGENEActiv gives: the sample's last 3 hex digits over 4 (10 bits, the 2
+// status bits dropped; a final sample cut to 10 or 11 digits: the 1 or 2 it
+// has, over 4, as std::stoll reads them), for a "Device Model" other than
+// one ending in "1.1" mapped as GGIRread maps it (256..511: (l - 128) * 2,
+// 512..767: (l - 320) * 4, 768..1023: (l - 656) * 16), then times Lux /
+// Volts, the header's "Lux:" and "Volts:" values: lux. As readGENEActiv
+// finds them: the first line of the file's first 69 (cut at a NUL; header
+// lines only) that contains "Lux" (or "Volts", "Device Model"), read as a
+// number once "Lux:" is taken out; NA where there is none, so every light
+// value is NA. The
+// number is read by strtod, the same as R's as.numeric() for the plain
+// numbers of real headers; options "light_lux", "light_volts" and
+// "light_model11" (R/decode.R gives R's own reading) replace what the
+// decoder found. The hex line of each page is kept (3600 bytes) so that
+// light is decoded only when asked.
+//
 // max_units counts pages ("Recorded Data" units, damaged ones included, as
 // the reference's page numbers do). GGIR's block k, readGENEActiv(start = s,
 // end = s + B - 1) with s = (k - 1) * B + 1, is the k-th read(out, B) into a
@@ -65,6 +82,7 @@
 #ifndef GRAVCAL_DECODE_GENEACTIV_HPP
 #define GRAVCAL_DECODE_GENEACTIV_HPP
 
+#include <cctype>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -98,6 +116,8 @@ constexpr int kCountRange = 4096;             // 12-bit counts
 constexpr int kCountSigned = 2048;
 constexpr double kCountScale = 100.0;         // g = (count * 100 - offset) / gain
 constexpr double kMaxTimeZoneHours = 14.0;
+constexpr int kLightHeaderLines = 69;          // readGENEActiv's readLines(filename, 69)
+constexpr int kLightRange = 1024;              // 10-bit light
 
 constexpr const char* kFirstLine = "Device Identity";
 constexpr const char* kPageStart = "Recorded Data";
@@ -286,6 +306,55 @@ inline bool is_line(const char* p, std::size_t n, const char* text) {
   return n == std::strlen(text) && std::memcmp(p, text, n) == 0;
 }
 
+// What readGENEActiv reads from its header for light (see the top of the
+// file): the first of the first 69 lines to contain "Lux", "Volts" and
+// "Device Model", as R's readLines() gives them (cut at a NUL).
+class LightHeader {
+ public:
+  void line(const char* p, std::size_t n) {
+    if (lines_++ >= kLightHeaderLines) return;
+    const void* nul = std::memchr(p, '\0', n);
+    if (nul != nullptr) n = static_cast<std::size_t>(static_cast<const char*>(nul) - p);
+    const std::string s(p, n);
+    if (!have_lux_ && s.find("Lux") != std::string::npos) {
+      have_lux_ = true;
+      lux = r_number(without(s, "Lux:"));
+    }
+    if (!have_volts_ && s.find("Volts") != std::string::npos) {
+      have_volts_ = true;
+      volts = r_number(without(s, "Volts:"));
+    }
+    if (!have_model_ && s.find("Device Model") != std::string::npos) {
+      have_model_ = true;
+      const std::string m = without(without(s, "Device Model:"), " ");
+      model11 = m.size() >= 3 && m.compare(m.size() - 3, 3, "1.1") == 0;
+    }
+  }
+  double lux = r_na_real(), volts = r_na_real();
+  bool model11 = false;  // no "Device Model" line: grepl() of NA is FALSE
+
+ private:
+  // gsub(key, "", s, fixed)
+  static std::string without(std::string s, const char* key) {
+    const std::size_t k = std::strlen(key);
+    for (std::size_t at = s.find(key); at != std::string::npos; at = s.find(key, at)) s.erase(at, k);
+    return s;
+  }
+  // as.numeric() of a text: blanks around, strtod's number, else NA
+  static double r_number(const std::string& s) {
+    std::size_t a = 0, b = s.size();
+    while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+    while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+    if (a == b) return r_na_real();
+    const std::string t = s.substr(a, b - a);
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    return end == t.c_str() + t.size() ? v : r_na_real();
+  }
+  int lines_ = 0;
+  bool have_lux_ = false, have_volts_ = false, have_model_ = false;
+};
+
 }  // namespace geneactiv
 
 class GeneactivDecoder : public Decoder {
@@ -299,6 +368,11 @@ class GeneactivDecoder : public Decoder {
         compat_(opts.num("compat", 1) != 0),
         fused_(opts.num("resample_fused", 0) != 0) {
     info_.format = "geneactiv";
+    static const char* const keys[3] = {"light_lux", "light_volts", "light_model11"};
+    for (int i = 0; i < 3; ++i) {
+      light_given_[i] = opts.has_num(keys[i]);
+      light_opt_[i] = opts.num(keys[i], 0);
+    }
   }
 
   bool open() override;
@@ -317,6 +391,8 @@ class GeneactivDecoder : public Decoder {
     std::int64_t seq = 0, stamp_ms = 0;
     geneactiv::Stamp stamp;
     std::int64_t offset = 0;
+    char hex[geneactiv::kDigitsPerPage];  // the hex line, for light
+    std::size_t hex_n = 0;
   };
 
   bool fail(const std::string& why) {
@@ -335,6 +411,8 @@ class GeneactivDecoder : public Decoder {
   void check_time();
   void advance_chain(double freq, std::size_t count);
   void emit(SampleBuffer& out);
+  void emit_light(const Page& p, std::size_t from, std::size_t k, double* light) const;
+  void light_table();
   void finish_block(SampleBuffer& out, std::size_t n0);
   void finish_input();
   void note_at(const char* what, std::int64_t offset);
@@ -355,6 +433,11 @@ class GeneactivDecoder : public Decoder {
   long offset_[3] = {0, 0, 0};
   bool have_gain_[3] = {false, false, false}, have_offset_[3] = {false, false, false};
   double lut_[3][geneactiv::kCountRange];
+  // light: the header's values, then each 10-bit value's lux
+  geneactiv::LightHeader light_header_;
+  bool light_given_[3] = {false, false, false};  // options light_lux, light_volts, light_model11
+  double light_opt_[3] = {0, 0, 0};
+  double light_lut_[geneactiv::kLightRange];
   double header_rate_ = 0;
   double tz_ms_ = 0;
   long header_pages_ = -1;
@@ -535,11 +618,14 @@ inline bool GeneactivDecoder::open() {
       return fail("no \"Recorded Data\" page within the first " +
                   std::to_string(geneactiv::kMaxHeaderLines) + " lines");
     }
+    light_header_.line(lines_.data, lines_.size);
     if (!header_line(lines_.data, lines_.size)) return false;
   }
   if (!check_header()) return false;
+  light_table();
   info_.has_temperature = true;
   info_.has_time = true;
+  info_.has_light = true;
   next_unit_ = parse_page();
   have_next_ = true;
   if (next_unit_ == Unit::good) {
@@ -608,6 +694,8 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
     ++count;
   }
   next_->count = count;
+  std::memcpy(next_->hex, p, n);
+  next_->hex_n = n;
   return (bad & 0x10u) == 0;
 }
 
@@ -798,6 +886,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   if (out.t != nullptr) {
     for (std::size_t j = 0; j < k; ++j) out.t[n + j] = p.temperature;
   }
+  if (out.light != nullptr) emit_light(p, emitted_, k, out.light + n);
   if (out.time != nullptr) {
     for (std::size_t j = 0; j < k; ++j) {
       const double i = static_cast<double>(emitted_ + j);
@@ -814,6 +903,38 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   emitted_ += k;
   report_.samples += static_cast<std::int64_t>(k);
   if (emitted_ >= p.count) pending_ = false;
+}
+
+// Light of samples [from, from + k) of page p (see the top of the file).
+inline void GeneactivDecoder::emit_light(const Page& p, std::size_t from, std::size_t k,
+                                         double* light) const {
+  using namespace geneactiv;
+  const unsigned char* h = hex_table().v;
+  for (std::size_t j = 0; j < k; ++j) {
+    const std::size_t at = (from + j) * kDigitsPerSample + kDigitsXyz;
+    const std::size_t digits = p.hex_n - at < 3 ? p.hex_n - at : 3;  // 1 or 2: a cut last sample
+    unsigned v = 0;
+    for (std::size_t d = 0; d < digits; ++d) v = (v << 4) | h[static_cast<unsigned char>(p.hex[at + d])];
+    light[j] = light_lut_[v >> 2];
+  }
+}
+
+// Each 10-bit value's light, as readGENEActiv computes it from the header's
+// values (or those the options give).
+inline void GeneactivDecoder::light_table() {
+  const double lux = light_given_[0] ? light_opt_[0] : light_header_.lux;
+  const double volts = light_given_[1] ? light_opt_[1] : light_header_.volts;
+  const bool model11 = light_given_[2] ? light_opt_[2] != 0 : light_header_.model11;
+  const double per = lux / volts;
+  for (int u = 0; u < geneactiv::kLightRange; ++u) {
+    const double l = u;
+    const double m = model11 ? l
+                     : l < 256 ? l
+                     : l < 512 ? (l - 128) * 2
+                     : l < 768 ? (l - 320) * 4
+                     : (l - 656) * 16;
+    light_lut_[u] = m * per;
+  }
 }
 
 // compat 1: the reference adds the first page's time and ((s - 1) * 300) /

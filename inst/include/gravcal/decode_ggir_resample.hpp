@@ -35,6 +35,12 @@
 // grid keeps its last point, which R's seq() clamps to the block's last
 // time stamp (pmin(x, to)): `keep_last`.
 //
+// Light, where the inner decoder has it (GENEActiv), is resampled as the
+// other columns are (GGIR's g.readaccfile resamples every column of
+// readGENEActiv's data but time). It is asked of the inner decoder from the
+// first read() whose buffer asks for it on: a caller that asks for light
+// after its first read gets NaN for the samples resampled before.
+//
 // Grid points are made at most kGenBatch at a time, so that a long gap in
 // the time stamps (which GGIR fills by interpolation) costs time, not
 // memory; a gap of more than kMaxGapPoints grid points (about 11.6 days at
@@ -48,6 +54,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,6 +99,7 @@ class GgirResamplerOf : public Decoder {
   }
 
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
+    if (out.light != nullptr && info_.has_light) want_light_ = true;
     if (!active_) {
       const std::int64_t u = inner_->read(out, max_units);
       report_ = inner_->report();
@@ -141,10 +149,11 @@ class GgirResamplerOf : public Decoder {
   static constexpr std::size_t kGenBatch = 4096;
   static constexpr double kMaxGapPoints = 1e8;
   static constexpr double kMaxTimeSteps = 2251799813685248.0;  // 2^51
-  static constexpr std::size_t kRawCols = 5;  // x, y, z, t, time
+  static constexpr std::size_t kRawCols = 6;  // x, y, z, t, time, light
+  static constexpr int kLight = 5;
   struct Point {
     std::int64_t k;
-    double v[5];  // x, y, z, t, time
+    double v[kRawCols];  // x, y, z, t, time, light
   };
 
   void start_call(std::int64_t max_units) {
@@ -161,7 +170,8 @@ class GgirResamplerOf : public Decoder {
   // Raw samples of the current call from the inner decoder; false when it
   // gave nothing.
   bool refill() {
-    SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true);
+    raw_light_ = want_light_;
+    SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true, raw_light_);
     inner_->continue_call(!first_read_);
     first_read_ = false;
     const std::int64_t u = inner_->read(b, left_);
@@ -177,6 +187,7 @@ class GgirResamplerOf : public Decoder {
   // interval that ends at it.
   void take(std::size_t i) {
     for (std::size_t c = 0; c < kRawCols; ++c) cur_[c] = raw_[c * kRawChunk + i];
+    if (!raw_light_) cur_[kLight] = std::numeric_limits<double>::quiet_NaN();
     // a time stamp so far from 1970 that one grid step is below its
     // resolution (beyond 2^51 steps: more than 700,000 years at 100 Hz)
     // has no grid around it: left out as a non-finite one is (the grid's
@@ -186,7 +197,7 @@ class GgirResamplerOf : public Decoder {
       return;
     }
     if (!have_prev_) {
-      for (int c = 0; c < 5; ++c) prev_[c] = cur_[c];
+      for (std::size_t c = 0; c < kRawCols; ++c) prev_[c] = cur_[c];
       from_ = cur_[4];
       have_prev_ = true;
       return;
@@ -225,13 +236,14 @@ class GgirResamplerOf : public Decoder {
       if (nearest_) u = ggir_nearest_weight(u);
       for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev_[c], cur_[c], fused_);
       p.v[4] = g;
+      p.v[kLight] = want_light_ ? kernels::ggir_lerp(u, prev_[kLight], cur_[kLight], fused_) : 0.0;
       pending_.push_back(p);
     }
     confirm_upto(cur_[4]);
   }
 
   void end_interval() {
-    for (int c = 0; c < 5; ++c) {
+    for (std::size_t c = 0; c < kRawCols; ++c) {
       prev2_[c] = prev_[c];
       prev_[c] = cur_[c];
     }
@@ -280,6 +292,7 @@ class GgirResamplerOf : public Decoder {
         if (nearest_) u = ggir_nearest_weight(u);
         for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev2_[c], prev_[c], fused_);
         p.v[4] = last_;
+        p.v[kLight] = want_light_ ? kernels::ggir_lerp(u, prev2_[kLight], prev_[kLight], fused_) : 0.0;
         ready_.push_back(p);
       }
     }
@@ -294,6 +307,7 @@ class GgirResamplerOf : public Decoder {
   void give(SampleBuffer& out) {
     while (head_ < ready_.size() && !out.full()) {
       const Point& p = ready_[head_++];
+      if (out.light != nullptr) out.light[out.n] = p.v[kLight];
       out.put(p.v[0], p.v[1], p.v[2], p.v[3], p.v[4]);
       ++given_;
     }
@@ -305,20 +319,22 @@ class GgirResamplerOf : public Decoder {
   bool keep_last_ = false;
   bool fused_ = false;
   bool active_ = false;
+  bool want_light_ = false;  // light asked for (and the inner decoder has it)
+  bool raw_light_ = false;   // the raw samples in raw_ have light
   double by_ = 0.0;
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
   bool in_call_ = false, first_read_ = true, have_prev_ = false, have_interval_ = false;
   bool gen_active_ = false;  // grid points of (prev_, cur_] still to make
-  double cur_[5] = {0, 0, 0, 0, 0};
+  double cur_[kRawCols] = {0, 0, 0, 0, 0, 0};
   std::int64_t bad_time_ = 0, gaps_not_filled_ = 0;
   std::vector<std::string> gap_notes_;
   std::int64_t left_ = -1;
   std::int64_t call_units_ = 0;
   std::int64_t k_ = 0;
   double from_ = 0.0, last_ = 0.0;
-  double prev_[5] = {0, 0, 0, 0, 0};
-  double prev2_[5] = {0, 0, 0, 0, 0};  // the sample before prev_
+  double prev_[kRawCols] = {0, 0, 0, 0, 0, 0};
+  double prev2_[kRawCols] = {0, 0, 0, 0, 0, 0};  // the sample before prev_
   std::vector<Point> pending_;  // computed, maybe the grid's last
   std::vector<Point> ready_;    // confirmed, not yet given
   std::size_t head_ = 0;

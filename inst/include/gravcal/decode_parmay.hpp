@@ -28,6 +28,9 @@
 // temperature's own time span. GGIR reads the whole file in one call (the
 // reader reads from its start to the file's end whatever the end asked),
 // so the decoder's unit, one packet, only counts progress.
+// No light: the format has no light sensor and readParmayMatrix() gives no
+// light column (acceleration, gyroscope, temperatures, heart rate), so
+// DeviceInfo::has_light stays false and SampleBuffer::light is not written.
 //
 // Damage: a packet whose CRC does not match is counted (bad_checksum). In
 // GGIR-compatible mode (option compat = 1, the default) it stays in the

@@ -84,7 +84,8 @@ struct BlockSpace {
   double* y = nullptr;
   double* z = nullptr;
   double* t = nullptr;
-  double* time = nullptr;  // null: the stage does not take time stamps
+  double* time = nullptr;   // null: the stage does not take time stamps
+  double* light = nullptr;  // null: the stage does not take light
   std::size_t capacity = 0;
 };
 

@@ -58,6 +58,9 @@ class Source {
   virtual std::int64_t read(SampleBuffer& out, std::int64_t max_units) = 0;
   virtual bool done() const = 0;
   virtual bool has_temperature() const = 0;
+  // The source gives a light value per sample (written into
+  // SampleBuffer::light when the stage asks for it).
+  virtual bool has_light() const { return false; }
 };
 
 // A device decoder as a source.
@@ -69,6 +72,7 @@ class DecoderSource : public Source {
   }
   bool done() const override { return d_.done(); }
   bool has_temperature() const override { return d_.info().has_temperature; }
+  bool has_light() const override { return d_.info().has_light; }
   Decoder& decoder() { return d_; }
 
  private:
@@ -196,63 +200,69 @@ class BlocksStage : public ForwardStage<GgirBlocks> {
 };
 
 // A collector of samples (a whole recording read into memory), with the
-// source's time stamps when `time`, written `chunk` samples at a time.
+// source's time stamps when `time` and its light when `light` (only for a
+// source that has light: Source::has_light()), written `chunk` samples at a
+// time.
 class CollectStage {
  public:
-  CollectStage(bool temperature, bool time, std::size_t chunk = SegmenterStage::chunk)
-      : temp_(temperature), time_(time), chunk_(std::max<std::size_t>(chunk, 1)) {}
+  enum Column { kX, kY, kZ, kTemperature, kTime, kLight, kColumns };
+  CollectStage(bool temperature, bool time, std::size_t chunk = SegmenterStage::chunk,
+               bool light = false)
+      : temp_(temperature), time_(time), light_(light), chunk_(std::max<std::size_t>(chunk, 1)) {}
   bool temperature() const { return temp_; }
+  bool light() const { return light_; }
   BlockSpace space(std::size_t want) {
     if (want < 1) want = 1;
     const std::size_t k = std::min(want, chunk_);
-    for (int c = 0; c < 5; ++c) {
-      if (on(c)) col[c].resize(n_ + k);
-    }
+    grow(n_ + k);
     BlockSpace s;
-    s.x = col[0].data() + n_;
-    s.y = col[1].data() + n_;
-    s.z = col[2].data() + n_;
-    s.t = temp_ ? col[3].data() + n_ : nullptr;
-    s.time = time_ ? col[4].data() + n_ : nullptr;
+    s.x = col[kX].data() + n_;
+    s.y = col[kY].data() + n_;
+    s.z = col[kZ].data() + n_;
+    s.t = temp_ ? col[kTemperature].data() + n_ : nullptr;
+    s.time = time_ ? col[kTime].data() + n_ : nullptr;
+    s.light = light_ ? col[kLight].data() + n_ : nullptr;
     s.capacity = k;
     return s;
   }
   template <class Sink>
   void commit(std::size_t n, bool has_t, Sink&&) {
-    if (temp_ && !has_t) {
-      std::fill(col[3].begin() + static_cast<std::ptrdiff_t>(n_),
-                col[3].begin() + static_cast<std::ptrdiff_t>(n_ + n),
-                std::numeric_limits<double>::quiet_NaN());
-    }
+    if (temp_ && !has_t) nan_fill(kTemperature, n);
     n_ += n;
-    for (int c = 0; c < 5; ++c) {
-      if (on(c)) col[c].resize(n_);
-    }
+    grow(n_);
   }
+  // lent samples (columns in memory: no time stamps, no light)
   template <class Sink>
   void push(const double* x, const double* y, const double* z, const double* t,
             std::size_t n, Sink&& sink) {
-    for (int c = 0; c < 5; ++c) {
-      if (on(c)) col[c].resize(n_ + n);
-    }
+    grow(n_ + n);
     const double* in[4] = {x, y, z, t};
     for (int c = 0; c < 4; ++c) {
       if (on(c) && in[c] != nullptr) std::copy(in[c], in[c] + n, col[c].begin() + static_cast<std::ptrdiff_t>(n_));
     }
-    if (time_) {
-      std::fill(col[4].begin() + static_cast<std::ptrdiff_t>(n_),
-                col[4].begin() + static_cast<std::ptrdiff_t>(n_ + n),
-                std::numeric_limits<double>::quiet_NaN());
-    }
+    if (time_) nan_fill(kTime, n);
+    if (light_) nan_fill(kLight, n);
     commit(n, t != nullptr, sink);
   }
   std::size_t size() const { return n_; }
-  // x, y, z, temperature, time
-  std::vector<double> col[5];
+  // x, y, z, temperature, time, light (Column)
+  std::vector<double> col[kColumns];
 
  private:
-  bool on(int c) const { return c < 3 || (c == 3 && temp_) || (c == 4 && time_); }
-  bool temp_, time_;
+  bool on(int c) const {
+    return c < 3 || (c == kTemperature && temp_) || (c == kTime && time_) || (c == kLight && light_);
+  }
+  void grow(std::size_t n) {
+    for (int c = 0; c < kColumns; ++c) {
+      if (on(c)) col[c].resize(n);
+    }
+  }
+  void nan_fill(int c, std::size_t n) {
+    std::fill(col[c].begin() + static_cast<std::ptrdiff_t>(n_),
+              col[c].begin() + static_cast<std::ptrdiff_t>(n_ + n),
+              std::numeric_limits<double>::quiet_NaN());
+  }
+  bool temp_, time_, light_;
   std::size_t chunk_;
   std::size_t n_ = 0;
 };
@@ -291,6 +301,7 @@ PumpResult pump(Source& src, Stage& stage, std::int64_t max_units, Sink&& sink,
       out.z = s.z;
       out.t = want_t ? s.t : nullptr;
       out.time = s.time;
+      out.light = src.has_light() ? s.light : nullptr;  // only a stage that asks
       out.capacity = s.capacity;
       u = src.read(out, left);
       stage.commit(out.n, out.t != nullptr, sink);
