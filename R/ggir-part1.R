@@ -243,7 +243,7 @@ meta_read_block <- function(h, units, capacity = 2^20) {
   parts <- list()
   left <- units
   repeat {
-    b <- gc_decoder_read(h$ptr, left, capacity, TRUE, TRUE)
+    b <- gc_decoder_read(h$ptr, left, capacity, TRUE, TRUE, TRUE)
     n <- b$n
     if (n > 0) {
       keep <- seq_len(n)
