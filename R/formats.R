@@ -13,9 +13,12 @@
 # * detect: for formats that share an extension, whether a file is this one
 #   (a file is the first format of its extension whose detector says yes or
 #   that has none);
-# * local_clock: TRUE where GGIR's reader takes the file's clock times for
-#   times in configtz (else desiredtz) and the native decoder gives them as
-#   UTC (g.getmeta() moves them: meta_zone_shift());
+# * local_clock: where GGIR's reader takes the file's clock times for times
+#   in configtz (else desiredtz) and the native decoder gives them as UTC
+#   (g.getmeta() moves them: meta_zone_shift()): "block" (GGIRread converts
+#   a block's first time) or "sample" (lubridate::force_tz() on each);
+# * ggir_timegaps: GGIR's g.getmeta() fills the recording's time gaps
+#   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
 # * own_rate: TRUE for a device format whose file records its sampling
 #   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
@@ -95,6 +98,7 @@ recording_formats <- list(
   gt3x = list(
     ext = c(gt3x = ".gt3x"), detect = NULL,
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
+    local_clock = "sample", ggir_timegaps = TRUE,
     block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),
@@ -120,7 +124,7 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
-    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = TRUE,
+    label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = "block",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),

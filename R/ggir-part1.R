@@ -103,7 +103,7 @@ meta_reader <- function(src) {
 }
 
 # The formats g.getmeta() reads so far.
-meta_formats <- c("cwa", "geneactiv")
+meta_formats <- c("cwa", "geneactiv", "gt3x")
 
 # The metrics of g.applymetrics() in the order GGIR computes them (its
 # result's names); `filtered`: a Butterworth filter's (ggir_filters.hpp,
@@ -304,11 +304,14 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
   i <- 1
   LD <- 2
   QClog <- NULL
+  prev_value <- c(0, 0, 1)
+  prev_time <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     data <- read_block()
-    if (isTRUE(format_entry(src$format)$local_clock) && !is.null(data$time)) {
-      data$time <- meta_zone_shift(data$time, zone)
+    clock <- format_entry(src$format)$local_clock
+    if (!is.null(clock) && !is.null(data$time)) {
+      data$time <- meta_zone_shift(data$time, zone, per_sample = identical(clock, "sample"))
     }
     nr <- meta_nrow(data)
     isLastBlock <- FALSE
@@ -327,6 +330,15 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
       }
     } else if (nr < short_rows) {
       isLastBlock <- TRUE
+    }
+    if (!is.null(data) && isTRUE(p$imputeTimegaps) &&
+        isTRUE(format_entry(src$format)$ggir_timegaps)) {
+      P <- meta_impute_timegaps(data, sf, prev_value, prev_time, c(ws3, ws2), src$filename)
+      data <- P$x
+      last <- meta_nrow(data)
+      prev_value <- c(data$x[last], data$y[last], data$z[last])
+      prev_time <- if (!is.null(data$time)) data$time[last]
+      QClog <- rbind(QClog, P$QClog)
     }
     if (!is.null(data)) {
       if (i == 1) {
@@ -418,16 +430,113 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
 # block's first time in the zone and counts the samples from there). A
 # whole number of seconds added to times in one binade: the same bits as
 # GGIR's sums.
-meta_zone_shift <- function(time, zone) {
+# With `per_sample` (lubridate::force_tz() on each time), the offset at
+# each sample: computed for the block's first and last, and for every
+# sample only when those differ (a change of offset within the block).
+meta_zone_shift <- function(time, zone, per_sample = FALSE) {
   if (!length(time) || identical(zone, "UTC") || identical(zone, "GMT")) return(time)
-  t1 <- floor(time[1])
-  wall <- format(as.POSIXct(t1, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
-  local <- as.numeric(as.POSIXct(wall, tz = zone))
-  if (is.na(local)) {
-    abort("The recording's clock time ", wall, " does not exist in the time zone \"", zone,
-          "\" (`configtz`/`desiredtz`).")
+  shift <- function(t) {
+    t1 <- floor(t)
+    wall <- format(as.POSIXct(t1, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+    local <- as.numeric(as.POSIXct(wall, tz = zone))
+    if (anyNA(local)) {
+      abort("The recording's clock time ", wall[is.na(local)][1], " does not exist in the ",
+            "time zone \"", zone, "\" (`configtz`/`desiredtz`).")
+    }
+    local - t1
   }
-  time + (local - t1)
+  d <- shift(time[1])
+  if (per_sample && shift(time[length(time)]) != d) d <- shift(time)
+  time + d
+}
+
+# GGIR's g.imputeTimegaps() as g.getmeta() calls it (k = 0.25 s, raised to
+# 2 / sf; the previous block's last value and time; epoch sizes given), on a
+# block's columns: samples with x = y = z = 0 dropped (the block's first
+# takes the previous block's last value, its last the value before it), a
+# step of k or more from the previous block's last time or between two
+# samples filled by repeating the sample before it round(step * sf) times
+# (normalised where its norm exceeds 1.005), every column repeated, the time
+# counted on in steps of 1 / sf. A file without time stamps gets them from
+# the clock, as in GGIR (QClog's start and end are then the wall clock's).
+# GGIR's epoch-level imputation of gaps longer than max(6 long epochs, 90
+# minutes) is not reproduced: such a gap is an error saying so (GGIR 3.3-9
+# itself stops on it in R before 4.3: "'origin' must be supplied").
+meta_impute_timegaps <- function(d, sf, plv, plt, epochsize, filename) {
+  k <- 0.25
+  no_time <- is.null(d$time)
+  if (no_time) d$time <- as.numeric(Sys.time()) + (seq_along(d$x) - 1) / sf
+  zeros <- which(d$x == 0 & d$y == 0 & d$z == 0)
+  imputelast <- FALSE
+  n <- length(d$x)
+  if (length(zeros)) {
+    if (zeros[1] == 1) {
+      zeros <- zeros[-1]
+      d$x[1] <- plv[1]
+      d$y[1] <- plv[2]
+      d$z[1] <- plv[3]
+    }
+    if (length(zeros) && zeros[length(zeros)] == n) {
+      zeros <- zeros[-length(zeros)]
+      imputelast <- TRUE
+    }
+    if (length(zeros)) d <- meta_rows(d, -zeros)
+  }
+  if (k < 2 / sf) k <- 2 / sf
+  dt <- diff(d$time)
+  if (!is.null(plt)) {
+    first <- d$time[1] - plt
+    if (first >= k) {
+      d <- meta_bind(meta_rows(d, 1), d)
+      d$time[1] <- plt
+      d$x[1] <- plv[1]
+      d$y[1] <- plv[2]
+      d$z[1] <- plv[3]
+      dt <- c(first, dt)
+    }
+  }
+  gapsi <- which(dt >= k)
+  ngaps <- length(gapsi)
+  gaplen <- 0
+  if (ngaps > 0) {
+    gap <- rep(1, length(d$x))
+    gap[gapsi] <- round(dt[gapsi] * sf)
+    gaplen <- sum(gap[gapsi])
+    limit <- max(c(((epochsize[2] / 60) * 6), 90)) * 60 * sf
+    if (any(gap > limit)) {
+      abort("\"", basename(filename), "\" has a time gap of ", format(round(max(gap) / sf / 60, 1)),
+            " minutes (idle sleep or no data), longer than GGIR's limit of ",
+            format(limit / sf / 60), " minutes, beyond which GGIR's g.getmeta() imputes whole ",
+            "epochs; gravcal's g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it ",
+            "in R before 4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
+    }
+    norm <- which(gap > 1)
+    xyz <- cbind(d$x[norm], d$y[norm], d$z[norm])
+    en <- sqrt(rowSums(xyz^2))
+    good <- which((abs(en) - 1) > 0.005)
+    if (length(good)) {
+      j <- norm[good]
+      d$x[j] <- d$x[j] / en[good]
+      d$y[j] <- d$y[j] / en[good]
+      d$z[j] <- d$z[j] / en[good]
+    }
+    within <- sequence(gap) - 1
+    d <- lapply(d, rep, gap)
+    d$time <- d$time + within * (1 / sf)
+  }
+  last <- length(d$x)
+  if (imputelast) {
+    d$x[last] <- d$x[last - 1]
+    d$y[last] <- d$y[last - 1]
+    d$z[last] <- d$z[last - 1]
+  }
+  start <- d$time[1]
+  end <- start + last
+  QClog <- data.frame(imputed = ngaps > 0, start = start, end = end,
+                      blockLengthSeconds = (end - start) / sf, timegaps_n = ngaps,
+                      timegaps_min = gaplen / sf / 60)
+  if (no_time) d$time <- NULL
+  list(x = d, QClog = QClog)
 }
 
 # The first block's start: GGIR's get_starttime_weekday_truncdata(), which

@@ -128,8 +128,35 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
-  gt3x <- system.file("extdata", "TAS1H30182785_2019-09-17.gt3x", package = "read.gt3x")
-  if (nzchar(gt3x)) {
-    expect_error(gravcal::g.getmeta(gt3x, verbose = FALSE), "does not read an ActiGraph .gt3x")
+  csv <- system.file("testfiles", "ActiGraph13.csv", package = "GGIRread")
+  if (nzchar(csv)) {
+    expect_error(gravcal::g.getmeta(csv, verbose = FALSE), "does not read an ActiGraph csv export")
   }
+})
+
+test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps imputed)", {
+  rec <- simulate_recording(hours = 28, sf = 30, seed = 13,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  f <- tempfile(fileext = ".gt3x")
+  # idle sleep (seconds without records): 30 min, 1 min, 5 s, and 3 s at the
+  # start of GGIR's second block (24 h of stored seconds later)
+  idle <- c(3600 * 15 + 0:1800, 3600 * 20 + 0:59, 3600 * 25 + 0:4, 3600 * 24.6 + 0:2)
+  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 30, start = rec$time[1],
+                       idle = idle)
+  b <- meta_both(f, cal_args[c("offset", "scale")])
+  expect_same_meta(b)
+  # the gaps were imputed: GGIR's QClog counts them per block
+  expect_identical(sum(b$gravcal$QClog$timegaps_n), 4L)
+  b2 <- meta_both(f, list(params_general = list(desiredtz = "America/New_York"),
+                          params_metrics = list(do.anglex = TRUE)))
+  expect_same_meta(b2)
+  expect_match(b2$gravcal$metashort$timestamp[1], "-0500$")
+})
+
+test_that("a time gap longer than GGIR's epoch-level limit is an error saying so", {
+  rec <- simulate_recording(hours = 8, sf = 10, seed = 14)
+  f <- tempfile(fileext = ".gt3x")
+  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 10, start = rec$time[1],
+                       idle = 3600 * 3 + 0:(2 * 3600))
+  expect_error(gravcal::g.getmeta(f, verbose = FALSE), "time gap of 120")
 })
