@@ -451,6 +451,16 @@ test_that("light is readGENEActiv's: the hex digits over 4, times Lux / Volts", 
   b <- gravcal:::native_read_all(g, "geneactiv", list(resample = 0), light = FALSE)
   expect_identical(names(b), cols[1:5])
   expect_same(b, a, cols[1:5])
+  # asked only from the second block on: the page already read ahead (the
+  # second block's first) has no light (NaN), the rest has
+  h <- gravcal:::native_open(g, "geneactiv", list(resample = 0))
+  b1 <- gravcal:::native_block(h, 1, 300, TRUE, TRUE, light = FALSE)
+  b2 <- gravcal:::native_block(h, 2, 600, TRUE, TRUE, light = TRUE)
+  gravcal:::gc_decoder_close(h$ptr)
+  expect_null(b1$cols$light)
+  expect_true(all(is.nan(b2$cols$light[1:300])))
+  expect_identical(b2$cols$light[301:600], a$light[601:900])
+  expect_identical(b2$cols$x, a$x[301:900])
 })
 
 # GGIR's blocks of a GENEActiv file through g.readaccfile (readGENEActiv,

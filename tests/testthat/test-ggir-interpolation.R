@@ -35,7 +35,8 @@ ref_cwa <- function(f, B, interpolationType = 1, frequency_tol = 0.1, tz = "UTC"
         error = function(e) NULL)
       if (is.null(P) || is.null(P$data)) break
       header <- P$header
-      out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time")]
+      # light too: the native decoder gives it (native_block()'s default)
+      out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time", "light")]
       s <- s + B
     }
     d <- do.call(rbind, out)

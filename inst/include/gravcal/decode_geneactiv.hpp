@@ -68,8 +68,10 @@
 // number is read by strtod, the same as R's as.numeric() for the plain
 // numbers of real headers; options "light_lux", "light_volts" and
 // "light_model11" (R/decode.R gives R's own reading) replace what the
-// decoder found. The hex line of each page is kept (3600 bytes) so that
-// light is decoded only when asked.
+// decoder found. Light is decoded only when asked, from a copy of the page's
+// hex line (3600 bytes) made while the reads ask for light: from open() to
+// the first read() without light, and again from a read() with it. A page
+// read before a caller starts asking has no copy: its light is NaN.
 //
 // max_units counts pages ("Recorded Data" units, damaged ones included, as
 // the reference's page numbers do). GGIR's block k, readGENEActiv(start = s,
@@ -82,6 +84,7 @@
 #ifndef GRAVCAL_DECODE_GENEACTIV_HPP
 #define GRAVCAL_DECODE_GENEACTIV_HPP
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstddef>
@@ -89,6 +92,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <limits>
 #include <string>
 
 #include "decode.hpp"
@@ -393,6 +397,7 @@ class GeneactivDecoder : public Decoder {
     std::int64_t offset = 0;
     char hex[geneactiv::kDigitsPerPage];  // the hex line, for light
     std::size_t hex_n = 0;
+    bool has_hex = false;  // hex holds the line (keep_hex_ when parsed)
   };
 
   bool fail(const std::string& why) {
@@ -437,6 +442,7 @@ class GeneactivDecoder : public Decoder {
   geneactiv::LightHeader light_header_;
   bool light_given_[3] = {false, false, false};  // options light_lux, light_volts, light_model11
   double light_opt_[3] = {0, 0, 0};
+  bool keep_hex_ = true;  // copy each page's hex line: the reads ask for light
   double light_lut_[geneactiv::kLightRange];
   double header_rate_ = 0;
   double tz_ms_ = 0;
@@ -694,8 +700,11 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
     ++count;
   }
   next_->count = count;
-  std::memcpy(next_->hex, p, n);
-  next_->hex_n = n;
+  next_->has_hex = keep_hex_;
+  if (keep_hex_) {
+    std::memcpy(next_->hex, p, n);
+    next_->hex_n = n;
+  }
   return (bad & 0x10u) == 0;
 }
 
@@ -910,6 +919,10 @@ inline void GeneactivDecoder::emit_light(const Page& p, std::size_t from, std::s
                                          double* light) const {
   using namespace geneactiv;
   const unsigned char* h = hex_table().v;
+  if (!p.has_hex) {
+    std::fill(light, light + k, std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
   for (std::size_t j = 0; j < k; ++j) {
     const std::size_t at = (from + j) * kDigitsPerSample + kDigitsXyz;
     const std::size_t digits = p.hex_n - at < 3 ? p.hex_n - at : 3;  // 1 or 2: a cut last sample
@@ -964,6 +977,7 @@ inline void GeneactivDecoder::finish_input() {
 
 inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_units) {
   const std::size_t n0 = out.n;
+  keep_hex_ = out.light != nullptr;
   std::int64_t units = 0;
   if (compat_ && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
     // a new reference call from page pages_seen_ + 1
