@@ -49,8 +49,8 @@ gc_crc32 <- function(bytes) {
     .Call(`_gravcal_gc_crc32`, bytes)
 }
 
-gc_ggir_block_epochs <- function(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused) {
-    .Call(`_gravcal_gc_ggir_block_epochs`, x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused)
+gc_ggir_block_epochs <- function(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use) {
+    .Call(`_gravcal_gc_ggir_block_epochs`, x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use)
 }
 
 gc_ggir_filter <- function(b, a, x, conv_fused, rec_fused) {

@@ -387,12 +387,14 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
       if (LD >= ws * sf) {
         use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
         S <- if ((LD - use) > 1) meta_rows(data, (use + 1):LD) else list()
-        data <- meta_rows(data, 1:use)
-        if (!is.null(model)) data <- model(data)
+        # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
+        # may not be whole), given to the core without a copy
+        n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
+        if (!is.null(model)) data <- model(meta_rows(data, seq_len(n_use)))
         r <- gc_ggir_block_epochs(
           data$x, data$y, data$z, if (use.temp) data$temperature,
           if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc,
-          filters, fused$conv, fused$rec)
+          filters, fused$conv, fused$rec, n_use)
         for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
         if (light.available) {

@@ -143,8 +143,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_ggir_block_epochs
-Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, Rcpp::Nullable<Rcpp::NumericVector> light, const Rcpp::List& cal, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused);
-RcppExport SEXP _gravcal_gc_ggir_block_epochs(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP lightSEXP, SEXP calSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
+Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, Rcpp::Nullable<Rcpp::NumericVector> light, const Rcpp::List& cal, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused, double n_use);
+RcppExport SEXP _gravcal_gc_ggir_block_epochs(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP lightSEXP, SEXP calSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP n_useSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -160,7 +160,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::List> >::type filters(filtersSEXP);
     Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
     Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_ggir_block_epochs(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused));
+    Rcpp::traits::input_parameter< double >::type n_use(n_useSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_block_epochs(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -395,7 +396,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
-    {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 13},
+    {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 14},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 7},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},

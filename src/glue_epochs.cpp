@@ -16,7 +16,7 @@ const double* column_or_null(const Rcpp::Nullable<Rcpp::NumericVector>& v, R_xle
                              Rcpp::NumericVector& keep, const char* what) {
   if (v.isNull()) return nullptr;
   keep = Rcpp::NumericVector(v.get());
-  if (keep.size() != n) Rcpp::stop("%s has another length than x", what);
+  if (keep.size() < n) Rcpp::stop("%s is shorter than the samples used", what);
   return keep.begin();
 }
 
@@ -31,7 +31,9 @@ Rcpp::NumericVector as_r(const std::vector<double>& v) {
 // temperature term applies meantemp, inv_tempoffset), sf, windowsizes
 // (ws3, ws2, ws), the short-epoch metric names (ggir_epochs.hpp
 // short_metrics()), non-wear settings (list: clipthres, sdcriter,
-// racriter, approach "2013"/"2023"). Returns list(short = named list of
+// racriter, approach "2013"/"2023"), the filters (ggir_filter_coefs() or
+// NULL) and whether R's stats::filter() fuses, and n_use: how many of the
+// columns' first samples form the block. Returns list(short = named list of
 // epoch means, nonwear, clipping, epochs, en, temperature, lightmean,
 // lightpeak), unrounded.
 // [[Rcpp::export(rng = false)]]
@@ -44,10 +46,13 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
                                 const Rcpp::CharacterVector& metrics,
                                 const Rcpp::List& nonwear,
                                 Rcpp::Nullable<Rcpp::List> filters, bool conv_fused,
-                                bool rec_fused) {
+                                bool rec_fused, double n_use) {
   namespace p1 = gravcal::ggir_part1;
-  const R_xlen_t n = x.size();
-  if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
+  const R_xlen_t len = x.size();
+  if (y.size() != len || z.size() != len) Rcpp::stop("x, y, z lengths differ");
+  // the block's first n_use samples (GGIR's data[1:use, ]), without a copy in R
+  if (!(n_use >= 0) || n_use > static_cast<double>(len)) Rcpp::stop("n_use out of range");
+  const R_xlen_t n = static_cast<R_xlen_t>(n_use);
   if (windowsizes.size() != 3) Rcpp::stop("windowsizes must have 3 values");
   if (!(sf > 0)) Rcpp::stop("sf must be positive");
   Rcpp::NumericVector tk, lk;
@@ -68,7 +73,8 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
     for (int a = 0; a < 3; ++a) c.inv_tempoffset[a] = ito[a];
   }
   const std::size_t un = static_cast<std::size_t>(n);
-  std::vector<double> cx(x.begin(), x.end()), cy(y.begin(), y.end()), cz(z.begin(), z.end());
+  std::vector<double> cx(x.begin(), x.begin() + n), cy(y.begin(), y.begin() + n),
+      cz(z.begin(), z.begin() + n);
   p1::apply_calibration(c, cx.data(), cy.data(), cz.data(), t, un);
   std::vector<std::string> names(metrics.size());
   for (R_xlen_t k = 0; k < metrics.size(); ++k) names[static_cast<std::size_t>(k)] = Rcpp::as<std::string>(metrics[k]);
