@@ -17,6 +17,9 @@
 #   in configtz (else desiredtz) and the native decoder gives them as UTC
 #   (g.getmeta() moves them: meta_zone_shift()): "block" (GGIRread converts
 #   a block's first time) or "sample" (lubridate::force_tz() on each);
+# * ggir_monitor: GGIR's monitor (its MONITOR code's name, lower case), for
+#   the rules GGIR keys on it (g.getmeta(): ActiGraph serial numbers'
+#   dynamic range);
 # * ggir_timegaps: GGIR's g.getmeta() fills the recording's time gaps
 #   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
 # * own_rate: TRUE for a device format whose file records its sampling
@@ -33,6 +36,7 @@
 #   native decoder (see open_source()).
 recording_formats <- list(
   actigraph_csv = list(
+    ggir_monitor = "actigraph",
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
     detect = function(file) is_actigraph_csv(file),
     label = "an ActiGraph csv export", unit = "line",
@@ -44,6 +48,7 @@ recording_formats <- list(
   # reads it no more), else read as the ad hoc csv file its header
   # describes (R/geneactiv-csv.R)
   geneactiv_csv = list(
+    ggir_monitor = "geneactiv",
     ext = c(csv = NA, csv.gz = NA), detect = function(file) is_geneactiv_csv(file),
     label = "a GENEActiv csv export", unit = "line", own_rate = TRUE,
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
@@ -60,6 +65,7 @@ recording_formats <- list(
   # y, z; GGIR resamples each block onto the rate it finds from the first
   # 100000 time stamps (R/axivity-csv.R)
   axivity_csv = list(
+    ggir_monitor = "axivity",
     ext = c(csv = NA, csv.gz = NA), detect = function(file) is_axivity_csv(file),
     label = "an Axivity csv export", unit = "line",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
@@ -77,6 +83,7 @@ recording_formats <- list(
   # rmc.* parameters (rmc.firstrow.acc; R/adhoc-csv.R), which give its
   # layout to the csv decoder (and to `source`, as `layout`)
   adhoc_csv = list(
+    ggir_monitor = "ad_hoc",
     ext = c(csv = NA, csv.gz = NA), detect = function(file) FALSE,
     label = "an ad hoc csv file (GGIR's rmc.* parameters)", unit = "line",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
@@ -96,6 +103,7 @@ recording_formats <- list(
       source_frame(rec$data, rec$sf, chunksize, arg)
     }),
   gt3x = list(
+    ggir_monitor = "actigraph",
     ext = c(gt3x = ".gt3x"), detect = NULL,
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     local_clock = "sample", ggir_timegaps = TRUE,
@@ -104,6 +112,7 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_gt3x_file(file),
     source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
   cwa = list(
+    ggir_monitor = "axivity",
     ext = c(cwa = ".cwa"), detect = NULL,
     label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
@@ -115,6 +124,7 @@ recording_formats <- list(
   # the folder or its acc.bin (GGIR's filename); GGIR reads it in blocks of
   # sf * 60 * 1440 / 2 samples whatever chunksize, and assumes 64 Hz
   movisens = list(
+    ggir_monitor = "movisens",
     ext = c(bin = "Movisens (a unisens folder or its acc.bin)"),
     detect = function(file) is_movisens_bin(file),
     label = "a Movisens recording", unit = "sample", own_rate = TRUE,
@@ -123,6 +133,7 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
+    ggir_monitor = "geneactiv",
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
     label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = "block",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
@@ -133,6 +144,7 @@ recording_formats <- list(
   # block's first packet to the end of the file whatever end it is given, so
   # GGIR's first block is the whole file (and its last)
   parmay = list(
+    ggir_monitor = "parmay_mtx",
     ext = c(bin = "Parmay Matrix .bin"), detect = function(file) is_parmay_bin(file),
     label = "a Parmay Matrix .bin file", unit = "packet", own_rate = TRUE,
     block_units = function(sf, chunksize) 2^52,

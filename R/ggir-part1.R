@@ -229,7 +229,18 @@ meta_calibration <- function(offset, scale, tempoffset, meantempcal) {
 # (get_nw_clip_block_params()) for the source.
 meta_nonwear <- function(src, p) {
   dynrange <- p$dynrange
-  clipthres <- if (length(dynrange)) dynrange - 0.5 else 7.5
+  # an ActiGraph's range from its serial number, whatever dynrange says
+  serial <- src$info$serial
+  if (identical(format_entry(src$format)$ggir_monitor, "actigraph") && is.character(serial)) {
+    for (r in list(c("CLE", 6), c("MOS", 8), c("NEO", 6))) {
+      if (length(grep(r[1], serial)) == 1) {
+        dynrange <- as.numeric(r[2])
+        break
+      }
+    }
+  }
+  mon <- format_entry(src$format)$ggir_monitor
+  clipthres <- if (length(dynrange)) dynrange - 0.5 else if (identical(mon, "movisens")) 15.5 else 7.5
   list(clipthres = clipthres, sdcriter = 0.013,
        racriter = p$nonwear_range_threshold / 1000,
        approach = p$nonwear_approach)

@@ -153,6 +153,19 @@ test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps
   expect_match(b2$gravcal$metashort$timestamp[1], "-0500$")
 })
 
+test_that("g.getmeta() takes an ActiGraph's dynamic range from its serial number, as GGIR", {
+  rec <- simulate_recording(hours = 27, sf = 30, seed = 15,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  n <- nrow(rec)
+  rec$x[round(0.3 * n) + 0:60] <- 5.8   # beyond a CLE's 6 g - 0.5, within 8 g - 0.5
+  f <- tempfile(fileext = ".gt3x")
+  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 30, start = rec$time[1],
+                       serial = "CLE2A2123456")
+  b <- meta_both(f, list(params_rawdata = list(dynrange = 8)))
+  expect_same_meta(b)
+  expect_true(any(b$gravcal$metalong$clippingscore > 0))
+})
+
 test_that("a time gap longer than GGIR's epoch-level limit is an error saying so", {
   rec <- simulate_recording(hours = 8, sf = 10, seed = 14)
   f <- tempfile(fileext = ".gt3x")
