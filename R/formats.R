@@ -20,6 +20,10 @@
 # * ggir_monitor: GGIR's monitor (its MONITOR code's name, lower case), for
 #   the rules GGIR keys on it (g.getmeta(): ActiGraph serial numbers'
 #   dynamic range);
+# * ggir_start(file, p): where GGIR's g.getmeta() starts a recording whose
+#   reader gives no time stamps (as POSIXlt in desiredtz);
+# * ggir_time: FALSE where GGIR's reader gives no time stamps although the
+#   native decoder does (g.getmeta() drops them);
 # * ggir_timegaps: GGIR's g.getmeta() fills the recording's time gaps
 #   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
 # * own_rate: TRUE for a device format whose file records its sampling
@@ -36,7 +40,8 @@
 #   native decoder (see open_source()).
 recording_formats <- list(
   actigraph_csv = list(
-    ggir_monitor = "actigraph",
+    ggir_monitor = "actigraph", ggir_timegaps = TRUE, ggir_time = FALSE,
+    ggir_start = function(file, p) actigraph_csv_start(file, p),
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
     detect = function(file) is_actigraph_csv(file),
     label = "an ActiGraph csv export", unit = "line",

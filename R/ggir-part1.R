@@ -103,7 +103,7 @@ meta_reader <- function(src) {
 }
 
 # The formats g.getmeta() reads so far.
-meta_formats <- c("cwa", "geneactiv", "gt3x")
+meta_formats <- c("cwa", "geneactiv", "gt3x", "actigraph_csv")
 
 # The metrics of g.applymetrics() in the order GGIR computes them (its
 # result's names); `filtered`: a Butterworth filter's (ggir_filters.hpp,
@@ -320,6 +320,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     data <- read_block()
+    if (isFALSE(format_entry(src$format)$ggir_time)) data$time <- NULL
     clock <- format_entry(src$format)$local_clock
     if (!is.null(clock) && !is.null(data$time)) {
       data$time <- meta_zone_shift(data$time, zone, per_sample = identical(clock, "sample"))
@@ -556,11 +557,14 @@ meta_impute_timegaps <- function(d, sf, plv, plt, epochsize, filename) {
 # starts the analysis at the next whole long epoch (the start's seconds
 # rounded up to the next minute).
 meta_start <- function(data, src, p, sf, ws2) {
-  if (is.null(data$time)) {
+  start_meas <- ws2 / 60
+  st <- if (!is.null(data$time)) {
+    as.POSIXlt(data$time[1], tz = p$desiredtz, origin = "1970-01-01")
+  } else if (!is.null(start <- format_entry(src$format)$ggir_start)) {
+    start(src$path, p)
+  } else {
     abort("\"", basename(src$filename), "\" has no time stamps to start from.")
   }
-  start_meas <- ws2 / 60
-  st <- as.POSIXlt(data$time[1], tz = p$desiredtz, origin = "1970-01-01")
   wday <- st$wday + 1
   wdayname <- c("Sunday", "Monday", "Tuesday", "Wednesday", "Thursday", "Friday",
                 "Saturday")[wday]
@@ -614,4 +618,59 @@ meta_result <- function(short, long, metnames, metricnames_long, starttime, wday
                  NFilePagesSkipped = 0, metalong = ml, metashort = ms, wday = wday,
                  wdayname = wdayname, windowsizes = p$windowsizes, bsc_qc = bsc_qc,
                  QClog = QClog))
+}
+
+# The start of an ActiGraph csv export, as GGIR's g.getstarttime() reads
+# it: "Start Time" and "Start Date" from the header lines below the first,
+# their date order from the first line's "date format" (as read.csv()
+# makes it a column name), read in configtz and given in desiredtz.
+actigraph_csv_start <- function(file, p) {
+  lines <- utils::read.csv(file, nrows = 8, skip = 1)[[1]]
+  field <- function(key) {
+    for (v in vapply(lines[seq_len(min(7, length(lines)))], format, "")) {
+      parts <- strsplit(v, key, fixed = TRUE)[[1]]
+      if (length(parts) > 1) return(gsub(" ", "", parts[2], fixed = TRUE))
+    }
+    abort(key, " not found in the header of \"", basename(file), "\".")
+  }
+  when <- paste0(field("Start Date"), " ", field("Start Time"))
+  top <- colnames(as.matrix(utils::read.csv(file, nrows = 1, skip = 0)))[1]
+  order <- actigraph_date_order(top)
+  if (is.na(order)) abort("The date format of \"", basename(file), "\" is not recognised.")
+  sep <- if (grepl("/", when, fixed = TRUE)) "/" else if (grepl("-", when, fixed = TRUE)) "-" else "."
+  sp <- strsplit(order, "")[[1]]
+  fmt <- paste0("%", sp[1], sep, "%", sp[2], sep, "%", sp[3], " %H:%M:%S")
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  as.POSIXlt(as.POSIXct(when, format = fmt, tz = ctz), tz = p$desiredtz)
+}
+
+# The order of day, month and year that an ActiGraph header's "date format"
+# (M/d/yyyy, dd.MM.yy, yyyy-MMM-d, ...; separators read as dots) gives, in
+# strptime letters ("mdY", "dbY", ...), by GGIR's rules: each order tested
+# by its patterns, the two-digit year given up where the four-digit one
+# matches, the abbreviated month preferred to the numeric. NA when none.
+actigraph_date_order <- function(top) {
+  has <- function(...) as.numeric(length(grep(paste(c(...), collapse = "|"), top)) > 0)
+  f <- c(
+    mdY = has("MM[.]dd[.]yyyy", "M[.]d[.]yyyy", "M[.]dd[.]yyyy", "MM[.]d[.]yyyy"),
+    mdy = has("MM[.]dd[.]yy", "M[.]d[.]yy", "M[.]dd[.]yy", "MM[.]d[.]yy"),
+    bdY = has("MMM[.]dd[.]yyyy", "MMM[.]d[.]yyyy"), bdy = has("MMM[.]dd[.]yy", "MMM[.]d[.]yy"),
+    dmY = has("d[.]M[.]yyyy", "d[.]MM[.]yyyy"), dmy = has("d[.]M[.]yy", "d[.]MM[.]yy"),
+    dbY = has("d[.]MMM[.]yyyy"), dby = has("d[.]MMM[.]yy"),
+    Ymd = has("yyyy[.]M[.]d", "yyyy[.]MM[.]d"), ymd = has("yy[.]M[.]d", "yy[.]MM[.]d"),
+    Ybd = has("yyyy[.]MMM[.]d"), ybd = has("yy[.]MMM[.]d"),
+    Ydm = has("yyyy[.]dd[.]MM", "yyyy[.]d[.]M", "yyyy[.]d[.]MM", "yyyy[.]dd[.]M"),
+    ydm = has("yy[.]dd[.]MM", "yy[.]d[.]M", "yy[.]d[.]MM", "yy[.]dd[.]M"),
+    Ydb = has("yyyy[.]dd[.]MMM", "yyyy[.]d[.]MMM"), ydb = has("yy[.]dd[.]MMM", "yy[.]d[.]MMM"))
+  # for each group of four (numeric and month-name, four- and two-digit
+  # year): drop the two-digit year where the four-digit matches, then the
+  # numeric month where the name matches
+  for (g in list(c("mdY", "mdy", "bdY", "bdy"), c("dmY", "dmy", "dbY", "dby"),
+                 c("Ymd", "ymd", "Ybd", "ybd"), c("Ydm", "ydm", "Ydb", "ydb"))) {
+    if (f[[g[1]]] == 1 && f[[g[2]]] == 1) f[[g[2]]] <- 0
+    if (f[[g[3]]] == 1 && f[[g[4]]] == 1) f[[g[4]]] <- 0
+    if (f[[g[1]]] == 1 && f[[g[3]]] == 1) f[[g[1]]] <- 0
+    if (f[[g[2]]] == 1 && f[[g[4]]] == 1) f[[g[2]]] <- 0
+  }
+  names(f)[which(f == 1)[1]]
 }

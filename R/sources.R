@@ -63,6 +63,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   if (!is.null(layout$serial)) src$info$serial <- layout$serial
   check_sf_agrees(sf, src$sf, format, datafile, sf_arg)
   src$filename <- ggir_file_name(datafile)
+  src$path <- datafile
   if (is.null(src$pump)) src <- reference_source(src)
   if (!is.null(shown)) src$format <- shown
   src

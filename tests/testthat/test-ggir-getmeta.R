@@ -33,10 +33,18 @@ meta_both <- function(file, args = list()) {
 
 `%||%` <- function(a, b) if (is.null(a)) b else a
 
-expect_same_meta <- function(b) {
+# `clock`: QClog's start and end are GGIR's wall clock (a file without time
+# stamps: g.imputeTimegaps() counts from Sys.time()), compared by type only
+expect_same_meta <- function(b, clock = FALSE) {
   R <- b$ggir
   G <- b$gravcal
   expect_identical(names(G), names(R))
+  if (clock) {
+    for (k in c("start", "end")) {
+      expect_identical(class(G$QClog[[k]]), class(R$QClog[[k]]))
+      G$QClog[[k]] <- R$QClog[[k]] <- NULL
+    }
+  }
   for (nm in setdiff(names(R), "bsc_qc")) {
     expect_identical(G[[nm]], R[[nm]], label = paste0("gravcal's M$", nm),
                      expected.label = paste0("GGIR's M$", nm))
@@ -51,14 +59,16 @@ meta_recording <- function(format, sf, hours, seed = 7, start = "2024-03-04 09:0
                             start = as.POSIXct(start, tz = "UTC"),
                             tempoffset = c(0.001, -0.002, 0.0005))
   n <- nrow(rec)
-  withr::with_seed(seed, {
-    for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
-      i <- round(s[1] * n):round(s[2] * n)
-      rec$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
-      rec$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
-      rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
-    }
-  })
+  old <- if (exists(".Random.seed", globalenv())) get(".Random.seed", globalenv())
+  on.exit(if (is.null(old)) rm(".Random.seed", envir = globalenv()) else
+    assign(".Random.seed", old, globalenv()))
+  set.seed(seed)
+  for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
+    i <- round(s[1] * n):round(s[2] * n)
+    rec$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
+    rec$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
+    rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
+  }
   rec$x[round(0.8 * n) + 0:40] <- 7.9
   f <- tempfile(fileext = if (format == "cwa") ".cwa" else ".bin")
   if (format == "cwa") {
@@ -128,9 +138,9 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
-  csv <- system.file("testfiles", "ActiGraph13.csv", package = "GGIRread")
+  csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
   if (nzchar(csv)) {
-    expect_error(gravcal::g.getmeta(csv, verbose = FALSE), "does not read an ActiGraph csv export")
+    expect_error(gravcal::g.getmeta(csv, verbose = FALSE), "does not read an Axivity csv export")
   }
 })
 
@@ -164,6 +174,35 @@ test_that("g.getmeta() takes an ActiGraph's dynamic range from its serial number
   b <- meta_both(f, list(params_rawdata = list(dynrange = 8)))
   expect_same_meta(b)
   expect_true(any(b$gravcal$metalong$clippingscore > 0))
+})
+
+test_that("g.getmeta() is GGIR's on an ActiGraph csv export (start from its header, zeros and gaps)", {
+  rec <- simulate_recording(hours = 27, sf = 30, seed = 16,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  n <- nrow(rec)
+  # 10 minutes and 4 samples of idle-sleep zeros: removed, then filled as gaps
+  for (i in list(round(0.4 * n) + 0:(30 * 600), round(0.7 * n) + 0:3)) {
+    rec$x[i] <- 0
+    rec$y[i] <- 0
+    rec$z[i] <- 0
+  }
+  f <- tempfile(fileext = ".csv")
+  gravcal:::write_actigraph_csv(rec, f, sf = 30, start = "2024-03-04 09:07:23")
+  b <- meta_both(f, c(cal_args[c("offset", "scale")],
+                      list(params_general = list(desiredtz = "Europe/London"))))
+  expect_same_meta(b, clock = TRUE)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-03-04T09:15:00+0000")
+  expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
+})
+
+test_that("the date order of an ActiGraph header, by GGIR's rules", {
+  top <- function(fmt) make.names(paste("--- date format", fmt, "Filter Normal ---"))
+  expect_identical(gravcal:::actigraph_date_order(top("M/d/yyyy")), "mdY")
+  expect_identical(gravcal:::actigraph_date_order(top("dd.MM.yyyy")), "dmY")
+  expect_identical(gravcal:::actigraph_date_order(top("yyyy-MM-dd")), "Ymd")
+  expect_identical(gravcal:::actigraph_date_order(top("d-MMM-yy")), "dby")
+  expect_identical(gravcal:::actigraph_date_order(top("MMM/dd/yyyy")), "bdY")
+  expect_identical(gravcal:::actigraph_date_order(top("none")), NA_character_)
 })
 
 test_that("a time gap longer than GGIR's epoch-level limit is an error saying so", {
