@@ -131,11 +131,12 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
       abort("`metadatadir` (GGIR's <outputdir>/output_<name> folder) is missing; give it, ",
             "or `outputdir` (then it is named as GGIR::GGIR() names it).")
     }
-    if (filelist && !length(studyname)) {
+    named_by_study <- part1_is_filelist(datadir, movisens = FALSE)
+    if (named_by_study && !length(studyname)) {
       abort("`studyname` must be given with `outputdir` when `datadir` is a list of files ",
             "(GGIR names the output folder output_<studyname>).")
     }
-    metadatadir <- file.path(outputdir, paste0("output_", if (filelist) studyname else {
+    metadatadir <- file.path(outputdir, paste0("output_", if (named_by_study) studyname else {
       basename(sub("/+$", "", datadir))
     }))
   }
@@ -272,9 +273,9 @@ keep_warn_option <- function(expr) {
 # Whether `datadir` names files rather than a folder (GGIR's rule: more
 # than one path, or one whose name holds .bi, .cs, .wa, .cw, .gt or .BI);
 # a Movisens folder of unisens folders counts as a list, as in GGIR.
-part1_is_filelist <- function(datadir) {
+part1_is_filelist <- function(datadir, movisens = TRUE) {
   if (length(datadir) != 1) return(TRUE)
-  grepl("[.](bi|cs|wa|cw|gt|BI)", datadir) || part1_is_movisens(datadir)
+  grepl("[.](bi|cs|wa|cw|gt|BI)", datadir) || (movisens && part1_is_movisens(datadir))
 }
 
 # GGIR's test for Movisens data: a unisens.xml beside the first file found.
