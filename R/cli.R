@@ -34,11 +34,32 @@
 #' not a failure. A batch job can therefore be resubmitted until it exits
 #' with 0: it resumes.
 #'
+#' @section The part1 verb:
+#' `Rscript -e 'gravcal::calibrate_cli()' -- part1 --out results/ data/`
+#' runs [g.part1()] (GGIR part 1 on gravcal) on one folder or on
+#' recordings: it writes the meta files GGIR's parts 2-5 read in
+#' `<out>/output_<folder name>/meta/basic` (for recordings, with
+#' `--studyname NAME`: `output_NAME`), as `GGIR::GGIR(outputdir = <out>)`
+#' names the folder, so that `GGIR::GGIR(mode = 2:5, datadir = , outputdir
+#' = <out>)` goes on from them. Options: `--out DIR` (GGIR's outputdir,
+#' required), `--studyname NAME`, `--overwrite` (redo recordings whose meta
+#' file exists; by default they are skipped), `--no-cal` (GGIR's `do.cal =
+#' FALSE`), `--coefs FILE` (coefficients instead of calibrating: GGIR's
+#' `backup.cal.coef`; another format [read_coefs()] reads is converted to
+#' GGIR's), `--params LIST` (GGIR's parameters as R arguments,
+#' `'desiredtz = "Europe/London", chunksize = 0.5'`, or an `.rds` file of
+#' their list), `--f0 N`, `--f1 N`, `--verbose` (GGIR's progress messages),
+#' `--help`. A recording's error does not stop the others (GGIR's
+#' `use_trycatch_serial = TRUE`). It prints `gravcal part1: N
+#' recording(s): a written, b already there, c not read (...), d failed;
+#' meta files in DIR`; the exit status is 0 when no recording failed, 1
+#' when any did, 2 when the run could not start.
+#'
 #' @param args The command-line arguments (by default those after `--`).
 #' @param quit End the R process with the exit status above (`TRUE`), or
 #'   return (`FALSE`, for use from R). `--help` always returns.
-#' @return The table of [calibrate_files()], invisibly (when `quit =
-#'   FALSE`); `NULL` after `--help`.
+#' @return The table of [calibrate_files()] (for `part1`, of [g.part1()]),
+#'   invisibly (when `quit = FALSE`); `NULL` after `--help`.
 #' @export
 #' @examples
 #' calibrate_cli("--help")

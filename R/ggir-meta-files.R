@@ -12,7 +12,9 @@
 #' same files. For each recording of `datadir` (a folder, searched
 #' recursively, or a vector of file paths) from the `f0`-th to the `f1`-th,
 #' it writes `<metadatadir>/meta/basic/meta_<file name>.RData` holding the
-#' objects GGIR's part 1 saves, built as GGIR builds them:
+#' objects GGIR's part 1 saves, built as GGIR builds them (Details).
+#'
+#' The objects:
 #'
 #' * `I`: `GGIR::g.inspectfile()`'s result for the file (GGIR's own function,
 #'   called with `desiredtz`, `params_rawdata` and `configtz` as GGIR's
@@ -30,7 +32,10 @@
 #'   coefficients, errors, `meantempcal`, `QCmessage`, `npoints`,
 #'   `nhoursused` and `use.temp`, read as GGIR reads them
 #'   (`data.table::fread()`); a file without a row there is calibrated
-#'   (`do.cal = TRUE`). `"redo"` ignores any such file;
+#'   (`do.cal = TRUE`). `"redo"` ignores any such file. (As in GGIR, the
+#'   coefficients come back through the csv's 15 significant digits, and
+#'   part 2's report has no `meantempcal` column, so a part 1 run again
+#'   after part 2 applies no temperature term: `M` is GGIR's either way);
 #' * `M`: [g.getmeta()] (gravcal's, identical to GGIR's but for `bsc_qc`)
 #'   with `C`'s `offset`, `scale`, `tempoffset` and `meantempcal`;
 #' * `filename_dir`, `filefoldername`: the file's name as GGIR lists it;
