@@ -39,7 +39,9 @@
 #' * `M`: [g.getmeta()] (gravcal's, identical to GGIR's but for `bsc_qc`)
 #'   with `C`'s `offset`, `scale`, `tempoffset` and `meantempcal`;
 #' * `filename_dir`, `filefoldername`: the file's name as GGIR lists it;
-#'   `tail_expansion_log`: `NULL`; `desiredtz_part1`: `desiredtz`;
+#'   `tail_expansion_log`: `NULL`, or with `recordingEndSleepHour` the
+#'   numbers of short and long epochs added to `M` past the recording's end
+#'   (as GGIR adds them); `desiredtz_part1`: `desiredtz`;
 #' * `GGIRversion`: `utils::packageVersion("GGIR")`, the installed GGIR's
 #'   version, as GGIR writes it. Parts 2-5 do not read it (each records its
 #'   own version), and the file is the one GGIR's part 1 would have written
@@ -74,7 +76,7 @@
 #' | `print.filename` | prints | honoured |
 #' | `use_trycatch_serial` | whether a file's error stops the run | honoured |
 #' | `do.parallel`, `maxNcores` | GGIR runs files in parallel on 4 or more cores, and then lowers `chunksize` to 0.5 (3-5 metrics) or 0.4 (6 or more), which changes `M` | the files run one after the other; `chunksize` lowered as GGIR would lower it on this machine, so `M` is GGIR's |
-#' | `recordingEndSleepHour` (`expand_tail_max_hours`) | `M` expanded past the recording's end, `tail_expansion_log` | refused: an error naming it |
+#' | `recordingEndSleepHour` (`expand_tail_max_hours`), `dayborder` | `M` expanded past the recording's end to 8 hours past the next day border when the recording ends late enough; `tail_expansion_log` | honoured |
 #' | `myfun` | an external function's values in `M` | refused: an error (g.getmeta()) |
 #' | `dataFormat`, `maxRecordingInterval`, `recording_split_*` | read by `GGIR::GGIR()` around part 1, not by g.part1() | no effect |
 #'
@@ -156,11 +158,6 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
   pr <- p$params_rawdata
   pc <- p$params_cleaning
   pg <- p$params_general
-  if (!is.null(pg[["recordingEndSleepHour"]])) {
-    abort("`recordingEndSleepHour` = ", pg[["recordingEndSleepHour"]], ": GGIR's part 1 ",
-          "then expands M past the recording's end (tail_expansion_log), which gravcal's ",
-          "g.part1() does not do yet; use GGIR::g.part1() for it, or leave it NULL.")
-  }
   if (length(f1) && isTRUE(f1 == 0)) warning("\nWarning: f1 = 0 is not a meaningful value")
   # the parameters g.getmeta() reads, checked before any file is read
   meta_params(pm, pr, pg, pc, list())
@@ -328,10 +325,9 @@ part1_meta_name <- function(fname, first) {
 # GGIR's chunksize in part 1: with do.parallel on a machine of 4 or more
 # cores and more than one file to a worker pool, 0.5 for 3-5 metrics and
 # 0.4 for 6 or more (from chunksize above 0.6).
-part1_parallel_chunksize <- function(pm, pr, pg, f0, f1) {
+part1_parallel_chunksize <- function(pm, pr, pg, f0, f1, cores = parallel::detectCores()[1]) {
   cs <- pr[["chunksize"]]
   if (!isTRUE(pg[["do.parallel"]])) return(cs)
-  cores <- parallel::detectCores()[1]
   if (is.na(cores) || cores <= 3) return(cs)
   maxn <- if (length(pg[["maxNcores"]])) pg[["maxNcores"]] else cores
   if (min(c(cores - 1, maxn, (f1 - f0) + 1)) <= 1) return(cs)
@@ -443,6 +439,13 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
                  params_cleaning = pc, daylimit = FALSE, tempoffset = tempoffset,
                  scale = C$scale, offset = C$offset, meantempcal = C$meantempcal,
                  inspectfileobject = I, verbose = verbose)
+  tail_expansion_log <- NULL
+  if (!is.null(pg[["recordingEndSleepHour"]])) {
+    ex <- part1_expand_tail(M, pg[["recordingEndSleepHour"]], pg[["dayborder"]],
+                            pg[["desiredtz"]], fnames[i])
+    M <- ex$M
+    tail_expansion_log <- ex$log
+  }
   if (verbose) {
     cat("\nSave .RData-file with: calibration report, file inspection report and all signal features...\n")
   }
@@ -453,7 +456,7 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
   env$I <- I
   env$C <- C
   env$filename_dir <- env$filefoldername <- fnames[i]
-  env$tail_expansion_log <- NULL
+  env$tail_expansion_log <- tail_expansion_log
   env$GGIRversion <- utils::packageVersion("GGIR")
   env$desiredtz_part1 <- pg[["desiredtz"]]
   tmp <- tempfile(pattern = ".part1-", tmpdir = basic, fileext = ".RData")
@@ -462,4 +465,67 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
                 "GGIRversion", "desiredtz_part1"), envir = env, file = tmp)
   if (!file.rename(tmp, target)) abort("Could not write \"", target, "\".")
   if (length(C$QCmessage)) as.character(C$QCmessage)[1] else ""
+}
+
+# recordingEndSleepHour: when the recording ends less than 24 h + dayborder
+# - recordingEndSleepHour (hours) before the next day border, GGIR's part 1
+# adds epochs from its last ones to 8 hours past that border (so that
+# parts 3-5 see a last night): metashort's metrics 0 (EN 1), its angles a
+# slow square wave of +-15 degrees, metalong's scores 0 with nonwearscore
+# -1, time stamps going on (GGIR's exported POSIXtime2iso8601() and
+# iso8601chartime2POSIX(), in desiredtz); M gains `nonwear` (NA for the
+# recorded short epochs, 0 for the added ones), as in GGIR. Returns
+# list(M, log = list(short =, long =) or NULL).
+part1_expand_tail <- function(M, end_hour, dayborder, tz, fname) {
+  if (!NROW(M$metashort) || !NROW(M$metalong)) {
+    abort("`recordingEndSleepHour`: \"", fname, "\" has no epochs to expand ",
+          "(too short or unreadable); GGIR's part 1 stops on it too.")
+  }
+  ws3 <- M$windowsizes[1]
+  ws2 <- M$windowsizes[2]
+  last <- c(long = as.character(M$metalong$timestamp[nrow(M$metalong)]),
+            short = as.character(M$metashort$timestamp[nrow(M$metashort)]))
+  # as POSIXct times without a zone of their own (GGIR fills such a vector)
+  last_ts <- .POSIXct(c(0, 0))
+  for (k in 1:2) last_ts[k] <- GGIR::iso8601chartime2POSIX(x = last[[k]], tz = tz)
+  last_ts <- list(long = last_ts[1], short = last_ts[2])
+  refhour <- 24 + dayborder
+  to_border <- vapply(last_ts, function(t) {
+    clock <- as.numeric(format(t, format = "%H", tz = tz)) * 3600 +
+      as.numeric(format(t, format = "%M", tz = tz)) * 60 +
+      as.numeric(format(t, format = "%S", tz = tz))
+    refhour * 3600 - clock
+  }, 0)
+  if (to_border[["long"]] > (refhour - (end_hour - dayborder)) * 3600) {
+    return(list(M = M, log = NULL))
+  }
+  to_border <- to_border + 8 * 3600
+  n_long <- ceiling(to_border[["long"]] / ws2) + 1
+  n_short <- ceiling(to_border[["short"]] / ws3) + 1
+  per <- ws2 / ws3
+  if (n_short / per < n_long) n_short <- n_long * per
+  # short epochs
+  nr <- nrow(M$metashort)
+  add <- M$metashort[nr, ]
+  add[, grep("timestamp|angle", names(add), invert = TRUE)] <- 0
+  if ("EN" %in% names(add)) add$EN <- 1
+  rows <- (nr + 1):(nr + n_short)
+  M$metashort[rows, ] <- add
+  M$nonwear[rows] <- 0
+  M$metashort$timestamp[rows] <- GGIR::POSIXtime2iso8601(
+    seq(last_ts$short + ws3, last_ts$short + n_short * ws3, by = ws3), tz = tz)
+  angles <- grep("angle", names(add))
+  if (length(angles)) M$metashort[rows, angles] <- round(sin(seq_along(rows) / per)) * 15
+  log <- list(short = length(rows))
+  # long epochs
+  nr <- nrow(M$metalong)
+  add <- M$metalong[nr, ]
+  add[, grep("timestamp", names(add), invert = TRUE)] <- 0
+  add[, "nonwearscore"] <- -1
+  rows <- (nr + 1):(nr + n_long)
+  M$metalong[rows, ] <- add
+  M$metalong$timestamp[rows] <- GGIR::POSIXtime2iso8601(
+    seq(last_ts$long + ws2, last_ts$long + n_long * ws2, by = ws2), tz = tz)
+  log$long <- length(rows)
+  list(M = M, log = log)
 }

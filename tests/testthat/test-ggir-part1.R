@@ -210,6 +210,20 @@ test_that("g.part1() is GGIR's without calibration, for f0 and f1", {
   expect_identical(C$scale, c(1, 1, 1))
 })
 
+test_that("g.part1() is GGIR's with recordingEndSleepHour (M's tail expanded)", {
+  skip_if_quick()
+  # days from noon to noon: both recordings end late enough before the
+  # border for GGIR to add epochs to 8 hours past it
+  b <- p1_both(list(do.parallel = FALSE, do.cal = FALSE, recordingEndSleepHour = 19,
+                    dayborder = 12, desiredtz = "Europe/London"))
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  obj <- b$gravcal$part1[["meta_p01.cwa.RData"]]
+  expect_gt(obj$tail_expansion_log$long, 100)
+  expect_identical(nrow(obj$M$metalong) - obj$tail_expansion_log$long,
+                   sum(obj$M$metalong$nonwearscore != -1))
+  expect_true("nonwear" %in% names(obj$M))
+})
+
 test_that("g.part1() skips done files, leaves others' formats to GGIR, refuses what it does not do", {
   skip_if_not_installed("GGIR")
   d <- tempfile("part1-small-")
@@ -246,8 +260,6 @@ test_that("g.part1() skips done files, leaves others' formats to GGIR, refuses w
                                                      verbose = FALSE)))
   expect_true(file.exists(file.path(out, paste0("output_", basename(d)), "meta", "basic",
                                     "meta_a.cwa.RData")))
-  expect_error(gravcal::g.part1(d, md, recordingEndSleepHour = 22, verbose = FALSE),
-               "recordingEndSleepHour")
   expect_error(gravcal::g.part1(d, md, myfun = list(FUN = mean), verbose = FALSE), "myfun")
   expect_error(gravcal::g.part1(d, md, do.neishabouricounts = TRUE, verbose = FALSE),
                "do.neishabouricounts")
@@ -280,4 +292,23 @@ test_that("GGIR's listing of a folder and of a list of files", {
   expect_true(gravcal:::part1_is_filelist(file.path(d, "a.cwa")))
   expect_identical(gravcal:::part1_files(file.path(d, c("a.cwa", "sub/c.bin")), TRUE)$fnames,
                    c("a.cwa", "c.bin"))
+})
+
+test_that("GGIR's chunksize when it would run files in parallel", {
+  skip_if_not_installed("GGIR")
+  p <- GGIR::load_params()
+  pm <- p$params_metrics
+  pr <- p$params_rawdata
+  pg <- p$params_general
+  cs <- function(..., f1 = 2, cores = 8) {
+    gravcal:::part1_parallel_chunksize(utils::modifyList(pm, list(...)), pr, pg, 1, f1, cores)
+  }
+  expect_identical(cs(), 1)                       # 2 metrics
+  expect_identical(cs(do.mad = TRUE), 0.5)        # 3
+  expect_identical(cs(do.mad = TRUE, do.en = TRUE, do.bfen = TRUE, do.hfen = TRUE), 0.4)
+  expect_identical(cs(do.mad = TRUE, cores = 3), 1)  # GGIR runs serially below 4 cores
+  expect_identical(cs(do.mad = TRUE, f1 = 1), 1)     # one file: serially
+  pg$do.parallel <- FALSE
+  expect_identical(gravcal:::part1_parallel_chunksize(utils::modifyList(pm, list(do.mad = TRUE)),
+                                                      pr, pg, 1, 2, 8), 1)
 })
