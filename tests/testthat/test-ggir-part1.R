@@ -20,6 +20,20 @@ p1_quiet0 <- function(expr) {
   out
 }
 
+# `expr` with the random numbers of set.seed(seed), the session's stream
+# restored after (withr is not among the package's Suggests)
+p1_with_seed <- function(seed, expr) {
+  g <- globalenv()
+  if (exists(".Random.seed", envir = g, inherits = FALSE)) {
+    old <- get(".Random.seed", envir = g, inherits = FALSE)
+    on.exit(assign(".Random.seed", old, envir = g), add = TRUE)
+  } else {
+    on.exit(rm(".Random.seed", envir = g), add = TRUE)
+  }
+  set.seed(seed)
+  expr
+}
+
 # A folder of two recordings of 26 hours written by the package's writers:
 # an Axivity .cwa at 25 Hz and a GENEActiv .bin at 30 Hz, each with rest on
 # a table (non-wear) and clipped samples (meta_recording() of
@@ -34,7 +48,7 @@ p1_folder <- function() {
                               start = as.POSIXct(start, tz = "UTC"),
                               tempoffset = c(0.001, -0.002, 0.0005))
       n <- nrow(r)
-      withr::with_seed(seed, {
+      p1_with_seed(seed, {
         for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
           i <- round(s[1] * n):round(s[2] * n)
           r$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
