@@ -52,8 +52,8 @@
 #' of `minimumFileSizeMB` or less left out with a warning; a file whose meta
 #' file exists is skipped unless `overwrite = TRUE`.
 #'
-#' gravcal's [g.getmeta()] reads Axivity `.cwa` and GENEActiv `.bin` files
-#' so far. The other files chosen are skipped with one warning naming them
+#' Files of a format gravcal's [g.getmeta()] does not read (see its page;
+#' and `.wav`, which gravcal does not read at all) are skipped with one warning naming them
 #' and their formats, and get no meta file: `GGIR::GGIR(mode = 1:5,
 #' overwrite = FALSE, ...)` (or `GGIR::g.part1()`) then makes theirs and
 #' leaves the ones written here. Nothing is written for a file whose
