@@ -1,0 +1,329 @@
+# gravcal::g.part1() against GGIR 3.3-9's g.part1() on the same folder of
+# recordings: the meta files' objects identical() (M and C but their
+# wall-clock bsc_qc), and GGIR's part 2 on gravcal's meta files the same as
+# on GGIR's. GGIR's side is cached (helper-ggir-cache.R) by the recordings'
+# bytes and the arguments.
+
+p1_quiet <- function(expr) {
+  out <- NULL
+  keep_warn(utils::capture.output(out <- suppressWarnings(expr)))
+  out
+}
+
+# quiet, warnings kept (collected in p1_state$warnings)
+p1_quiet0 <- function(expr) {
+  out <- NULL
+  keep_warn(utils::capture.output(out <- withCallingHandlers(expr, warning = function(w) {
+    p1_state$warnings <- c(p1_state$warnings, conditionMessage(w))
+    invokeRestart("muffleWarning")
+  })))
+  out
+}
+
+# `expr` with the random numbers of set.seed(seed), the session's stream
+# restored after (withr is not among the package's Suggests)
+p1_with_seed <- function(seed, expr) {
+  g <- globalenv()
+  if (exists(".Random.seed", envir = g, inherits = FALSE)) {
+    old <- get(".Random.seed", envir = g, inherits = FALSE)
+    on.exit(assign(".Random.seed", old, envir = g), add = TRUE)
+  } else {
+    on.exit(rm(".Random.seed", envir = g), add = TRUE)
+  }
+  set.seed(seed)
+  expr
+}
+
+# A folder of two recordings of 26 hours written by the package's writers:
+# an Axivity .cwa at 25 Hz and a GENEActiv .bin at 30 Hz, each with rest on
+# a table (non-wear) and clipped samples (meta_recording() of
+# test-ggir-getmeta.R's kind). Made once a session.
+p1_state <- new.env()
+p1_folder <- function() {
+  if (is.null(p1_state$dir) || !dir.exists(p1_state$dir)) {
+    d <- tempfile("part1-data-")
+    dir.create(d)
+    rec <- function(format, sf, seed, start, name) {
+      r <- simulate_recording(hours = 26, sf = sf, seed = seed,
+                              start = as.POSIXct(start, tz = "UTC"),
+                              tempoffset = c(0.001, -0.002, 0.0005))
+      n <- nrow(r)
+      p1_with_seed(seed, {
+        for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
+          i <- round(s[1] * n):round(s[2] * n)
+          r$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
+          r$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
+          r$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
+        }
+      })
+      r$x[round(0.8 * n) + 0:40] <- 7.9
+      f <- file.path(d, name)
+      if (format == "cwa") {
+        gravcal:::write_cwa(as.matrix(r[, c("x", "y", "z")]), f, sf = sf,
+                            start = as.numeric(r$time[1]), temperature = r$temperature)
+      } else {
+        gravcal:::write_geneactiv_bin(r, f, sf = sf, start = start)
+      }
+    }
+    rec("cwa", 25, 21, "2024-03-04 09:07:23", "p01.cwa")
+    rec("bin", 30, 22, "2024-03-05 10:01:07", "p02.bin")
+    p1_state$dir <- d
+  }
+  p1_state$dir
+}
+
+# The objects of the meta files (or ms2.out files) in `folder`, by file,
+# with M's and C's bsc_qc (wall-clock times and memory) replaced by their
+# column names.
+p1_objects <- function(folder) {
+  out <- list()
+  for (f in sort(dir(folder))) {
+    e <- new.env()
+    load(file.path(folder, f), envir = e)
+    v <- mget(sort(ls(e, all.names = TRUE)), envir = e)
+    for (nm in intersect(c("M", "C"), names(v))) {
+      if (!is.null(v[[nm]]$bsc_qc)) v[[nm]]$bsc_qc <- names(v[[nm]]$bsc_qc)
+    }
+    out[[f]] <- v
+  }
+  out
+}
+
+# Part 2 (GGIR::GGIR(mode = 2), with its report) on the meta files of
+# outputdir/output_<data folder>: the ms2.out objects and the report's csv
+# files as text.
+p1_part2 <- function(datadir, outputdir) {
+  p1_quiet(GGIR::GGIR(mode = 2, datadir = datadir, outputdir = outputdir, do.report = 2,
+                      do.parallel = FALSE, verbose = FALSE, visualreport = FALSE))
+  md <- file.path(outputdir, paste0("output_", basename(datadir)))
+  csv <- c("part2_summary.csv", "part2_daysummary.csv", "QC/data_quality_report.csv")
+  list(ms2 = p1_objects(file.path(md, "meta", "ms2.out")),
+       csv = lapply(stats::setNames(csv, csv), function(f) {
+         readLines(file.path(md, "results", f))
+       }))
+}
+
+p1_run <- function(fun, datadir, outputdir, args) {
+  md <- file.path(outputdir, paste0("output_", basename(datadir)))
+  f1 <- if (is.null(args$f1)) 2 else args$f1
+  tab <- p1_quiet(do.call(fun, c(list(datadir = datadir, metadatadir = md, f1 = f1,
+                                      verbose = FALSE), args[setdiff(names(args), "f1")])))
+  list(tab = tab, md = md)
+}
+
+# GGIR's part 1 (then part 2 and part 1 again, which retrieves the
+# coefficients from part 2's report, when `then_part2`) and gravcal's on the
+# folder with the same arguments.
+p1_both <- function(args, then_part2 = FALSE, backup = NULL) {
+  skip_if_not_installed("GGIR")
+  d <- p1_folder()
+  files <- file.path(d, dir(d))
+  # a coefficient file given as its rows: the cache key holds them, not a
+  # temporary path
+  write_backup <- function() {
+    if (is.null(backup)) return(args)
+    f <- tempfile(fileext = ".csv")
+    utils::write.csv(backup, f, row.names = FALSE)
+    c(args, list(backup.cal.coef = f))
+  }
+  key <- c(args, list(backup = backup, then_part2 = then_part2))
+  ggir <- ggir_cached("g.part1", files, key, {
+    out <- tempfile("part1-ggir-")
+    dir.create(out)
+    r <- p1_run(GGIR::g.part1, d, out, write_backup())
+    res <- list(part1 = p1_objects(file.path(r$md, "meta", "basic")))
+    if (then_part2) {
+      res$part2 <- p1_part2(d, out)
+      p1_run(GGIR::g.part1, d, out, c(args, list(overwrite = TRUE)))
+      res$again <- p1_objects(file.path(r$md, "meta", "basic"))
+    }
+    unlink(out, recursive = TRUE)
+    res
+  })
+  out <- tempfile("part1-gravcal-")
+  dir.create(out)
+  t0 <- proc.time()[["elapsed"]]
+  r <- p1_run(gravcal::g.part1, d, out, write_backup())
+  grav <- list(part1 = p1_objects(file.path(r$md, "meta", "basic")), tab = r$tab,
+               seconds = proc.time()[["elapsed"]] - t0)
+  if (then_part2) {
+    grav$part2 <- p1_part2(d, out)
+    p1_run(gravcal::g.part1, d, out, c(args, list(overwrite = TRUE)))
+    grav$again <- p1_objects(file.path(r$md, "meta", "basic"))
+  }
+  list(ggir = ggir, gravcal = grav, md = r$md)
+}
+
+expect_same_objects <- function(G, R, what) {
+  expect_identical(names(G), names(R), label = paste(what, ": gravcal's files"))
+  for (f in names(R)) {
+    expect_identical(names(G[[f]]), names(R[[f]]), label = paste(what, f, ": objects"))
+    for (nm in names(R[[f]])) {
+      expect_true(identical(G[[f]][[nm]], R[[f]][[nm]]),
+                  label = paste0(what, " ", f, ": gravcal's ", nm, " identical() to GGIR's"))
+    }
+  }
+}
+
+test_that("g.part1() writes GGIR's meta files; GGIR's part 2 gives the same on them", {
+  skip_if_quick()
+  b <- p1_both(list(do.parallel = FALSE), then_part2 = TRUE)
+  expect_identical(names(b$ggir$part1), c("meta_p01.cwa.RData", "meta_p02.bin.RData"))
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  obj <- b$gravcal$part1[["meta_p01.cwa.RData"]]
+  expect_identical(names(obj), sort(c("M", "I", "C", "filename_dir", "filefoldername",
+                                      "tail_expansion_log", "GGIRversion",
+                                      "desiredtz_part1")))
+  # what the comparison saw: a calibration, temperature, non-wear, clipping
+  expect_gt(obj$C$npoints, 1000)
+  expect_false(identical(obj$C$scale, c(1, 1, 1)))
+  expect_true(any(obj$M$metalong$nonwearscore > 0))
+  expect_true(any(obj$M$metalong$clippingscore > 0))
+  expect_identical(obj$GGIRversion, utils::packageVersion("GGIR"))
+  expect_identical(b$gravcal$tab$status, c("written", "written"))
+  # part 2 on gravcal's meta files: its ms2.out files and its report's csv
+  # files (no run-time columns there) the same as on GGIR's
+  expect_same_objects(b$gravcal$part2$ms2, b$ggir$part2$ms2, "part 2 ms2.out")
+  expect_identical(b$gravcal$part2$csv, b$ggir$part2$csv)
+  expect_gt(length(b$gravcal$part2$csv$part2_daysummary.csv), 2)
+  # part 1 again after part 2 (overwrite = TRUE): the coefficients
+  # retrieved from part 2's data_quality_report.csv (backup.cal.coef =
+  # "retrieve"), as GGIR retrieves them, types and all
+  expect_same_objects(b$gravcal$again, b$ggir$again, "part 1 again")
+  # (through the csv's 15 significant digits)
+  expect_equal(b$gravcal$again[["meta_p01.cwa.RData"]]$C$scale, obj$C$scale, tolerance = 1e-14)
+})
+
+test_that("g.part1() is GGIR's with backup.cal.coef (a file with one recording), desiredtz", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  d <- p1_folder()
+  C <- p1_quiet(gravcal::g.calibrate(file.path(d, "p01.cwa"), verbose = FALSE))
+  f <- tempfile(fileext = ".csv")
+  write_ggir_coefs(list(p01.cwa = C), f)
+  backup <- utils::read.csv(f, stringsAsFactors = FALSE)
+  b <- p1_both(list(do.parallel = FALSE, desiredtz = "Europe/Amsterdam"), backup = backup)
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  got <- b$gravcal$part1
+  # p01.cwa: retrieved (no g.calibrate() list: no spheredata); p02.bin: not
+  # in the file, so calibrated
+  expect_null(got[["meta_p01.cwa.RData"]]$C$spheredata)
+  expect_equal(got[["meta_p01.cwa.RData"]]$C$scale, C$scale, tolerance = 1e-14)
+  expect_false(is.null(got[["meta_p02.bin.RData"]]$C$spheredata))
+  expect_identical(got[["meta_p01.cwa.RData"]]$desiredtz_part1, "Europe/Amsterdam")
+})
+
+test_that("g.part1() is GGIR's without calibration, for f0 and f1", {
+  skip_if_quick()
+  # GGIR's order: .bin before .cwa; f0 = f1 = 2 is p01.cwa alone
+  b <- p1_both(list(do.parallel = FALSE, do.cal = FALSE, f0 = 2, f1 = 2))
+  expect_identical(names(b$ggir$part1), "meta_p01.cwa.RData")
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  C <- b$gravcal$part1[[1]]$C
+  expect_identical(C$QCmessage, "Autocalibration not done")
+  expect_identical(C$scale, c(1, 1, 1))
+})
+
+test_that("g.part1() is GGIR's with recordingEndSleepHour (M's tail expanded)", {
+  skip_if_quick()
+  # days from noon to noon: both recordings end late enough before the
+  # border for GGIR to add epochs to 8 hours past it
+  b <- p1_both(list(do.parallel = FALSE, do.cal = FALSE, recordingEndSleepHour = 19,
+                    dayborder = 12, desiredtz = "Europe/London"))
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  obj <- b$gravcal$part1[["meta_p01.cwa.RData"]]
+  expect_gt(obj$tail_expansion_log$long, 100)
+  expect_identical(nrow(obj$M$metalong) - obj$tail_expansion_log$long,
+                   sum(obj$M$metalong$nonwearscore != -1))
+  expect_true("nonwear" %in% names(obj$M))
+})
+
+test_that("g.part1() skips done files, leaves others' formats to GGIR, refuses what it does not do", {
+  skip_if_not_installed("GGIR")
+  d <- tempfile("part1-small-")
+  dir.create(d)
+  rec <- simulate_recording(hours = 3, sf = 25, seed = 5,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file.path(d, "a.cwa"), sf = 25,
+                      start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  # listed by GGIR (.wav), read by no reader of gravcal's
+  writeBin(as.raw(1:100), file.path(d, "b.wav"))
+  out <- tempfile("part1-out-")
+  md <- file.path(out, "output_x")
+  p1_state$warnings <- NULL
+  tab <- p1_quiet0(gravcal::g.part1(d, md, minimumFileSizeMB = 0, do.parallel = FALSE,
+                                    verbose = FALSE))
+  expect_true(any(grepl("b.wav (a format gravcal does not know)", p1_state$warnings, fixed = TRUE) &
+                    grepl("overwrite = FALSE", p1_state$warnings, fixed = TRUE)))
+  expect_identical(tab$file, c("b.wav", "a.cwa"))
+  expect_identical(tab$status, c("not read", "written"))
+  meta <- file.path(md, "meta", "basic", "meta_a.cwa.RData")
+  expect_true(file.exists(meta))
+  expect_identical(dir(file.path(md, "meta", "basic"), all.files = TRUE, no.. = TRUE),
+                   "meta_a.cwa.RData")
+  expect_true(dir.exists(file.path(md, "results", "QC")))
+  # done: skipped unless overwrite = TRUE
+  before <- file.mtime(meta)
+  tab <- (p1_quiet0(gravcal::g.part1(d, md, minimumFileSizeMB = 0,
+                                                     do.parallel = FALSE, verbose = FALSE)))
+  expect_identical(tab$status[tab$file == "a.cwa"], "exists")
+  expect_identical(file.mtime(meta), before)
+  # too small (GGIR's default minimumFileSizeMB = 2): none left
+  expect_error(suppressWarnings(gravcal::g.part1(d, md, verbose = FALSE)), "No files to analyse")
+  # GGIR's outputdir naming
+  tab <- (p1_quiet0(gravcal::g.part1(d, outputdir = out, minimumFileSizeMB = 0,
+                                                     verbose = FALSE)))
+  expect_true(file.exists(file.path(out, paste0("output_", basename(d)), "meta", "basic",
+                                    "meta_a.cwa.RData")))
+  expect_error(gravcal::g.part1(d, md, myfun = list(FUN = mean), verbose = FALSE), "myfun")
+  expect_error(gravcal::g.part1(d, md, do.neishabouricounts = TRUE, verbose = FALSE),
+               "do.neishabouricounts")
+  expect_error(gravcal::g.part1(d, verbose = FALSE), "metadatadir")
+  expect_error(gravcal::g.part1(file.path(d, "a.cwa"), outputdir = out, verbose = FALSE),
+               "studyname")
+  # use_trycatch_serial: a file's error is reported, the run goes on
+  bad <- file.path(d, "c.cwa")
+  writeBin(as.raw(rep(0, 3000)), bad)
+  tab <- (p1_quiet0(gravcal::g.part1(d, md, minimumFileSizeMB = 0,
+                                                     use_trycatch_serial = TRUE,
+                                                     overwrite = TRUE, verbose = FALSE)))
+  expect_identical(tab$status[tab$file == "c.cwa"], "failed")
+  expect_identical(tab$status[tab$file == "a.cwa"], "written")
+})
+
+test_that("GGIR's listing of a folder and of a list of files", {
+  d <- tempfile("part1-list-")
+  dir.create(file.path(d, "sub"), recursive = TRUE)
+  for (f in c("a.cwa", "B.CWA", "sub/c.bin", "d.csv", "e.gt3x", "notes.txt", "f.wav")) {
+    writeBin(as.raw(1), file.path(d, f))
+  }
+  expect_false(gravcal:::part1_is_filelist(d))
+  got <- gravcal:::part1_files(d, FALSE)
+  if (requireNamespace("GGIR", quietly = TRUE)) {
+    expect_identical(got, GGIR::datadir2fnames(d, FALSE)[c("fnames", "fnamesfull")])
+  }
+  expect_identical(got$fnames[c(1:3, 6)], c("d.csv", "c.bin", "f.wav", "e.gt3x"))
+  expect_identical(sort(got$fnames[4:5]), sort(c("a.cwa", "B.CWA")))
+  expect_true(gravcal:::part1_is_filelist(file.path(d, "a.cwa")))
+  expect_identical(gravcal:::part1_files(file.path(d, c("a.cwa", "sub/c.bin")), TRUE)$fnames,
+                   c("a.cwa", "c.bin"))
+})
+
+test_that("GGIR's chunksize when it would run files in parallel", {
+  skip_if_not_installed("GGIR")
+  p <- GGIR::load_params()
+  pm <- p$params_metrics
+  pr <- p$params_rawdata
+  pg <- p$params_general
+  cs <- function(..., f1 = 2, cores = 8) {
+    gravcal:::part1_parallel_chunksize(utils::modifyList(pm, list(...)), pr, pg, 1, f1, cores)
+  }
+  expect_identical(cs(), 1)                       # 2 metrics
+  expect_identical(cs(do.mad = TRUE), 0.5)        # 3
+  expect_identical(cs(do.mad = TRUE, do.en = TRUE, do.bfen = TRUE, do.hfen = TRUE), 0.4)
+  expect_identical(cs(do.mad = TRUE, cores = 3), 1)  # GGIR runs serially below 4 cores
+  expect_identical(cs(do.mad = TRUE, f1 = 1), 1)     # one file: serially
+  pg$do.parallel <- FALSE
+  expect_identical(gravcal:::part1_parallel_chunksize(utils::modifyList(pm, list(do.mad = TRUE)),
+                                                      pr, pg, 1, 2, 8), 1)
+})
