@@ -419,6 +419,12 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   temp_warn <- attr(res, "gravcal")$temperature_warnings
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!compat) {
+    # rest that is not rest (near-rest.R): windows far off the sphere after
+    # the fit are left out and the fit done again on the others
+    if (fit$status %in% c("ok", "high_error") && NROW(res$spheredata) > 0) {
+      fit <- ggir_near_rest(res, fit, a, src$sf, call,
+                            clock = near_rest_clock(x, fit$input))
+    }
     fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
                                     excluded_reasons)
     fit$guards <- list(max_norm_error = guards$max_norm_error,

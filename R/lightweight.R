@@ -111,12 +111,47 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
       "samples in g and is sf right?"), nrow(w))))
   }
   if (choice$selection == "cells") {
-    pts <- select_points(rest, selection = "cells", cell = choice$cell)
-    fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+    fit_rest <- function(keep) {
+      pts <- select_points(rest[keep, , drop = FALSE], selection = "cells",
+                           cell = choice$cell)
+      fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+      if (fit$status == "sphere_not_covered") return(fit)
+      fit$call <- call
+      fit$selection <- choice
+      guard_fit(fit)
+    }
+    fit <- fit_rest(rep(TRUE, nrow(rest)))
     if (fit$status == "sphere_not_covered") return(fit)
-    fit$call <- call
-    fit$selection <- choice
-    fit <- guard_fit(fit)
+    # rest that is not rest (near_rest_trim(), near-rest.R): the windows
+    # far off the sphere after the fit are left out and the fit done again
+    v <- point_matrix(rest, "rest")
+    nr <- near_rest_trim(fit, v, rest$temperature, function(keep) {
+      f <- fit_rest(keep)
+      # the points' rows are those of the windows kept
+      if (!is.null(f$points$row)) f$points$row <- which(keep)[f$points$row]
+      f
+    })
+    fit <- nr$fit
+    rejected_windows <- rest[nr$out, , drop = FALSE]
+    rejected_windows$residual <- near_rest_residuals(
+      fit, v[nr$out, , drop = FALSE], rejected_windows$temperature)
+    secs <- if (inherits(rest$start, "POSIXct")) {
+      as.numeric(rest$start) - as.numeric(w$start[1])
+    } else rest$start - w$start[1]
+    stretches <- near_rest_stretches(
+      secs, nr$out, near_rest_residuals(fit, v, rest$temperature),
+      attr(w, "window"), clock = if (inherits(w$start, "POSIXct")) {
+        w$start[1]
+      } else near_rest_clock(NULL, attr(w, "input")))
+    if (any(nr$out)) {
+      keep <- !nr$out
+      fit$points$row <- match(fit$points$row, which(keep))
+      rest <- rest[keep, , drop = FALSE]
+      rownames(rest) <- NULL
+      attr(rest, "n_windows") <- nrow(w)
+    }
+    fit <- add_near_rest(fit, nr$rejected, stretches)
+    fit$rejected_windows <- rejected_windows
     if (!is.null(choice$segments) && fit$status == "ok") {
       fit <- fit_segments(fit, rest$start, origin = w$start[1],
                           segment_fitter_lw(fit, rest, args$fit_gradient,
