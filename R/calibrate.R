@@ -353,7 +353,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                                   file = if (is.character(x)) basename(x),
                                   timed = !is.character(x) &&
                                     "time" %in% tolower(names(x)),
-                                  max_identical = max_identical)
+                                  max_identical = max_identical,
+                                  off_sphere = la$off_sphere)
   # a stuck temperature sensor: the rest windows' temperature does not vary
   # (see ?plausible_bounds)
   fit$temperature_check <- temperature_check(

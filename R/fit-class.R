@@ -196,7 +196,7 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
 print_rejected <- function(x) {
   line <- format_rejected(x$rejected)
   if (is.null(line)) return(invisible())
-  cat("  rest windows off the sphere: ", line, "\n", sep = "")
+  cat("  off the sphere, left out: ", line, "\n", sep = "")
   for (s in format_stretches(x$rejected_stretches)) cat("    ", s, "\n", sep = "")
   invisible()
 }
@@ -278,7 +278,8 @@ print.summary.gravcal_fit <- function(x, ...) {
   e$after_mg <- round(e$after_mg, 2)
   e$improvement <- round(e$improvement, 2)
   print(e, row.names = FALSE)
-  if (!is.null(format_rejected(x$rejected))) {
+  if (!is.null(format_rejected(x$rejected)) &&
+      (x$rejected$windows > 0 || nzchar(x$rejected$note))) {
     cat("\nRest windows off the sphere, left out:\n")
     print_rejected(x)
   }

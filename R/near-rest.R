@@ -43,11 +43,12 @@ near_rest_rule <- list(
 
 # The rule on residuals `r` given the windows left out so far (`out`):
 # list(out, centre, spread, threshold) (g).
-near_rest_cut <- function(r, out = rep(FALSE, length(r))) {
+near_rest_cut <- function(r, out = rep(FALSE, length(r)),
+                          k = near_rest_rule$k) {
   kept <- r[!out & is.finite(r)]
   m <- stats::median(kept)
   s <- 1.4826 * stats::median(abs(kept - m))
-  thr <- max(near_rest_rule$k * s, near_rest_rule$floor)
+  thr <- max(k * s, near_rest_rule$floor)
   list(out = !is.finite(r) | abs(r - m) > thr, centre = m, spread = s,
        threshold = thr)
 }
@@ -63,7 +64,8 @@ near_rest_residuals <- function(fit, v, temperature) {
 # fit on the windows `keep` (logical), giving a fit. Returns list(fit, out,
 # rejected): `out` the windows left out (all FALSE when none or when the
 # rule was not applied), `rejected` what fit$rejected reports.
-near_rest_trim <- function(fit, v, temperature, refit) {
+near_rest_trim <- function(fit, v, temperature, refit,
+                           k = near_rest_rule$k) {
   n <- nrow(v)
   out <- rep(FALSE, n)
   cut <- NULL
@@ -73,7 +75,7 @@ near_rest_trim <- function(fit, v, temperature, refit) {
   first <- fit
   if (applied(fit) && n > 0) {
     repeat {
-      cut <- near_rest_cut(near_rest_residuals(fit, v, temperature), out)
+      cut <- near_rest_cut(near_rest_residuals(fit, v, temperature), out, k)
       if (identical(cut$out, out) || rounds >= near_rest_rule$max_rounds) break
       if (mean(cut$out) > near_rest_rule$max_share) {
         note <- sprintf(paste0(
@@ -104,7 +106,7 @@ near_rest_trim <- function(fit, v, temperature, refit) {
     windows = sum(out), of = n, share = if (n > 0) mean(out) else 0,
     threshold = if (is.null(cut)) NA_real_ else cut$threshold,
     spread = if (is.null(cut)) NA_real_ else cut$spread,
-    k = near_rest_rule$k, floor = near_rest_rule$floor,
+    k = k, floor = near_rest_rule$floor,
     max_share = near_rest_rule$max_share, rounds = rounds, note = note)
   list(fit = fit, out = out, rejected = rejected)
 }
@@ -201,8 +203,9 @@ add_near_rest <- function(fit, rejected, stretches) {
 format_rejected <- function(rejected) {
   if (is.null(rejected)) return(NULL)
   if (is.na(rejected$threshold)) return(NULL)
-  sprintf(paste0("%d of %d (%.1f %%) more than %.1f mg off the others ",
-                 "(%g x robust spread %.2f mg, at least %g mg)%s"),
+  sprintf(paste0("%d of %d rest windows (%.1f %%): more than %.1f mg off ",
+                 "the others after the fit (%g x robust spread %.2f mg, at ",
+                 "least %g mg)%s"),
           rejected$windows, rejected$of, 100 * rejected$share,
           1000 * rejected$threshold, rejected$k, 1000 * rejected$spread,
           1000 * rejected$floor,
@@ -218,7 +221,8 @@ format_rejected <- function(rejected) {
 # `rejected_windows` (the procedure's window number `window`, its `start`
 # in seconds from the first sample, its means, temperature and residual).
 # `a`: calibrate(method = "ggir")'s settings; `clock`: near_rest_clock().
-ggir_near_rest <- function(res, fit, a, sf, call, clock = NULL) {
+ggir_near_rest <- function(res, fit, a, sf, call, clock = NULL,
+                           k = near_rest_rule$k) {
   sd <- res$spheredata
   info <- attr(res, "gravcal")
   tt <- isTRUE(res$use.temp)
@@ -240,7 +244,7 @@ ggir_near_rest <- function(res, fit, a, sf, call, clock = NULL) {
       info, list(icp = g$icp, meantemp = g$meantemp))
     ggir_fit(out, FALSE, call, a$minloadcrit)
   }
-  nr <- near_rest_trim(fit, v, temp, refit)
+  nr <- near_rest_trim(fit, v, temp, refit, k)
   f <- nr$fit
   r <- near_rest_residuals(f, v, temp)
   secs <- (rows - 1) * ggir_constants$window
