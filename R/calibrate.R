@@ -111,7 +111,8 @@
 #' postures and move the fit. So, in gravcal's own modes (the lightweight
 #' method's default `selection = "cells"`, and the GGIR method with
 #' `ggir_compat = FALSE`; never `ggir_compat = TRUE` nor [g.calibrate()],
-#' whose rest windows stay GGIR's), after the fit each rest window's
+#' whose rest windows stay GGIR's), after a fit that is applied (status
+#' `"ok"` or `"high_error"`) each rest window's
 #' residual `r = |a| - 1` is computed (`a` its calibrated mean, the
 #' temperature term included), with the median `m` and the robust spread
 #' `s = 1.4826 MAD` of the residuals of the windows kept; a window is left

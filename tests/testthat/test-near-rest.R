@@ -10,7 +10,11 @@
 # N(0, 0.01), offsets N(0, 0.02) g). `clean` is the same recording without
 # those hours (the rows cut out: simulate_recording() draws the vehicle's
 # random numbers last, so the rest of the recording is the same).
+# (simulated once per file and rate: the tests share it)
+near_rest_cache <- new.env()
 near_rest_case <- function(sf = 10, vehicle = 3, seed = 44) {
+  key <- paste(sf, vehicle, seed)
+  if (!is.null(near_rest_cache[[key]])) return(near_rest_cache[[key]])
   set.seed(7)
   p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.01),
          stats::rnorm(3, sd = 0.02))
@@ -19,7 +23,8 @@ near_rest_case <- function(sf = 10, vehicle = 3, seed = 44) {
                             tempoffset = c(0.001, -0.0008, 0.0012),
                             start = as.POSIXct("2024-03-04 00:00:00", tz = "UTC"))
   cont <- attr(rec, "truth")$contaminated
-  list(rec = rec, clean = rec[-(cont$from:cont$to), ], stretch = cont, sf = sf)
+  near_rest_cache[[key]] <- list(rec = rec, clean = rec[-(cont$from:cont$to), ],
+                                 stretch = cont, sf = sf)
 }
 
 # fit f's coefficients against the clean fit's, in units of their combined
