@@ -103,6 +103,50 @@
 #' A window left out for several reasons counts once: identical first, then
 #' clipped, then norm.
 #'
+#' **Rest that is not rest.** A window can pass every rule above and still
+#' not be a sensor at rest: in a car, a bus or a train the wrist keeps a
+#' posture, the vibration's sd is low, and the vehicle's accelerations put
+#' the norm of each window's mean 30-80 mg off 1 g, of either sign (within
+#' the 0.3 g guard). Hours of such windows outnumber a day's distinct rest
+#' postures and move the fit. So, in gravcal's own modes (the lightweight
+#' method's default `selection = "cells"`, and the GGIR method with
+#' `ggir_compat = FALSE`; never `ggir_compat = TRUE` nor [g.calibrate()],
+#' whose rest windows stay GGIR's), after a fit that is applied (status
+#' `"ok"` or `"high_error"`) each rest window's
+#' residual `r = |a| - 1` is computed (`a` its calibrated mean, the
+#' temperature term included), with the median `m` and the robust spread
+#' `s = 1.4826 MAD` of the residuals of the windows kept; a window is left
+#' out when `|r - m| > max(off_sphere * s, 5 mg)`, and the fit is done
+#' again on the windows kept, until the windows left out no longer change
+#' (at most 5 fits; a window can come back). `off_sphere` is 5 by default:
+#' beyond any normal residual in a week of windows (a chance of 6e-7 per
+#' window), so a clean recording loses none; 5 mg is the floor because it
+#' is the smallest offset change that matters to a user's results
+#' ([plausible_bounds()]'s `practical_min`), and very clean recordings
+#' have spreads well under 1 mg. When more than a third of the rest
+#' windows would be left out (the spread is the clean windows', so they
+#' must be a clear majority), or when the fit without them fails, none is
+#' left out and the message says so. `off_sphere = Inf` turns the rule off.
+#' The fit, its errors and its standard errors are those of the windows
+#' kept, which are its `windows` (and, for the GGIR method, its `points`
+#' and `ggir$spheredata`). `fit$rejected` counts the windows left out
+#' (`windows`, `of`, `share`, `threshold` and `spread` in g, `k`, `floor`,
+#' `max_share`, `rounds`, `note`) and `fit$rejected_windows` lists them
+#' with their `residual`. Runs of windows left out that last 30 minutes or
+#' more (successive ones at most 5 minutes apart) are reported in
+#' `fit$rejected_stretches` (`start`, `end`: date-times from the samples'
+#' `time` column or the file's clock, else seconds from the first sample;
+#' `hours`, `windows`, `median_mg`: the median `| |a| - 1 |` of its
+#' windows, in mg) and in the message, `print()` and `summary()`: "3.0 h
+#' from 2024-03-04 22:30 look like rest but are not on the sphere (median
+#' 54 mg off)". On 28-hour recordings with three hours of such near-rest,
+#' both methods give, within 2 combined standard errors, the coefficients
+#' of the same recording without those hours, with status `"ok"` where it
+#' was `"high_error"` (`bench/results/near-rest.md`). With
+#' `selection = "paper"` the rule does not run (the paper's procedure, as
+#' a device runs it). Pooled recordings ([calibrate_files()] with `pool`)
+#' leave out windows by the same rule, without stretches.
+#'
 #' **Coefficients that change over time.** With `segments = "day"` (or a
 #' number of hours) the lightweight method also fits each day (segment) of
 #' the recording on its own rest windows, with the model and reference
@@ -176,7 +220,9 @@
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
 #'   `chunk_size`, `progress`, `reader`, `rmc`), the guards (`max_norm_error`, in g,
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
-#'   file or unknown; `max_identical`, default 0.8; see Details), the choice of points and model
+#'   file or unknown; `max_identical`, default 0.8; `off_sphere`, the cut-off
+#'   of the rule on rest that is not on the sphere in robust spreads, default
+#'   5, `Inf` for none; see Details), the choice of points and model
 #'   (`selection`, `"cells"` or `"paper"`; `cell`, in g, default 0.05;
 #'   `max_se`, default 0.01; `model`, default `"auto"`; `use_temp`,
 #'   default TRUE; `segments`, default none, and `change_alpha`, default
@@ -194,8 +240,8 @@
 #'   [rest_windows()]; the rest rule stays `max_sd`, where
 #'   [g.calibrate()] takes GGIR's `1.2 * rmc.noise`), `verbose` and, in
 #'   gravcal's own mode only (an error with `ggir_compat = TRUE`), the
-#'   guards `max_norm_error`, `range_g` and `max_identical` (as for the
-#'   lightweight method), `segments`, `change_alpha`, `budget`, `target_se`
+#'   guards `max_norm_error`, `range_g`, `max_identical` and `off_sphere`
+#'   (as for the lightweight method), `segments`, `change_alpha`, `budget`, `target_se`
 #'   and `check_hours` (see "The GGIR method").
 #' @section The GGIR method:
 #' `method = "ggir"` runs the procedure of GGIR's `g.calibrate()` (see
@@ -298,6 +344,11 @@
 #'   * for the lightweight method from [calibrate()]: `excluded`,
 #'     `excluded_windows` and `guards`; for the GGIR method in gravcal's own
 #'     mode: `excluded` and `guards` (see Details);
+#'   * in gravcal's own modes (the lightweight method's default selection,
+#'     the GGIR method with `ggir_compat = FALSE`): `rejected`,
+#'     `rejected_windows` and `rejected_stretches`, the rest windows left
+#'     out as not on the sphere and their stretches of time (see "Rest that
+#'     is not rest" in Details);
 #'   * in gravcal's own modes (both methods), `temperature_check`: the
 #'     temperature sensor, a list with `available`, `flat` (the rest
 #'     windows' temperature does not vary: sd below 0.01 degrees C), `sd`,
@@ -353,7 +404,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
                                   file = if (is.character(x)) basename(x),
                                   timed = !is.character(x) &&
                                     "time" %in% tolower(names(x)),
-                                  max_identical = max_identical)
+                                  max_identical = max_identical,
+                                  off_sphere = la$off_sphere)
   # a stuck temperature sensor: the rest windows' temperature does not vary
   # (see ?plausible_bounds)
   fit$temperature_check <- temperature_check(

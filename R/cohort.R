@@ -168,7 +168,11 @@
 #'   `plausibility_note` (see Plausibility above), `hours` (of samples read), `windows`,
 #'   `rest_windows`, `excluded_norm`, `excluded_clipped` and
 #'   `excluded_identical` (rest windows the guards left out, by reason; NA
-#'   where they do not run: GGIR-compatible mode); what the file's reader did: `reader` (`"native"` or
+#'   where they do not run: GGIR-compatible mode), `rejected_windows` and
+#'   `rejected_hours` (rest windows left out as not on the sphere, and the
+#'   hours of their stretches, see "Rest that is not rest" in
+#'   [calibrate()]; NA where the rule does not run: GGIR-compatible mode,
+#'   `selection = "paper"`, given coefficients); what the file's reader did: `reader` (`"native"` or
 #'   `"reference"`), `samples` read, `skipped` (units its decoder could
 #'   not use: damaged blocks, pages, records or lines), `gaps` and
 #'   `gap_seconds` (jumps in time), `truncated` and `read_notes` (the first
@@ -609,6 +613,12 @@ cohort_row <- function(file, id, fit, error, warnings, seconds, method) {
     excluded_norm = excluded_count(fit, "norm"),
     excluded_clipped = excluded_count(fit, "clipped"),
     excluded_identical = excluded_count(fit, "identical"),
+    # rest windows left out as not on the sphere, and the hours of their
+    # stretches (near-rest.R; NA where the rule does not run)
+    rejected_windows = if (na || is.null(fit$rejected)) NA_integer_ else
+      as.integer(fit$rejected$windows),
+    rejected_hours = if (na || is.null(fit$rejected)) NA_real_ else
+      sum(fit$rejected_stretches$hours),
     # what the reader read and skipped (native decoders)
     reader = if (is.null(inp$reader)) NA_character_ else inp$reader,
     samples = num(inp$samples),

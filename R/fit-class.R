@@ -146,6 +146,7 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
     cat("  rest windows left out: ", format_excluded(x$excluded, x$guards),
         "\n", sep = "")
   }
+  print_rejected(x)
   if (identical(x$budget$budget, "adaptive")) {
     b <- x$budget
     cat(sprintf("  adaptive budget: read %.1f%s hours, %s\n", b$hours_read,
@@ -188,6 +189,16 @@ print.gravcal_fit <- function(x, digits = 5, ...) {
     }
   }
   invisible(x)
+}
+
+# The rest windows the fit left out as not on the sphere, and their
+# stretches of time (near-rest.R), for print() and summary().
+print_rejected <- function(x) {
+  line <- format_rejected(x$rejected)
+  if (is.null(line)) return(invisible())
+  cat("  off the sphere, left out: ", line, "\n", sep = "")
+  for (s in format_stretches(x$rejected_stretches)) cat("    ", s, "\n", sep = "")
+  invisible()
 }
 
 # A segment boundary for people: hours from the start of the recording.
@@ -241,7 +252,8 @@ summary.gravcal_fit <- function(object, ...) {
                  message = object$message, coefficients = co, errors = err,
                  df = if (is.null(object$df)) NA_integer_ else object$df,
                  bins = bins, iterations = object$iterations,
-                 converged = object$converged),
+                 converged = object$converged, rejected = object$rejected,
+                 rejected_stretches = object$rejected_stretches),
             class = "summary.gravcal_fit")
 }
 
@@ -266,6 +278,11 @@ print.summary.gravcal_fit <- function(x, ...) {
   e$after_mg <- round(e$after_mg, 2)
   e$improvement <- round(e$improvement, 2)
   print(e, row.names = FALSE)
+  if (!is.null(format_rejected(x$rejected)) &&
+      (x$rejected$windows > 0 || nzchar(x$rejected$note))) {
+    cat("\nRest windows off the sphere, left out:\n")
+    print_rejected(x)
+  }
   if (!is.null(x$bins)) {
     cat("\nPoints per orientation bin:\n")
     print(x$bins)

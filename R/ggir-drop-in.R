@@ -378,7 +378,7 @@ cwa_time_span <- function(file) {
 calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   d <- split_dots(dots, list(ggir = ggir_param_names("own"),
                              guards = c("max_norm_error", "range_g",
-                                        "max_identical")))
+                                        "max_identical", "off_sphere")))
   args <- d$ggir
   a <- ggir_param_values("own", list(args))
   # own mode's guards on rest windows; GGIR-compatible mode keeps GGIR's
@@ -419,6 +419,14 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
   temp_warn <- attr(res, "gravcal")$temperature_warnings
   fit <- ggir_fit(res, compat, call, a$minloadcrit)
   if (!compat) {
+    # rest that is not rest (near-rest.R): windows far off the sphere after
+    # the fit are left out and the fit done again on the others
+    if (fit$status %in% c("ok", "high_error") && NROW(res$spheredata) > 0 &&
+        is.finite(guards$off_sphere)) {
+      fit <- ggir_near_rest(res, fit, a, src$sf, call,
+                            clock = near_rest_clock(x, fit$input),
+                            k = guards$off_sphere)
+    }
     fit$excluded <- stats::setNames(as.integer(ex[excluded_reasons]),
                                     excluded_reasons)
     fit$guards <- list(max_norm_error = guards$max_norm_error,

@@ -3,12 +3,12 @@
 
 # The lightweight method's arguments from calibrate()'s `...`, routed and
 # checked: list(args (by destination), choice, max_norm_error, range_g,
-# max_identical).
+# max_identical, off_sphere).
 lightweight_args <- function(dots) {
   args <- split_dots(dots, list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
                      "chunk_size", "progress", "reader", "rmc"),
-    guards = c("max_norm_error", "range_g", "max_identical"),
+    guards = c("max_norm_error", "range_g", "max_identical", "off_sphere"),
     choice = c("selection", "cell", "max_se", "model", "use_temp",
                "segments", "change_alpha", "budget", "target_se",
                "check_hours"),
@@ -19,11 +19,14 @@ lightweight_args <- function(dots) {
   choice <- check_choice_args(args$choice, args$select_points)
   g <- guard_args(args$guards)
   list(args = args, choice = choice, max_norm_error = g$max_norm_error,
-       range_g = g$range_g, max_identical = g$max_identical)
+       range_g = g$range_g, max_identical = g$max_identical,
+       off_sphere = g$off_sphere)
 }
 
-# The guards' arguments (max_norm_error, range_g, max_identical), checked,
-# with their defaults; range_g NULL when not given (the file's, or unknown).
+# The guards' arguments (max_norm_error, range_g, max_identical, and the
+# cut-off of the rule on rest that is not on the sphere, off_sphere, in
+# robust spreads: near-rest.R), checked, with their defaults; range_g NULL
+# when not given (the file's, or unknown).
 guard_args <- function(gargs) {
   max_norm_error <- if (is.null(gargs$max_norm_error)) 0.3 else
     gargs$max_norm_error
@@ -38,8 +41,12 @@ guard_args <- function(gargs) {
   max_identical <- if (is.null(gargs$max_identical)) default_max_identical else
     gargs$max_identical
   check_number(max_identical, "max_identical", min = 0, max = 1)
+  off_sphere <- gargs$off_sphere %||% near_rest_rule$k
+  if (!identical(off_sphere, Inf)) {
+    check_number(off_sphere, "off_sphere", min = 1)
+  }
   list(max_norm_error = max_norm_error, range_g = range_g,
-       max_identical = max_identical)
+       max_identical = max_identical, off_sphere = off_sphere)
 }
 
 # The lightweight method from its windows (rest_windows()'s table, with its
@@ -48,7 +55,8 @@ guard_args <- function(gargs) {
 # whether the windows' start comes from a `time` column.
 lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
                                      call, file = NULL, timed = FALSE,
-                                     max_identical = default_max_identical) {
+                                     max_identical = default_max_identical,
+                                     off_sphere = near_rest_rule$k) {
   if (is.null(range_g)) range_g <- attr(w, "input")$range_g
   rest <- w[w$rest, , drop = FALSE]
   why <- guard_windows(rest, max_norm_error, range_g, max_identical)
@@ -111,12 +119,53 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
       "samples in g and is sf right?"), nrow(w))))
   }
   if (choice$selection == "cells") {
-    pts <- select_points(rest, selection = "cells", cell = choice$cell)
-    fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+    fit_rest <- function(keep) {
+      pts <- select_points(rest[keep, , drop = FALSE], selection = "cells",
+                           cell = choice$cell)
+      fit <- fit_chosen_model(pts, args$fit_gradient, choice, fail)
+      if (fit$status == "sphere_not_covered") return(fit)
+      fit$call <- call
+      fit$selection <- choice
+      guard_fit(fit)
+    }
+    fit <- fit_rest(rep(TRUE, nrow(rest)))
     if (fit$status == "sphere_not_covered") return(fit)
-    fit$call <- call
-    fit$selection <- choice
-    fit <- guard_fit(fit)
+    # rest that is not rest (near_rest_trim(), near-rest.R): the windows
+    # far off the sphere after the fit are left out and the fit done again
+    # (off_sphere = Inf: not applied)
+    if (is.finite(off_sphere)) {
+      v <- point_matrix(rest, "rest")
+      nr <- near_rest_trim(fit, v, rest$temperature, function(keep) {
+        f <- fit_rest(keep)
+        # the points' rows are those of the windows kept
+        if (!is.null(f$points$row)) f$points$row <- which(keep)[f$points$row]
+        f
+      }, k = off_sphere)
+      fit <- nr$fit
+      rejected_windows <- rest[nr$out, , drop = FALSE]
+      rejected_windows$residual <- near_rest_residuals(
+        fit, v[nr$out, , drop = FALSE], rejected_windows$temperature)
+      secs <- if (inherits(rest$start, "POSIXct")) {
+        as.numeric(rest$start) - as.numeric(w$start[1])
+      } else rest$start - w$start[1]
+      # a device's recordings pooled (pool.R) have no one time line: their
+      # windows are left out, without stretches
+      pooled <- identical(attr(w, "input")$source, "pooled")
+      stretches <- near_rest_stretches(
+        secs, nr$out & !pooled, near_rest_residuals(fit, v, rest$temperature),
+        attr(w, "window"), clock = if (inherits(w$start, "POSIXct")) {
+          w$start[1]
+        } else near_rest_clock(NULL, attr(w, "input")))
+      if (any(nr$out)) {
+        keep <- !nr$out
+        fit$points$row <- match(fit$points$row, which(keep))
+        rest <- rest[keep, , drop = FALSE]
+        rownames(rest) <- NULL
+        attr(rest, "n_windows") <- nrow(w)
+      }
+      fit <- add_near_rest(fit, nr$rejected, stretches)
+      fit$rejected_windows <- rejected_windows
+    }
     if (!is.null(choice$segments) && fit$status == "ok") {
       fit <- fit_segments(fit, rest$start, origin = w$start[1],
                           segment_fitter_lw(fit, rest, args$fit_gradient,

@@ -95,7 +95,8 @@ pooled_fit <- function(paths, fits, method, args) {
   la$choice$budget <- "all"
   lightweight_from_windows(w, la$args, la$choice, la$max_norm_error,
                            la$range_g, call = NULL, file = NULL,
-                           max_identical = la$max_identical)
+                           max_identical = la$max_identical,
+                           off_sphere = la$off_sphere)
 }
 
 # The GGIR method pooled. Each recording's rest windows are those GGIR's

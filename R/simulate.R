@@ -139,11 +139,24 @@ check_params <- function(params) {
 #'   0.05-0.2 g on each axis (either sign), as a stuck sensor gives. With
 #'   both 0 the recording (and the random numbers drawn) are those without
 #'   the arguments.
+#' @param vehicle Hours (default 0) of near-rest that is not rest, as in a
+#'   vehicle, in one stretch from a random whole half hour that overlaps no
+#'   `idle_sleep` or `stuck` stretch: the wearer's arm keeps a posture
+#'   (a new one, from the same postures as the recording's rest, every 10
+#'   minutes) while the vehicle's accelerations scale the true vector's
+#'   norm by 1 + d, d drawn for each 10 s from +-(0.03 to 0.08) (either
+#'   sign, uniform in size), and the road's vibration adds Gaussian noise
+#'   of sd 5 mg on each axis: every 10 s window passes the rest rules of
+#'   both methods (low sd, small range, norm well within 0.3 g of 1 g) but
+#'   its norm is 30-80 mg off 1 g. The stretch goes through the same sensor
+#'   (distortion, temperature offset, noise, resolution) as the rest of the
+#'   recording, and its random numbers are drawn after all others, so
+#'   outside the stretch the recording is the one without `vehicle`.
 #' @return A data frame with columns `time`, `x`, `y`, `z` and (optionally)
 #'   `temperature`, and an attribute `truth`: a list with `params`, `K`,
-#'   `offset`, `tempoffset`, `meantemp` and `sf`, and, with `idle_sleep` or
-#'   `stuck`, `contaminated`: a data frame of the stretches (`kind`,
-#'   `from`, `to`: sample numbers).
+#'   `offset`, `tempoffset`, `meantemp` and `sf`, and, with `idle_sleep`,
+#'   `stuck` or `vehicle`, `contaminated`: a data frame of the stretches
+#'   (`kind`, `from`, `to`: sample numbers).
 #' @export
 #' @examples
 #' rec <- simulate_recording(hours = 1, sf = 10, seed = 1)
@@ -155,13 +168,15 @@ simulate_recording <- function(hours = 72, sf = 30, params = NULL,
                                tempoffset = c(0, 0, 0), rest_fraction = 0.4,
                                start = as.POSIXct("2024-01-01 00:00:00",
                                                   tz = "UTC"),
-                               seed = NULL, idle_sleep = 0, stuck = 0) {
+                               seed = NULL, idle_sleep = 0, stuck = 0,
+                               vehicle = 0) {
   check_number(hours, "hours", min = 0, min_inclusive = FALSE)
   check_number(idle_sleep, "idle_sleep", min = 0)
   check_number(stuck, "stuck", min = 0)
-  if (idle_sleep + stuck > hours) {
-    abort("`idle_sleep` + `stuck` must be at most `hours` (", format(hours),
-          "), not ", format(idle_sleep + stuck), ".")
+  check_number(vehicle, "vehicle", min = 0)
+  if (idle_sleep + stuck + vehicle > hours) {
+    abort("`idle_sleep` + `stuck` + `vehicle` must be at most `hours` (",
+          format(hours), "), not ", format(idle_sleep + stuck + vehicle), ".")
   }
   check_sf(sf)
   check_number(noise, "noise", min = 0)
@@ -255,8 +270,55 @@ simulate_recording <- function(hours = 72, sf = 30, params = NULL,
     params = stats::setNames(unname(params), param_names()),
     K = params_to_K(params), offset = unname(params[7:9]),
     tempoffset = tempoffset, meantemp = meantemp, sf = sf)
+  if (vehicle > 0) {
+    veh <- vehicle_stretch(n, sf, vehicle, bad, postures, params, temp,
+                           meantemp, tempoffset, noise, resolution)
+    out[veh$rows, c("x", "y", "z")] <- veh$v
+    bad <- rbind(bad, data.frame(kind = "vehicle", from = veh$rows[1],
+                                 to = veh$rows[length(veh$rows)],
+                                 stringsAsFactors = FALSE))
+  }
   if (!is.null(bad)) attr(out, "truth")$contaminated <- bad
   out
+}
+
+# Vehicle-like near-rest (simulate_recording()'s `vehicle`): the rows of one
+# stretch of `hours` from a whole half hour clear of the stretches `bad`,
+# and its measured samples v (through the sensor: params, temperature
+# offset, noise, resolution). Per 10 minutes a posture of `postures`, per
+# 10 s a norm of 1 + d (|d| in 0.03-0.08, either sign), 5 mg of vibration.
+vehicle_stretch <- function(n, sf, hours, bad, postures, params, temp,
+                            meantemp, tempoffset, noise, resolution) {
+  len <- as.integer(round(hours * 3600 * sf))
+  slot <- max(1L, as.integer(round(1800 * sf)))
+  starts <- seq(0L, n - len, by = slot)
+  if (!is.null(bad) && nrow(bad)) {
+    clear <- vapply(starts, function(s) {
+      all(bad$to < s + 1L | bad$from > s + len)
+    }, TRUE)
+    starts <- starts[clear]
+  }
+  if (!length(starts) || len < 1) {
+    abort("`vehicle` (", format(hours), " h) finds no whole half hour to ",
+          "start from that leaves it clear of the other stretches.")
+  }
+  at <- starts[sample.int(length(starts), 1)]
+  rows <- at + seq_len(len)
+  ts <- (seq_len(len) - 1) / sf
+  piece <- floor(ts / 600) + 1
+  pidx <- sample.int(nrow(postures), max(piece), replace = TRUE,
+                     prob = attr(postures, "prob"))
+  tick <- floor(ts / 10) + 1
+  d <- sample(c(-1, 1), max(tick), replace = TRUE) *
+    stats::runif(max(tick), 0.03, 0.08)
+  a <- postures[pidx[piece], , drop = FALSE] * (1 + d[tick]) +
+    matrix(stats::rnorm(3 * len, sd = 0.005), ncol = 3)
+  if (!is.null(temp) && any(tempoffset != 0)) {
+    a <- a - outer(temp[rows] - meantemp, tempoffset)
+  }
+  v <- distort(a, params) + matrix(stats::rnorm(3 * len, sd = noise), ncol = 3)
+  if (resolution > 0) v <- round(v / resolution) * resolution
+  list(rows = rows, v = v)
 }
 
 # Samples v (n x 3) with `idle_sleep` and `stuck` hours replaced by

@@ -117,7 +117,12 @@ source_input <- function(src, samples) {
        range_g = if (is.numeric(src$info$range_g) &&
                      length(src$info$range_g) == 1) src$info$range_g else
                        NA_real_,
-       samples = samples, report = rep)
+       samples = samples, report = rep,
+       # the first sample's time (UNIX seconds, the file's clock) where the
+       # decoder knows it: near_rest_clock() dates the stretches with it
+       start_time = if (is.numeric(src$info$start_time) &&
+                        length(src$info$start_time) == 1) src$info$start_time else
+                          NA_real_)
 }
 
 # A file whose reader found no sample at all, having skipped what it read,
