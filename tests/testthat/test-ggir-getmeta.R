@@ -52,32 +52,9 @@ expect_same_meta <- function(b, clock = FALSE) {
   expect_true(is.data.frame(G$bsc_qc))
 }
 
-# A recording of `hours` written as a device file, with stretches at rest on
-# a table (flat, 1 mg noise: GGIR's non-wear) and a few clipped samples.
 meta_recording <- function(format, sf, hours, seed = 7, start = "2024-03-04 09:07:23") {
-  rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
-                            start = as.POSIXct(start, tz = "UTC"),
-                            tempoffset = c(0.001, -0.002, 0.0005))
-  n <- nrow(rec)
-  old <- if (exists(".Random.seed", globalenv())) get(".Random.seed", globalenv())
-  on.exit(if (is.null(old)) rm(".Random.seed", envir = globalenv()) else
-    assign(".Random.seed", old, globalenv()))
-  set.seed(seed)
-  for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
-    i <- round(s[1] * n):round(s[2] * n)
-    rec$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
-    rec$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
-    rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
-  }
-  rec$x[round(0.8 * n) + 0:40] <- 7.9
-  f <- tempfile(fileext = if (format == "cwa") ".cwa" else ".bin")
-  if (format == "cwa") {
-    gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = sf,
-                        start = as.numeric(rec$time[1]), temperature = rec$temperature)
-  } else {
-    gravcal:::write_geneactiv_bin(rec, f, sf = sf, start = start)
-  }
-  f
+  write_meta_recording(tempfile(fileext = if (format == "cwa") ".cwa" else ".bin"),
+                       format, sf, hours, seed, start)
 }
 
 cal_args <- list(offset = c(0.01, -0.02, 0.005), scale = c(1.01, 0.99, 1.002),

@@ -20,19 +20,6 @@ p1_quiet0 <- function(expr) {
   out
 }
 
-# `expr` with the random numbers of set.seed(seed), the session's stream
-# restored after (withr is not among the package's Suggests)
-p1_with_seed <- function(seed, expr) {
-  g <- globalenv()
-  if (exists(".Random.seed", envir = g, inherits = FALSE)) {
-    old <- get(".Random.seed", envir = g, inherits = FALSE)
-    on.exit(assign(".Random.seed", old, envir = g), add = TRUE)
-  } else {
-    on.exit(rm(".Random.seed", envir = g), add = TRUE)
-  }
-  set.seed(seed)
-  expr
-}
 
 # A folder of two recordings of 26 hours written by the package's writers:
 # an Axivity .cwa at 25 Hz and a GENEActiv .bin at 30 Hz, each with rest on
@@ -44,26 +31,7 @@ p1_folder <- function() {
     d <- tempfile("part1-data-")
     dir.create(d)
     rec <- function(format, sf, seed, start, name) {
-      r <- simulate_recording(hours = 26, sf = sf, seed = seed,
-                              start = as.POSIXct(start, tz = "UTC"),
-                              tempoffset = c(0.001, -0.002, 0.0005))
-      n <- nrow(r)
-      p1_with_seed(seed, {
-        for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
-          i <- round(s[1] * n):round(s[2] * n)
-          r$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
-          r$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
-          r$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
-        }
-      })
-      r$x[round(0.8 * n) + 0:40] <- 7.9
-      f <- file.path(d, name)
-      if (format == "cwa") {
-        gravcal:::write_cwa(as.matrix(r[, c("x", "y", "z")]), f, sf = sf,
-                            start = as.numeric(r$time[1]), temperature = r$temperature)
-      } else {
-        gravcal:::write_geneactiv_bin(r, f, sf = sf, start = start)
-      }
+      write_meta_recording(file.path(d, name), format, sf, 26, seed, start)
     }
     rec("cwa", 25, 21, "2024-03-04 09:07:23", "p01.cwa")
     rec("bin", 30, 22, "2024-03-05 10:01:07", "p02.bin")

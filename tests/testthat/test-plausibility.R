@@ -264,17 +264,26 @@ test_that("plausible_bounds() states a practical minimum change per coefficient"
                     temperature_stuck_hours = 12))
 })
 
+# Coefficients of 8 devices of 3-4 recordings (`n`): each device's scales
+# (around 1, sd 1 %), offsets (sd 20 mg) and temperature offsets (sd 0.5 mg
+# per degree C), its recordings that plus differences of sd `within`
+# (scale, offset, temperature offset; the scale's relative to it when
+# `relative`). One row a recording.
+device_cohort <- function(n, within, relative = FALSE) {
+  do.call(rbind, lapply(n, function(k) {
+    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02),
+           stats::rnorm(3, sd = 0.0005))
+    t(replicate(k, p + c((if (relative) p[1:3] else 1) * stats::rnorm(3, sd = within[1]),
+                         stats::rnorm(3, sd = within[2]), stats::rnorm(3, sd = within[3]))))
+  }))
+}
+
 test_that("a device outlier needs a change of practical size, not only a large z", {
   set.seed(41)
   # 8 devices of 3-4 recordings that agree within a device to 0.5 mg and
   # 0.03 % (fits of 26 h), standard errors 0.2 mg and 0.02 %
   n <- rep(c(3, 4), 4)
-  co <- do.call(rbind, lapply(n, function(k) {
-    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02),
-           stats::rnorm(3, sd = 0.0005))
-    t(replicate(k, p + c(stats::rnorm(3, sd = 0.0003), stats::rnorm(3, sd = 0.0005),
-                         stats::rnorm(3, sd = 0.00002))))
-  }))
+  co <- device_cohort(n, c(0.0003, 0.0005, 0.00002))
   serial <- rep(sprintf("S%d", 1:8), n)
   se <- c(0.0002, 0.0002, 0.0002, 0.0002, 0.0002, 0.0002, 0.00001, 0.00001, 0.00001)
   tab <- cohort_tab_t(co, se, serial)
@@ -322,12 +331,7 @@ test_that("a device outlier needs a change of practical size, not only a large z
 test_that("the issue's cohort: recordings 1.5 mg and 0.1 % apart are not flagged, faults are", {
   set.seed(44)
   n <- rep(c(3, 4), 4)
-  co <- do.call(rbind, lapply(n, function(k) {
-    p <- c(1 + stats::rnorm(3, sd = 0.01), stats::rnorm(3, sd = 0.02),
-           stats::rnorm(3, sd = 0.0005))
-    t(replicate(k, p + c(p[1:3] * stats::rnorm(3, sd = 0.001), stats::rnorm(3, sd = 0.0015),
-                         stats::rnorm(3, sd = 0.00005))))
-  }))
+  co <- device_cohort(n, c(0.001, 0.0015, 0.00005), relative = TRUE)
   serial <- rep(sprintf("S%d", 1:8), n)
   tab <- cohort_tab_t(co, c(rep(0.0003, 6), rep(0.00003, 3)), serial)
   j <- gravcal:::cohort_plausibility(tab)

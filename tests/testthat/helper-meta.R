@@ -1,0 +1,30 @@
+# Recordings for GGIR part 1's tests (test-ggir-getmeta.R, test-ggir-part1.R):
+# simulate_recording() of `hours` with temperature offsets, two stretches at
+# rest on a table (flat, 1 mg noise: GGIR's non-wear) and 41 samples at 7.9
+# g (clipping), written to `file` as a .cwa ("cwa") or GENEActiv .bin
+# ("bin"). The bytes depend only on the arguments (the cached GGIR results
+# are keyed by them); the session's random numbers are left as they were.
+write_meta_recording <- function(file, format, sf, hours, seed, start) {
+  rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
+                            start = as.POSIXct(start, tz = "UTC"),
+                            tempoffset = c(0.001, -0.002, 0.0005))
+  n <- nrow(rec)
+  g <- globalenv()
+  old <- if (exists(".Random.seed", envir = g, inherits = FALSE)) get(".Random.seed", envir = g)
+  on.exit(if (is.null(old)) rm(".Random.seed", envir = g) else assign(".Random.seed", old, envir = g))
+  set.seed(seed)
+  for (s in list(c(0.20, 0.27), c(0.55, 0.58))) {
+    i <- round(s[1] * n):round(s[2] * n)
+    rec$x[i] <- 0.02 + stats::rnorm(length(i), 0, 0.001)
+    rec$y[i] <- -0.01 + stats::rnorm(length(i), 0, 0.001)
+    rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
+  }
+  rec$x[round(0.8 * n) + 0:40] <- 7.9
+  if (format == "cwa") {
+    gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file, sf = sf,
+                        start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  } else {
+    gravcal:::write_geneactiv_bin(rec, file, sf = sf, start = start)
+  }
+  invisible(file)
+}
