@@ -130,6 +130,7 @@ recording_formats <- list(
   # sf * 60 * 1440 / 2 samples whatever chunksize, and assumes 64 Hz
   movisens = list(
     ggir_monitor = "movisens",
+    ggir_start = function(file, p) movisens_start(file, p),
     ext = c(bin = "Movisens (a unisens folder or its acc.bin)"),
     detect = function(file) is_movisens_bin(file),
     label = "a Movisens recording", unit = "sample", own_rate = TRUE,

@@ -21,7 +21,10 @@
 #' readers give; the per-sample work is C++.
 #'
 #' @section What this version covers:
-#' Formats: Axivity `.cwa`, GENEActiv `.bin`. Metrics: every `do.*` of
+#' Formats: Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x` and csv
+#' exports (their time gaps and idle-sleep zeros filled as GGIR fills them, up
+#' to GGIR's 90-minute limit: a longer gap is an error), Movisens. Metrics:
+#' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too) and
 #' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
 #' LFEN, the per-axis filtered signals and zero crossings) need the signal
@@ -103,7 +106,7 @@ meta_reader <- function(src) {
 }
 
 # The formats g.getmeta() reads so far.
-meta_formats <- c("cwa", "geneactiv", "gt3x", "actigraph_csv")
+meta_formats <- c("cwa", "geneactiv", "gt3x", "actigraph_csv", "movisens")
 
 # The metrics of g.applymetrics() in the order GGIR computes them (its
 # result's names); `filtered`: a Butterworth filter's (ggir_filters.hpp,
@@ -673,4 +676,20 @@ actigraph_date_order <- function(top) {
     if (f[[g[2]]] == 1 && f[[g[4]]] == 1) f[[g[2]]] <- 0
   }
   names(f)[which(f == 1)[1]]
+}
+
+# The start of a Movisens recording as GGIR's g.getstarttime() takes it:
+# unisens.xml's timestampStart as unisensR reads it, its clock moved into
+# configtz (where given: lubridate::force_tz()), given in desiredtz.
+movisens_start <- function(file, p) {
+  for (pkg in c("unisensR", "lubridate")) {
+    if (!requireNamespace(pkg, quietly = TRUE)) {
+      abort("The start of a Movisens recording as GGIR reads it needs the ", pkg,
+            " package: install.packages(\"", pkg, "\").")
+    }
+  }
+  st <- unisensR::readUnisensStartTime(dirname(file))
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  if (!identical(ctz, "")) st <- lubridate::force_tz(st, ctz)
+  as.POSIXlt(st, tz = p$desiredtz)
 }

@@ -189,3 +189,22 @@ test_that("a time gap longer than GGIR's epoch-level limit is an error saying so
                        idle = 3600 * 3 + 0:(2 * 3600))
   expect_error(gravcal::g.getmeta(f, verbose = FALSE), "time gap of 120")
 })
+
+test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml)", {
+  skip_if_not_installed("unisensR")
+  skip_if_not_installed("lubridate")
+  rec <- simulate_recording(hours = 27, sf = 64, seed = 17,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  d <- tempfile("movisens-")
+  dir.create(d)
+  gravcal:::write_movisens(rec[, c("x", "y", "z")], d, sf = 64, start = "2024-03-04 09:07:23",
+                           temperature = rec$temperature[seq(1, nrow(rec), by = 64)])
+  f <- file.path(d, "acc.bin")
+  b <- meta_both(f, cal_args)
+  expect_same_meta(b)
+  b2 <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam",
+                                                configtz = "Europe/Amsterdam")))
+  expect_same_meta(b2)
+  expect_identical(b2$gravcal$metashort$timestamp[1], "2024-03-04T09:15:00+0100")
+  expect_true("temperaturemean" %in% names(b$gravcal$metalong))
+})
