@@ -17,7 +17,12 @@
 # Faults: D2-r2 offset.x + 50 mg (a jump); D4-r1 the raw signal x 0.95
 # (attenuation); D6-r3 scale.x 1.35 (an implausible gain); D8-r2 a stuck
 # temperature sensor (its temperature column constant at its first value,
-# the signal still drifting with the true temperature).
+# the signal still drifting with the true temperature); D5-r2 three hours of
+# vehicle-like near-rest (simulate_recording(vehicle = 3): norm 30-80 mg off
+# 1 g, low sd; issue 44 item 1), whose twin without those hours (the same
+# recording otherwise) is calibrated too: the coefficients of the two are
+# compared in units of their combined standard errors (the same
+# temperature level: nothing to restate).
 #
 # Writes bench/results/cohort-flags.md.
 suppressPackageStartupMessages(library(gravcal))
@@ -46,6 +51,8 @@ recs$fault[recs$file == "D2-r2.cwa"] <- "offset jump +50 mg"
 recs$fault[recs$file == "D4-r1.cwa"] <- "attenuation x0.95"
 recs$fault[recs$file == "D6-r3.cwa"] <- "implausible gain 1.35"
 recs$fault[recs$file == "D8-r2.cwa"] <- "stuck temperature"
+recs$fault[recs$file == "D5-r2.cwa"] <- "near-rest 3 h"
+dir.create(file.path(work, "twin"))
 for (i in seq_len(nrow(recs))) {
   r <- recs[i, ]
   dv <- devices[[r$device]]
@@ -54,8 +61,10 @@ for (i in seq_len(nrow(recs))) {
   p[1:3] <- p[1:3] * (1 + stats::rnorm(3, sd = 0.001))
   if (r$fault == "implausible gain 1.35") p[1] <- 1.35
   shift <- stats::runif(1, -4, 4)
+  for (twin in if (r$fault == "near-rest 3 h") c(TRUE, FALSE) else FALSE) {
   rec <- simulate_recording(hours = hours, sf = sf, params = p,
-                            tempoffset = dv$tempoffset, seed = r$seed)
+                            tempoffset = dv$tempoffset, seed = r$seed,
+                            vehicle = if (r$fault == "near-rest 3 h" && !twin) 3 else 0)
   K <- gravcal:::params_to_K(p[1:6])
   temp <- rec$temperature + shift
   # the device's offsets hold at 28 degrees C: at this recording's level
@@ -66,9 +75,10 @@ for (i in seq_len(nrow(recs))) {
   if (r$fault == "attenuation x0.95") v <- v * 0.95
   if (r$fault == "stuck temperature") temp[] <- temp[1]
   v <- round(v * 256) / 256
-  gravcal:::write_cwa(v, file.path(work, "cohort", r$file), sf = sf, packed = FALSE,
-                      temperature = temp, device_id = dv$id)
+  gravcal:::write_cwa(v, file.path(work, if (twin) "twin" else "cohort", r$file), sf = sf,
+                      packed = FALSE, temperature = temp, device_id = dv$id)
   recs$temp_level[i] <- mean(temp)
+  }
 }
 t_written <- Sys.time()
 # the judgement before issue 44: that commit's plausibility.R over this
@@ -91,13 +101,26 @@ for (method in c("ggir", "lightweight")) {
                                status = res$status[m],
                                before = if (is.null(old)) NA else old[m],
                                after = res$plausibility[m],
+                               rejected_h = res$rejected_hours[m],
                                note = res$plausibility_note[m],
                                stringsAsFactors = FALSE)
   attr(runs[[method]], "devices") <- attr(res, "devices")
+  # the near-rest recording against its twin: coefficient differences in
+  # combined standard errors
+  tw <- calibrate_files(file.path(work, "twin"), method = method,
+                        outdir = file.path(work, paste0("twin-", method)))
+  a <- res[res$file == "D5-r2.cwa", ]
+  cols <- intersect(c(paste0("scale.", c("x", "y", "z")), paste0("offset.", c("x", "y", "z")),
+                      paste0("temperature.offset.", c("x", "y", "z"))), names(res))
+  cols <- cols[paste0(cols, ".se") %in% names(res)]
+  z <- vapply(cols, function(k) (a[[k]] - tw[[k]]) /
+                sqrt(a[[paste0(k, ".se")]]^2 + tw[[paste0(k, ".se")]]^2), 0)
+  attr(runs[[method]], "twin") <- list(z = z, status = c(a$status, tw$status),
+                                       rejected = c(a$rejected_hours, tw$rejected_hours))
 }
 t_done <- Sys.time()
 fmt <- function(x, d = 2) formatC(x, format = "f", digits = d)
-md <- c("# Flags on the issue's cohort (issue 44, items 2 and 3)", "",
+md <- c("# Flags on the issue's cohort (issue 44, items 1 to 3)", "",
         sprintf(paste0("`Rscript bench/cohort-flags.R %g %g` (gravcal %s, %s): %d recordings of ",
                        "8 devices, %g h each at %g Hz, written as .cwa files (%.0f s); both methods ",
                        "calibrated in %.0f s. `before`: the judgement of R/plausibility.R at %s ",
@@ -111,14 +134,22 @@ for (method in names(runs)) {
   clean <- r$fault == "none"
   md <- c(md, sprintf("## method = \"%s\"", method), "",
           sprintf(paste0("Clean recordings flagged: before %d of %d, after %d of %d. ",
-                         "Faulty recordings flagged: before %d of %d, after %d of %d."),
+                         "Faulty recordings flagged: before %d of %d, after %d of %d (near-rest: ",
+                         "flagged when 2.5 h or more of its rest windows are left out)."),
                   sum(r$before[clean] != "ok", na.rm = TRUE), sum(clean),
                   sum(r$after[clean] != "ok", na.rm = TRUE), sum(clean),
                   sum(r$before[!clean] != "ok" | is.na(r$before[!clean])), sum(!clean),
-                  sum(r$after[!clean] != "ok" | is.na(r$after[!clean])), sum(!clean)),
-          "", "| file | fault | status | before | after | note (after) |", "|---|---|---|---|---|---|",
-          sprintf("| %s | %s | %s | %s | %s | %s |", r$file, r$fault, r$status, r$before,
-                  r$after, gsub("|", "/", r$note, fixed = TRUE)),
+                  sum(r$after[!clean] != "ok" | is.na(r$after[!clean]) |
+                        (!is.na(r$rejected_h[!clean]) & r$rejected_h[!clean] >= 2.5)), sum(!clean)),
+          "", "| file | fault | status | before | after | rejected h | note (after) |",
+          "|---|---|---|---|---|---|---|",
+          sprintf("| %s | %s | %s | %s | %s | %s | %s |", r$file, r$fault, r$status, r$before,
+                  r$after, fmt(r$rejected_h, 1), gsub("|", "/", r$note, fixed = TRUE)),
+          "", with(attr(r, "twin"), sprintf(paste0(
+            "Near-rest D5-r2 against its twin without those hours: status %s (twin %s), ",
+            "rejected %s h (twin %s h); largest coefficient difference %s combined se (%s)."),
+            status[1], status[2], fmt(rejected[1], 1), fmt(rejected[2], 1),
+            fmt(max(abs(z)), 2), names(z)[which.max(abs(z))])),
           "", "Device references (after):", "",
           "| serial | recordings | reference recordings | left out |", "|---|---|---|---|",
           with(attr(r, "devices"), sprintf("| %s | %d | %s | %s |", serial, recordings,
