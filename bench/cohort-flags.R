@@ -30,8 +30,11 @@ args <- commandArgs(trailingOnly = TRUE)
 hours <- if (length(args) >= 1) as.numeric(args[1]) else 26
 sf <- if (length(args) >= 2) as.numeric(args[2]) else 12.5
 before <- Sys.getenv("GRAVCAL_BEFORE", "201160c")
-work <- file.path(tempdir(), "cohort-flags")
-unlink(work, recursive = TRUE)
+# GRAVCAL_BENCH_KEEP: a folder to write the recordings and results into and
+# keep (default: the session's temporary folder, removed)
+keep <- Sys.getenv("GRAVCAL_BENCH_KEEP")
+work <- if (nzchar(keep)) keep else file.path(tempdir(), "cohort-flags")
+if (!nzchar(keep)) unlink(work, recursive = TRUE)
 dir.create(file.path(work, "cohort"), recursive = TRUE)
 t0 <- Sys.time()
 set.seed(44)
@@ -159,4 +162,4 @@ for (method in names(runs)) {
 dir.create(file.path("bench", "results"), showWarnings = FALSE, recursive = TRUE)
 writeLines(md, file.path("bench", "results", "cohort-flags.md"))
 cat(md, sep = "\n")
-unlink(work, recursive = TRUE)
+if (!nzchar(keep)) unlink(work, recursive = TRUE)
