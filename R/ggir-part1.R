@@ -162,6 +162,21 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
     for (nm in names(v)) p[nm] <- list(v[[nm]])
   }
   for (nm in names(dots)) p[nm] <- list(dots[[nm]])
+  # GGIR's ad hoc csv reading (rmc.*): not read by g.getmeta() yet
+  rmc <- grep("^rmc[.]", names(p), value = TRUE)
+  if (length(rmc) && !is.null(p$rmc.firstrow.acc)) {
+    abort("`rmc.firstrow.acc`: gravcal's g.getmeta() does not read ad hoc csv files yet; ",
+          "use GGIR::g.getmeta() for them.")
+  }
+  # legacy arguments that are no parameter GGIR knows: said, as GGIR's
+  # extract_params() would leave them
+  known <- c(unlist(lapply(d, names)), ggir_param_known(), "sf")
+  extra <- setdiff(names(dots), known)
+  if (length(extra)) {
+    warning("g.getmeta(): ignored argument", if (length(extra) > 1) "s", " ",
+            paste0("`", extra, "`", collapse = ", "), " (no GGIR parameter g.getmeta() reads)",
+            call. = FALSE)
+  }
   do <- grep("^do[.]", names(d$metrics), value = TRUE)
   for (nm in do) check_flag(p[[nm]], nm)
   tab <- meta_metric_table()
