@@ -90,6 +90,7 @@ test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter bl
 })
 
 test_that("g.getmeta() is GGIR's on a GENEActiv .bin recording, in a zone with an offset", {
+  skip_if_quick()
   f <- meta_recording("bin", 50, 28, seed = 9, start = "2024-06-04 22:59:58")
   b <- meta_both(f, c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam"),
                                      params_rawdata = list(nonwear_range_threshold = 100))))
@@ -124,6 +125,7 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
 })
 
 test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps imputed)", {
+  skip_if_quick()
   rec <- simulate_recording(hours = 28, sf = 30, seed = 13,
                             start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
   f <- tempfile(fileext = ".gt3x")
@@ -143,6 +145,7 @@ test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps
 })
 
 test_that("g.getmeta() takes an ActiGraph's dynamic range from its serial number, as GGIR", {
+  skip_if_quick()
   rec <- simulate_recording(hours = 27, sf = 30, seed = 15,
                             start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
   n <- nrow(rec)
@@ -156,6 +159,7 @@ test_that("g.getmeta() takes an ActiGraph's dynamic range from its serial number
 })
 
 test_that("g.getmeta() is GGIR's on an ActiGraph csv export (start from its header, zeros and gaps)", {
+  skip_if_quick()
   rec <- simulate_recording(hours = 27, sf = 30, seed = 16,
                             start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
   n <- nrow(rec)
@@ -193,6 +197,7 @@ test_that("a time gap longer than GGIR's epoch-level limit is an error saying so
 })
 
 test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml)", {
+  skip_if_quick()
   skip_if_not_installed("unisensR")
   skip_if_not_installed("lubridate")
   rec <- simulate_recording(hours = 27, sf = 64, seed = 17,
