@@ -179,3 +179,40 @@ print.summary.gravcal_epochs <- function(x, ...) {
       " min above per 24 h (se ", format(signif(r$min_above_day_se, 2)), ")\n", sep = "")
   invisible(x)
 }
+
+# ---- the cohort table's outcome columns (calibrate_files(outcomes = TRUE))
+
+outcome_columns <- c("enmo_mg", "enmo_mg_se", "min_above_100mg_day", "min_above_100mg_day_se")
+
+# A recording's whole-recording outcomes with `fit` (summary.gravcal_epochs()
+# at 100 mg): list(row = a one-row data frame of outcome_columns, note = why
+# they are missing, or the warnings raised, or NULL). The epoch signals are
+# computed from the file where epoch_signals() reads its format, else from
+# the samples read_recording() gives.
+outcome_row <- function(file, fit, sf) {
+  row <- as.data.frame(stats::setNames(as.list(rep(NA_real_, 4)), outcome_columns))
+  if (is.null(fit)) return(list(row = row, note = NULL))
+  warns <- character(0)
+  err <- NULL
+  s <- tryCatch(withCallingHandlers({
+    ep <- if (file_format(file) %in% meta_formats) {
+      epoch_signals(file, fit = fit, sf = sf, metrics = "ENMO")
+    } else {
+      r <- read_recording(file, sf = sf)
+      epoch_signals(r$data, fit = fit, sf = r$sf, metrics = "ENMO")
+    }
+    ep$summary$recording
+  }, warning = function(w) {
+    warns <<- c(warns, conditionMessage(w))
+    invokeRestart("muffleWarning")
+  }), error = function(e) {
+    err <<- conditionMessage(e)
+    NULL
+  })
+  if (!is.null(s)) {
+    row[1, ] <- list(s$enmo_mg, s$enmo_mg_se, s$min_above_day, s$min_above_day_se)
+  }
+  note <- if (!is.null(err)) paste0("outcomes not computed: ", sub("[.]$", "", err))
+  else if (length(warns)) paste0("outcomes: ", paste(unique(warns), collapse = "; "))
+  list(row = row, note = note)
+}
