@@ -79,7 +79,11 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   model <- NULL
   gradient <- NULL
   if (!is.null(fit)) {
-    if (inherits(fit, "gravcal_fit") && any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0)) {
+    # a fit GGIR's coefficients cannot hold is applied as apply_calibration()
+    # applies it: cross-axis terms, or a temperature term of a fit that is
+    # not GGIR's (GGIR's coefficients keep it only with `use_temp`)
+    if (inherits(fit, "gravcal_fit") && (any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0) ||
+                                         (any(fit$tempoffset != 0) && !isTRUE(fit$use_temp)))) {
       gradient <- outcome_gradient_spec(fit, any(fit$tempoffset != 0))
       model <- function(d) {
         df <- data.frame(x = d$x, y = d$y, z = d$z)
