@@ -53,6 +53,10 @@ gc_ggir_block_epochs <- function(x, y, z, temperature, light, cal, sf, windowsiz
     .Call(`_gravcal_gc_ggir_block_epochs`, x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use)
 }
 
+gc_enmo_gradient <- function(x, y, z, temperature, n_use, sf, ws3, cal) {
+    .Call(`_gravcal_gc_enmo_gradient`, x, y, z, temperature, n_use, sf, ws3, cal)
+}
+
 gc_ggir_filter <- function(b, a, x, conv_fused, rec_fused) {
     .Call(`_gravcal_gc_ggir_filter`, b, a, x, conv_fused, rec_fused)
 }

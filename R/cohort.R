@@ -143,6 +143,16 @@
 #'   `error_after_mg` on its own rest points with the given coefficients, no
 #'   standard errors, `parameters` 0; `calibration_ggir_coefs.csv` holds
 #'   them. Not with `pool = "device"`.
+#' @param outcomes Add each recording's outcomes with its calibration and
+#'   their standard errors from the fit's covariance (`TRUE`), or not
+#'   (`FALSE`, default: no epoch signals are computed). The worker that
+#'   calibrates a recording then computes its epoch signals
+#'   ([epoch_signals()], ENMO, from the file, or from the samples
+#'   [read_recording()] gives for a format it does not read) and their
+#'   [summary.gravcal_epochs()]; a recording whose fit is replaced after
+#'   (`pool`, `coefs`) has them computed again with the new fit. Results
+#'   saved without outcomes are computed again; those saved with them serve
+#'   runs without.
 #' @return A data frame, one row per recording, in the order of `files`:
 #'   `file` (the recording's identity, see above), `status` (see [calibrate()], `"given"` (see
 #'   `coefs`), or `"failed"`),
@@ -178,7 +188,14 @@
 #'   `gap_seconds` (jumps in time), `truncated` and `read_notes` (the first
 #'   problems, where they were); `warnings` (the warnings raised while
 #'   calibrating that recording, separated by `"; "`) and `seconds` (time
-#'   taken). The fits are in `attr(, "fits")`.
+#'   taken); with `outcomes = TRUE`, last, `enmo_mg` (the mean ENMO of the
+#'   recording's 5 s epochs, mg), `min_above_100mg_day` (minutes of epochs
+#'   above 100 mg per 24 hours) and their standard errors from the
+#'   calibration's uncertainty, `enmo_mg_se` and `min_above_100mg_day_se`
+#'   (NA where the fit has no covariance), as
+#'   `summary(epoch_signals(file, fit))$recording` gives them; why they are
+#'   missing, if they are, is in `message`. The fits are in
+#'   `attr(, "fits")`.
 #' @seealso [calibrate_cli()] for batch scripts.
 #' @export
 #' @examples
@@ -197,7 +214,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
                             ..., resume = TRUE,
                             pattern = format_file_pattern(),
                             pool = c("none", "device"), recursive = FALSE,
-                            coefs = NULL) {
+                            coefs = NULL, outcomes = FALSE) {
   method <- match_choice(method, "method")
   pool <- match_choice(pool, "pool")
   if (!is.null(coefs) && pool == "device") {
@@ -209,6 +226,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
     abort("`outdir` must be a directory path for the results.")
   }
   check_flag(recursive, "recursive")
+  check_flag(outcomes, "outcomes")
   cohort <- cohort_files(files, pattern, recursive, outdir)
   paths <- cohort$path
   ids <- cohort$id
@@ -236,11 +254,15 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   saved <- lapply(seq_along(paths), function(i) {
     if (resume) read_saved(slots[i], file_identity(paths[i]), settings) else list()
   })
-  todo <- which(vapply(saved, function(s) is.null(s$result), TRUE))
+  # (with `outcomes`, also the results saved without them: the key is the
+  # same, so that a run without outcomes reuses results saved with them)
+  todo <- which(vapply(saved, function(s) {
+    is.null(s$result) || (outcomes && is.null(s$result$outcomes))
+  }, TRUE))
   # what is redone is not taken from an earlier run if this one fails
   unlink(slots[todo])
   failures <- run_cohort(todo, cohort_worker(paths, ids, slots, method, args,
-                                             settings), ids)
+                                             settings, outcomes), ids)
 
   results <- lapply(seq_along(paths), function(i) {
     s <- saved[[i]]
@@ -265,6 +287,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   tab <- do.call(rbind, lapply(results, `[[`, "row"))
   rownames(tab) <- NULL
   fits <- stats::setNames(lapply(results, `[[`, "fit"), ids)
+  own_fits <- fits
   if (pool == "device") {
     pooled <- pool_devices(paths, ids, tab, fits, method, args)
     tab <- pooled$tab
@@ -281,6 +304,7 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
       fits[[i]] <- g
     }
   }
+  if (outcomes) tab <- add_outcomes(tab, results, fits, own_fits, paths, args$sf)
   # whether each recording's temperature varies (the fit's own check)
   tab <- add_temperature_flat(tab, fits)
   # each fit judged against the bounds and its device's other recordings
@@ -306,6 +330,22 @@ calibrate_files <- function(files, method = c("ggir", "lightweight"), outdir,
   attr(tab, "fits") <- fits
   attr(tab, "devices") <- judged$devices
   tab
+}
+
+# The outcome columns (outcome_row()) at the end of the table: the workers'
+# with each recording's own fit, computed again here for a recording whose
+# fit was replaced after them (pooled, given coefficients); their notes
+# joined to `message`.
+add_outcomes <- function(tab, results, fits, own_fits, paths, sf) {
+  rows <- lapply(seq_along(fits), function(i) {
+    o <- results[[i]]$outcomes
+    if (is.null(o) || !identical(fits[[i]], own_fits[[i]])) {
+      o <- outcome_row(paths[i], fits[[i]], sf_for_file(paths[i], sf))
+    }
+    if (!is.null(o$note)) tab$message[i] <<- join_notes(tab$message[i], o$note)
+    o$row
+  })
+  cbind(tab, do.call(rbind, rows))
 }
 
 # Column `temperature_flat` after `meantempcal`: TRUE when the recording
@@ -446,7 +486,8 @@ md5_raw <- function(bytes) {
 }
 
 # The function each worker runs for recording i: calibrate, save at once.
-cohort_worker <- function(paths, ids, slots, method, args, settings) {
+cohort_worker <- function(paths, ids, slots, method, args, settings, outcomes = FALSE) {
+  force(outcomes)
   force(paths)
   force(ids)
   force(slots)
@@ -456,6 +497,7 @@ cohort_worker <- function(paths, ids, slots, method, args, settings) {
   function(i, p) {
     identity <- file_identity(paths[i])
     res <- calibrate_one(paths[i], ids[i], method, args)
+    if (outcomes) res$outcomes <- outcome_row(paths[i], res$fit, sf_for_file(paths[i], args$sf))
     res$key <- list(identity = identity, settings = settings)
     write_bytes_atomic(serialize(res, NULL), slots[i])
     if (!is.null(p)) p(message = ids[i])

@@ -29,22 +29,35 @@
 #' @param start For a data frame without a `time` column: the time of its
 #'   first sample (POSIXct).
 #' @param tz The time zone of the time stamps (GGIR's `desiredtz`).
+#' @param se With a `fit` that has a covariance of its coefficients
+#'   ([vcov.gravcal_fit()]) and ENMO among the metrics: compute the
+#'   gradient of each short epoch's ENMO with respect to the coefficients,
+#'   in the same pass, so that [summary.gravcal_epochs()] gives the
+#'   standard errors the calibration's uncertainty puts on the daily mean
+#'   ENMO and time above 100 mg (`TRUE`, default), or not (`FALSE`: a
+#'   little faster, no standard errors).
 #' @param ... More of GGIR's parameters, by name (for example
 #'   `nonwear_approach`, `nonwear_range_threshold`, `dynrange`, `hb`,
 #'   `chunksize`).
 #' @return A `gravcal_epochs` object: a list with `short` (a data frame:
 #'   `time` and one column per metric) and `long` (`time`, `nonwearscore`,
 #'   `clippingscore`, `lightmean`, `lightpeak`, `temperaturemean` where the
-#'   recording has them, `EN`), and `windowsizes`, `sf`, `file`.
-#' @seealso [g.getmeta()] for GGIR's list.
+#'   recording has them, `EN`), and `windowsizes`, `sf`, `file`; with ENMO,
+#'   `summary`, the daily outcomes and their standard errors
+#'   ([summary.gravcal_epochs()] at 100 mg); with standard errors,
+#'   `enmo_gradient` (a matrix: a row per short epoch, a column per
+#'   coefficient as [coef()] names them) and `vcov`, the fit's covariance.
+#' @seealso [g.getmeta()] for GGIR's list; [summary.gravcal_epochs()].
 #' @export
 #' @examples
 #' rec <- simulate_recording(hours = 4, sf = 10, seed = 1)
 #' ep <- epoch_signals(rec, fit = calibrate(rec, sf = 10))
 #' head(ep$short)
+#' ep$summary
 #' plot(ep)
 epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"),
-                          windowsizes = c(5, 900, 3600), start = NULL, tz = "UTC", ...) {
+                          windowsizes = c(5, 900, 3600), start = NULL, tz = "UTC",
+                          se = TRUE, ...) {
   if (!is.character(metrics) || !length(metrics) || anyNA(metrics)) {
     abort("`metrics` must be GGIR metric names, not ", describe(metrics), ".")
   }
@@ -58,13 +71,20 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   if (!(is.character(tz) && length(tz) == 1 && !is.na(tz))) {
     abort("`tz` must be a time zone name, not ", describe(tz), ".")
   }
+  check_flag(se, "se")
   dots <- list(...)
   do <- stats::setNames(as.list(known %in% metrics), meta_do_name(tab$name))
   p <- meta_params(do, list(), list(windowsizes = windowsizes, desiredtz = tz), list(), dots)
   cal <- meta_calibration(c(0, 0, 0), c(1, 1, 1), c(0, 0, 0), c())
   model <- NULL
+  gradient <- NULL
   if (!is.null(fit)) {
-    if (inherits(fit, "gravcal_fit") && any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0)) {
+    # a fit GGIR's coefficients cannot hold is applied as apply_calibration()
+    # applies it: cross-axis terms, or a temperature term of a fit that is
+    # not GGIR's (GGIR's coefficients keep it only with `use_temp`)
+    if (inherits(fit, "gravcal_fit") && (any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0) ||
+                                         (any(fit$tempoffset != 0) && !isTRUE(fit$use_temp)))) {
+      gradient <- outcome_gradient_spec(fit, any(fit$tempoffset != 0))
       model <- function(d) {
         df <- data.frame(x = d$x, y = d$y, z = d$z)
         if (!is.null(d$temperature)) df$temperature <- d$temperature
@@ -81,8 +101,10 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
                               unlist(row[c("temperature.offset.x", "temperature.offset.y",
                                            "temperature.offset.z")]),
                               if (isTRUE(row$use.temperature)) row$meantempcal)
+      gradient <- outcome_gradient_spec(fit, isTRUE(row$use.temperature))
     }
   }
+  if (!se || !"ENMO" %in% metrics) gradient <- NULL
   if (is.character(x)) {
     src <- open_source(x, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
                        read_opts = list(interpolation = p$interpolationType,
@@ -97,8 +119,14 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   } else {
     src <- epochs_frame_source(x, sf, start, p$chunksize)
   }
-  M <- meta_run(src, p, cal, FALSE, FALSE, model = model)
-  epochs_result(M, src, p, tz)
+  M <- meta_run(src, p, cal, FALSE, FALSE, model = model, gradient = gradient)
+  ep <- epochs_result(M, src, p, tz)
+  if (!is.null(gradient)) {
+    ep$enmo_gradient <- M$enmo_gradient
+    ep$vcov <- fit$vcov
+  }
+  if ("ENMO" %in% names(ep$short)) ep$summary <- summary.gravcal_epochs(ep)
+  ep
 }
 
 # Samples in memory as a source for meta_run(): blocks of GGIR's csv size.

@@ -302,8 +302,12 @@ meta_bind <- function(a, b) {
   stats::setNames(lapply(nm, function(k) c(a[[k]], b[[k]])), nm)
 }
 
-# g.getmeta()'s loop over the blocks of an open native source.
-meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
+# g.getmeta()'s loop over the blocks of an open native source. With
+# `gradient` (outcome_gradient_spec(): the fit's linear model), also each
+# short epoch's ENMO gradient with respect to the fit's coefficients, from
+# the raw samples of each block (M$enmo_gradient, a matrix; epoch_signals()
+# only: g.getmeta()'s M never has it).
+meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL) {
   read_block <- meta_reader(src)
   sf <- src$sf
   ws3 <- p$windowsizes[1]
@@ -321,6 +325,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
     fused <- stats_filter_fused()
   }
   short <- list()   # per metric, the blocks' rounded epoch values
+  grads <- list()
   long <- list()
   filetooshort <- filecorrupt <- FALSE
   S <- list()
@@ -420,6 +425,11 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
         # may not be whole), given to the core without a copy
         n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
+        if (!is.null(gradient)) {
+          temp <- if (gradient$temp && (use.temp || !is.null(model))) data$temperature
+          grads[[length(grads) + 1]] <- gc_enmo_gradient(data$x, data$y, data$z, temp, n_use,
+                                                          sf, ws3, gradient)
+        }
         if (!is.null(model)) data <- model(meta_rows(data, seq_len(n_use)))
         r <- gc_ggir_block_epochs(
           data$x, data$y, data$z, if (use.temp) data$temperature,
@@ -452,8 +462,10 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL) {
             unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
             "reproduced (M$QClog is NULL).", call. = FALSE)
   }
-  meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
-              filetooshort, filecorrupt, p, ws3, ws2, QClog)
+  M <- meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
+                   filetooshort, filecorrupt, p, ws3, ws2, QClog)
+  if (!is.null(gradient)) M$enmo_gradient <- do.call(rbind, grads)
+  invisible(M)
 }
 
 # A block's time stamps, from a decoder that reads the file's clock as UTC,

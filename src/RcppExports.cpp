@@ -165,6 +165,23 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_enmo_gradient
+Rcpp::NumericMatrix gc_enmo_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, double n_use, double sf, double ws3, const Rcpp::List& cal);
+RcppExport SEXP _gravcal_gc_enmo_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP n_useSEXP, SEXP sfSEXP, SEXP ws3SEXP, SEXP calSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temperature(temperatureSEXP);
+    Rcpp::traits::input_parameter< double >::type n_use(n_useSEXP);
+    Rcpp::traits::input_parameter< double >::type sf(sfSEXP);
+    Rcpp::traits::input_parameter< double >::type ws3(ws3SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type cal(calSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_enmo_gradient(x, y, z, temperature, n_use, sf, ws3, cal));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_ggir_filter
 Rcpp::NumericVector gc_ggir_filter(const Rcpp::NumericVector& b, const Rcpp::NumericVector& a, const Rcpp::NumericVector& x, bool conv_fused, bool rec_fused);
 RcppExport SEXP _gravcal_gc_ggir_filter(SEXP bSEXP, SEXP aSEXP, SEXP xSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
@@ -397,6 +414,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
     {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 14},
+    {"_gravcal_gc_enmo_gradient", (DL_FUNC) &_gravcal_gc_enmo_gradient, 8},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 7},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},

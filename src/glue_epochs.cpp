@@ -146,3 +146,54 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
   }
   return out;
 }
+
+// The gradient of each short epoch's ENMO with respect to a linear
+// calibration's coefficients (ggir_epochs.hpp enmo_gradient()), for one
+// block: x, y, z raw (g), temperature (or NULL: no temperature term), n_use
+// as above, sf, the short epoch ws3 (s), and the calibration as a list: K
+// (3 x 3), offset, and, for the temperature term, tempoffset and meantemp.
+// Returns a matrix, one row per short epoch, 12 columns named as coef().
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericMatrix gc_enmo_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
+                                     const Rcpp::NumericVector& z,
+                                     Rcpp::Nullable<Rcpp::NumericVector> temperature,
+                                     double n_use, double sf, double ws3, const Rcpp::List& cal) {
+  namespace p1 = gravcal::ggir_part1;
+  const R_xlen_t len = x.size();
+  if (y.size() != len || z.size() != len) Rcpp::stop("x, y, z lengths differ");
+  if (!(n_use >= 0) || n_use > static_cast<double>(len)) Rcpp::stop("n_use out of range");
+  if (!(sf > 0) || !(ws3 > 0)) Rcpp::stop("sf and ws3 must be positive");
+  const R_xlen_t n = static_cast<R_xlen_t>(n_use);
+  Rcpp::NumericVector tk;
+  const double* t = column_or_null(temperature, n, tk, "temperature");
+  p1::LinearCalibration m;
+  const Rcpp::NumericMatrix K = cal["K"];
+  const Rcpp::NumericVector off = cal["offset"];
+  if (K.nrow() != 3 || K.ncol() != 3 || off.size() != 3) Rcpp::stop("K must be 3 x 3, offset 3 values");
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m.K[r][c] = K(r, c);
+    m.offset[r] = off[r];
+  }
+  if (t != nullptr) {
+    const Rcpp::NumericVector to = cal["tempoffset"];
+    if (to.size() != 3) Rcpp::stop("tempoffset needs 3 values");
+    m.temp = true;
+    m.meantemp = Rcpp::as<double>(cal["meantemp"]);
+    for (int a = 0; a < 3; ++a) m.tempoffset[a] = to[a];
+  }
+  std::vector<double> g;
+  try {
+    g = p1::enmo_gradient(x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), sf * ws3, m);
+  } catch (const std::exception& e) {
+    Rcpp::stop(e.what());
+  }
+  const std::size_t C = p1::kGradientColumns;
+  const std::size_t ne = g.size() / C;
+  Rcpp::NumericMatrix out(static_cast<int>(ne), static_cast<int>(C));
+  for (std::size_t e = 0; e < ne; ++e) {
+    for (std::size_t c = 0; c < C; ++c) out(static_cast<int>(e), static_cast<int>(c)) = g[e * C + c];
+  }
+  Rcpp::colnames(out) = Rcpp::CharacterVector::create("k_xx", "k_yy", "k_zz", "k_xy", "k_xz", "k_yz",
+                                                      "o_x", "o_y", "o_z", "t_x", "t_y", "t_z");
+  return out;
+}

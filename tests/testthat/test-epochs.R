@@ -40,6 +40,16 @@ test_that("epoch_signals() of samples in memory: ENMO by its definition, a fit's
   b <- epoch_signals(apply_calibration(rec, fit), metrics = "ENMO")
   expect_identical(a$short, b$short)
   expect_false(identical(a$short$ENMO, ep$short$ENMO))
+  # a lightweight fit without cross-axis terms but with a temperature term:
+  # that term applied too
+  rt <- simulate_recording(hours = 30, sf = 10, seed = 25,
+                           params = c(1.02, 0.98, 1.01, 0, 0, 0, 0.03, -0.02, 0.01),
+                           tempoffset = c(0.002, -0.001, 0.0015),
+                           start = as.POSIXct("2024-01-01 00:00:00", tz = "UTC"))
+  ft <- calibrate(rt, sf = 10, model = "scale_offset")
+  expect_true(all(ft$tempoffset != 0))
+  expect_identical(epoch_signals(rt, fit = ft, metrics = "ENMO")$short,
+                   epoch_signals(apply_calibration(rt, ft), metrics = "ENMO")$short)
   p <- tempfile(fileext = ".png")
   grDevices::png(p)
   expect_invisible(plot(a))

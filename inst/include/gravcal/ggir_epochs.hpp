@@ -566,6 +566,75 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
   return out;
 }
 
+// The gradient of each short epoch's ENMO with respect to the coefficients
+// of a linear calibration, for the standard error that the coefficients'
+// uncertainty puts on summaries of ENMO (the delta method; R/outcome-se.R).
+// Model: a = K (v + o) + (t - meantemp) tempoffset, K lower triangular (the
+// fit's; GGIR's diagonal scale is K = diag(scale)). ENMO of a sample is
+// max(|a| - 1, 0), so its gradient is [|a| > 1] (a / |a|)' da/dtheta with
+// da/dk_ij = (v_j + o_j) e_i (i >= j), da/do_j = K[, j] and
+// da/dt_j = (t - meantemp) e_j. An epoch's gradient is the mean of its
+// samples' over the epochs per_epoch() cuts (R's round(seq(1, n + 1, by))
+// bounds), in plain double sums: a derivative, not a promised bit.
+// Columns in coef()'s order: k_xx, k_yy, k_zz, k_xy, k_xz, k_yz, o_x, o_y,
+// o_z, t_x, t_y, t_z; row-major, out[e * kGradientColumns + c].
+constexpr std::size_t kGradientColumns = 12;
+
+struct LinearCalibration {
+  double K[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // K[row][column]
+  double offset[3] = {0, 0, 0};
+  bool temp = false;  // the temperature term applies
+  double meantemp = 0;
+  double tempoffset[3] = {0, 0, 0};
+};
+
+inline std::vector<double> enmo_gradient(const double* x, const double* y, const double* z,
+                                         const double* t, std::size_t n, double by,
+                                         const LinearCalibration& m) {
+  constexpr std::size_t C = kGradientColumns;
+  const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
+  std::vector<double> out;
+  if (sel.size() < 2) return out;
+  const std::size_t ne = sel.size() - 1;
+  out.assign(ne * C, 0.0);
+  const bool temp = m.temp && t != nullptr;
+  std::size_t from = static_cast<std::size_t>(r_round0(sel[0])) - 1;
+  for (std::size_t e = 0; e < ne; ++e) {
+    const std::size_t to = static_cast<std::size_t>(r_round0(sel[e + 1])) - 1;
+    double* g = &out[e * C];
+    for (std::size_t i = from; i < to; ++i) {
+      const double u[3] = {x[i] + m.offset[0], y[i] + m.offset[1], z[i] + m.offset[2]};
+      const double dt = temp ? t[i] - m.meantemp : 0;
+      double a[3];
+      for (int r = 0; r < 3; ++r) {
+        a[r] = m.K[r][0] * u[0] + m.K[r][1] * u[1] + m.K[r][2] * u[2];
+        if (temp) a[r] = a[r] + dt * m.tempoffset[r];
+      }
+      const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+      if (!(na > 1)) continue;  // ENMO is 0 here, and so is its gradient
+      const double q[3] = {a[0] / na, a[1] / na, a[2] / na};
+      g[0] += q[0] * u[0];
+      g[1] += q[1] * u[1];
+      g[2] += q[2] * u[2];
+      g[3] += q[1] * u[0];
+      g[4] += q[2] * u[0];
+      g[5] += q[2] * u[1];
+      for (int j = 0; j < 3; ++j) {
+        g[6 + j] += q[0] * m.K[0][j] + q[1] * m.K[1][j] + q[2] * m.K[2][j];
+      }
+      if (temp) {
+        g[9] += q[0] * dt;
+        g[10] += q[1] * dt;
+        g[11] += q[2] * dt;
+      }
+    }
+    const double len = static_cast<double>(to > from ? to - from : 1);
+    for (std::size_t c = 0; c < C; ++c) g[c] = g[c] / len;
+    from = to;
+  }
+  return out;
+}
+
 }  // namespace ggir_part1
 }  // namespace gravcal
 
