@@ -23,7 +23,12 @@ say <- function(...) cat(format(Sys.time(), "%H:%M:%S"), ..., "\n")
 
 files <- c(cwa = file.path(data_dir, sprintf("week%g.cwa", days)),
            bin = file.path(data_dir, sprintf("week%g.bin", days)))
+# GRAVCAL_BENCH_FORMATS: some of them only ("cwa,bin")
+only <- Sys.getenv("GRAVCAL_BENCH_FORMATS")
+if (nzchar(only)) files <- files[intersect(names(files), strsplit(only, ",")[[1]])]
 if (!all(file.exists(files))) {
+  files <- c(cwa = file.path(data_dir, sprintf("week%g.cwa", days)),
+             bin = file.path(data_dir, sprintf("week%g.bin", days)))[names(files)]
   say("writing the week files")
   day <- simulate_recording(hours = 24, sf = sf, seed = 1,
                             tempoffset = c(0.002, -0.001, 0.0015),
@@ -31,9 +36,13 @@ if (!all(file.exists(files))) {
   n <- nrow(day)
   wk <- day[rep(seq_len(n), days), ]
   wk$time <- day$time[1] + (seq_len(nrow(wk)) - 1) / sf
-  gravcal:::write_cwa(as.matrix(wk[, c("x", "y", "z")]), files[["cwa"]], sf = sf,
-                      start = as.numeric(wk$time[1]), temperature = wk$temperature)
-  gravcal:::write_geneactiv_bin(wk, files[["bin"]], sf = sf, start = "2024-03-04 08:00:00")
+  if ("cwa" %in% names(files)) {
+    gravcal:::write_cwa(as.matrix(wk[, c("x", "y", "z")]), files[["cwa"]], sf = sf,
+                        start = as.numeric(wk$time[1]), temperature = wk$temperature)
+  }
+  if ("bin" %in% names(files)) {
+    gravcal:::write_geneactiv_bin(wk, files[["bin"]], sf = sf, start = "2024-03-04 08:00:00")
+  }
   rm(day, wk)
 }
 
