@@ -111,7 +111,7 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
                                         frequency_tol = p$frequency_tol, zone = tz,
                                         zone_arg = "tz"),
                        arg = "x", part = "getmeta")
-    if (!src$format %in% meta_formats || is.null(src$native)) {
+    if (!src$format %in% meta_formats() || is.null(src$native)) {
       abort("epoch_signals() does not read ", format_entry(src$format)$label %||% src$format,
             " yet; read it with read_recording() and give the samples.")
     }

@@ -17,6 +17,7 @@
 #   in configtz (else desiredtz) and the native decoder gives them as UTC
 #   (g.getmeta() moves them: meta_zone_shift()): "block" (GGIRread converts
 #   a block's first time) or "sample" (lubridate::force_tz() on each);
+# * ggir_getmeta: TRUE where g.getmeta() (GGIR part 1) reads the format;
 # * ggir_monitor: GGIR's monitor (its MONITOR code's name, lower case), for
 #   the rules GGIR keys on it (g.getmeta(): ActiGraph serial numbers'
 #   dynamic range);
@@ -40,6 +41,7 @@
 #   native decoder (see open_source()).
 recording_formats <- list(
   actigraph_csv = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "actigraph", ggir_timegaps = TRUE, ggir_time = FALSE,
     ggir_start = function(file, p) actigraph_csv_start(file, p),
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
@@ -108,6 +110,7 @@ recording_formats <- list(
       source_frame(rec$data, rec$sf, chunksize, arg)
     }),
   gt3x = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "actigraph",
     ext = c(gt3x = ".gt3x"), detect = NULL,
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
@@ -117,6 +120,7 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_gt3x_file(file),
     source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
   cwa = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "axivity",
     ext = c(cwa = ".cwa"), detect = NULL,
     label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
@@ -129,6 +133,7 @@ recording_formats <- list(
   # the folder or its acc.bin (GGIR's filename); GGIR reads it in blocks of
   # sf * 60 * 1440 / 2 samples whatever chunksize, and assumes 64 Hz
   movisens = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "movisens",
     ggir_start = function(file, p) movisens_start(file, p),
     ext = c(bin = "Movisens (a unisens folder or its acc.bin)"),
@@ -139,6 +144,7 @@ recording_formats <- list(
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "geneactiv",
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
     label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = "block",

@@ -213,7 +213,7 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
       next
     }
     fmt <- tryCatch(file_format(fnamesfull[i]), error = function(e) NA_character_)
-    if (is.na(fmt) || !fmt %in% meta_formats) {
+    if (is.na(fmt) || !fmt %in% meta_formats()) {
       what <- if (is.na(fmt)) "a format gravcal does not know" else format_entry(fmt)$label
       out[[length(out) + 1]] <- part1_row(fnames[i], "not read", what, meta)
       next
@@ -225,7 +225,7 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
   skipped <- tab$status == "not read"
   if (any(skipped)) {
     warning("gravcal's g.part1() reads ",
-            paste(vapply(meta_formats, function(f) format_entry(f)$label, ""), collapse = " and "),
+            paste(vapply(meta_formats(), function(f) format_entry(f)$label, ""), collapse = " and "),
             " files; no meta file written for ", sum(skipped), " file(s): ",
             paste0(tab$file[skipped], " (", tab$message[skipped], ")", collapse = ", "),
             ". GGIR::GGIR(mode = 1, overwrite = FALSE, ...) makes theirs and keeps these.",

@@ -80,9 +80,9 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   }
   src <- open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native",
                      compat = TRUE, read_opts = read_opts, part = "getmeta")
-  if (!src$format %in% meta_formats || is.null(src$native)) {
+  if (!src$format %in% meta_formats() || is.null(src$native)) {
     abort("gravcal's g.getmeta() does not read ", format_entry(src$format)$label %||% src$format,
-          " yet (it reads ", paste(vapply(meta_formats, function(f) format_entry(f)$label, ""),
+          " yet (it reads ", paste(vapply(meta_formats(), function(f) format_entry(f)$label, ""),
                                     collapse = " and "),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
@@ -105,8 +105,10 @@ meta_reader <- function(src) {
   }
 }
 
-# The formats g.getmeta() reads so far.
-meta_formats <- c("cwa", "geneactiv", "gt3x", "actigraph_csv", "movisens")
+# The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).
+meta_formats <- function() {
+  names(Filter(function(f) isTRUE(f$ggir_getmeta), recording_formats))
+}
 
 # The metrics of g.applymetrics() in the order GGIR computes them (its
 # result's names); `filtered`: a Butterworth filter's (ggir_filters.hpp,

@@ -204,7 +204,7 @@ outcome_row <- function(file, fit, sf) {
   warns <- character(0)
   err <- NULL
   s <- tryCatch(withCallingHandlers({
-    ep <- if (file_format(file) %in% meta_formats) {
+    ep <- if (file_format(file) %in% meta_formats()) {
       epoch_signals(file, fit = fit, sf = sf, metrics = "ENMO")
     } else {
       r <- read_recording(file, sf = sf)
