@@ -709,16 +709,20 @@ actigraph_date_order <- function(top) {
 
 # The start of a Movisens recording as GGIR's g.getstarttime() takes it:
 # unisens.xml's timestampStart as unisensR reads it, its clock moved into
-# configtz (where given: lubridate::force_tz()), given in desiredtz.
+# configtz where given (as lubridate::force_tz() moves it: the same
+# calendar time, read in that zone), given in desiredtz.
 movisens_start <- function(file, p) {
-  for (pkg in c("unisensR", "lubridate")) {
-    if (!requireNamespace(pkg, quietly = TRUE)) {
-      abort("The start of a Movisens recording as GGIR reads it needs the ", pkg,
-            " package: install.packages(\"", pkg, "\").")
-    }
+  if (!requireNamespace("unisensR", quietly = TRUE)) {
+    abort("The start of a Movisens recording as GGIR reads it needs the unisensR ",
+          "package: install.packages(\"unisensR\").")
   }
   st <- unisensR::readUnisensStartTime(dirname(file))
   ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
-  if (!identical(ctz, "")) st <- lubridate::force_tz(st, ctz)
+  if (!identical(ctz, "")) {
+    whole <- floor(as.numeric(st))
+    wall <- format(as.POSIXct(whole, origin = "1970-01-01", tz = attr(st, "tzone") %||% ""),
+                   "%Y-%m-%d %H:%M:%S")
+    st <- as.POSIXct(wall, tz = ctz) + (as.numeric(st) - whole)
+  }
   as.POSIXlt(st, tz = p$desiredtz)
 }

@@ -199,7 +199,6 @@ test_that("a time gap longer than GGIR's epoch-level limit is an error saying so
 test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml)", {
   skip_if_quick()
   skip_if_not_installed("unisensR")
-  skip_if_not_installed("lubridate")
   rec <- simulate_recording(hours = 27, sf = 64, seed = 17,
                             start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
   d <- tempfile("movisens-")
