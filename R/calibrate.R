@@ -131,9 +131,13 @@
 #' kept, which are its `windows` (and, for the GGIR method, its `points`
 #' and `ggir$spheredata`). `fit$rejected` counts the windows left out
 #' (`windows`, `of`, `share`, `threshold` and `spread` in g, `k`, `floor`,
-#' `max_share`, `rounds`, `note`) and `fit$rejected_windows` lists them
+#' `max_share`, `rounds`, `note`, `in_stretch`) and `fit$rejected_windows` lists them
 #' with their `residual`. Runs of windows left out that last 30 minutes or
-#' more (successive ones at most 5 minutes apart) are reported in
+#' more (successive ones at most 5 minutes apart) are stretches: every
+#' window within a stretch's time span is left out with them, those that
+#' happen to lie near the sphere too (a vehicle's norm passes through 1 g;
+#' the cut-off is wider when the model does not fit the device exactly),
+#' counted in `fit$rejected$in_stretch`. Stretches are reported in
 #' `fit$rejected_stretches` (`start`, `end`: date-times from the samples'
 #' `time` column or the file's clock, else seconds from the first sample;
 #' `hours`, `windows`, `median_mg`: the median `| |a| - 1 |` of its

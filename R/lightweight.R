@@ -135,22 +135,22 @@ lightweight_from_windows <- function(w, args, choice, max_norm_error, range_g,
     # (off_sphere = Inf: not applied)
     if (is.finite(off_sphere)) {
       v <- point_matrix(rest, "rest")
-      nr <- near_rest_trim(fit, v, rest$temperature, function(keep) {
-        f <- fit_rest(keep)
-        # the points' rows are those of the windows kept
-        if (!is.null(f$points$row)) f$points$row <- which(keep)[f$points$row]
-        f
-      }, k = off_sphere)
-      fit <- nr$fit
-      rejected_windows <- rest[nr$out, , drop = FALSE]
-      rejected_windows$residual <- near_rest_residuals(
-        fit, v[nr$out, , drop = FALSE], rejected_windows$temperature)
       secs <- if (inherits(rest$start, "POSIXct")) {
         as.numeric(rest$start) - as.numeric(w$start[1])
       } else rest$start - w$start[1]
       # a device's recordings pooled (pool.R) have no one time line: their
       # windows are left out, without stretches
       pooled <- identical(attr(w, "input")$source, "pooled")
+      nr <- near_rest_trim(fit, v, rest$temperature, function(keep) {
+        f <- fit_rest(keep)
+        # the points' rows are those of the windows kept
+        if (!is.null(f$points$row)) f$points$row <- which(keep)[f$points$row]
+        f
+      }, k = off_sphere, start = if (!pooled) secs, window = attr(w, "window"))
+      fit <- nr$fit
+      rejected_windows <- rest[nr$out, , drop = FALSE]
+      rejected_windows$residual <- near_rest_residuals(
+        fit, v[nr$out, , drop = FALSE], rejected_windows$temperature)
       stretches <- near_rest_stretches(
         secs, nr$out & !pooled, near_rest_residuals(fit, v, rest$temperature),
         attr(w, "window"), clock = if (inherits(w$start, "POSIXct")) {

@@ -12,7 +12,10 @@
 # residuals, robust to the windows it is to find); a window is left out
 # when |r_i - m| > max(k s, floor). Then the fit again on the windows kept,
 # the residuals of all rest windows again (a window may come back), until
-# the windows left out do not change (at most max_rounds fits). A trimmed
+# the windows left out do not change (at most max_rounds fits). Runs of
+# windows left out that last min_stretch or more are stretches, and every
+# window within a stretch's span is left out with them (near_rest_widen()).
+# A trimmed
 # refit of this kind is the concentration step of least trimmed squares
 # (Rousseeuw & Van Driessen 2006) with a data-driven cut-off in place of a
 # fixed share.
@@ -59,23 +62,65 @@ near_rest_residuals <- function(fit, v, temperature) {
   sqrt(rowSums(calibrate_points(fit, v, temperature)^2)) - 1
 }
 
+# Runs of windows left out: `start` (seconds) of every rest window, `out`
+# which are left out, `window` their length (s). A data frame of the runs
+# (from, to in seconds, the indices `i` of their windows left out, in time
+# order, as a list column), successive windows left out at most
+# near_rest_rule$max_gap apart, those lasting near_rest_rule$min_stretch or
+# more only.
+near_rest_runs <- function(start, out, window) {
+  i <- which(out)
+  if (!length(i)) {
+    return(data.frame(from = numeric(0), to = numeric(0), i = I(list())))
+  }
+  i <- i[order(start[i])]
+  t <- start[i]
+  run <- cumsum(c(TRUE, diff(t) > near_rest_rule$max_gap))
+  idx <- unname(split(i, run))
+  from <- vapply(idx, function(j) start[j[1]], 0)
+  to <- vapply(idx, function(j) start[j[length(j)]] + window, 0)
+  keep <- to - from >= near_rest_rule$min_stretch
+  data.frame(from = from[keep], to = to[keep], i = I(idx[keep]))
+}
+
+# The windows of a stretch share its cause: a window inside a stretch's
+# time span that happens to lie near the sphere (a vehicle's norm passes
+# through 1 g, or its residual is within the cut-off of a spread widened
+# by a model that does not fit the device exactly) is not rest either.
+# `out` widened to every window whose start lies within a stretch.
+near_rest_widen <- function(out, start, window) {
+  if (is.null(start)) return(out)
+  runs <- near_rest_runs(start, out, window)
+  for (j in seq_len(nrow(runs))) {
+    out <- out | (start >= runs$from[j] & start < runs$to[j])
+  }
+  out
+}
+
 # The loop: `fit` the first fit (applied: "ok" or "high_error"), `v` and
 # `temperature` the rest windows it was fitted to, `refit(keep)` the same
-# fit on the windows `keep` (logical), giving a fit. Returns list(fit, out,
+# fit on the windows `keep` (logical), giving a fit; `start` the windows'
+# starts (seconds on one time line; NULL: no stretches, as for pooled
+# recordings) and `window` their length (s). Each round leaves out the
+# windows beyond the cut-off and, with `start`, every window within the
+# stretches they form (near_rest_widen()). Returns list(fit, out,
 # rejected): `out` the windows left out (all FALSE when none or when the
 # rule was not applied), `rejected` what fit$rejected reports.
 near_rest_trim <- function(fit, v, temperature, refit,
-                           k = near_rest_rule$k) {
+                           k = near_rest_rule$k, start = NULL, window = NULL) {
   n <- nrow(v)
   out <- rep(FALSE, n)
   cut <- NULL
   note <- ""
   rounds <- 0L
+  beyond <- 0L
   applied <- function(f) f$status %in% c("ok", "high_error")
   first <- fit
   if (applied(fit) && n > 0) {
     repeat {
       cut <- near_rest_cut(near_rest_residuals(fit, v, temperature), out, k)
+      beyond <- sum(cut$out)
+      cut$out <- near_rest_widen(cut$out, start, window)
       if (identical(cut$out, out) || rounds >= near_rest_rule$max_rounds) break
       if (mean(cut$out) > near_rest_rule$max_share) {
         note <- sprintf(paste0(
@@ -104,6 +149,7 @@ near_rest_trim <- function(fit, v, temperature, refit,
   }
   rejected <- list(
     windows = sum(out), of = n, share = if (n > 0) mean(out) else 0,
+    in_stretch = if (any(out)) as.integer(sum(out) - min(beyond, sum(out))) else 0L,
     threshold = if (is.null(cut)) NA_real_ else cut$threshold,
     spread = if (is.null(cut)) NA_real_ else cut$spread,
     k = k, floor = near_rest_rule$floor,
@@ -122,21 +168,11 @@ near_rest_stretches <- function(start, out, r, window, clock = NULL) {
                       end = if (is.null(clock)) numeric(0) else clock[0],
                       hours = numeric(0), windows = integer(0),
                       median_mg = numeric(0))
-  i <- which(out)
-  if (!length(i)) return(empty)
-  i <- i[order(start[i])]
-  t <- start[i]
-  run <- cumsum(c(TRUE, diff(t) > near_rest_rule$max_gap))
-  rows <- lapply(split(seq_along(i), run), function(j) {
-    from <- t[j[1]]
-    to <- t[j[length(j)]] + window
-    data.frame(from = from, to = to, hours = (to - from) / 3600,
-               windows = length(j),
-               median_mg = 1000 * stats::median(abs(r[i[j]])))
-  })
-  s <- do.call(rbind, rows)
-  s <- s[s$to - s$from >= near_rest_rule$min_stretch, , drop = FALSE]
+  s <- near_rest_runs(start, out, window)
   if (!nrow(s)) return(empty)
+  s$hours <- (s$to - s$from) / 3600
+  s$windows <- lengths(s$i)
+  s$median_mg <- vapply(s$i, function(j) 1000 * stats::median(abs(r[j])), 0)
   data.frame(start = if (is.null(clock)) s$from else clock + s$from,
              end = if (is.null(clock)) s$to else clock + s$to,
              hours = s$hours, windows = s$windows, median_mg = s$median_mg,
@@ -182,8 +218,8 @@ near_rest_message <- function(rejected, stretches) {
   if (rejected$windows == 0) return("")
   paste0(sprintf(paste0(
     "%d rest windows (%.1f %%) left out, more than %.1f mg off the others ",
-    "after the fit"), rejected$windows, 100 * rejected$share,
-    1000 * rejected$threshold),
+    "after the fit%s"), rejected$windows, 100 * rejected$share,
+    1000 * rejected$threshold, format_in_stretch(rejected)),
     if (NROW(stretches)) paste0(": ", paste(format_stretches(stretches),
                                             collapse = "; ")))
 }
@@ -199,16 +235,23 @@ add_near_rest <- function(fit, rejected, stretches) {
   fit
 }
 
+# " or within the stretches they form (N)" when the widening left out more.
+format_in_stretch <- function(rejected) {
+  n <- rejected$in_stretch
+  if (is.null(n) || n == 0) return("")
+  sprintf(" or within the stretches they form (%d)", n)
+}
+
 # The one-line summary print() shows (NULL when the rule did not run).
 format_rejected <- function(rejected) {
   if (is.null(rejected)) return(NULL)
   if (is.na(rejected$threshold)) return(NULL)
   sprintf(paste0("%d of %d rest windows (%.1f %%): more than %.1f mg off ",
                  "the others after the fit (%g x robust spread %.2f mg, at ",
-                 "least %g mg)%s"),
+                 "least %g mg)%s%s"),
           rejected$windows, rejected$of, 100 * rejected$share,
           1000 * rejected$threshold, rejected$k, 1000 * rejected$spread,
-          1000 * rejected$floor,
+          1000 * rejected$floor, format_in_stretch(rejected),
           if (nzchar(rejected$note)) " - none left out, see the message" else "")
 }
 
@@ -244,10 +287,11 @@ ggir_near_rest <- function(res, fit, a, sf, call, clock = NULL,
       info, list(icp = g$icp, meantemp = g$meantemp))
     ggir_fit(out, FALSE, call, a$minloadcrit)
   }
-  nr <- near_rest_trim(fit, v, temp, refit, k)
+  secs <- (rows - 1) * ggir_constants$window
+  nr <- near_rest_trim(fit, v, temp, refit, k, start = secs,
+                       window = ggir_constants$window)
   f <- nr$fit
   r <- near_rest_residuals(f, v, temp)
-  secs <- (rows - 1) * ggir_constants$window
   stretches <- near_rest_stretches(secs, nr$out, r, ggir_constants$window,
                                    clock)
   f <- add_near_rest(f, nr$rejected, stretches)

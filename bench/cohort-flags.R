@@ -21,8 +21,9 @@
 # vehicle-like near-rest (simulate_recording(vehicle = 3): norm 30-80 mg off
 # 1 g, low sd; issue 44 item 1), whose twin without those hours (the same
 # recording otherwise) is calibrated too: the coefficients of the two are
-# compared in units of their combined standard errors (the same
-# temperature level: nothing to restate).
+# compared in units of their combined standard errors, the offsets
+# restated at the twin's mean temperature (the windows left out move the
+# recording's mean temperature of its rest).
 #
 # Writes bench/results/cohort-flags.md.
 suppressPackageStartupMessages(library(gravcal))
@@ -116,8 +117,14 @@ for (method in c("ggir", "lightweight")) {
   cols <- intersect(c(paste0("scale.", c("x", "y", "z")), paste0("offset.", c("x", "y", "z")),
                       paste0("temperature.offset.", c("x", "y", "z"))), names(res))
   cols <- cols[paste0(cols, ".se") %in% names(res)]
-  z <- vapply(cols, function(k) (a[[k]] - tw[[k]]) /
-                sqrt(a[[paste0(k, ".se")]]^2 + tw[[paste0(k, ".se")]]^2), 0)
+  # the offsets restated at the twin's mean temperature (the windows left
+  # out move the contaminated recording's own mean temperature)
+  se_cols <- paste0(cols, ".se")
+  ra <- gravcal:::offsets_at_temperature(
+    unlist(a[cols]), stats::setNames(unlist(a[se_cols]), cols),
+    a$meantempcal, tw$meantempcal)
+  z <- vapply(cols, function(k) (ra$co[[k]] - tw[[k]]) /
+                sqrt(ra$se[[k]]^2 + tw[[paste0(k, ".se")]]^2), 0)
   attr(runs[[method]], "twin") <- list(z = z, status = c(a$status, tw$status),
                                        rejected = c(a$rejected_hours, tw$rejected_hours))
 }

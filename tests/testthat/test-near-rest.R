@@ -82,6 +82,50 @@ test_that("stretches are runs of left-out windows, small gaps allowed, 30 min or
                "^0.8 h from 2024-03-04 08:16 look like rest but are not on the sphere \\(median 50 mg off\\)$")
 })
 
+test_that("a stretch takes every window within its span, those near the sphere too", {
+  set.seed(5)
+  n <- 1200
+  u <- gravcal:::random_unit_vectors(n)
+  start <- seq(0, by = 10, length.out = n)
+  # 1 h from 3000 s off the sphere by 50 mg, a fifth of it within the
+  # cut-off (a vehicle's norm passing near 1 g); an isolated window
+  # within the floor elsewhere
+  d <- rep(0, n)
+  span <- 301:661
+  d[span] <- rep(c(0.05, -0.05, 0.05, 0.05, 0.002), length.out = length(span))
+  v <- u * (1 + d + stats::rnorm(n, sd = 0.0005))
+  fit <- gravcal:::new_fit(points = data.frame(mean_x = v[, 1], mean_y = v[, 2],
+                                               mean_z = v[, 3]),
+                           method = "ggir")
+  kept <- NULL
+  refit <- function(keep) {
+    kept <<- keep
+    fit
+  }
+  # without the windows' times: only those beyond the cut-off
+  nr <- gravcal:::near_rest_trim(fit, v, NULL, refit)
+  expect_identical(which(nr$out), span[d[span] != 0.002])
+  expect_identical(nr$rejected$in_stretch, 0L)
+  # with them: the whole span, counted apart, and the fit of what is left
+  nr <- gravcal:::near_rest_trim(fit, v, NULL, refit, start = start, window = 10)
+  expect_identical(which(nr$out), span)
+  expect_identical(kept, !nr$out)
+  expect_identical(nr$rejected$windows, length(span))
+  expect_identical(nr$rejected$in_stretch, sum(d[span] == 0.002))
+  r <- gravcal:::near_rest_residuals(fit, v, NULL)
+  s <- gravcal:::near_rest_stretches(start, nr$out, r, 10)
+  expect_equal(s$start, 3000)
+  expect_equal(s$windows, length(span))
+  expect_match(gravcal:::near_rest_message(nr$rejected, s),
+               "^361 rest windows \\(30.1 %\\) left out, more than 5.0 mg off the others after the fit or within the stretches they form \\(72\\): 1.0 h from")
+  # a run too short to be a stretch takes nothing more
+  d2 <- rep(0, n)
+  d2[301:420] <- rep(c(0.05, 0.002), 60)          # 20 min
+  v2 <- u * (1 + d2 + stats::rnorm(n, sd = 0.0005))
+  nr <- gravcal:::near_rest_trim(fit, v2, NULL, refit, start = start, window = 10)
+  expect_identical(which(nr$out), seq.int(301L, 419L, by = 2L))
+})
+
 test_that("more than a third off the others: nothing left out, and the fit says so", {
   set.seed(3)
   u <- gravcal:::random_unit_vectors(300)
