@@ -49,12 +49,44 @@ gc_crc32 <- function(bytes) {
     .Call(`_gravcal_gc_crc32`, bytes)
 }
 
-gc_ggir_block_epochs <- function(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use) {
-    .Call(`_gravcal_gc_ggir_block_epochs`, x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use)
+gc_meta_store <- function(temperature, time, light) {
+    .Call(`_gravcal_gc_meta_store`, temperature, time, light)
 }
 
-gc_enmo_gradient <- function(x, y, z, temperature, n_use, sf, ws3, cal) {
-    .Call(`_gravcal_gc_enmo_gradient`, x, y, z, temperature, n_use, sf, ws3, cal)
+gc_meta_store_read <- function(ptr, decoder, units, capacity, want_time) {
+    .Call(`_gravcal_gc_meta_store_read`, ptr, decoder, units, capacity, want_time)
+}
+
+gc_meta_store_put <- function(ptr, cols, from) {
+    .Call(`_gravcal_gc_meta_store_put`, ptr, cols, from)
+}
+
+gc_meta_store_rows <- function(ptr, from, count) {
+    .Call(`_gravcal_gc_meta_store_rows`, ptr, from, count)
+}
+
+gc_meta_store_size <- function(ptr) {
+    .Call(`_gravcal_gc_meta_store_size`, ptr)
+}
+
+gc_meta_store_set_xyz <- function(ptr, x, y, z) {
+    invisible(.Call(`_gravcal_gc_meta_store_set_xyz`, ptr, x, y, z))
+}
+
+gc_meta_store_fill_gap <- function(ptr, last, reps) {
+    invisible(.Call(`_gravcal_gc_meta_store_fill_gap`, ptr, last, reps))
+}
+
+gc_meta_store_keep <- function(ptr, from, count) {
+    .Call(`_gravcal_gc_meta_store_keep`, ptr, from, count)
+}
+
+gc_meta_store_epochs <- function(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use) {
+    .Call(`_gravcal_gc_meta_store_epochs`, ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use)
+}
+
+gc_meta_store_gradient <- function(ptr, n_use, sf, ws3, cal, temperature) {
+    .Call(`_gravcal_gc_meta_store_gradient`, ptr, n_use, sf, ws3, cal, temperature)
 }
 
 gc_ggir_filter <- function(b, a, x, conv_fused, rec_fused) {

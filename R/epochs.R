@@ -85,15 +85,7 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
     if (inherits(fit, "gravcal_fit") && (any(abs(fit$K[row(fit$K) != col(fit$K)]) > 0) ||
                                          (any(fit$tempoffset != 0) && !isTRUE(fit$use_temp)))) {
       gradient <- outcome_gradient_spec(fit, any(fit$tempoffset != 0))
-      model <- function(d) {
-        df <- data.frame(x = d$x, y = d$y, z = d$z)
-        if (!is.null(d$temperature)) df$temperature <- d$temperature
-        y <- apply_calibration(df, fit)
-        d$x <- y$x
-        d$y <- y$y
-        d$z <- y$z
-        d
-      }
+      model <- epochs_model(fit)
     } else {
       row <- ggir_coef_row(fit, "fit")
       cal <- meta_calibration(unlist(row[c("offset.x", "offset.y", "offset.z")]),
@@ -119,6 +111,12 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   } else {
     src <- epochs_frame_source(x, sf, start, p$chunksize)
   }
+  if (!is.null(model) && any(fit$tempoffset != 0) &&
+      !isTRUE(if (!is.null(src$native)) src$native$info$temperature else
+        !is.null(src$samples$temperature))) {
+    abort("`fit` has a temperature offset, so `x` must have a temperature (a `temperature` ",
+          "column, or a device file that records it).")
+  }
   M <- meta_run(src, p, cal, FALSE, FALSE, model = model, gradient = gradient)
   ep <- epochs_result(M, src, p, tz)
   if (!is.null(gradient)) {
@@ -127,6 +125,37 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   }
   if ("ENMO" %in% names(ep$short)) ep$summary <- summary.gravcal_epochs(ep)
   ep
+}
+
+# A gravcal fit that GGIR's coefficients cannot hold, as meta_run() applies
+# it to each block, with the bits of apply_calibration(): its linear model
+# in the core (apply_model()'s "matrix" arithmetic), GGIR's model (a GGIR
+# fit without cross-axis terms, its temperature term outside GGIR's
+# coefficients) as g.getmeta's calibration (apply_model()'s "ggir"
+# arithmetic is g.getmeta's operation order), coefficients that change over
+# time (segments) by apply_calibration() in R.
+epochs_model <- function(fit) {
+  uses_temp <- any(fit$tempoffset != 0)
+  if (uses_temp && !is.finite(fit$meantemp)) {
+    abort("`fit` has a temperature offset but no finite `meantemp`.")
+  }
+  if (segmented(fit)) {
+    return(list(fun = function(d) {
+      df <- data.frame(x = d$x, y = d$y, z = d$z)
+      if (!is.null(d$temperature)) df$temperature <- d$temperature
+      y <- apply_calibration(df, fit)
+      list(x = y$x, y = y$y, z = y$z)
+    }))
+  }
+  K <- unname(fit$K)
+  if (identical(fit$method, "ggir") && all(K[row(K) != col(K)] == 0)) {
+    return(list(ggir = meta_calibration(as.double(fit$offset), diag(K),
+                                        as.double(fit$tempoffset),
+                                        if (uses_temp) fit$meantemp)))
+  }
+  c(list(K = K, offset = unname(as.double(fit$offset))),
+    if (uses_temp) list(tempoffset = unname(as.double(fit$tempoffset)),
+                        meantemp = fit$meantemp))
 }
 
 # Samples in memory as a source for meta_run(): blocks of GGIR's csv size.

@@ -90,19 +90,34 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   meta_run(src, p, cal, daylimit, verbose)
 }
 
-# The reader of GGIR's blocks for meta_run(): a native decoder's, or slices
-# of samples in memory (`units` rows a block).
-meta_reader <- function(src) {
-  if (!is.null(src$native)) return(function() meta_read_block(src$native, src$units))
-  s <- src$samples
-  from <- 0
-  function() {
-    n <- length(s$x)
-    if (from >= n) return(NULL)
-    i <- (from + 1):min(n, from + src$units)
-    from <<- max(i)
-    meta_rows(s[!vapply(s, is.null, TRUE)], i)
+# The block store of meta_run() (gc_meta_store(), ggir_block_store.hpp)
+# and its reader: one of GGIR's blocks appended to it, from a native
+# decoder or from samples in memory (`units` rows a block). `time`: keep a
+# time column (GGIR's time-gap imputation reads it).
+meta_store <- function(src, time) {
+  cols <- if (!is.null(src$native)) {
+    c(temperature = isTRUE(src$native$info$temperature),
+      light = isTRUE(src$native$info$light))
+  } else {
+    c(temperature = !is.null(src$samples$temperature), light = !is.null(src$samples$light))
   }
+  store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]])
+  want_time <- !isFALSE(format_entry(src$format)$ggir_time)
+  if (!is.null(src$native)) {
+    read <- function() gc_meta_store_read(store, src$native$ptr, src$units, 2^20, want_time)
+  } else {
+    s <- src$samples[!vapply(src$samples, is.null, TRUE)]
+    if (!want_time) s$time <- NULL
+    from <- 0
+    read <- function() {
+      n <- length(s$x)
+      i <- if (from < n) (from + 1):min(n, from + src$units) else integer(0)
+      from <<- from + length(i)
+      gc_meta_store_put(store, meta_rows(s, i), -1)
+    }
+  }
+  list(store = store, read = read, temperature = cols[["temperature"]],
+       light = cols[["light"]], keep_time = time, want_time = want_time)
 }
 
 # The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).
@@ -266,35 +281,6 @@ meta_nonwear <- function(src, p) {
        approach = p$nonwear_approach)
 }
 
-# One of GGIR's blocks from a native decoder: every sample of `units` units
-# (the pump's rule: until the units are read and the last write left room),
-# as a list of columns (x, y, z, and time, temperature, light where the
-# format has them).
-meta_read_block <- function(h, units, capacity = 2^20) {
-  parts <- list()
-  left <- units
-  repeat {
-    b <- gc_decoder_read(h$ptr, left, capacity, TRUE, TRUE, TRUE)
-    n <- b$n
-    if (n > 0) {
-      keep <- seq_len(n)
-      parts[[length(parts) + 1]] <- lapply(b[c("x", "y", "z", "temperature", "time", "light")],
-                                           function(v) if (!is.null(v)) v[keep])
-    }
-    left <- left - b$units
-    if (n == 0 && b$units == 0) break
-    if (left <= 0 && n < capacity) break
-    if (isTRUE(b$done)) break
-  }
-  if (!length(parts)) return(NULL)
-  cols <- c("time", "x", "y", "z", "temperature", "light")
-  out <- lapply(stats::setNames(cols, cols), function(nm) {
-    v <- lapply(parts, `[[`, nm)
-    if (is.null(v[[1]])) NULL else unlist(v, use.names = FALSE)
-  })
-  out[!vapply(out, is.null, TRUE)]
-}
-
 # Rows `i` of a block (a list of equal-length columns).
 meta_rows <- function(d, i) lapply(d, function(v) v[i])
 meta_nrow <- function(d) if (length(d)) length(d$x) else 0L
@@ -304,13 +290,21 @@ meta_bind <- function(a, b) {
   stats::setNames(lapply(nm, function(k) c(a[[k]], b[[k]])), nm)
 }
 
-# g.getmeta()'s loop over the blocks of an open native source. With
-# `gradient` (outcome_gradient_spec(): the fit's linear model), also each
-# short epoch's ENMO gradient with respect to the fit's coefficients, from
+# g.getmeta()'s loop over the blocks of an open native source (or samples
+# in memory), each block held in the core (meta_store()): R decides what
+# GGIR decides per block (the last block, the start, the gap to the carry,
+# the carry), the core reads, fills, calibrates and computes. `model`: a
+# calibration GGIR's coefficients cannot hold, applied before the epoch
+# signals instead of `cal`: list(K, offset and, for a temperature term,
+# tempoffset and meantemp), the linear model as apply_model() applies it,
+# list(fun) a function of a block's columns giving them calibrated, or
+# list(ggir) a calibration as meta_calibration() gives it, in place of
+# `cal`. With `gradient` (outcome_gradient_spec(): the fit's linear
+# model), also each short epoch's ENMO gradient with respect to the fit's
+# coefficients, from
 # the raw samples of each block (M$enmo_gradient, a matrix; epoch_signals()
 # only: g.getmeta()'s M never has it).
 meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL) {
-  read_block <- meta_reader(src)
   sf <- src$sf
   ws3 <- p$windowsizes[1]
   ws2 <- p$windowsizes[2]
@@ -326,17 +320,23 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
                                  zc.hb = p$zc.hb, zc.sb = p$zc.sb, zc.order = p$zc.order)
     fused <- stats_filter_fused()
   }
+  fe <- format_entry(src$format)
+  impute <- isTRUE(p$imputeTimegaps) && isTRUE(fe$ggir_timegaps)
+  ms <- meta_store(src, time = impute && !isFALSE(fe$ggir_time))
+  store <- ms$store
   short <- list()   # per metric, the blocks' rounded epoch values
   grads <- list()
   long <- list()
   filetooshort <- filecorrupt <- FALSE
-  S <- list()
+  carry <- 0        # rows carried from the block before
+  carry_time <- NA_real_  # the carry's last time stamp (desiredtz's clock)
   starttime <- NULL
   wday <- wdayname <- NULL
   light.available <- use.temp <- FALSE
   metricnames_long <- NULL
   short_rows <- src$short_rows %||% 0
   zone <- if (length(p$configtz)) p$configtz else p$desiredtz
+  clock <- fe$local_clock
   i <- 1
   LD <- 2
   QClog <- NULL
@@ -344,44 +344,52 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   prev_time <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
-    data <- read_block()
-    if (isFALSE(format_entry(src$format)$ggir_time)) data$time <- NULL
-    clock <- format_entry(src$format)$local_clock
-    if (!is.null(clock) && !is.null(data$time)) {
-      data$time <- meta_zone_shift(data$time, zone, per_sample = identical(clock, "sample"))
+    info <- ms$read()
+    nr <- info$n
+    # the times GGIR's logic reads: the first read, the last two of the
+    # block, in the zone's clock as GGIR's reader gives them
+    times <- c(info$first_time, info$tail_time[2], info$tail_time[1])
+    if (!ms$want_time || nr == 0) times[] <- NA_real_
+    if (!is.null(clock) && !is.na(times[1])) {
+      times <- meta_zone_shift(times, zone, per_sample = identical(clock, "sample"))
     }
-    nr <- meta_nrow(data)
     isLastBlock <- FALSE
+    have <- TRUE
     if (nr == 0) {
       isLastBlock <- TRUE
       if (i == 1) {
         warning("\nFile empty, possibly corrupt.\n", call. = FALSE)
         filetooshort <- filecorrupt <- TRUE
       }
-      data <- NULL
+      have <- FALSE
     } else if (nr < sf * ws * 2 + 1) {
       isLastBlock <- TRUE
       if (i == 1) {
-        data <- NULL
+        have <- FALSE
         filetooshort <- TRUE
       }
     } else if (nr < short_rows) {
       isLastBlock <- TRUE
     }
-    if (!is.null(data) && isTRUE(p$imputeTimegaps) &&
-        isTRUE(format_entry(src$format)$ggir_timegaps)) {
-      P <- meta_impute_timegaps(data, sf, prev_value, prev_time, c(ws3, ws2), src$filename)
-      data <- P$x
-      last <- meta_nrow(data)
-      prev_value <- c(data$x[last], data$y[last], data$z[last])
-      prev_time <- if (!is.null(data$time)) data$time[last]
+    if (have && impute) {
+      d <- gc_meta_store_rows(store, carry, nr)
+      if (!is.null(clock) && !is.null(d$time)) {
+        d$time <- meta_zone_shift(d$time, zone, per_sample = identical(clock, "sample"))
+      }
+      P <- meta_impute_timegaps(d, sf, prev_value, prev_time, c(ws3, ws2), src$filename)
+      d <- P$x
+      last <- meta_nrow(d)
+      prev_value <- c(d$x[last], d$y[last], d$z[last])
+      prev_time <- if (!is.null(d$time)) d$time[last]
       QClog <- rbind(QClog, P$QClog)
+      info <- gc_meta_store_put(store, d, carry)
+      if (ms$keep_time) times <- c(info$first_time, info$tail_time[2], info$tail_time[1])
     }
-    if (!is.null(data)) {
+    if (have) {
       if (i == 1) {
-        light.available <- "light" %in% names(data)
-        use.temp <- "temperature" %in% names(data)
-        if (use.temp && mean(data$temperature[1:10], na.rm = TRUE) > 50) {
+        light.available <- ms$light
+        use.temp <- ms$temperature
+        if (use.temp && mean(info$head_temp[1:10], na.rm = TRUE) > 50) {
           warning("temperature value is unreaslistically high (> 50 Celcius) and will not be used.",
                   call. = FALSE)
           use.temp <- FALSE
@@ -390,32 +398,26 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
                               if (light.available) c("lightmean", "lightpeak"),
                               if (use.temp) "temperaturemean", "EN")
       }
-      if (meta_nrow(S) > 0) {
-        if (!is.null(data$time) && !is.null(S$time)) {
-          gap <- as.numeric(data$time[1] - S$time[length(S$time)])
-          if (gap > 3600 * sf) {
-            abort("Time gap observed of more than 1 hour between data chunks for ",
-                  basename(src$filename), " (GGIR's g.getmeta() stops here too).")
-          } else if (gap > 3 / sf && gap <= 60 * sf) {
-            last <- length(S$x)
-            v <- c(S$x[last], S$y[last], S$z[last])
-            v <- v / sqrt(sum(v^2))
-            S$x[last] <- v[1]
-            S$y[last] <- v[2]
-            S$z[last] <- v[3]
-            S <- meta_bind(S, meta_rows(S, rep(last, round(gap * sf))))
-          }
+      if (carry > 0 && !is.na(times[1]) && !is.na(carry_time)) {
+        gap <- as.numeric(times[1] - carry_time)
+        if (gap > 3600 * sf) {
+          abort("Time gap observed of more than 1 hour between data chunks for ",
+                basename(src$filename), " (GGIR's g.getmeta() stops here too).")
+        } else if (gap > 3 / sf && gap <= 60 * sf) {
+          gc_meta_store_fill_gap(store, carry, round(gap * sf))
         }
-        data <- meta_bind(S, data)
       }
       if (i == 1) {
-        sw <- meta_start(data, src, p, sf, ws2)
+        sw <- meta_start(list(time = if (!is.na(times[1])) times[1]), src, p, sf, ws2)
         starttime <- sw$starttime
         wday <- sw$wday
         wdayname <- sw$wdayname
-        if (sw$shift > 1) data <- meta_rows(data, -seq_len(sw$shift))
+        if (sw$shift > 1) {
+          k <- min(sw$shift, info$size)
+          gc_meta_store_keep(store, k, info$size - k)
+        }
       }
-      LD <- meta_nrow(data)
+      LD <- gc_meta_store_size(store)
       if (LD < ws * sf && i == 1) {
         warning("\nWarning data too short for doing non-wear detection 3\n", call. = FALSE)
         isLastBlock <- TRUE
@@ -423,20 +425,26 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       }
       if (LD >= ws * sf) {
         use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
-        S <- if ((LD - use) > 1) meta_rows(data, (use + 1):LD) else list()
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
-        # may not be whole), given to the core without a copy
+        # may not be whole)
         n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
         if (!is.null(gradient)) {
-          temp <- if (gradient$temp && (use.temp || !is.null(model))) data$temperature
-          grads[[length(grads) + 1]] <- gc_enmo_gradient(data$x, data$y, data$z, temp, n_use,
-                                                          sf, ws3, gradient)
+          grads[[length(grads) + 1]] <- gc_meta_store_gradient(
+            store, n_use, sf, ws3, gradient,
+            gradient$temp && (use.temp || !is.null(model)))
         }
-        if (!is.null(model)) data <- model(meta_rows(data, seq_len(n_use)))
-        r <- gc_ggir_block_epochs(
-          data$x, data$y, data$z, if (use.temp) data$temperature,
-          if (light.available) data$light, cal, sf, p$windowsizes, asked, nwc,
-          filters, fused$conv, fused$rec, n_use)
+        lin <- NULL
+        cal_b <- cal
+        if (!is.null(model$fun)) {
+          d <- model$fun(gc_meta_store_rows(store, 0, n_use))
+          gc_meta_store_set_xyz(store, d$x, d$y, d$z)
+        } else if (!is.null(model$ggir)) {
+          cal_b <- model$ggir
+        } else if (!is.null(model)) {
+          lin <- model
+        }
+        r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
+                                  filters, fused$conv, fused$rec, n_use)
         for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
         if (light.available) {
@@ -446,6 +454,22 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         if (use.temp) blk$temperaturemean <- round(r$temperature, 4)
         blk$EN <- round(r$en, 4)
         long[[length(long) + 1]] <- blk
+        # the carry: GGIR's data[(use + 1):LD, ] when more than one row is
+        # left (R's `:` and its index truncation on a use that may not be
+        # whole); its last time stamp for the next block's gap
+        if ((LD - use) > 1) {
+          from <- floor(use + 1) - 1
+          count <- floor(abs(LD - (use + 1)) + 1 + 1.1920928955078125e-07)
+        } else {
+          from <- LD
+          count <- 0
+        }
+        back <- LD - (from + count)
+        carry_time <- if (count > 0 && back < 2) times[3 - back] else NA_real_
+        carry <- gc_meta_store_keep(store, from, count)
+        if (ms$keep_time && carry > 0) {
+          carry_time <- gc_meta_store_rows(store, carry - 1, 1)$time
+        }
       }
     } else {
       LD <- 0

@@ -142,17 +142,110 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_ggir_block_epochs
-Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, Rcpp::Nullable<Rcpp::NumericVector> light, const Rcpp::List& cal, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused, double n_use);
-RcppExport SEXP _gravcal_gc_ggir_block_epochs(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP lightSEXP, SEXP calSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP n_useSEXP) {
+// gc_meta_store
+SEXP gc_meta_store(bool temperature, bool time, bool light);
+RcppExport SEXP _gravcal_gc_meta_store(SEXP temperatureSEXP, SEXP timeSEXP, SEXP lightSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
+    Rcpp::traits::input_parameter< bool >::type time(timeSEXP);
+    Rcpp::traits::input_parameter< bool >::type light(lightSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store(temperature, time, light));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_read
+Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capacity, bool want_time);
+RcppExport SEXP _gravcal_gc_meta_store_read(SEXP ptrSEXP, SEXP decoderSEXP, SEXP unitsSEXP, SEXP capacitySEXP, SEXP want_timeSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type decoder(decoderSEXP);
+    Rcpp::traits::input_parameter< double >::type units(unitsSEXP);
+    Rcpp::traits::input_parameter< double >::type capacity(capacitySEXP);
+    Rcpp::traits::input_parameter< bool >::type want_time(want_timeSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_read(ptr, decoder, units, capacity, want_time));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_put
+Rcpp::List gc_meta_store_put(SEXP ptr, const Rcpp::List& cols, double from);
+RcppExport SEXP _gravcal_gc_meta_store_put(SEXP ptrSEXP, SEXP colsSEXP, SEXP fromSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type cols(colsSEXP);
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_put(ptr, cols, from));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_rows
+Rcpp::List gc_meta_store_rows(SEXP ptr, double from, double count);
+RcppExport SEXP _gravcal_gc_meta_store_rows(SEXP ptrSEXP, SEXP fromSEXP, SEXP countSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type count(countSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_rows(ptr, from, count));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_size
+double gc_meta_store_size(SEXP ptr);
+RcppExport SEXP _gravcal_gc_meta_store_size(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_size(ptr));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_set_xyz
+void gc_meta_store_set_xyz(SEXP ptr, const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z);
+RcppExport SEXP _gravcal_gc_meta_store_set_xyz(SEXP ptrSEXP, SEXP xSEXP, SEXP ySEXP, SEXP zSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temperature(temperatureSEXP);
-    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type light(lightSEXP);
+    gc_meta_store_set_xyz(ptr, x, y, z);
+    return R_NilValue;
+END_RCPP
+}
+// gc_meta_store_fill_gap
+void gc_meta_store_fill_gap(SEXP ptr, double last, double reps);
+RcppExport SEXP _gravcal_gc_meta_store_fill_gap(SEXP ptrSEXP, SEXP lastSEXP, SEXP repsSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< double >::type last(lastSEXP);
+    Rcpp::traits::input_parameter< double >::type reps(repsSEXP);
+    gc_meta_store_fill_gap(ptr, last, reps);
+    return R_NilValue;
+END_RCPP
+}
+// gc_meta_store_keep
+double gc_meta_store_keep(SEXP ptr, double from, double count);
+RcppExport SEXP _gravcal_gc_meta_store_keep(SEXP ptrSEXP, SEXP fromSEXP, SEXP countSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type count(countSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_keep(ptr, from, count));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gc_meta_store_epochs
+Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal, Rcpp::Nullable<Rcpp::List> model, bool use_temp, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused, double n_use);
+RcppExport SEXP _gravcal_gc_meta_store_epochs(SEXP ptrSEXP, SEXP calSEXP, SEXP modelSEXP, SEXP use_tempSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP n_useSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
     Rcpp::traits::input_parameter< const Rcpp::List& >::type cal(calSEXP);
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::List> >::type model(modelSEXP);
+    Rcpp::traits::input_parameter< bool >::type use_temp(use_tempSEXP);
     Rcpp::traits::input_parameter< double >::type sf(sfSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type windowsizes(windowsizesSEXP);
     Rcpp::traits::input_parameter< const Rcpp::CharacterVector& >::type metrics(metricsSEXP);
@@ -161,24 +254,22 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
     Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
     Rcpp::traits::input_parameter< double >::type n_use(n_useSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_ggir_block_epochs(x, y, z, temperature, light, cal, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use));
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_epochs(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use));
     return rcpp_result_gen;
 END_RCPP
 }
-// gc_enmo_gradient
-Rcpp::NumericMatrix gc_enmo_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, Rcpp::Nullable<Rcpp::NumericVector> temperature, double n_use, double sf, double ws3, const Rcpp::List& cal);
-RcppExport SEXP _gravcal_gc_enmo_gradient(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP temperatureSEXP, SEXP n_useSEXP, SEXP sfSEXP, SEXP ws3SEXP, SEXP calSEXP) {
+// gc_meta_store_gradient
+Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, double ws3, const Rcpp::List& cal, bool temperature);
+RcppExport SEXP _gravcal_gc_meta_store_gradient(SEXP ptrSEXP, SEXP n_useSEXP, SEXP sfSEXP, SEXP ws3SEXP, SEXP calSEXP, SEXP temperatureSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::NumericVector> >::type temperature(temperatureSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
     Rcpp::traits::input_parameter< double >::type n_use(n_useSEXP);
     Rcpp::traits::input_parameter< double >::type sf(sfSEXP);
     Rcpp::traits::input_parameter< double >::type ws3(ws3SEXP);
     Rcpp::traits::input_parameter< const Rcpp::List& >::type cal(calSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_enmo_gradient(x, y, z, temperature, n_use, sf, ws3, cal));
+    Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_gradient(ptr, n_use, sf, ws3, cal, temperature));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -413,8 +504,16 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
-    {"_gravcal_gc_ggir_block_epochs", (DL_FUNC) &_gravcal_gc_ggir_block_epochs, 14},
-    {"_gravcal_gc_enmo_gradient", (DL_FUNC) &_gravcal_gc_enmo_gradient, 8},
+    {"_gravcal_gc_meta_store", (DL_FUNC) &_gravcal_gc_meta_store, 3},
+    {"_gravcal_gc_meta_store_read", (DL_FUNC) &_gravcal_gc_meta_store_read, 5},
+    {"_gravcal_gc_meta_store_put", (DL_FUNC) &_gravcal_gc_meta_store_put, 3},
+    {"_gravcal_gc_meta_store_rows", (DL_FUNC) &_gravcal_gc_meta_store_rows, 3},
+    {"_gravcal_gc_meta_store_size", (DL_FUNC) &_gravcal_gc_meta_store_size, 1},
+    {"_gravcal_gc_meta_store_set_xyz", (DL_FUNC) &_gravcal_gc_meta_store_set_xyz, 4},
+    {"_gravcal_gc_meta_store_fill_gap", (DL_FUNC) &_gravcal_gc_meta_store_fill_gap, 3},
+    {"_gravcal_gc_meta_store_keep", (DL_FUNC) &_gravcal_gc_meta_store_keep, 3},
+    {"_gravcal_gc_meta_store_epochs", (DL_FUNC) &_gravcal_gc_meta_store_epochs, 12},
+    {"_gravcal_gc_meta_store_gradient", (DL_FUNC) &_gravcal_gc_meta_store_gradient, 6},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 7},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},

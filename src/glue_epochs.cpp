@@ -1,81 +1,253 @@
-// Rcpp glue for GGIR part 1's epoch signals of one block (ggir_epochs.hpp).
-// Converts and checks shapes only.
+// Rcpp glue for GGIR part 1's blocks (ggir_block_store.hpp) and their
+// epoch signals (ggir_epochs.hpp). Converts and checks shapes only.
 #include "gravcal/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "gravcal/ggir_block_store.hpp"
 #include "gravcal/ggir_epochs.hpp"
 #include "r_services.h"
+#include "sources_glue.h"
 
 namespace {
 
-const double* column_or_null(const Rcpp::Nullable<Rcpp::NumericVector>& v, R_xlen_t n,
-                             Rcpp::NumericVector& keep, const char* what) {
-  if (v.isNull()) return nullptr;
-  keep = Rcpp::NumericVector(v.get());
-  if (keep.size() < n) Rcpp::stop("%s is shorter than the samples used", what);
-  return keep.begin();
-}
+using Store = gravcal::ggir_part1::BlockStore;
 
 Rcpp::NumericVector as_r(const std::vector<double>& v) {
   return Rcpp::NumericVector(v.begin(), v.end());
 }
 
+double na_if_nan(double v) { return std::isnan(v) ? NA_REAL : v; }
+
+// What R's block logic reads after rows were added: see gc_meta_store_read().
+Rcpp::List read_info(const Store& s, std::size_t before, std::size_t got) {
+  Rcpp::NumericVector head;
+  if (s.has(Store::kT) && got > 0) {
+    const double* t = s.col(Store::kT) + before;
+    head = Rcpp::NumericVector(t, t + std::min<std::size_t>(got, 10));
+  }
+  return Rcpp::List::create(
+      Rcpp::Named("n") = static_cast<double>(got), Rcpp::Named("size") = static_cast<double>(s.size()),
+      Rcpp::Named("first_time") = got > 0 ? na_if_nan(s.first_read_time()) : NA_REAL,
+      Rcpp::Named("tail_time") = Rcpp::NumericVector::create(na_if_nan(s.tail_time(0)),
+                                                             na_if_nan(s.tail_time(1))),
+      Rcpp::Named("head_temp") = head);
+}
+
+// gravcal's linear model from R: list(K (3 x 3), offset and, for the
+// temperature term, tempoffset and meantemp).
+gravcal::ggir_part1::LinearModel linear_model(const Rcpp::List& cal, bool have_temp) {
+  gravcal::ggir_part1::LinearModel m;
+  const Rcpp::NumericMatrix K = cal["K"];
+  const Rcpp::NumericVector off = cal["offset"];
+  if (K.nrow() != 3 || K.ncol() != 3 || off.size() != 3) Rcpp::stop("K must be 3 x 3, offset 3 values");
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m.K[r][c] = K(r, c);
+    m.offset[r] = off[r];
+  }
+  if (cal.containsElementNamed("tempoffset") && have_temp) {
+    const Rcpp::NumericVector to = cal["tempoffset"];
+    if (to.size() != 3) Rcpp::stop("tempoffset needs 3 values");
+    m.temp = true;
+    m.meantemp = Rcpp::as<double>(cal["meantemp"]);
+    for (int a = 0; a < 3; ++a) m.tempoffset[a] = to[a];
+  }
+  return m;
+}
+
+// The block store (ggir_block_store.hpp) behind an external pointer.
+Store* store(SEXP ptr) {
+  Rcpp::XPtr<Store> p(ptr);
+  if (p.get() == nullptr) Rcpp::stop("the block store is gone");
+  return p.get();
+}
+
+// Rows [0, n_use) of the store, checked.
+std::size_t rows_used(const Store& s, double n_use) {
+  if (!(n_use >= 0) || n_use > static_cast<double>(s.size())) Rcpp::stop("n_use out of range");
+  return static_cast<std::size_t>(n_use);
+}
+
 }  // namespace
 
-// One block of g.getmeta(): x, y, z (raw, g), temperature and light (or
-// NULL), the calibration (list: offset, inv_scale, and when the
-// temperature term applies meantemp, inv_tempoffset), sf, windowsizes
-// (ws3, ws2, ws), the short-epoch metric names (ggir_epochs.hpp
-// short_metrics()), non-wear settings (list: clipthres, sdcriter,
-// racriter, approach "2013"/"2023"), the filters (ggir_filter_coefs() or
-// NULL) and whether R's stats::filter() fuses, and n_use: how many of the
-// columns' first samples form the block. Returns list(short = named list of
-// epoch means, nonwear, clipping, epochs, en, temperature, lightmean,
-// lightpeak), unrounded.
+// A store for one of g.getmeta()'s blocks, with a temperature, time and
+// light column where asked.
 // [[Rcpp::export(rng = false)]]
-Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
-                                const Rcpp::NumericVector& z,
-                                Rcpp::Nullable<Rcpp::NumericVector> temperature,
-                                Rcpp::Nullable<Rcpp::NumericVector> light,
-                                const Rcpp::List& cal, double sf,
+SEXP gc_meta_store(bool temperature, bool time, bool light) {
+  return Rcpp::XPtr<Store>(new Store(temperature, time, light), true);
+}
+
+// One block from an open decoder (gc_decoder_open()'s ptr) appended to the
+// store: `units` units in reads of at most `capacity` samples. Returns
+// list(n = rows read, size, first_time = the first row read's time,
+// tail_time = the store's last two rows' times (last first), head_temp =
+// the first 10 temperatures read), times NA where unknown.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capacity,
+                              bool want_time) {
+  Store* s = store(ptr);
+  gravcal_glue::OpenFile* f = gravcal_glue::open_file(decoder);
+  if (!(capacity >= 1) || capacity > 1e9) Rcpp::stop("capacity must be in [1, 1e9]");
+  const std::size_t before = s->size();
+  std::size_t got = 0;
+  try {
+    got = s->read(*f->decoder, static_cast<std::int64_t>(units), static_cast<std::size_t>(capacity),
+                  want_time);
+  } catch (const std::exception& e) {
+    Rcpp::stop(e.what());
+  }
+  return read_info(*s, before, got);
+}
+
+// Rows given from R (samples in memory) appended, or (`from` >= 0) put in
+// place of the rows from `from` on (R's imputation of the rows read): a
+// list of columns x, y, z and, where the store keeps them, temperature,
+// time, light (absent: NA). Returns what gc_meta_store_read() returns.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_meta_store_put(SEXP ptr, const Rcpp::List& cols, double from) {
+  Store* s = store(ptr);
+  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light"};
+  const R_xlen_t n = Rf_xlength(cols["x"]);
+  const double* src[Store::kCols];
+  for (int c = 0; c < Store::kCols; ++c) {
+    src[c] = nullptr;
+    if (!cols.containsElementNamed(names[c])) continue;
+    SEXP v = cols[names[c]];
+    src[c] = gravcal_glue::column(v, n, c >= Store::kT, names[c]);
+  }
+  const std::size_t before = from >= 0 ? static_cast<std::size_t>(from) : s->size();
+  if (from >= 0) {
+    if (from > static_cast<double>(s->size())) Rcpp::stop("from beyond the block");
+    s->replace_tail(before, src, static_cast<std::size_t>(n));
+  } else {
+    s->append(src, static_cast<std::size_t>(n));
+  }
+  return read_info(*s, before, static_cast<std::size_t>(n));
+}
+
+// Rows [from, from + count) of the store as R columns (those it keeps).
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_meta_store_rows(SEXP ptr, double from, double count) {
+  const Store* s = store(ptr);
+  if (!(from >= 0) || !(count >= 0) || from + count > static_cast<double>(s->size()))
+    Rcpp::stop("rows beyond the block");
+  const std::size_t a = static_cast<std::size_t>(from), k = static_cast<std::size_t>(count);
+  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light"};
+  Rcpp::List out;
+  for (int c = 0; c < Store::kCols; ++c) {
+    if (!s->has(c)) continue;
+    const double* v = s->col(c);
+    out[names[c]] = Rcpp::NumericVector(v + a, v + a + k);
+  }
+  return out;
+}
+
+// The rows the store holds.
+// [[Rcpp::export(rng = false)]]
+double gc_meta_store_size(SEXP ptr) { return static_cast<double>(store(ptr)->size()); }
+
+// Rows [0, length(x)) of x, y, z replaced (a block calibrated in R).
+// [[Rcpp::export(rng = false)]]
+void gc_meta_store_set_xyz(SEXP ptr, const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
+                           const Rcpp::NumericVector& z) {
+  Store* s = store(ptr);
+  const R_xlen_t n = x.size();
+  if (y.size() != n || z.size() != n || static_cast<double>(n) > static_cast<double>(s->size()))
+    Rcpp::stop("x, y, z must have equal lengths within the block");
+  std::copy(x.begin(), x.end(), s->col(Store::kX));
+  std::copy(y.begin(), y.end(), s->col(Store::kY));
+  std::copy(z.begin(), z.end(), s->col(Store::kZ));
+}
+
+// GGIR's fill of a gap after the carry (its last row, 1-based `last`):
+// normalised, repeated `reps` times.
+// [[Rcpp::export(rng = false)]]
+void gc_meta_store_fill_gap(SEXP ptr, double last, double reps) {
+  Store* s = store(ptr);
+  if (!(last >= 1) || last > static_cast<double>(s->size()) || !(reps >= 0) || reps > 1e9)
+    Rcpp::stop("gap fill out of range");
+  gravcal::with_r_acc(gravcal_glue::r_long_double(), [&](auto acc) {
+    s->fill_gap<decltype(acc)>(static_cast<std::size_t>(last) - 1, static_cast<std::size_t>(reps));
+    return 0;
+  });
+}
+
+// The store reduced to its rows [from, from + count) (0-based from): the
+// start's shift, or the carry after a block.
+// [[Rcpp::export(rng = false)]]
+double gc_meta_store_keep(SEXP ptr, double from, double count) {
+  Store* s = store(ptr);
+  if (!(from >= 0) || !(count >= 0) || from + count > static_cast<double>(s->size()))
+    Rcpp::stop("rows beyond the block");
+  s->keep(static_cast<std::size_t>(from), static_cast<std::size_t>(count));
+  return static_cast<double>(s->size());
+}
+
+// One block of g.getmeta(): the store's first n_use rows (GGIR's
+// data[1:use, ]), calibrated in place, then its epoch signals; use_temp:
+// the temperature column is g.getmeta()'s (calibration, long epochs). The
+// calibration: `model` (list: K, offset and, for a temperature term,
+// tempoffset, meantemp: gravcal's linear model as apply_model() applies
+// it), else `cal` as g.getmeta applies it (list: offset, inv_scale, and
+// when the temperature term applies meantemp, inv_tempoffset); the rows
+// after n_use (the carry) are untouched. sf, windowsizes (ws3, ws2, ws),
+// the short-epoch metric names (ggir_epochs.hpp short_metrics()), non-wear
+// settings (list: clipthres, sdcriter, racriter, approach "2013"/"2023"),
+// the filters (ggir_filter_coefs() or NULL) and whether R's stats::filter()
+// fuses. Returns list(short = named list of epoch means, nonwear,
+// clipping, epochs, en, temperature, lightmean, lightpeak), unrounded.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
+                                Rcpp::Nullable<Rcpp::List> model, bool use_temp, double sf,
                                 const Rcpp::NumericVector& windowsizes,
                                 const Rcpp::CharacterVector& metrics,
                                 const Rcpp::List& nonwear,
                                 Rcpp::Nullable<Rcpp::List> filters, bool conv_fused,
                                 bool rec_fused, double n_use) {
   namespace p1 = gravcal::ggir_part1;
-  const R_xlen_t len = x.size();
-  if (y.size() != len || z.size() != len) Rcpp::stop("x, y, z lengths differ");
-  // the block's first n_use samples (GGIR's data[1:use, ]), without a copy in R
-  if (!(n_use >= 0) || n_use > static_cast<double>(len)) Rcpp::stop("n_use out of range");
-  const R_xlen_t n = static_cast<R_xlen_t>(n_use);
+  Store* s = store(ptr);
+  const std::size_t un = rows_used(*s, n_use);
   if (windowsizes.size() != 3) Rcpp::stop("windowsizes must have 3 values");
   if (!(sf > 0)) Rcpp::stop("sf must be positive");
-  Rcpp::NumericVector tk, lk;
-  const double* t = column_or_null(temperature, n, tk, "temperature");
-  const double* li = column_or_null(light, n, lk, "light");
-  p1::Calibration c;
-  const Rcpp::NumericVector off = cal["offset"], isc = cal["inv_scale"];
-  if (off.size() != 3 || isc.size() != 3) Rcpp::stop("offset and inv_scale need 3 values");
-  for (int a = 0; a < 3; ++a) {
-    c.offset[a] = off[a];
-    c.inv_scale[a] = isc[a];
+  double* cx = s->col(Store::kX);
+  double* cy = s->col(Store::kY);
+  double* cz = s->col(Store::kZ);
+  // the temperature: for GGIR's calibration and its epoch means when used
+  // (g.getmeta() drops a temperature over 50 degrees C); gravcal's model
+  // takes the column whenever the recording has one
+  const double* tcol = s->col(Store::kT);
+  const double* t = use_temp ? tcol : nullptr;
+  const double* li = s->col(Store::kLight);
+  if (model.isNotNull()) {
+    const p1::LinearModel m = linear_model(Rcpp::List(model.get()), tcol != nullptr);
+    try {
+      p1::apply_linear(m, cx, cy, cz, tcol, un);
+    } catch (const std::exception& e) {
+      Rcpp::stop(e.what());
+    }
+  } else {
+    p1::Calibration c;
+    const Rcpp::NumericVector off = cal["offset"], isc = cal["inv_scale"];
+    if (off.size() != 3 || isc.size() != 3) Rcpp::stop("offset and inv_scale need 3 values");
+    for (int a = 0; a < 3; ++a) {
+      c.offset[a] = off[a];
+      c.inv_scale[a] = isc[a];
+    }
+    if (cal.containsElementNamed("meantemp") && t != nullptr) {
+      const Rcpp::NumericVector ito = cal["inv_tempoffset"];
+      if (ito.size() != 3) Rcpp::stop("inv_tempoffset needs 3 values");
+      c.temp = true;
+      c.meantemp = Rcpp::as<double>(cal["meantemp"]);
+      for (int a = 0; a < 3; ++a) c.inv_tempoffset[a] = ito[a];
+    }
+    p1::apply_calibration(c, cx, cy, cz, t, un);
   }
-  if (cal.containsElementNamed("meantemp") && t != nullptr) {
-    const Rcpp::NumericVector ito = cal["inv_tempoffset"];
-    if (ito.size() != 3) Rcpp::stop("inv_tempoffset needs 3 values");
-    c.temp = true;
-    c.meantemp = Rcpp::as<double>(cal["meantemp"]);
-    for (int a = 0; a < 3; ++a) c.inv_tempoffset[a] = ito[a];
-  }
-  const std::size_t un = static_cast<std::size_t>(n);
-  std::vector<double> cx(x.begin(), x.begin() + n), cy(y.begin(), y.begin() + n),
-      cz(z.begin(), z.begin() + n);
-  p1::apply_calibration(c, cx.data(), cy.data(), cz.data(), t, un);
   std::vector<std::string> names(metrics.size());
   for (R_xlen_t k = 0; k < metrics.size(); ++k) names[static_cast<std::size_t>(k)] = Rcpp::as<std::string>(metrics[k]);
   p1::NonwearConfig nw;
@@ -118,21 +290,21 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
   try {
     gravcal::with_r_acc(ld, [&](auto acc) {
       using Acc = decltype(acc);
-      const std::vector<std::vector<double>> s =
-          p1::short_metrics<Acc>(cx.data(), cy.data(), cz.data(), un, sf, windowsizes[0], names,
-                                have_f ? &fc : nullptr, arith);
-      for (std::size_t k = 0; k < s.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(s[k]);
+      const std::vector<std::vector<double>> sm =
+          p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
+                                 have_f ? &fc : nullptr, arith);
+      for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
-      const double* xyz[3] = {cx.data(), cy.data(), cz.data()};
+      const double* xyz[3] = {cx, cy, cz};
       const p1::NonwearResult r = p1::nonwear_clipping<Acc>(xyz, un, nw);
       const double M = windowsizes[1] * sf;
-      std::vector<double> en(un);
-      for (std::size_t i = 0; i < un; ++i) en[i] = p1::r_norm(cx[i], cy[i], cz[i]);
       out = Rcpp::List::create(
           Rcpp::Named("short") = shorts, Rcpp::Named("nonwear") = as_r(r.nonwear),
           Rcpp::Named("clipping") = as_r(r.clipping),
           Rcpp::Named("epochs") = static_cast<double>(r.epochs),
-          Rcpp::Named("en") = as_r(p1::per_epoch<Acc>(en.data(), un, M, true)),
+          Rcpp::Named("en") = as_r(p1::per_epoch_of<Acc>(un, M, true, [cx, cy, cz](std::size_t i) {
+            return p1::r_norm(cx[i], cy[i], cz[i]);
+          })),
           Rcpp::Named("temperature") =
               t ? Rcpp::RObject(as_r(p1::per_epoch<Acc>(t, un, M, true))) : Rcpp::RObject(),
           Rcpp::Named("lightmean") =
@@ -148,42 +320,33 @@ Rcpp::List gc_ggir_block_epochs(const Rcpp::NumericVector& x, const Rcpp::Numeri
 }
 
 // The gradient of each short epoch's ENMO with respect to a linear
-// calibration's coefficients (ggir_epochs.hpp enmo_gradient()), for one
-// block: x, y, z raw (g), temperature (or NULL: no temperature term), n_use
-// as above, sf, the short epoch ws3 (s), and the calibration as a list: K
-// (3 x 3), offset, and, for the temperature term, tempoffset and meantemp.
-// Returns a matrix, one row per short epoch, 12 columns named as coef().
+// calibration's coefficients (ggir_epochs.hpp enmo_gradient()), for the
+// store's first n_use rows, raw (before gc_meta_store_epochs() calibrates
+// them): sf, the short epoch ws3 (s), and the calibration as a list: K
+// (3 x 3), offset, and, for the temperature term (with `temperature`),
+// tempoffset and meantemp. Returns a matrix, one row per short epoch, 12
+// columns named as coef().
 // [[Rcpp::export(rng = false)]]
-Rcpp::NumericMatrix gc_enmo_gradient(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
-                                     const Rcpp::NumericVector& z,
-                                     Rcpp::Nullable<Rcpp::NumericVector> temperature,
-                                     double n_use, double sf, double ws3, const Rcpp::List& cal) {
+Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, double ws3,
+                                           const Rcpp::List& cal, bool temperature) {
   namespace p1 = gravcal::ggir_part1;
-  const R_xlen_t len = x.size();
-  if (y.size() != len || z.size() != len) Rcpp::stop("x, y, z lengths differ");
-  if (!(n_use >= 0) || n_use > static_cast<double>(len)) Rcpp::stop("n_use out of range");
+  const Store* s = store(ptr);
+  const std::size_t n = rows_used(*s, n_use);
   if (!(sf > 0) || !(ws3 > 0)) Rcpp::stop("sf and ws3 must be positive");
-  const R_xlen_t n = static_cast<R_xlen_t>(n_use);
-  Rcpp::NumericVector tk;
-  const double* t = column_or_null(temperature, n, tk, "temperature");
+  const double* t = temperature ? s->col(Store::kT) : nullptr;
+  const p1::LinearModel lm = linear_model(cal, t != nullptr);
   p1::LinearCalibration m;
-  const Rcpp::NumericMatrix K = cal["K"];
-  const Rcpp::NumericVector off = cal["offset"];
-  if (K.nrow() != 3 || K.ncol() != 3 || off.size() != 3) Rcpp::stop("K must be 3 x 3, offset 3 values");
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) m.K[r][c] = K(r, c);
-    m.offset[r] = off[r];
+    for (int c = 0; c < 3; ++c) m.K[r][c] = lm.K[r][c];
+    m.offset[r] = lm.offset[r];
+    m.tempoffset[r] = lm.tempoffset[r];
   }
-  if (t != nullptr) {
-    const Rcpp::NumericVector to = cal["tempoffset"];
-    if (to.size() != 3) Rcpp::stop("tempoffset needs 3 values");
-    m.temp = true;
-    m.meantemp = Rcpp::as<double>(cal["meantemp"]);
-    for (int a = 0; a < 3; ++a) m.tempoffset[a] = to[a];
-  }
+  m.temp = lm.temp;
+  m.meantemp = lm.meantemp;
   std::vector<double> g;
   try {
-    g = p1::enmo_gradient(x.begin(), y.begin(), z.begin(), t, static_cast<std::size_t>(n), sf * ws3, m);
+    g = p1::enmo_gradient(s->col(Store::kX), s->col(Store::kY), s->col(Store::kZ),
+                          m.temp ? t : nullptr, n, sf * ws3, m);
   } catch (const std::exception& e) {
     Rcpp::stop(e.what());
   }

@@ -99,39 +99,43 @@ inline std::vector<double> r_seq_by(double from, double to, double by) {
 // R's round(x) (digits 0): to the nearest integer, ties to even.
 inline double r_round0(double x) { return std::nearbyint(x); }
 
-// R's cumsum(c(0, x)) with R's accumulator Acc: out[0] = 0, out[i + 1] the
-// sum of x[0..i] rounded to double.
-template <class Acc>
-void r_cumsum0(const double* x, std::size_t n, std::vector<double>& out) {
-  out.resize(n + 1);
-  Acc s = 0;
-  out[0] = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    s += x[i];
-    out[i + 1] = static_cast<double>(s);
-  }
-}
-
 // GGIR's averagePerEpoch() (mean = true) and sumPerEpoch() (mean = false)
-// of x[0..n) for epochs of `by` samples (sf * epoch length, maybe not
-// whole).
-template <class Acc>
-std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
-  std::vector<double> cs;
-  r_cumsum0<Acc>(x, n, cs);
+// of the values f(0), ..., f(n - 1) for epochs of `by` samples (sf * epoch
+// length, maybe not whole): the differences of R's cumsum(c(0, x)) (R's
+// accumulator Acc, each sum rounded to double) at round(seq(1, n + 1, by)),
+// divided by the epoch's length. The sums are taken as the values stream
+// (the rounded bounds never decrease), so that neither the values nor their
+// cumulative sums are held.
+template <class Acc, class F>
+std::vector<double> per_epoch_of(std::size_t n, double by, bool mean, F&& f) {
   const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
   std::vector<double> out;
   if (sel.size() < 2) return out;
   out.resize(sel.size() - 1);
+  Acc s = 0;
+  std::size_t at = 0;  // values summed so far: the sum is cumsum's [at]
+  // cumsum(c(0, x))[j] (1-based j within 1..n + 1)
+  auto cum = [&](double j) {
+    const std::size_t to = static_cast<std::size_t>(j) - 1;
+    for (; at < to; ++at) s += f(at);
+    return static_cast<double>(s);
+  };
   double prev = r_round0(sel[0]);
+  double cprev = cum(prev);
   for (std::size_t i = 1; i < sel.size(); ++i) {
     const double cur = r_round0(sel[i]);
-    // 1-based indices into cs (whole numbers within 1..n + 1)
-    const double d = cs[static_cast<std::size_t>(cur) - 1] - cs[static_cast<std::size_t>(prev) - 1];
+    const double ccur = cum(cur);
+    const double d = ccur - cprev;
     out[i - 1] = mean ? d / std::fabs(cur - prev) : d;
     prev = cur;
+    cprev = ccur;
   }
   return out;
+}
+
+template <class Acc>
+std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
+  return per_epoch_of<Acc>(n, by, mean, [x](std::size_t i) { return x[i]; });
 }
 
 // The calibration as g.getmeta applies it, in place: v = (v + offset) /
@@ -203,20 +207,38 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
   }
 }
 
+// GGIR's rollmed() of one axis of a block, as a view: the value at sample
+// i is the running median of the 10 Hz subsample (xm[i / step]) up to LN
+// = xm.size() * step, the last median after it; or, in GGIR's fallback
+// (when LN exceeds the block), the raw axis itself. Held at the
+// subsample's rate: a tenth of the block, or none.
+struct RollMed {
+  std::vector<double> xm;
+  const double* raw = nullptr;  // the fallback: the raw axis
+  std::size_t step = 1, LN = 0;
+  double tail = kNaN;
+  double operator[](std::size_t i) const {
+    if (raw != nullptr) return raw[i];
+    return i < LN ? xm[i / step] : tail;
+  }
+};
+
 // GGIR's rollmed(): the smoothed axis used for the angles and the
 // roll_med_acc metrics, for one axis of a block.
-inline void ggir_rollmed(const double* x, std::size_t LX, double sf, std::vector<double>& out) {
+inline RollMed ggir_rollmed(const double* x, std::size_t LX, double sf) {
   const double fl = std::floor(sf / 10);
   const std::size_t step = static_cast<std::size_t>(std::max(fl, 1.0));
   const double newsf = step > 1 ? 10.0 : sf;
   double winsi = r_round0(newsf * 5);
   if (r_round0(winsi / 2) == winsi / 2) winsi = winsi + 1;
   if (std::fmod(winsi, 2.0) == 0) winsi = winsi + 1;
+  RollMed r;
   std::vector<double> sub;
   sub.reserve(LX / step + 1);
   for (std::size_t i = 0; i < LX; i += step) sub.push_back(x[i]);
-  std::vector<double> xm;
+  std::vector<double>& xm = r.xm;
   rolling_median(sub, static_cast<std::size_t>(winsi), xm);
+  std::vector<double>().swap(sub);
   const std::size_t LN0 = xm.size();
   // the head: zeros among the first S2check values take the first value
   // there that is not zero (NA when there is none)
@@ -260,39 +282,60 @@ inline void ggir_rollmed(const double* x, std::size_t LX, double sf, std::vector
   }
   const std::size_t LN = LN0 * step;
   if (LN > LX) {
-    out.assign(x, x + LX);  // GGIR's fallback: the raw axis
-    return;
+    std::vector<double>().swap(xm);
+    r.raw = x;  // GGIR's fallback: the raw axis
+    return r;
   }
-  out.resize(LX);
-  for (std::size_t i = 0; i < LN; ++i) out[i] = xm[i / step];
-  for (std::size_t i = LN; i < LX; ++i) out[i] = LN ? xm[LN0 - 1] : kNaN;
+  r.step = step;
+  r.LN = LN;
+  r.tail = LN ? xm[LN0 - 1] : kNaN;
+  return r;
 }
 
-// After rollmed() of the three axes: when any value of any axis is NA, each
-// axis's NA values take that axis's last value that is not NA.
-inline void fill_na_last(std::vector<double>* ax[3]) {
-  bool any = false;
-  for (int a = 0; a < 3 && !any; ++a) {
-    for (double v : *ax[a]) {
-      if (std::isnan(v)) {
-        any = true;
-        break;
+// After rollmed() of the three axes (n samples each): when any value of
+// any axis is NA, each axis's NA values take that axis's last value that is
+// not NA.
+inline void fill_na_last(RollMed* ax[3], std::size_t n) {
+  auto has_nan = [n](const RollMed& r) {
+    if (r.raw != nullptr) {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (std::isnan(r.raw[i])) return true;
       }
+      return false;
     }
-  }
+    const std::size_t used = r.LN / r.step;
+    for (std::size_t j = 0; j < used; ++j) {
+      if (std::isnan(r.xm[j])) return true;
+    }
+    return r.LN < n && std::isnan(r.tail);
+  };
+  bool any = false;
+  for (int a = 0; a < 3 && !any; ++a) any = has_nan(*ax[a]);
   if (!any) return;
   for (int a = 0; a < 3; ++a) {
-    std::vector<double>& v = *ax[a];
+    RollMed& r = *ax[a];
+    if (r.raw != nullptr) {
+      if (!has_nan(r)) continue;
+      // the raw axis copied, to be filled
+      r.xm.assign(r.raw, r.raw + n);
+      r.raw = nullptr;
+      r.step = 1;
+      r.LN = n;
+      r.tail = kNaN;
+    }
     double last = kNaN;
-    for (std::size_t i = v.size(); i-- > 0;) {
-      if (!std::isnan(v[i])) {
-        last = v[i];
+    for (std::size_t i = n; i-- > 0;) {
+      const double v = r[i];
+      if (!std::isnan(v)) {
+        last = v;
         break;
       }
     }
-    for (double& e : v) {
-      if (std::isnan(e)) e = last;
+    const std::size_t used = r.LN / r.step;
+    for (std::size_t j = 0; j < used; ++j) {
+      if (std::isnan(r.xm[j])) r.xm[j] = last;
     }
+    if (std::isnan(r.tail)) r.tail = last;
   }
 }
 
@@ -471,30 +514,25 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
                                                RFilterArith arith = {}) {
   const double by = sf * ws3;
   std::vector<std::vector<double>> out(names.size());
-  std::vector<double> sig(n);
-  std::vector<double> rm[3];
+  RollMed rm[3];
   bool have_rm = false;
   auto need_rm = [&]() {
     if (have_rm) return;
     const double* v[3] = {x, y, z};
-    for (int a = 0; a < 3; ++a) ggir_rollmed(v[a], n, sf, rm[a]);
-    std::vector<double>* p[3] = {&rm[0], &rm[1], &rm[2]};
-    fill_na_last(p);
+    for (int a = 0; a < 3; ++a) rm[a] = ggir_rollmed(v[a], n, sf);
+    RollMed* p[3] = {&rm[0], &rm[1], &rm[2]};
+    fill_na_last(p, n);
     have_rm = true;
   };
-  std::vector<double> en;
-  auto need_en = [&]() {
-    if (!en.empty() || n == 0) return;
-    en.resize(n);
-    for (std::size_t i = 0; i < n; ++i) en[i] = r_norm(x[i], y[i], z[i]);
-  };
+  auto en = [x, y, z](std::size_t i) { return r_norm(x[i], y[i], z[i]); };
   const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
-  std::vector<double> work;
+  std::vector<double> sig, work;
   for (std::size_t k = 0; k < names.size(); ++k) {
     const std::string& nm = names[k];
     FilteredMetric fm;
     if (filtered_metric_from_name(nm.c_str(), &fm)) {
       if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
+      sig.resize(n);
       work.resize(3 * n);
       const SignalStatus st = ggir_filtered_signal(fm, x, y, z, n, *fc, sig.data(), work.data(), arith);
       if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
@@ -513,52 +551,45 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
     const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
     if (base == "roll_med_acc" && axis >= 0) {
       need_rm();
-      out[k] = per_epoch<Acc>(rm[axis].data(), n, by, true);
+      const RollMed& r = rm[axis];
+      out[k] = per_epoch_of<Acc>(n, by, true, [&r](std::size_t i) { return r[i]; });
     } else if (base == "dev_roll_med_acc" && axis >= 0) {
       need_rm();
       const double* v = axis == 0 ? x : axis == 1 ? y : z;
-      for (std::size_t i = 0; i < n; ++i) sig[i] = std::fabs(v[i] - rm[axis][i]);
-      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+      const RollMed& r = rm[axis];
+      out[k] = per_epoch_of<Acc>(n, by, true, [v, &r](std::size_t i) { return std::fabs(v[i] - r[i]); });
     } else if (base == "angle" && axis >= 0) {
       need_rm();
-      const std::vector<double>& a = rm[axis];
-      const std::vector<double>& b = rm[(axis + 1) % 3];
-      const std::vector<double>& c = rm[(axis + 2) % 3];
+      const RollMed& a = rm[axis];
+      const RollMed& b = rm[(axis + 1) % 3];
+      const RollMed& c = rm[(axis + 2) % 3];
       // GGIR's order: angle_x: atan(x / sqrt(y^2 + z^2)); angle_y: y over
       // x, z; angle_z: z over x, y
-      const std::vector<double>& p = axis == 1 ? c : b;  // first in the sum
-      const std::vector<double>& q = axis == 1 ? b : c;
-      for (std::size_t i = 0; i < n; ++i) {
-        sig[i] = std::atan(a[i] / (std::sqrt(p[i] * p[i] + q[i] * q[i]))) / deg;
-      }
-      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+      const RollMed& p = axis == 1 ? c : b;  // first in the sum
+      const RollMed& q = axis == 1 ? b : c;
+      out[k] = per_epoch_of<Acc>(n, by, true, [&a, &p, &q, deg](std::size_t i) {
+        const double pi = p[i], qi = q[i];
+        return std::atan(a[i] / (std::sqrt(pi * pi + qi * qi))) / deg;
+      });
     } else if (nm == "ENMO") {
-      need_en();
-      for (std::size_t i = 0; i < n; ++i) {
-        const double e = en[i] - 1;
-        sig[i] = e < 0 ? 0 : e;
-      }
-      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) {
+        const double e = en(i) - 1;
+        return e < 0 ? 0 : e;
+      });
     } else if (nm == "EN") {
-      need_en();
-      out[k] = per_epoch<Acc>(en.data(), n, by, true);
+      out[k] = per_epoch_of<Acc>(n, by, true, en);
     } else if (nm == "ENMOa") {
-      need_en();
-      for (std::size_t i = 0; i < n; ++i) sig[i] = std::fabs(en[i] - 1);
-      out[k] = per_epoch<Acc>(sig.data(), n, by, true);
+      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) { return std::fabs(en(i) - 1); });
     } else if (nm == "MAD") {
-      need_en();
       // rep(epoch means, each = sf * ws3) (each truncated to an integer),
       // recycled against EN as R's `-` recycles
-      const std::vector<double> means = per_epoch<Acc>(en.data(), n, by, true);
+      const std::vector<double> means = per_epoch_of<Acc>(n, by, true, en);
       const std::size_t each = static_cast<std::size_t>(by);
       const std::size_t m = means.size() * each;
       const std::size_t len = (n == 0 || m == 0) ? 0 : std::max(n, m);
-      std::vector<double> mad(len);
-      for (std::size_t i = 0; i < len; ++i) {
-        mad[i] = std::fabs(en[i % n] - means[(i % m) / each]);
-      }
-      out[k] = per_epoch<Acc>(mad.data(), len, by, true);
+      out[k] = per_epoch_of<Acc>(len, by, true, [&en, &means, n, m, each](std::size_t i) {
+        return std::fabs(en(i % n) - means[(i % m) / each]);
+      });
     } else {
       throw std::runtime_error("unknown GGIR metric: " + nm);
     }
