@@ -29,8 +29,9 @@ double na_if_nan(double v) { return std::isnan(v) ? NA_REAL : v; }
 Rcpp::List read_info(const Store& s, std::size_t before, std::size_t got) {
   Rcpp::NumericVector head;
   if (s.has(Store::kT) && got > 0) {
-    const double* t = s.col(Store::kT) + before;
-    head = Rcpp::NumericVector(t, t + std::min<std::size_t>(got, 10));
+    const std::size_t k = std::min<std::size_t>(got, 10);
+    head = Rcpp::NumericVector(k);
+    for (std::size_t i = 0; i < k; ++i) head[static_cast<R_xlen_t>(i)] = s.value(Store::kT, before + i);
   }
   return Rcpp::List::create(
       Rcpp::Named("n") = static_cast<double>(got), Rcpp::Named("size") = static_cast<double>(s.size()),
@@ -143,7 +144,13 @@ Rcpp::List gc_meta_store_rows(SEXP ptr, double from, double count) {
   for (int c = 0; c < Store::kCols; ++c) {
     if (!s->has(c)) continue;
     const double* v = s->col(c);
-    out[names[c]] = Rcpp::NumericVector(v + a, v + a + k);
+    if (v != nullptr) {
+      out[names[c]] = Rcpp::NumericVector(v + a, v + a + k);
+    } else {
+      Rcpp::NumericVector r(Rcpp::no_init(static_cast<R_xlen_t>(k)));
+      for (std::size_t i = 0; i < k; ++i) r[static_cast<R_xlen_t>(i)] = s->value(c, a + i);
+      out[names[c]] = r;
+    }
   }
   return out;
 }
@@ -221,13 +228,14 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   // the temperature: for GGIR's calibration and its epoch means when used
   // (g.getmeta() drops a temperature over 50 degrees C); gravcal's model
   // takes the column whenever the recording has one
-  const double* tcol = s->col(Store::kT);
-  const double* t = use_temp ? tcol : nullptr;
-  const double* li = s->col(Store::kLight);
+  const gravcal::ggir_part1::RunColumn* tcol = s->runs(Store::kT);
+  const gravcal::ggir_part1::RunColumn* t = use_temp ? tcol : nullptr;
+  const gravcal::ggir_part1::RunColumn* li = s->runs(Store::kLight);
+  auto temp_at = [tcol](std::size_t i) { return tcol->at(i); };
   if (model.isNotNull()) {
     const p1::LinearModel m = linear_model(Rcpp::List(model.get()), tcol != nullptr);
     try {
-      p1::apply_linear(m, cx, cy, cz, tcol, un);
+      p1::apply_linear(m, cx, cy, cz, temp_at, un);
     } catch (const std::exception& e) {
       Rcpp::stop(e.what());
     }
@@ -246,7 +254,7 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       c.meantemp = Rcpp::as<double>(cal["meantemp"]);
       for (int a = 0; a < 3; ++a) c.inv_tempoffset[a] = ito[a];
     }
-    p1::apply_calibration(c, cx, cy, cz, t, un);
+    p1::apply_calibration(c, cx, cy, cz, temp_at, t != nullptr, un);
   }
   std::vector<std::string> names(metrics.size());
   for (R_xlen_t k = 0; k < metrics.size(); ++k) names[static_cast<std::size_t>(k)] = Rcpp::as<std::string>(metrics[k]);
@@ -285,6 +293,7 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   gravcal::RFilterArith arith;
   arith.conv_fused = conv_fused;
   arith.rec_fused = rec_fused;
+  auto light_at = [li](std::size_t i) { return li->at(i); };
   Rcpp::List shorts(metrics.size());
   Rcpp::List out;
   try {
@@ -306,11 +315,11 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
             return p1::r_norm(cx[i], cy[i], cz[i]);
           })),
           Rcpp::Named("temperature") =
-              t ? Rcpp::RObject(as_r(p1::per_epoch<Acc>(t, un, M, true))) : Rcpp::RObject(),
+              t ? Rcpp::RObject(as_r(p1::per_epoch_of<Acc>(un, M, true, temp_at))) : Rcpp::RObject(),
           Rcpp::Named("lightmean") =
-              li ? Rcpp::RObject(as_r(p1::per_epoch<Acc>(li, un, M, true))) : Rcpp::RObject(),
+              li ? Rcpp::RObject(as_r(p1::per_epoch_of<Acc>(un, M, true, light_at))) : Rcpp::RObject(),
           Rcpp::Named("lightpeak") =
-              li ? Rcpp::RObject(as_r(p1::light_peaks(li, un, M))) : Rcpp::RObject());
+              li ? Rcpp::RObject(as_r(p1::light_peaks(light_at, un, M))) : Rcpp::RObject());
       return 0;
     });
   } catch (const std::exception& e) {
@@ -333,7 +342,7 @@ Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, do
   const Store* s = store(ptr);
   const std::size_t n = rows_used(*s, n_use);
   if (!(sf > 0) || !(ws3 > 0)) Rcpp::stop("sf and ws3 must be positive");
-  const double* t = temperature ? s->col(Store::kT) : nullptr;
+  const p1::RunColumn* t = temperature ? s->runs(Store::kT) : nullptr;
   const p1::LinearModel lm = linear_model(cal, t != nullptr);
   p1::LinearCalibration m;
   for (int r = 0; r < 3; ++r) {
@@ -346,7 +355,7 @@ Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, do
   std::vector<double> g;
   try {
     g = p1::enmo_gradient(s->col(Store::kX), s->col(Store::kY), s->col(Store::kZ),
-                          m.temp ? t : nullptr, n, sf * ws3, m);
+                          [t](std::size_t i) { return t->at(i); }, m.temp, n, sf * ws3, m);
   } catch (const std::exception& e) {
     Rcpp::stop(e.what());
   }

@@ -222,7 +222,7 @@ fi
 identity="test-fp-build.R test-ggir.R test-ggir-params.R test-ggir-interpolation.R test-ggir-segments.R
 test-ggir-stress.R test-decode-cwa.R test-decode-geneactiv.R test-decode-gt3x.R test-decode-csv.R
 test-decode-parmay.R test-decode-movisens.R test-axivity-csv.R test-adhoc-csv.R test-windows.R
-test-fit-icp.R test-simd.R test-formats.R test-ggir-getmeta.R test-ggir-filters.R test-ggir-part1.R test-epochs.R"
+test-fit-icp.R test-simd.R test-formats.R test-ggir-getmeta.R test-ggir-filters.R test-ggir-part1.R test-epochs.R test-meta-store.R"
 # with `all`, every test file once: the identity files first, then the rest
 # (so a run cut short still has them); one row printed as each file ends
 in_chroot tests "

@@ -1,20 +1,25 @@
 // gravcal: the samples of one of GGIR part 1's blocks, held in the core.
 //
-// GGIR's g.getmeta() reads a recording in blocks of about a day; each block
-// is the previous block's last samples (the carry: those past its last
-// whole long epoch), then the samples read. Its epoch signals
+// GGIR's g.getmeta() reads a recording in blocks of a day or more; each
+// block is the previous block's last samples (the carry: those past its
+// last whole long epoch), then the samples read. Its epoch signals
 // (ggir_epochs.hpp) are computed over the block's first whole long epochs,
 // and the rest is carried on. BlockStore holds that block as columns the
 // decoder writes into directly, so that no block passes through R: R keeps
 // GGIR's decisions (when a block is the last, the start, the gap between
 // blocks), the store does what they ask.
 //
-// Memory: the columns grow by a quarter as the decoder's samples come
-// (never sized by a number read from the file), one column at a time, and
-// keep their capacity from block to block: a block costs about 1.25 times
-// its samples' columns. Time stamps are kept as a column only when asked
-// (GGIR's time-gap imputation needs them); otherwise the block's first time
-// and its last two are kept, which is all GGIR's block logic reads.
+// Memory, about the block's x, y and z and no more:
+// * a block is read in parts of a fixed size, then put together in one
+//   array per axis of exactly its length, each part freed as it is copied;
+//   after the block only the carry is kept. Nothing is sized by a number
+//   read from the file.
+// * temperature and light (a value per page in .cwa and GENEActiv files)
+//   are kept as runs of one value (RunColumn), as plain values only when
+//   their runs are short.
+// * time stamps are kept as a column only when asked (GGIR's time-gap
+//   imputation needs them); otherwise the block's first time and its last
+//   two are kept, which is all GGIR's block logic reads.
 #ifndef GRAVCAL_GGIR_BLOCK_STORE_HPP
 #define GRAVCAL_GGIR_BLOCK_STORE_HPP
 
@@ -22,12 +27,13 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
 #include "decode.hpp"
-#include "r_arith.hpp"
 
 namespace gravcal {
 namespace ggir_part1 {
@@ -36,6 +42,7 @@ namespace ggir_part1 {
 // R ("matrix" arithmetic): u = v + offset; a_i = K[i][0] u_0 + K[i][1] u_1
 // + K[i][2] u_2, summed left to right, then + (t - meantemp) tempoffset_i.
 // The same bits as R's vectorised expression (one rounding per operation).
+// `t(i)`: the temperature of row i, asked in increasing i.
 struct LinearModel {
   double K[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // K[row][column]
   double offset[3] = {0, 0, 0};
@@ -44,20 +51,17 @@ struct LinearModel {
   double tempoffset[3] = {0, 0, 0};
 };
 
-inline void apply_linear(const LinearModel& m, double* x, double* y, double* z,
-                         const double* t, std::size_t n) {
-  if (m.temp && t == nullptr) throw std::runtime_error("the model's temperature term needs a temperature");
+template <class T>
+void apply_linear(const LinearModel& m, double* x, double* y, double* z, T&& t, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const double u[3] = {x[i] + m.offset[0], y[i] + m.offset[1], z[i] + m.offset[2]};
+    const double dt = m.temp ? t(i) - m.meantemp : 0;
     double a[3];
     for (int r = 0; r < 3; ++r) {
       double s = m.K[r][0] * u[0];
       s = s + m.K[r][1] * u[1];
       s = s + m.K[r][2] * u[2];
-      if (m.temp) {
-        const double dt = t[i] - m.meantemp;
-        s = s + dt * m.tempoffset[r];
-      }
+      if (m.temp) s = s + dt * m.tempoffset[r];
       a[r] = s;
     }
     x[i] = a[0];
@@ -66,9 +70,154 @@ inline void apply_linear(const LinearModel& m, double* x, double* y, double* z,
   }
 }
 
+// A column of doubles held as runs of one value (bit for bit: NaN runs
+// too), or as plain values once its runs are short (more than one run per
+// kPlainRun rows on average). at(i) reads any row; reads in increasing
+// order are cheap (the run last read is remembered).
+class RunColumn {
+ public:
+  static constexpr std::size_t kPlainRun = 8;
+
+  std::size_t size() const { return n_; }
+  bool plain() const { return plain_; }
+  void clear() {
+    plain_ = false;
+    std::vector<double>().swap(v_);
+    std::vector<std::size_t>().swap(end_);
+    n_ = 0;
+    hint_ = 0;
+  }
+
+  void push(const double* p, std::size_t k) {
+    if (plain_) {
+      v_.insert(v_.end(), p, p + k);
+    } else {
+      for (std::size_t i = 0; i < k; ++i) {
+        if (!end_.empty() && same(v_.back(), p[i])) {
+          ++end_.back();
+        } else {
+          v_.push_back(p[i]);
+          end_.push_back(n_ + i + 1);
+        }
+      }
+    }
+    n_ += k;
+    if (!plain_ && end_.size() > 64 && end_.size() * kPlainRun > n_) to_plain();
+  }
+
+  void push_repeat(double value, std::size_t k) {
+    for (std::size_t i = 0; i < k; ++i) push(&value, 1);
+  }
+
+  double at(std::size_t i) const {
+    if (plain_) return v_[i];
+    const std::size_t h = hint_;
+    if (h < end_.size() && i < end_[h] && (h == 0 || end_[h - 1] <= i)) return v_[h];
+    if (h + 1 < end_.size() && end_[h] <= i && i < end_[h + 1]) {
+      hint_ = h + 1;
+      return v_[h + 1];
+    }
+    hint_ = static_cast<std::size_t>(std::upper_bound(end_.begin(), end_.end(), i) - end_.begin());
+    return v_[hint_];
+  }
+
+  // rows [from, from + count) kept
+  void keep(std::size_t from, std::size_t count) {
+    RunColumn c;
+    c.plain_ = plain_;
+    for (std::size_t i = from; i < from + count;) {
+      if (plain_) {
+        c.push(v_.data() + from, count);
+        break;
+      }
+      const double v = at(i);
+      const std::size_t stop = std::min(end_[hint_], from + count);
+      c.push_repeat_run(v, stop - i);
+      i = stop;
+    }
+    swap(c);
+  }
+
+  // `reps` copies of row `row` inserted after it
+  void repeat_row(std::size_t row, std::size_t reps) {
+    RunColumn c;
+    c.plain_ = plain_;
+    copy_rows(c, 0, row + 1);
+    c.push_repeat_run(at(row), reps);
+    copy_rows(c, row + 1, n_ - row - 1);
+    swap(c);
+  }
+
+  void swap(RunColumn& o) {
+    std::swap(plain_, o.plain_);
+    v_.swap(o.v_);
+    end_.swap(o.end_);
+    std::swap(n_, o.n_);
+    hint_ = 0;
+    o.hint_ = 0;
+  }
+
+ private:
+  static bool same(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+  void push_repeat_run(double v, std::size_t k) {
+    if (k == 0) return;
+    if (plain_) {
+      v_.insert(v_.end(), k, v);
+      n_ += k;
+      return;
+    }
+    if (!end_.empty() && same(v_.back(), v)) {
+      end_.back() += k;
+    } else {
+      v_.push_back(v);
+      end_.push_back(n_ + k);
+    }
+    n_ += k;
+  }
+
+  void copy_rows(RunColumn& c, std::size_t from, std::size_t count) const {
+    for (std::size_t i = from; i < from + count;) {
+      if (plain_) {
+        c.v_.insert(c.v_.end(), v_.begin() + static_cast<std::ptrdiff_t>(from),
+                    v_.begin() + static_cast<std::ptrdiff_t>(from + count));
+        c.n_ += count;
+        return;
+      }
+      const double v = at(i);
+      const std::size_t stop = std::min(end_[hint_], from + count);
+      c.push_repeat_run(v, stop - i);
+      i = stop;
+    }
+  }
+
+  void to_plain() {
+    std::vector<double> p(n_);
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < end_.size(); ++k) {
+      std::fill(p.begin() + static_cast<std::ptrdiff_t>(at), p.begin() + static_cast<std::ptrdiff_t>(end_[k]), v_[k]);
+      at = end_[k];
+    }
+    v_.swap(p);
+    std::vector<std::size_t>().swap(end_);
+    plain_ = true;
+    hint_ = 0;
+  }
+
+  bool plain_ = false;
+  std::vector<double> v_;          // plain values, or each run's value
+  std::vector<std::size_t> end_;   // each run's end (exclusive row)
+  std::size_t n_ = 0;
+  mutable std::size_t hint_ = 0;   // the run last read
+};
+
 class BlockStore {
  public:
   static constexpr int kX = 0, kY = 1, kZ = 2, kT = 3, kTime = 4, kLight = 5, kCols = 6;
+  // rows of a part a block is read into: 40 MB a column, above the size
+  // from which allocators map memory of its own (glibc: 32 MB at most), so
+  // that a part freed is memory given back, not kept in the heap
+  static constexpr std::size_t kPartRows = std::size_t{5} << 20;
 
   BlockStore(bool temperature, bool time, bool light) {
     has_[kX] = has_[kY] = has_[kZ] = true;
@@ -79,8 +228,12 @@ class BlockStore {
 
   bool has(int c) const { return has_[c]; }
   std::size_t size() const { return n_; }
-  double* col(int c) { return has_[c] ? cols_[c].data() : nullptr; }
-  const double* col(int c) const { return has_[c] ? cols_[c].data() : nullptr; }
+  // x, y, z and time: plain arrays of size() values
+  double* col(int c) { return has_[c] && !is_run(c) ? cols_[c].data() : nullptr; }
+  const double* col(int c) const { return has_[c] && !is_run(c) ? cols_[c].data() : nullptr; }
+  // temperature and light (nullptr when not kept)
+  const RunColumn* runs(int c) const { return has_[c] && is_run(c) ? &runs_[c == kT ? 0 : 1] : nullptr; }
+  double value(int c, std::size_t i) const { return is_run(c) ? runs(c)->at(i) : cols_[c][i]; }
 
   // The times GGIR's block logic reads, whether or not a time column is
   // kept: the first row read by the last read(), and the store's last two
@@ -101,53 +254,87 @@ class BlockStore {
     const std::size_t before = n_;
     first_time_ = nan();
     std::int64_t left = units;
-    std::vector<double> scratch_time;
-    const bool time_col = has_[kTime];
     const bool ask_time = want_time && d.info().has_time;
-    if (ask_time && !time_col) scratch_time.resize(chunk);
+    const bool ask_t = has_[kT] && d.info().has_temperature;
+    const bool ask_light = has_[kLight] && d.info().has_light;
+    // the decoder writes into parts of kPartRows rows (each column's part a
+    // single allocation large enough to be the system's own mapping, given
+    // back when freed), a new part when the one being filled has less room
+    // than a read
+    const std::size_t part_rows = std::max(kPartRows, chunk);
+    // (not zeroed: the pages a part does not use are never touched)
+    std::vector<std::unique_ptr<double[]>> parts[kCols];
+    std::vector<std::size_t> used;  // rows in each part
+    std::vector<double> t_buf, light_buf, time_buf;
+    if (ask_t) t_buf.resize(chunk);
+    if (ask_light) light_buf.resize(chunk);
+    if (ask_time && !has_[kTime]) time_buf.resize(chunk);
+    const bool part_time = ask_time && has_[kTime];
+    std::size_t got_all = 0;
     for (;;) {
-      reserve(n_ + chunk);
+      if (used.empty() || part_rows - used.back() < chunk) {
+        for (int c = 0; c < kCols; ++c) {
+          if (c <= kZ || (c == kTime && part_time)) parts[c].emplace_back(new double[part_rows]);
+        }
+        used.push_back(0);
+      }
+      const std::size_t at = used.back();
       SampleBuffer out;
-      out.x = cols_[kX].data() + n_;
-      out.y = cols_[kY].data() + n_;
-      out.z = cols_[kZ].data() + n_;
-      if (has_[kT] && d.info().has_temperature) out.t = cols_[kT].data() + n_;
-      if (has_[kLight] && d.info().has_light) out.light = cols_[kLight].data() + n_;
-      if (ask_time) out.time = time_col ? cols_[kTime].data() + n_ : scratch_time.data();
+      out.x = parts[kX].back().get() + at;
+      out.y = parts[kY].back().get() + at;
+      out.z = parts[kZ].back().get() + at;
+      if (ask_t) out.t = t_buf.data();
+      if (ask_light) out.light = light_buf.data();
+      if (ask_time) out.time = part_time ? parts[kTime].back().get() + at : time_buf.data();
       out.capacity = chunk;
       const std::int64_t u = d.read(out, left);
       const std::size_t got = out.n;
       if (got > 0) {
-        if (out.t == nullptr && has_[kT]) fill(kT, n_, got);
-        if (out.light == nullptr && has_[kLight]) fill(kLight, n_, got);
+        used.back() += got;
+        if (has_[kT]) push_or_nan(runs_[0], out.t, got);
+        if (has_[kLight]) push_or_nan(runs_[1], out.light, got);
         if (out.time != nullptr) {
-          if (n_ == before) first_time_ = out.time[0];
+          if (got_all == 0) first_time_ = out.time[0];
           note_tail(out.time, got);
-        } else if (time_col) {
-          fill(kTime, n_, got);
         }
-        n_ += got;
+        got_all += got;
       }
       left -= u;
       if (got == 0 && u == 0) break;
       if (left <= 0 && got < chunk) break;
       if (d.done()) break;
     }
-    return n_ - before;
+    for (int c = 0; c < kCols; ++c) {
+      if (!has_[c] || is_run(c)) continue;
+      if (c == kTime && parts[c].empty()) {
+        cols_[c].resize(before);
+        cols_[c].resize(before + got_all, nan());
+        continue;
+      }
+      assemble(c, before, parts[c], used);
+    }
+    n_ = before + got_all;
+    return got_all;
   }
 
   // Rows appended from columns in memory (samples given to R), `k` rows.
   // Absent columns (nullptr) of a kept kind are NaN.
   void append(const double* const src[kCols], std::size_t k) {
-    reserve(n_ + k);
     first_time_ = nan();
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
-      if (src[c] != nullptr) {
-        std::copy(src[c], src[c] + k, cols_[c].begin() + static_cast<std::ptrdiff_t>(n_));
-      } else {
-        fill(c, n_, k);
+      if (is_run(c)) {
+        push_or_nan(runs_[c == kT ? 0 : 1], src[c], k);
+        continue;
       }
+      std::vector<std::unique_ptr<double[]>> one;
+      one.emplace_back(new double[std::max<std::size_t>(k, 1)]);
+      if (src[c] != nullptr) {
+        std::copy(src[c], src[c] + k, one[0].get());
+      } else {
+        std::fill(one[0].get(), one[0].get() + k, nan());
+      }
+      assemble(c, n_, one, std::vector<std::size_t>(1, k));
     }
     if (k > 0 && src[kTime] != nullptr) {
       first_time_ = src[kTime][0];
@@ -160,6 +347,14 @@ class BlockStore {
   // rows read).
   void replace_tail(std::size_t from, const double* const src[kCols], std::size_t k) {
     if (from > n_) throw std::out_of_range("replace_tail beyond the block");
+    for (int c = 0; c < kCols; ++c) {
+      if (!has_[c]) continue;
+      if (is_run(c)) {
+        runs_[c == kT ? 0 : 1].keep(0, from);
+      } else {
+        cols_[c].resize(from);
+      }
+    }
     n_ = from;
     tail_time_[0] = tail_time_[1] = nan();
     append(src, k);
@@ -180,24 +375,22 @@ class BlockStore {
     const double norm = std::sqrt(static_cast<double>(s));
     for (int c = kX; c <= kZ; ++c) cols_[c][last] = cols_[c][last] / norm;
     if (reps == 0) return;
-    reserve(n_ + reps);
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
+      if (is_run(c)) {
+        runs_[c == kT ? 0 : 1].repeat_row(last, reps);
+        continue;
+      }
       std::vector<double>& v = cols_[c];
-      const auto at = v.begin() + static_cast<std::ptrdiff_t>(last + 1);
-      std::copy_backward(at, v.begin() + static_cast<std::ptrdiff_t>(n_),
-                         v.begin() + static_cast<std::ptrdiff_t>(n_ + reps));
-      std::fill(at, at + static_cast<std::ptrdiff_t>(reps), v[last]);
+      const double val = v[last];
+      v.insert(v.begin() + static_cast<std::ptrdiff_t>(last + 1), reps, val);
     }
     if (last + 1 == n_) tail_time_[1] = tail_time_[0];  // the repeated row is the last now
     n_ += reps;
   }
 
-  // The first k rows dropped (the first block's start).
-  void drop_front(std::size_t k) { keep(std::min(k, n_), n_ - std::min(k, n_)); }
-
-  // Rows [from, from + count) become the store (the carry), the rest
-  // dropped; the capacity stays for the next block.
+  // Rows [from, from + count) become the store (the start's shift, or the
+  // carry after a block), the rest dropped and its memory freed.
   void keep(std::size_t from, std::size_t count) {
     if (from > n_ || count > n_ - from) throw std::out_of_range("keep beyond the block");
     if (from + count < n_) {
@@ -209,10 +402,14 @@ class BlockStore {
       tail_time_[1] = nan();
     }
     for (int c = 0; c < kCols; ++c) {
-      if (!has_[c] || from == 0) continue;
-      std::vector<double>& v = cols_[c];
-      std::copy(v.begin() + static_cast<std::ptrdiff_t>(from),
-                v.begin() + static_cast<std::ptrdiff_t>(from + count), v.begin());
+      if (!has_[c]) continue;
+      if (is_run(c)) {
+        runs_[c == kT ? 0 : 1].keep(from, count);
+        continue;
+      }
+      std::vector<double> v(cols_[c].begin() + static_cast<std::ptrdiff_t>(from),
+                            cols_[c].begin() + static_cast<std::ptrdiff_t>(from + count));
+      cols_[c].swap(v);
     }
     n_ = count;
     if (n_ == 0) tail_time_[0] = tail_time_[1] = nan();
@@ -220,10 +417,33 @@ class BlockStore {
 
  private:
   static double nan() { return std::numeric_limits<double>::quiet_NaN(); }
+  static bool is_run(int c) { return c == kT || c == kLight; }
 
-  void fill(int c, std::size_t from, std::size_t k) {
-    std::fill(cols_[c].begin() + static_cast<std::ptrdiff_t>(from),
-              cols_[c].begin() + static_cast<std::ptrdiff_t>(from + k), nan());
+  static void push_or_nan(RunColumn& r, const double* p, std::size_t k) {
+    if (p != nullptr) {
+      r.push(p, k);
+    } else {
+      const double na = nan();
+      for (std::size_t i = 0; i < k; ++i) r.push(&na, 1);
+    }
+  }
+
+  // column c: its first `keep` rows, then the first used[k] rows of each
+  // part k, in one array of exactly that length; each part freed once
+  // copied
+  void assemble(int c, std::size_t keep, std::vector<std::unique_ptr<double[]>>& parts,
+                const std::vector<std::size_t>& used) {
+    std::size_t total = keep;
+    for (std::size_t k = 0; k < parts.size(); ++k) total += used[k];
+    std::vector<double> v;
+    v.reserve(total);
+    v.insert(v.end(), cols_[c].begin(), cols_[c].begin() + static_cast<std::ptrdiff_t>(keep));
+    std::vector<double>().swap(cols_[c]);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      v.insert(v.end(), parts[k].get(), parts[k].get() + used[k]);
+      parts[k].reset();
+    }
+    cols_[c].swap(v);
   }
 
   // the last two times of the rows just written (t[0..k))
@@ -237,25 +457,10 @@ class BlockStore {
     }
   }
 
-  // room for `rows`, growing each kept column by at least a quarter, one at
-  // a time (at most one column's old and new copies held at once)
-  void reserve(std::size_t rows) {
-    if (rows <= cap_) return;
-    const std::size_t grown = cap_ + cap_ / 4;
-    const std::size_t cap = std::max(rows, grown);
-    for (int c = 0; c < kCols; ++c) {
-      if (!has_[c]) continue;
-      std::vector<double> v(cap);
-      std::copy(cols_[c].begin(), cols_[c].begin() + static_cast<std::ptrdiff_t>(n_), v.begin());
-      cols_[c].swap(v);
-    }
-    cap_ = cap;
-  }
-
   bool has_[kCols] = {false, false, false, false, false, false};
-  std::vector<double> cols_[kCols];
+  std::vector<double> cols_[kCols];  // x, y, z, time (temperature and light: runs_)
+  RunColumn runs_[2];                // temperature, light
   std::size_t n_ = 0;
-  std::size_t cap_ = 0;
   double first_time_ = nan();
   // tail_time_[0]: the last row's time, [1]: the one before
   double tail_time_[2] = {nan(), nan()};

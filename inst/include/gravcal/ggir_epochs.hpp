@@ -149,16 +149,19 @@ struct Calibration {
   double inv_tempoffset[3] = {1, 1, 1};
 };
 
-inline void apply_calibration(const Calibration& c, double* x, double* y, double* z,
-                              const double* t, std::size_t n) {
+// `t(i)`: the temperature of row i (asked in increasing i, axis by axis),
+// `have_t` whether there is one.
+template <class T>
+void apply_calibration(const Calibration& c, double* x, double* y, double* z, T&& t,
+                       bool have_t, std::size_t n) {
   double* v[3] = {x, y, z};
   for (int a = 0; a < 3; ++a) {
     double* p = v[a];
     const double o = c.offset[a], s = c.inv_scale[a];
     for (std::size_t i = 0; i < n; ++i) p[i] = (p[i] + o) / s;
-    if (c.temp && t != nullptr) {
+    if (c.temp && have_t) {
       const double m = c.meantemp, to = c.inv_tempoffset[a];
-      for (std::size_t i = 0; i < n; ++i) p[i] = p[i] + (t[i] - m) / to;
+      for (std::size_t i = 0; i < n; ++i) p[i] = p[i] + (t(i) - m) / to;
     }
   }
 }
@@ -477,7 +480,8 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
 
 // GGIR's lightpeak: for li in 1:(n / M), max(light[((li - 1) M):(li M)])
 // (index 0 dropped, so the first epoch has M values and the others M + 1).
-inline std::vector<double> light_peaks(const double* light, std::size_t n, double M) {
+template <class L>
+std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
   std::vector<double> out;
   const RColon loop = r_colon(1, static_cast<double>(n) / M);
   if (static_cast<double>(n) / M < 1) return out;
@@ -487,8 +491,9 @@ inline std::vector<double> light_peaks(const double* light, std::size_t n, doubl
     double mx = -std::numeric_limits<double>::infinity();
     bool na = false;
     at_r_indices(r_colon((li - 1) * M, li * M), n, [&](std::size_t j) {
-      if (std::isnan(light[j])) na = true;
-      else if (light[j] > mx) mx = light[j];
+      const double v = light(j);
+      if (std::isnan(v)) na = true;
+      else if (v > mx) mx = v;
     });
     // indices beyond the end are NA in R, and max() without na.rm is NA
     const RColon c = r_colon((li - 1) * M, li * M);
@@ -619,8 +624,9 @@ struct LinearCalibration {
   double tempoffset[3] = {0, 0, 0};
 };
 
-inline std::vector<double> enmo_gradient(const double* x, const double* y, const double* z,
-                                         const double* t, std::size_t n, double by,
+template <class T>
+std::vector<double> enmo_gradient(const double* x, const double* y, const double* z,
+                                         T&& t, bool have_t, std::size_t n, double by,
                                          const LinearCalibration& m) {
   constexpr std::size_t C = kGradientColumns;
   const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
@@ -628,14 +634,14 @@ inline std::vector<double> enmo_gradient(const double* x, const double* y, const
   if (sel.size() < 2) return out;
   const std::size_t ne = sel.size() - 1;
   out.assign(ne * C, 0.0);
-  const bool temp = m.temp && t != nullptr;
+  const bool temp = m.temp && have_t;
   std::size_t from = static_cast<std::size_t>(r_round0(sel[0])) - 1;
   for (std::size_t e = 0; e < ne; ++e) {
     const std::size_t to = static_cast<std::size_t>(r_round0(sel[e + 1])) - 1;
     double* g = &out[e * C];
     for (std::size_t i = from; i < to; ++i) {
       const double u[3] = {x[i] + m.offset[0], y[i] + m.offset[1], z[i] + m.offset[2]};
-      const double dt = temp ? t[i] - m.meantemp : 0;
+      const double dt = temp ? t(i) - m.meantemp : 0;
       double a[3];
       for (int r = 0; r < 3; ++r) {
         a[r] = m.K[r][0] * u[0] + m.K[r][1] * u[1] + m.K[r][2] * u[2];

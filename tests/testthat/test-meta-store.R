@@ -1,0 +1,124 @@
+# The block store of g.getmeta() and epoch_signals() (ggir_block_store.hpp,
+# gc_meta_store*()): a block held in the core must give back, bit for bit,
+# the samples R would have held (GGIR's data[...] of each step), whatever
+# the runs of its temperature and light.
+
+store_cols <- function(n, seed = 1) {
+  set.seed(seed)
+  list(x = stats::rnorm(n), y = stats::rnorm(n), z = stats::rnorm(n),
+       # a value per "page" of 120 samples (.cwa), with NaN runs and a -0
+       temperature = rep(c(20.5, NaN, 21, -0, 0, 21), length.out = ceiling(n / 120))[
+         ceiling(seq_len(n) / 120)],
+       time = 1.7e9 + (seq_len(n) - 1) / 100,
+       # a value per sample: kept as plain values
+       light = stats::runif(n))
+}
+
+same_bits <- function(a, b) {
+  expect_identical(length(a), length(b))
+  # identical() takes -0 for 0 and any NaN for NaN: compare the bytes
+  expect_identical(writeBin(a, raw()), writeBin(b, raw()))
+}
+
+test_that("rows put in come back bit for bit, after keep and replace too", {
+  d <- store_cols(5000)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  info <- gravcal:::gc_meta_store_put(st, d, -1)
+  expect_identical(info$n, 5000)
+  expect_identical(info$first_time, d$time[1])
+  expect_identical(info$tail_time, rev(utils::tail(d$time, 2)))
+  same_bits(info$head_temp, d$temperature[1:10])
+  r <- gravcal:::gc_meta_store_rows(st, 0, 5000)
+  for (k in names(d)) same_bits(r[[k]], d[[k]])
+  # a slice kept (the carry), then rows appended after it
+  expect_identical(gravcal:::gc_meta_store_keep(st, 1234, 1500), 1500)
+  r <- gravcal:::gc_meta_store_rows(st, 0, 1500)
+  for (k in names(d)) same_bits(r[[k]], d[[k]][1235:2734])
+  e <- store_cols(700, seed = 2)
+  gravcal:::gc_meta_store_put(st, e, -1)
+  r <- gravcal:::gc_meta_store_rows(st, 0, 2200)
+  for (k in names(d)) same_bits(r[[k]], c(d[[k]][1235:2734], e[[k]]))
+  # the rows after the carry replaced (R's time-gap imputation)
+  f <- store_cols(300, seed = 3)
+  gravcal:::gc_meta_store_put(st, f, 1500)
+  r <- gravcal:::gc_meta_store_rows(st, 0, gravcal:::gc_meta_store_size(st))
+  for (k in names(d)) same_bits(r[[k]], c(d[[k]][1235:2734], f[[k]]))
+  # columns a store does not keep are absent; absent columns given are NA
+  st2 <- gravcal:::gc_meta_store(TRUE, FALSE, FALSE)
+  gravcal:::gc_meta_store_put(st2, d[c("x", "y", "z")], -1)
+  r <- gravcal:::gc_meta_store_rows(st2, 0, 10)
+  expect_named(r, c("x", "y", "z", "temperature"))
+  expect_true(all(is.na(r$temperature)))
+  expect_error(gravcal:::gc_meta_store_rows(st2, 4990, 20), "beyond the block")
+  expect_error(gravcal:::gc_meta_store_keep(st2, 10, 5000), "beyond the block")
+})
+
+test_that("GGIR's gap fill: the carry's last row normalised and repeated, every column", {
+  d <- store_cols(1000)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  gravcal:::gc_meta_store_put(st, d, -1)
+  gravcal:::gc_meta_store_put(st, store_cols(10, seed = 9), -1)
+  gravcal:::gc_meta_store_fill_gap(st, 1000, 37)
+  r <- gravcal:::gc_meta_store_rows(st, 0, gravcal:::gc_meta_store_size(st))
+  expect_identical(length(r$x), 1047L)
+  # as meta_run() did it in R: v / sqrt(sum(v^2)), rows repeated
+  v <- c(d$x[1000], d$y[1000], d$z[1000])
+  v <- v / sqrt(sum(v^2))
+  expect_identical(c(r$x[1000], r$y[1000], r$z[1000]), v)
+  for (k in c("x", "y", "z")) {
+    expect_identical(r[[k]][1001:1037], rep(r[[k]][1000], 37))
+  }
+  for (k in c("temperature", "time", "light")) {
+    same_bits(r[[k]][1000:1037], rep(d[[k]][1000], 38))
+  }
+  same_bits(r$light[1038:1047], store_cols(10, seed = 9)$light)
+})
+
+test_that("a block read from a decoder is the samples the decoder gives, in GGIR's blocks", {
+  skip_if_not_installed("GGIRread")
+  f <- system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread")
+  if (!nzchar(f)) skip("GGIRread has no test file ax3_testfile.cwa")
+  # the decoder's own blocks of `units` units, as R read them before the
+  # store (the blocks matter: the decoder replays GGIRread's arithmetic per
+  # block)
+  decoded <- function(units) {
+    h <- gravcal:::gc_decoder_open(f, "cwa", list())
+    on.exit(gravcal:::gc_decoder_close(h$ptr))
+    ref <- list()
+    repeat {
+      b <- gravcal:::gc_decoder_read(h$ptr, units, 1000, TRUE, TRUE, TRUE)
+      if (b$n > 0) {
+        i <- seq_len(b$n)
+        ref[[length(ref) + 1]] <- lapply(b[c("x", "y", "z", "temperature", "time", "light")],
+                                         function(v) v[i])
+      }
+      if (b$n == 0 && b$units == 0) break
+    }
+    lapply(stats::setNames(nm = names(ref[[1]])), function(k) unlist(lapply(ref, `[[`, k)))
+  }
+  ref <- decoded(20)
+  h2 <- gravcal:::gc_decoder_open(f, "cwa", list())
+  on.exit(gravcal:::gc_decoder_close(h2$ptr), add = TRUE)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  n <- 0
+  repeat {
+    info <- gravcal:::gc_meta_store_read(st, h2$ptr, 20, 1000, TRUE)
+    if (info$n == 0) break
+    n <- n + info$n
+  }
+  expect_gt(n, 10000)
+  r <- gravcal:::gc_meta_store_rows(st, 0, n)
+  for (k in names(ref)) same_bits(r[[k]], ref[[k]])
+  expect_identical(info$tail_time, rev(utils::tail(ref$time, 2)))
+  # without a time column: the block's first and last times still known
+  ref <- decoded(40)
+  h3 <- gravcal:::gc_decoder_open(f, "cwa", list())
+  on.exit(gravcal:::gc_decoder_close(h3$ptr), add = TRUE)
+  st3 <- gravcal:::gc_meta_store(TRUE, FALSE, TRUE)
+  info <- gravcal:::gc_meta_store_read(st3, h3$ptr, 40, 1000, TRUE)
+  expect_identical(info$first_time, ref$time[1])
+  expect_identical(info$tail_time, rev(ref$time[info$n - 1:0]))
+  r <- gravcal:::gc_meta_store_rows(st3, 0, info$n)
+  expect_named(r, c("x", "y", "z", "temperature", "light"))
+  for (k in names(r)) same_bits(r[[k]], ref[[k]][seq_len(info$n)])
+})
