@@ -98,11 +98,9 @@ epoch_signals <- function(x, fit = NULL, sf = NULL, metrics = c("ENMO", "anglez"
   }
   if (!se || !"ENMO" %in% metrics) gradient <- NULL
   if (is.character(x)) {
-    src <- open_source(x, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
-                       read_opts = list(interpolation = p$interpolationType,
-                                        frequency_tol = p$frequency_tol, zone = tz,
-                                        zone_arg = "tz"),
-                       arg = "x", part = "getmeta")
+    src <- meta_source(x, p, sf, "x", list(interpolation = p$interpolationType,
+                                           frequency_tol = p$frequency_tol, zone = tz,
+                                           zone_arg = "tz"))
     if (!src$format %in% meta_formats() || is.null(src$native)) {
       abort("epoch_signals() does not read ", format_entry(src$format)$label %||% src$format,
             " yet; read it with read_recording() and give the samples.")

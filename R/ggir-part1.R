@@ -78,8 +78,7 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
     ggir_check_inspect(inspectfileobject, datafile, adhoc = FALSE)
     sf <- inspectfileobject$sf
   }
-  src <- open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native",
-                     compat = TRUE, read_opts = read_opts, part = "getmeta")
+  src <- meta_source(datafile, p, sf, "datafile", read_opts)
   if (!src$format %in% meta_formats() || is.null(src$native)) {
     abort("gravcal's g.getmeta() does not read ", format_entry(src$format)$label %||% src$format,
           " yet (it reads ", paste(vapply(meta_formats(), function(f) format_entry(f)$label, ""),
@@ -88,6 +87,76 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   }
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
   meta_run(src, p, cal, daylimit, verbose)
+}
+
+# g.getmeta()'s source: the file's native decoder, and for a format whose
+# time gaps GGIR's g.getmeta() fills (with imputeTimegaps) the filling in
+# the decoder (decode_ggir_timegaps.hpp, g.getmeta's mode): with the limit
+# beyond which GGIR imputes whole epochs instead and, for a clock read per
+# sample in a time zone, the zone's shifts of the file's clock
+# (meta_clock_table()), which GGIR's reader applies before the gaps are
+# seen. The file is opened once to learn its start, then again with these.
+meta_source <- function(datafile, p, sf, arg, read_opts) {
+  open <- function(ro) {
+    open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
+                read_opts = ro, arg = arg, part = "getmeta")
+  }
+  src <- open(read_opts)
+  fe <- format_entry(src$format)
+  if (is.null(src$native) || !isTRUE(p$imputeTimegaps) || !isTRUE(fe$ggir_timegaps)) {
+    return(src)
+  }
+  ro <- c(read_opts, list(getmeta_timegaps = 1,
+                          getmeta_gap_limit = max(c(((p$windowsizes[2] / 60) * 6), 90))))
+  zone <- if (length(p$configtz)) p$configtz else p$desiredtz
+  start <- src$info$start_time
+  tab <- if (identical(fe$local_clock, "sample") && !isFALSE(fe$ggir_time) &&
+             is.numeric(start) && length(start) == 1 && is.finite(start)) {
+    meta_clock_table(zone, start)
+  }
+  if (!is.null(tab)) {
+    ro$clock <- tab$text
+    ro$clock_until <- tab$until
+  }
+  gc_decoder_close(src$native$ptr)
+  src <- open(ro)
+  src$getmeta_timegaps <- TRUE
+  src$clock_shifted <- !is.null(tab)
+  src
+}
+
+# The shift GGIR's reader adds to each time of a per-sample clock (the
+# file's clock, read as UTC, read again as the clock time in `zone`), as a
+# table of its changes over `days` from two days before `start`: the zone's
+# offset changes found to the second (UTC instants, at every 10 minutes,
+# then halved), each taking effect at the clock time where the zone's
+# clock first shows it: a clock time that occurs twice (the hour a clock
+# goes back) is read as the later one, a clock time that does not occur
+# (the hour a clock goes forward) with the new offset, as GGIR's .gt3x
+# times show. NULL in UTC. list(text = "second shift ...", until = the
+# table's last second).
+meta_clock_table <- function(zone, start, days = 400) {
+  if (!length(zone) || !nzchar(zone) || zone %in% c("UTC", "GMT")) return(NULL)
+  off <- function(t) {
+    as.POSIXlt(as.POSIXct(t, origin = "1970-01-01", tz = "UTC"), tz = zone)$gmtoff
+  }
+  from <- floor(start / 600) * 600 - 2 * 86400
+  until <- from + (days + 2) * 86400
+  g <- seq(from, until, by = 600)
+  o <- off(g)
+  if (anyNA(o)) abort("The time zone \"", zone, "\" gives no offsets from UTC.")
+  ch <- which(o[-1] != o[-length(o)])
+  at <- vapply(ch, function(i) {
+    lo <- g[i]
+    hi <- g[i + 1]
+    while (hi - lo > 1) {
+      mid <- floor((lo + hi) / 2)
+      if (off(mid) == o[i + 1]) hi <- mid else lo <- mid
+    }
+    hi + min(o[i], o[i + 1])
+  }, 0)
+  list(text = paste(sprintf("%.0f %.0f", c(from, at), -c(o[1], o[ch + 1])), collapse = " "),
+       until = until)
 }
 
 # The block store of meta_run() (gc_meta_store(), ggir_block_store.hpp)
@@ -283,12 +352,6 @@ meta_nonwear <- function(src, p) {
 
 # Rows `i` of a block (a list of equal-length columns).
 meta_rows <- function(d, i) lapply(d, function(v) v[i])
-meta_nrow <- function(d) if (length(d)) length(d$x) else 0L
-meta_bind <- function(a, b) {
-  if (!meta_nrow(a)) return(b)
-  nm <- union(names(a), names(b))
-  stats::setNames(lapply(nm, function(k) c(a[[k]], b[[k]])), nm)
-}
 
 # g.getmeta()'s loop over the blocks of an open native source (or samples
 # in memory), each block held in the core (meta_store()): R decides what
@@ -321,8 +384,18 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     fused <- stats_filter_fused()
   }
   fe <- format_entry(src$format)
-  impute <- isTRUE(p$imputeTimegaps) && isTRUE(fe$ggir_timegaps)
-  ms <- meta_store(src, time = impute && !isFALSE(fe$ggir_time))
+  # the time gaps filled by the decoder (meta_source()); its counters, per
+  # block, give GGIR's QClog
+  impute <- isTRUE(src$getmeta_timegaps)
+  counters <- function() {
+    k <- src$report()$counters
+    g <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+    c(read = g("timegap_rows_read"), gaps = g("timegaps_imputed"), rows = g("timegap_rows"),
+      over = g("timegaps_over_limit"), longest = g("timegap_longest_rows"),
+      missing = g("clock_time_missing"), exceeded = g("clock_table_exceeded"))
+  }
+  before <- if (impute) counters()
+  ms <- meta_store(src, time = FALSE)
   store <- ms$store
   short <- list()   # per metric, the blocks' rounded epoch values
   grads <- list()
@@ -340,17 +413,39 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   i <- 1
   LD <- 2
   QClog <- NULL
-  prev_value <- c(0, 0, 1)
-  prev_time <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     info <- ms$read()
     nr <- info$n
+    if (impute) {
+      # GGIR's decisions below take the rows read, before the gaps are filled
+      now <- counters()
+      step <- now - before
+      before <- now
+      nr <- step[["read"]]
+      if (step[["over"]] > 0) {
+        limit <- max(c(((ws2 / 60) * 6), 90))
+        abort("\"", basename(src$filename), "\" has a time gap of ",
+              format(round(now[["longest"]] / sf / 60, 1)),
+              " minutes (idle sleep or no data), longer than GGIR's limit of ", format(limit),
+              " minutes, beyond which GGIR's g.getmeta() imputes whole epochs; gravcal's ",
+              "g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it in R before ",
+              "4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
+      }
+      if (step[["missing"]] > 0) {
+        abort("The recording's clock passes through times that do not exist in the time zone \"",
+              zone, "\" (`configtz`/`desiredtz`).")
+      }
+      if (step[["exceeded"]] > 0) {
+        abort("\"", basename(src$filename), "\" runs more than 400 days from its start: ",
+              "gravcal's g.getmeta() reads a per-sample clock in a time zone for 400 days.")
+      }
+    }
     # the times GGIR's logic reads: the first read, the last two of the
     # block, in the zone's clock as GGIR's reader gives them
     times <- c(info$first_time, info$tail_time[2], info$tail_time[1])
-    if (!ms$want_time || nr == 0) times[] <- NA_real_
-    if (!is.null(clock) && !is.na(times[1])) {
+    if (!ms$want_time || info$n == 0) times[] <- NA_real_
+    if (!is.null(clock) && !is.na(times[1]) && !isTRUE(src$clock_shifted)) {
       times <- meta_zone_shift(times, zone, per_sample = identical(clock, "sample"))
     }
     isLastBlock <- FALSE
@@ -372,18 +467,14 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       isLastBlock <- TRUE
     }
     if (have && impute) {
-      d <- gc_meta_store_rows(store, carry, nr)
-      if (!is.null(clock) && !is.null(d$time)) {
-        d$time <- meta_zone_shift(d$time, zone, per_sample = identical(clock, "sample"))
-      }
-      P <- meta_impute_timegaps(d, sf, prev_value, prev_time, c(ws3, ws2), src$filename)
-      d <- P$x
-      last <- meta_nrow(d)
-      prev_value <- c(d$x[last], d$y[last], d$z[last])
-      prev_time <- if (!is.null(d$time)) d$time[last]
-      QClog <- rbind(QClog, P$QClog)
-      info <- gc_meta_store_put(store, d, carry)
-      if (ms$keep_time) times <- c(info$first_time, info$tail_time[2], info$tail_time[1])
+      # GGIR's QClog of the block: its start (the clock's when the file has
+      # no time stamps, as GGIR's), its start plus its rows as its end
+      start <- if (!is.na(times[1])) times[1] else as.numeric(Sys.time())
+      end <- start + info$n
+      QClog <- rbind(QClog, data.frame(imputed = step[["gaps"]] > 0, start = start, end = end,
+                                       blockLengthSeconds = (end - start) / sf,
+                                       timegaps_n = as.integer(step[["gaps"]]),
+                                       timegaps_min = step[["rows"]] / sf / 60))
     }
     if (have) {
       if (i == 1) {
@@ -518,95 +609,6 @@ meta_zone_shift <- function(time, zone, per_sample = FALSE) {
   d <- shift(time[1])
   if (per_sample && shift(time[length(time)]) != d) d <- shift(time)
   time + d
-}
-
-# GGIR's g.imputeTimegaps() as g.getmeta() calls it (k = 0.25 s, raised to
-# 2 / sf; the previous block's last value and time; epoch sizes given), on a
-# block's columns: samples with x = y = z = 0 dropped (the block's first
-# takes the previous block's last value, its last the value before it), a
-# step of k or more from the previous block's last time or between two
-# samples filled by repeating the sample before it round(step * sf) times
-# (normalised where its norm exceeds 1.005), every column repeated, the time
-# counted on in steps of 1 / sf. A file without time stamps gets them from
-# the clock, as in GGIR (QClog's start and end are then the wall clock's).
-# GGIR's epoch-level imputation of gaps longer than max(6 long epochs, 90
-# minutes) is not reproduced: such a gap is an error saying so (GGIR 3.3-9
-# itself stops on it in R before 4.3: "'origin' must be supplied").
-meta_impute_timegaps <- function(d, sf, plv, plt, epochsize, filename) {
-  k <- 0.25
-  no_time <- is.null(d$time)
-  if (no_time) d$time <- as.numeric(Sys.time()) + (seq_along(d$x) - 1) / sf
-  zeros <- which(d$x == 0 & d$y == 0 & d$z == 0)
-  imputelast <- FALSE
-  n <- length(d$x)
-  if (length(zeros)) {
-    if (zeros[1] == 1) {
-      zeros <- zeros[-1]
-      d$x[1] <- plv[1]
-      d$y[1] <- plv[2]
-      d$z[1] <- plv[3]
-    }
-    if (length(zeros) && zeros[length(zeros)] == n) {
-      zeros <- zeros[-length(zeros)]
-      imputelast <- TRUE
-    }
-    if (length(zeros)) d <- meta_rows(d, -zeros)
-  }
-  if (k < 2 / sf) k <- 2 / sf
-  dt <- diff(d$time)
-  if (!is.null(plt)) {
-    first <- d$time[1] - plt
-    if (first >= k) {
-      d <- meta_bind(meta_rows(d, 1), d)
-      d$time[1] <- plt
-      d$x[1] <- plv[1]
-      d$y[1] <- plv[2]
-      d$z[1] <- plv[3]
-      dt <- c(first, dt)
-    }
-  }
-  gapsi <- which(dt >= k)
-  ngaps <- length(gapsi)
-  gaplen <- 0
-  if (ngaps > 0) {
-    gap <- rep(1, length(d$x))
-    gap[gapsi] <- round(dt[gapsi] * sf)
-    gaplen <- sum(gap[gapsi])
-    limit <- max(c(((epochsize[2] / 60) * 6), 90)) * 60 * sf
-    if (any(gap > limit)) {
-      abort("\"", basename(filename), "\" has a time gap of ", format(round(max(gap) / sf / 60, 1)),
-            " minutes (idle sleep or no data), longer than GGIR's limit of ",
-            format(limit / sf / 60), " minutes, beyond which GGIR's g.getmeta() imputes whole ",
-            "epochs; gravcal's g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it ",
-            "in R before 4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
-    }
-    norm <- which(gap > 1)
-    xyz <- cbind(d$x[norm], d$y[norm], d$z[norm])
-    en <- sqrt(rowSums(xyz^2))
-    good <- which((abs(en) - 1) > 0.005)
-    if (length(good)) {
-      j <- norm[good]
-      d$x[j] <- d$x[j] / en[good]
-      d$y[j] <- d$y[j] / en[good]
-      d$z[j] <- d$z[j] / en[good]
-    }
-    within <- sequence(gap) - 1
-    d <- lapply(d, rep, gap)
-    d$time <- d$time + within * (1 / sf)
-  }
-  last <- length(d$x)
-  if (imputelast) {
-    d$x[last] <- d$x[last - 1]
-    d$y[last] <- d$y[last - 1]
-    d$z[last] <- d$z[last - 1]
-  }
-  start <- d$time[1]
-  end <- start + last
-  QClog <- data.frame(imputed = ngaps > 0, start = start, end = end,
-                      blockLengthSeconds = (end - start) / sf, timegaps_n = ngaps,
-                      timegaps_min = gaplen / sf / 60)
-  if (no_time) d$time <- NULL
-  list(x = d, QClog = QClog)
 }
 
 # The first block's start: GGIR's get_starttime_weekday_truncdata(), which

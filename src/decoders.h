@@ -5,7 +5,9 @@
 #ifndef GRAVCAL_GLUE_DECODERS_H
 #define GRAVCAL_GLUE_DECODERS_H
 
+#include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "gravcal/decode.hpp"
@@ -179,12 +181,48 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
   return f;
 }
 
+// g.getmeta()'s time-gap imputation over a decoder (option getmeta_timegaps
+// = 1; GgirTimegapsOf's carry mode): getmeta_gap_limit (minutes), and
+// clock, GGIR's reader's clock shifts as text "second shift second shift
+// ..." (shift NaN: the clock time does not exist), up to clock_until.
+inline DecoderPtr getmeta_timegaps(DecoderPtr d, const gravcal::Options& opts) {
+  gravcal::GgirTimegapsMode m;
+  m.carry = true;
+  m.limit_minutes = opts.num("getmeta_gap_limit", 0);
+  const std::string clock = opts.str("clock", "");
+  std::size_t at = 0;
+  while (at < clock.size()) {
+    std::size_t used = 0;
+    const std::string rest = clock.substr(at);
+    double v = 0;
+    if (rest.compare(0, 3, "NaN") == 0) {
+      v = std::numeric_limits<double>::quiet_NaN();
+      used = 3;
+    } else {
+      v = std::stod(rest, &used);
+    }
+    m.clock.push_back(v);
+    at += used;
+    while (at < clock.size() && clock[at] == ' ') ++at;
+  }
+  if (m.clock.size() % 2 != 0) throw std::invalid_argument("clock: pairs of second and shift");
+  m.clock_until = opts.num("clock_until", std::numeric_limits<double>::infinity());
+  if (r_long_double()) {
+    using Gaps = gravcal::GgirTimegapsOf<gravcal::Decoder, long double>;
+    return DecoderPtr(new Gaps(std::move(d), 0, std::move(m)));
+  }
+  using Gaps = gravcal::GgirTimegapsOf<gravcal::Decoder, double>;
+  return DecoderPtr(new Gaps(std::move(d), 0, std::move(m)));
+}
+
 // The decoder for `format` on `bytes`, or null when there is none.
 inline DecoderPtr make_decoder(const std::string& format, gravcal::ByteSource& bytes,
                                const gravcal::Options& opts) {
   const DecoderKind* kind = find_decoder(format);
   if (kind == nullptr) return nullptr;
-  return kind->make(bytes, opts, format);
+  DecoderPtr d = kind->make(bytes, opts, format);
+  if (d && opts.num("getmeta_timegaps", 0) != 0) return getmeta_timegaps(std::move(d), opts);
+  return d;
 }
 
 }  // namespace gravcal_glue

@@ -144,6 +144,33 @@ test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps
   expect_match(b2$gravcal$metashort$timestamp[1], "-0500$")
 })
 
+test_that("g.getmeta() is GGIR's on a .gt3x recording across a daylight-saving change (the clock's jump filled as a gap)", {
+  skip_if_quick()
+  # 2024-10-27 03:00 in Amsterdam: GGIR's reader reads the file's clock in
+  # the zone sample by sample, so that the clock time 03:00 after 02:59:59
+  # (an hour taken as summer time, the next as winter time) jumps by an
+  # hour, and g.imputeTimegaps() fills the jump as a time gap (the
+  # decoder's clock table, meta_clock_table())
+  rec <- simulate_recording(hours = 30, sf = 10, seed = 23,
+                            start = as.POSIXct("2024-10-26 12:03:07", tz = "UTC"))
+  f <- tempfile(fileext = ".gt3x")
+  on.exit(unlink(f))
+  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 10, start = rec$time[1],
+                       idle = 3600 * 20 + 0:40)
+  b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  # the idle 41 s and the clock's hour
+  expect_gt(sum(b$gravcal$QClog$timegaps_min), 60)
+  expect_identical(sum(b$gravcal$QClog$timegaps_n), 2L)
+  # and in spring (2024-03-31 02:00), where the clock steps back: no gap
+  rec$time <- rec$time - as.difftime(210, units = "days")
+  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 10, start = rec$time[1],
+                       idle = 3600 * 20 + 0:40)
+  b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  expect_identical(sum(b$gravcal$QClog$timegaps_n), 1L)
+})
+
 test_that("g.getmeta() takes an ActiGraph's dynamic range from its serial number, as GGIR", {
   skip_if_quick()
   rec <- simulate_recording(hours = 27, sf = 30, seed = 15,

@@ -37,11 +37,41 @@
 
 namespace gravcal {
 
+// g.getmeta()'s use of g.imputeTimegaps() (GgirTimegapsMode::carry): each
+// block is given the previous block's last sample and time (GGIR's
+// PreviousLastValue and PreviousLastTime; at the first block 0, 0, 1 and
+// none). A zero first sample takes the previous block's last x, y, z; a step
+// of k or more from the previous block's last time to the block's first
+// time is filled like any other, from a sample with the previous block's
+// last x, y, z, the first sample's other columns, at the previous block's
+// last time. Gaps of more than `limit_minutes` (g.getmeta's max(6 long
+// epochs, 90 minutes), beyond which GGIR imputes whole epochs instead) are
+// not filled but counted ("timegaps_over_limit", the longest in
+// "timegap_longest_rows"); "timegap_rows" counts the rows of the gaps filled
+// (GGIR's QClog timegaps_min, in rows), "timegap_rows_read" the rows the
+// inner decoder gave (before the gaps were filled). An inner decoder without time stamps
+// is given times 1 / sf apart from 0 in each block (GGIR counts from the
+// clock then: only their differences matter). `clock`: the shift GGIR's
+// reader adds to each time (the file's clock, read as UTC, read again in the
+// analysis' time zone), as its changes: from second clock[2k] on (the
+// floor of the time) the shift is clock[2k + 1] (NaN: that clock time does
+// not exist in the zone, counted as "clock_time_missing"); before the first
+// change, or empty: none. Times beyond the table's last change + its span
+// are counted as "clock_table_exceeded".
+struct GgirTimegapsMode {
+  bool carry = false;
+  double limit_minutes = 0;  // > 0: gaps of more rows than limit_minutes * 60 * sf
+  std::vector<double> clock;
+  double clock_until = 0;    // the table holds up to this second
+};
+
 template <class Inner, class Acc = long double>
 class GgirTimegapsOf : public Decoder {
  public:
-  // sf: the rate GGIR imputes at (the layout's: rmc.sf or the header's)
-  GgirTimegapsOf(std::unique_ptr<Inner> inner, double sf) : inner_(std::move(inner)), sf_(sf) {}
+  // sf: the rate GGIR imputes at (the layout's: rmc.sf or the header's; 0:
+  // the inner decoder's)
+  GgirTimegapsOf(std::unique_ptr<Inner> inner, double sf, GgirTimegapsMode mode = {})
+      : inner_(std::move(inner)), sf_(sf), mode_(std::move(mode)) {}
 
   bool open() override {
     const bool ok = inner_->open();
@@ -54,6 +84,8 @@ class GgirTimegapsOf : public Decoder {
     k_ = 0.25;
     if (k_ < 2 / sf_) k_ = 2 / sf_;
     raw_.assign(kCols * kRawChunk, 0.0);
+    inner_time_ = inner_->info().has_time;
+    if (mode_.limit_minutes > 0) limit_rows_ = mode_.limit_minutes * 60 * sf_;
     return true;
   }
 
@@ -107,6 +139,7 @@ class GgirTimegapsOf : public Decoder {
     have_zero_ = false;
     runs_.clear();
     head_ = 0;
+    synth_ = 0;
   }
 
   bool refill() {
@@ -116,7 +149,42 @@ class GgirTimegapsOf : public Decoder {
     if (left_ > 0) left_ -= u;
     raw_n_ = b.n;
     raw_at_ = 0;
+    rows_read_ += static_cast<std::int64_t>(b.n);
+    double* time = raw_.data() + 4 * kRawChunk;
+    if (!inner_time_) {
+      for (std::size_t i = 0; i < b.n; ++i) time[i] = static_cast<double>(synth_++) / sf_;
+    } else if (!mode_.clock.empty()) {
+      for (std::size_t i = 0; i < b.n; ++i) time[i] = time[i] + clock_shift(time[i]);
+    }
     return b.n > 0 || u > 0;
+  }
+
+  // GGIR's reader's shift of time t (see GgirTimegapsMode::clock)
+  double clock_shift(double t) {
+    const double f = std::floor(t);
+    const std::vector<double>& c = mode_.clock;
+    if (f >= mode_.clock_until) {
+      ++clock_exceeded_;
+      return 0;
+    }
+    if (f < c[0]) return 0;
+    // the change in force: the last with c[2k] <= f (from the one before)
+    if (!(clock_at_ < c.size() && c[clock_at_] <= f &&
+          (clock_at_ + 2 >= c.size() || f < c[clock_at_ + 2]))) {
+      std::size_t lo = 0, hi = c.size() / 2;  // changes [lo, hi)
+      while (hi - lo > 1) {
+        const std::size_t mid = (lo + hi) / 2;
+        if (c[2 * mid] <= f) lo = mid;
+        else hi = mid;
+      }
+      clock_at_ = 2 * lo;
+    }
+    const double d = c[clock_at_ + 1];
+    if (std::isnan(d)) {
+      ++clock_missing_;
+      return 0;
+    }
+    return d;
   }
 
   void take(std::size_t i) {
@@ -125,7 +193,19 @@ class GgirTimegapsOf : public Decoder {
     const bool zero = s[0] == 0 && s[1] == 0 && s[2] == 0;
     if (first_) {
       first_ = false;
-      if (zero) s[2] = 1;  // GGIR's PreviousLastValue c(0, 0, 1)
+      if (zero) {
+        // GGIR's PreviousLastValue: c(0, 0, 1), or g.getmeta()'s previous
+        // block's last
+        for (int c = 0; c < 3; ++c) s[c] = plv_[c];
+      }
+      if (mode_.carry && have_plt_ && s[4] - plt_ >= k_) {
+        double p[kCols];
+        for (std::size_t c = 0; c < kCols; ++c) p[c] = s[c];
+        for (int c = 0; c < 3; ++c) p[c] = plv_[c];
+        p[4] = plt_;
+        hold(p);
+        release(s[4]);
+      }
       hold(s);
       return;
     }
@@ -155,7 +235,10 @@ class GgirTimegapsOf : public Decoder {
     const double dt = next - held_[4];
     if (dt >= k_) {
       const double n = std::nearbyint(dt * sf_);
-      if (n > kMaxGapRows) {
+      if (limit_rows_ > 0 && n > limit_rows_) {
+        ++over_limit_;
+        if (n > longest_) longest_ = n;
+      } else if (n > kMaxGapRows) {
         ++gaps_not_filled_;
         if (gap_notes_.size() < 5) {
           gap_notes_.push_back("time stamps jump by " + std::to_string(dt) +
@@ -164,6 +247,7 @@ class GgirTimegapsOf : public Decoder {
       } else {
         ++gaps_;
         rows_added_ += static_cast<std::int64_t>(n) - 1;
+        gap_rows_ += static_cast<std::int64_t>(n);
         r.n = static_cast<std::int64_t>(n);
         const Acc ss = static_cast<Acc>(r.v[0] * r.v[0]) + static_cast<Acc>(r.v[1] * r.v[1]) +
                        static_cast<Acc>(r.v[2] * r.v[2]);
@@ -195,6 +279,14 @@ class GgirTimegapsOf : public Decoder {
       }
     }
     have_zero_ = false;
+    if (mode_.carry && !runs_.empty()) {
+      // the block's last sample: the next block's PreviousLastValue and,
+      // with time stamps of the file's, PreviousLastTime
+      const Run& r = runs_.back();
+      for (int c = 0; c < 3; ++c) plv_[c] = r.v[c];
+      plt_ = r.v[4] + static_cast<double>(r.n - 1) * by_;
+      have_plt_ = inner_time_;
+    }
   }
 
   void drain(SampleBuffer& out) {
@@ -218,6 +310,14 @@ class GgirTimegapsOf : public Decoder {
     if (rows_added_ > 0) r.count("timegap_samples_added", rows_added_);
     if (zeros_dropped_ > 0) r.count("timegaps_zero_samples_dropped", zeros_dropped_);
     if (gaps_not_filled_ > 0) r.count("timegaps_not_filled", gaps_not_filled_);
+    if (mode_.carry) {
+      r.count("timegap_rows_read", rows_read_);
+      r.count("timegap_rows", gap_rows_);
+      r.count("timegaps_over_limit", over_limit_);
+      r.count("timegap_longest_rows", static_cast<std::int64_t>(longest_));
+      r.count("clock_time_missing", clock_missing_);
+      r.count("clock_table_exceeded", clock_exceeded_);
+    }
     for (const auto& n : gap_notes_) r.note(n);
   }
 
@@ -234,6 +334,16 @@ class GgirTimegapsOf : public Decoder {
   std::int64_t gaps_ = 0, rows_added_ = 0, zeros_dropped_ = 0;
   std::int64_t gaps_not_filled_ = 0;
   std::vector<std::string> gap_notes_;
+  GgirTimegapsMode mode_;
+  bool inner_time_ = true;
+  std::int64_t synth_ = 0;
+  double plv_[3] = {0, 0, 1};
+  double plt_ = 0;
+  bool have_plt_ = false;
+  double limit_rows_ = 0, longest_ = 0;
+  std::int64_t gap_rows_ = 0, over_limit_ = 0, clock_missing_ = 0, clock_exceeded_ = 0;
+  std::int64_t rows_read_ = 0;
+  std::size_t clock_at_ = 0;
 };
 
 }  // namespace gravcal
