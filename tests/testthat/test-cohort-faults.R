@@ -66,6 +66,9 @@ slots_of <- function(out) {
 }
 
 test_that("a worker killed mid-file fails only its recording; a rerun completes", {
+  skip_if_quick()
+  # slow tier: two multisession workers started twice (seconds of wall time);
+  # make quick keeps the run killed mid-run (below)
   skip_if_not_installed("future")
   skip_on_os("windows")
   dir <- fault_cohort()
@@ -156,6 +159,8 @@ test_that("a full disk is an error naming the file; nothing written is lost", {
 })
 
 test_that("a really full disk (a small tmpfs) loses nothing", {
+  skip_if_quick()
+  # slow tier; make quick keeps the injected full disk (above)
   skip_on_os(c("windows", "mac"))
   mnt <- tempfile("tmpfs")
   dir.create(mnt)
