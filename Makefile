@@ -32,7 +32,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: quick test-ggir-cache profile-tests test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -103,13 +103,20 @@ test-ggir-cache: install setup-test
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
 	  GRAVCAL_GGIR_CACHE_MODE=verify $(RSCRIPT) ../../tools/run-tests.R
 
-# the time of each test file and of the slowest tests, into
-# bench/results/test-profile.md (PROFILE_OUT)
+# the time (wall and CPU) of each test file and of the slowest tests, into
+# bench/results/test-profile.md (PROFILE_OUT); profile-quick: the same of
+# make quick's tier, into bench/results/test-profile-quick.md
 PROFILE_OUT ?= bench/results/test-profile.md
 profile-tests: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
 	  $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_OUT))
+
+PROFILE_QUICK_OUT ?= bench/results/test-profile-quick.md
+profile-quick: install setup-test
+	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_QUICK_OUT))
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
 # tests (double, float, fixed point), the Cortex-M4 build (no heap), the

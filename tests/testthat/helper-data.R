@@ -44,9 +44,12 @@ scrub_dir <- function(d) {
   }
 }
 
-# The slow tier: tests that take tens of seconds each. make quick sets
-# GRAVCAL_TEST_TIER=quick and leaves them out; make test and R CMD check run
-# them all.
+# The slow tier: tests that take tens of seconds each, and tests of a few
+# seconds (large files, GGIR run beside gravcal, processes started and
+# killed) whose path a quicker test still checks in make quick. make quick
+# sets GRAVCAL_TEST_TIER=quick and leaves them out (about 3 1/4 minutes on an
+# idle 2-core machine; bench/results/test-profile-quick.md); make test and
+# R CMD check run them all.
 skip_if_quick <- function() {
   if (identical(Sys.getenv("GRAVCAL_TEST_TIER"), "quick")) {
     testthat::skip("slow tier, left out by make quick (GRAVCAL_TEST_TIER=quick)")

@@ -507,6 +507,9 @@ test_that("text time in a zone with daylight saving: g.calibrate() is GGIR's acr
 })
 
 test_that("rmc.doresample with text time: g.calibrate() is GGIR's, in a zone of fixed offset", {
+  skip_if_quick()
+  # slow tier; make quick keeps rmc.doresample's filled gaps against GGIR's
+  # (above)
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   f <- tempfile(fileext = ".csv")

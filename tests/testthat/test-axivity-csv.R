@@ -169,6 +169,9 @@ test_that("fread's date-times: the csv decoder's value of every millisecond is f
 })
 
 test_that("an Axivity csv export with OMGUI's header line: GGIR stops, so g.calibrate() refuses it", {
+  skip_if_quick()
+  # slow tier: GGIR's error is recomputed on every run (errors are never
+  # cached); make quick keeps the other Axivity csv cases
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   rec <- simulate_recording(hours = 2, sf = 10, seed = 24, temperature = FALSE)

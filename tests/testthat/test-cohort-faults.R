@@ -7,15 +7,28 @@
 # "calibrate:REGEX" kills the process that starts a recording, "pause:REGEX"
 # makes a recording take 3 s.
 
-fault_cohort <- function(n = 4) {
-  dir <- tempfile("faults")
-  dir.create(dir)
-  for (i in seq_len(n)) {
-    saveRDS(simulate_recording(hours = 8, sf = 5, seed = 200 + i),
-            file.path(dir, sprintf("p%02d.rds", i)))
+# A new folder of n (at most 4) recordings, p01.rds to p04.rds. They are the
+# same in every test (seeds 201 to 204): simulated and saved once per run,
+# then copied (the same bytes, a new file) into each test's folder.
+fault_cohort <- local({
+  template <- NULL
+  function(n = 4) {
+    stopifnot(n <= 4)
+    if (is.null(template)) {
+      t <- tempfile("faults-template")
+      dir.create(t)
+      for (i in 1:4) {
+        saveRDS(simulate_recording(hours = 8, sf = 5, seed = 200 + i),
+                file.path(t, sprintf("p%02d.rds", i)))
+      }
+      template <<- t
+    }
+    dir <- tempfile("faults")
+    dir.create(dir)
+    stopifnot(all(file.copy(file.path(template, sprintf("p%02d.rds", seq_len(n))), dir)))
+    dir
   }
-  dir
-}
+})
 
 # the table without what may differ between equal runs
 strip <- function(tab) {
@@ -53,6 +66,9 @@ slots_of <- function(out) {
 }
 
 test_that("a worker killed mid-file fails only its recording; a rerun completes", {
+  skip_if_quick()
+  # slow tier: two multisession workers started twice (seconds of wall time);
+  # make quick keeps the run killed mid-run (below)
   skip_if_not_installed("future")
   skip_on_os("windows")
   dir <- fault_cohort()
@@ -143,6 +159,8 @@ test_that("a full disk is an error naming the file; nothing written is lost", {
 })
 
 test_that("a really full disk (a small tmpfs) loses nothing", {
+  skip_if_quick()
+  # slow tier; make quick keeps the injected full disk (above)
   skip_on_os(c("windows", "mac"))
   mnt <- tempfile("tmpfs")
   dir.create(mnt)

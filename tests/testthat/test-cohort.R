@@ -278,16 +278,26 @@ test_that("calibrate_cli() calibrates files given on the command line", {
 # ---- the recording's identity: its path relative to the cohort's root ----
 
 # Recordings in subfolders of a new folder: `files` names them relative to
-# it; each a different 8-hour recording at 5 Hz.
-nested_cohort <- function(files) {
-  dir <- tempfile("nested")
-  for (i in seq_along(files)) {
-    f <- file.path(dir, files[i])
-    dir.create(dirname(f), recursive = TRUE, showWarnings = FALSE)
-    saveRDS(simulate_recording(hours = 8, sf = 5, seed = 500 + i), f)
+# it; each a different 8-hour recording at 5 Hz (the i-th of seed 500 + i,
+# simulated and saved once per run, then copied: the same bytes in every
+# test).
+nested_cohort <- local({
+  saved <- character()
+  function(files) {
+    dir <- tempfile("nested")
+    for (i in seq_along(files)) {
+      if (length(saved) < i) {
+        s <- tempfile(sprintf("nested-%d-", i), fileext = ".rds")
+        saveRDS(simulate_recording(hours = 8, sf = 5, seed = 500 + i), s)
+        saved[i] <<- s
+      }
+      f <- file.path(dir, files[i])
+      dir.create(dirname(f), recursive = TRUE, showWarnings = FALSE)
+      stopifnot(file.copy(saved[i], f))
+    }
+    dir
   }
-  dir
-}
+})
 
 strip_run <- function(tab) {
   attr(tab, "fits") <- NULL

@@ -3,6 +3,10 @@
 # test-ggir-getmeta.R) and the metric's definition computed here in R.
 
 test_that("epoch_signals() of a file with g.calibrate()'s coefficients is g.getmeta()'s M", {
+  skip_if_quick()
+  # slow tier: 27 hours at 25 Hz written, calibrated and read twice; make
+  # quick keeps epoch_signals() of samples in memory (below) and g.getmeta()'s
+  # identity (test-ggir-getmeta.R)
   rec <- simulate_recording(hours = 27, sf = 25, seed = 21,
                             start = as.POSIXct("2024-05-01 10:02:11", tz = "UTC"))
   f <- tempfile(fileext = ".cwa")

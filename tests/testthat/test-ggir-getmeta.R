@@ -99,6 +99,9 @@ test_that("g.getmeta() is GGIR's on a GENEActiv .bin recording, in a zone with a
 })
 
 test_that("g.getmeta() is GGIR's without calibration, for a daylimit, and on a file too short", {
+  skip_if_quick()
+  # slow tier: two more 30-hour recordings; make quick keeps g.getmeta()'s
+  # identity on a calibrated .cwa (above)
   f <- meta_recording("cwa", 25, 30, seed = 10)
   expect_same_meta(meta_both(f, list(daylimit = 1)))
   short <- meta_recording("cwa", 25, 1.5, seed = 11)

@@ -129,6 +129,9 @@ test_that("g.calibrate() is GGIR's with interpolationType 1 and 2 (.cwa)", {
 })
 
 test_that("g.calibrate() is GGIR's with frequency_tol 0.1 and 0.02 (.cwa, a clock off by 5 %)", {
+  skip_if_quick()
+  # slow tier: a 30-hour .cwa through both, twice; make quick keeps the
+  # decoder's imputation against readAxivity's (above)
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   f <- synth_cwa(seed = 62, drift = TRUE)
@@ -146,6 +149,9 @@ test_that("g.calibrate() is GGIR's with frequency_tol 0.1 and 0.02 (.cwa, a cloc
 })
 
 test_that("desiredtz: a zone with a fixed offset over the recording gives GGIR's result", {
+  skip_if_quick()
+  # slow tier: a 30-hour .cwa through both; make quick keeps the zone's
+  # offsets (R/zone.R) and the refused block start below
   skip_if_not_installed("GGIR")
   skip_if_not_installed("GGIRread")
   # GGIR's desiredtz = "" is the session's zone: Europe/Amsterdam (UTC + 1

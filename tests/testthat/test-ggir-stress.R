@@ -325,6 +325,9 @@ st_dup_windows <- function(X, L, ks, seed) {
 }
 
 test_that("duplicate filter: equal means and tied sds, GENEActiv .bin (exact sums)", {
+  skip_if_quick()
+  # slow tier; make quick keeps the duplicate filter against R's comparisons
+  # (test-ggir.R) and lazy_r_sd() at the threshold (the rest-rule cases above)
   # Aims at lazy_r_sd()'s tie logic (may_tie(), the held and reference
   # windows): sds in double must become R's wherever GGIR's filter could
   # find 3 of 6 values equal. GENEActiv counts are multiples of 1/256 g, so
@@ -701,6 +704,9 @@ test_that("block counts on the edges: a first block of two hours, and whole bloc
 # --- 5. csv numbers in every form fread reads ------------------------------
 
 test_that("csv numbers: forms fread reads as numbers, read as fread reads them", {
+  skip_if_quick()
+  # slow tier; make quick keeps the number parser against fread
+  # (test-decode-csv.R: numbers of every shape) and the csv rest-rule cases
   # Aims at the csv decoder's number parser (fread 1.14.8's long double
   # product, its 18-digit limit, the fast path for plain numbers): each
   # value written in one of many forms, chosen per value: 15 and 17

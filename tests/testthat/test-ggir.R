@@ -489,6 +489,9 @@ test_that("g.calibrate matches GGIR on a GENEActiv .bin of several blocks", {
 })
 
 test_that("an ActiGraph csv with a time stamp column gives the same calibration", {
+  skip_if_quick()
+  # slow tier: 14 hours at 20 Hz written and read twice; make quick keeps the
+  # ActiGraph csv identity without a time column (above)
   skip_if_not_installed("GGIR")
   rec <- simulate_recording(hours = 14, sf = 20, seed = 31)
   f1 <- tempfile(fileext = ".csv")
