@@ -6,10 +6,14 @@
 # process of its own (Rscript), cold, the file in the page cache; the time
 # is the process's elapsed time, the memory its peak resident set (GNU time).
 # GGIR's results and gravcal's are compared (identical() on every element
-# of M but bsc_qc) in a last process.
+# of M but bsc_qc) in a last process. Contenders: g.getmeta() alone (GGIR's
+# given its g.inspectfile()), and part 1 as a GGIR user runs it, g.part1()
+# on a folder holding the file (inspection, calibration, the epoch signals,
+# the meta file), with the default metrics and (.cwa) with every metric
+# GGIR computes itself (all do.* but the counts of external packages).
 #
 #   Rscript bench/part1.R       (from the package root, gravcal and GGIR
-#                                installed; about 20 minutes)
+#                                installed; about 40 minutes)
 #
 # GRAVCAL_BENCH_DATA: where the week files are written and kept (default: a
 # folder beside tempdir()). Writes bench/results/part1.md and part1.csv.
@@ -22,13 +26,12 @@ out_dir <- file.path("bench", "results")
 say <- function(...) cat(format(Sys.time(), "%H:%M:%S"), ..., "\n")
 
 files <- c(cwa = file.path(data_dir, sprintf("week%g.cwa", days)),
-           bin = file.path(data_dir, sprintf("week%g.bin", days)))
+           bin = file.path(data_dir, sprintf("week%g.bin", days)),
+           gt3x = file.path(data_dir, sprintf("week%g.gt3x", days)))
 # GRAVCAL_BENCH_FORMATS: some of them only ("cwa,bin")
 only <- Sys.getenv("GRAVCAL_BENCH_FORMATS")
 if (nzchar(only)) files <- files[intersect(names(files), strsplit(only, ",")[[1]])]
 if (!all(file.exists(files))) {
-  files <- c(cwa = file.path(data_dir, sprintf("week%g.cwa", days)),
-             bin = file.path(data_dir, sprintf("week%g.bin", days)))[names(files)]
   say("writing the week files")
   day <- simulate_recording(hours = 24, sf = sf, seed = 1,
                             tempoffset = c(0.002, -0.001, 0.0015),
@@ -40,16 +43,31 @@ if (!all(file.exists(files))) {
     gravcal:::write_cwa(as.matrix(wk[, c("x", "y", "z")]), files[["cwa"]], sf = sf,
                         start = as.numeric(wk$time[1]), temperature = wk$temperature)
   }
-  if ("bin" %in% names(files)) {
+  if ("bin" %in% names(files) && !file.exists(files[["bin"]])) {
     gravcal:::write_geneactiv_bin(wk, files[["bin"]], sf = sf, start = "2024-03-04 08:00:00")
+  }
+  if ("gt3x" %in% names(files) && !file.exists(files[["gt3x"]])) {
+    gravcal:::write_gt3x(as.matrix(wk[, c("x", "y", "z")]), files[["gt3x"]], sf = sf,
+                         start = wk$time[1])
   }
   rm(day, wk)
 }
+# each file alone in a folder (g.part1() reads folders), as a link
+folders <- vapply(names(files), function(fmt) {
+  d <- file.path(data_dir, paste0("folder-", fmt))
+  dir.create(d, showWarnings = FALSE)
+  l <- file.path(d, basename(files[[fmt]]))
+  if (!file.exists(l)) file.symlink(normalizePath(files[[fmt]]), l)
+  d
+}, "")
 
 # One contender in a process of its own: elapsed seconds and peak RSS (MB).
-run <- function(code, file) {
+run <- function(code, file, folder) {
   script <- tempfile(fileext = ".R")
-  writeLines(c(sprintf("f <- %s", deparse(file)), code), script)
+  out <- tempfile("part1-out-")
+  writeLines(c(sprintf("f <- %s", deparse(file)), sprintf("d <- %s", deparse(folder)),
+               sprintf("md <- %s", deparse(file.path(out, "output_folder"))), code), script)
+  on.exit(unlink(out, recursive = TRUE))
   for (i in 1:2) invisible(readBin(file, "raw", 1))  # in the page cache
   tm <- tempfile()
   t0 <- Sys.time()
@@ -64,18 +82,20 @@ contenders <- list(
   "GGIR g.getmeta" = c(quiet, "I <- q(GGIR::g.inspectfile(f))",
                        "M <- q(GGIR::g.getmeta(f, inspectfileobject = I, verbose = FALSE))"),
   "gravcal g.getmeta" = c(quiet, "M <- q(gravcal::g.getmeta(f, verbose = FALSE))"),
-  "GGIR g.calibrate + g.getmeta" = c(quiet, "I <- q(GGIR::g.inspectfile(f))",
-    "C <- q(GGIR::g.calibrate(f, inspectfileobject = I, verbose = FALSE))",
-    paste("M <- q(GGIR::g.getmeta(f, inspectfileobject = I, verbose = FALSE, offset = C$offset,",
-          "scale = C$scale, tempoffset = C$tempoffset, meantempcal = C$meantempcal))")),
-  "gravcal g.calibrate + g.getmeta" = c(quiet, "C <- q(gravcal::g.calibrate(f, verbose = FALSE))",
-    paste("M <- q(gravcal::g.getmeta(f, verbose = FALSE, offset = C$offset,",
-          "scale = C$scale, tempoffset = C$tempoffset, meantempcal = C$meantempcal))")))
+  "GGIR g.part1" = c(quiet, "q(GGIR::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE))"),
+  "gravcal g.part1" = c(quiet, "q(gravcal::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE))"))
+every <- c("pm <- GGIR::load_params()$params_metrics",
+           "for (k in grep('^do[.]', names(pm), value = TRUE)) pm[[k]] <- !k %in% c('do.brondcounts', 'do.neishabouricounts')")
+contenders[["GGIR g.part1, every metric"]] <- c(quiet, every,
+  "q(GGIR::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE, params_metrics = pm))")
+contenders[["gravcal g.part1, every metric"]] <- c(quiet, every,
+  "q(gravcal::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE, params_metrics = pm))")
 rows <- list()
 for (fmt in names(files)) {
   for (nm in names(contenders)) {
+    if (grepl("every metric", nm) && fmt != "cwa") next
     say(fmt, nm)
-    r <- run(contenders[[nm]], files[[fmt]])
+    r <- run(contenders[[nm]], files[[fmt]], folders[[fmt]])
     rows[[length(rows) + 1]] <- data.frame(format = fmt, contender = nm, seconds = r[["seconds"]],
                                            rss_mb = r[["rss_mb"]])
   }
@@ -91,7 +111,8 @@ same <- vapply(files, function(f) {
 }, TRUE)
 utils::write.csv(res, file.path(out_dir, "part1.csv"), row.names = FALSE)
 ratio <- function(fmt, a, b) {
-  res$seconds[res$format == fmt & res$contender == a] / res$seconds[res$format == fmt & res$contender == b]
+  r <- res$seconds[res$format == fmt & res$contender == a] / res$seconds[res$format == fmt & res$contender == b]
+  if (length(r)) sprintf("%.1fx", r) else "-"
 }
 md <- c("# GGIR part 1's epoch signals: GGIR against gravcal (bench/part1.R)", "",
         sprintf("%g days at %g Hz (simulate_recording()'s day, nights at rest, repeated), %s, R %s, GGIR %s, GGIRread %s; %s.",
@@ -100,12 +121,14 @@ md <- c("# GGIR part 1's epoch signals: GGIR against gravcal (bench/part1.R)", "
         "Each contender in a cold R process of its own; elapsed seconds and peak resident memory.", "",
         "| format | contender | seconds | peak MB |", "|---|---|---:|---:|",
         sprintf("| %s | %s | %.1f | %.0f |", res$format, res$contender, res$seconds, res$rss_mb), "",
-        "| format | g.getmeta: GGIR / gravcal | part 1 pair: GGIR / gravcal | M identical (all but bsc_qc) |",
-        "|---|---:|---:|---|",
+        paste("| format | g.getmeta: GGIR / gravcal | g.part1: GGIR / gravcal |",
+              "g.part1, every metric | M identical (all but bsc_qc) |"),
+        "|---|---:|---:|---:|---|",
         vapply(names(files), function(fmt) {
-          sprintf("| %s | %.1fx | %.1fx | %s |", fmt,
+          sprintf("| %s | %s | %s | %s | %s |", fmt,
                   ratio(fmt, "GGIR g.getmeta", "gravcal g.getmeta"),
-                  ratio(fmt, "GGIR g.calibrate + g.getmeta", "gravcal g.calibrate + g.getmeta"),
+                  ratio(fmt, "GGIR g.part1", "gravcal g.part1"),
+                  ratio(fmt, "GGIR g.part1, every metric", "gravcal g.part1, every metric"),
                   same[[fmt]])
         }, ""))
 writeLines(md, file.path(out_dir, "part1.md"))

@@ -1,5 +1,7 @@
-// gravcal: GGIR's time-gap imputation of ad hoc csv files
-// (rmc.check4timegaps = TRUE).
+// gravcal: GGIR's time-gap imputation, g.imputeTimegaps(): of ad hoc csv
+// files as g.calibrate reads them (rmc.check4timegaps = TRUE), and of every
+// block g.getmeta() reads from a format whose gaps it fills (.gt3x,
+// ActiGraph csv; GgirTimegapsMode below).
 //
 // GGIR 3.3-9's read.myacc.csv() hands each block of lines it reads (one
 // g.readaccfile() call: GGIR's block) to g.imputeTimegaps() with k = 0.25 s,
