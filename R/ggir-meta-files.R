@@ -57,8 +57,17 @@
 #' and their formats, and get no meta file: `GGIR::GGIR(mode = 1:5,
 #' overwrite = FALSE, ...)` (or `GGIR::g.part1()`) then makes theirs and
 #' leaves the ones written here. Nothing is written for a file whose
-#' processing fails: the error stops the run, or with `use_trycatch_serial =
-#' TRUE` is printed at the end, as GGIR does.
+#' processing fails: with `use_trycatch_serial = TRUE` (GGIR's default) its
+#' error is printed at the end and its row says `"failed"`, as GGIR does;
+#' otherwise the run ends in an error naming the file (after the other
+#' files, which GGIR would not have begun).
+#'
+#' The files run as [calibrate_files()] runs a cohort's: one future per
+#' file on the `future::plan()` the session has set (sequential by default;
+#' `plan(multisession)` on a laptop, `future.batchtools` on Slurm), with
+#' progress through progressr, when the future package is installed; a file
+#' whose R process dies is reported as failed, and the files that worker had
+#' not begun are run again.
 #'
 #' @section GGIR's parameters:
 #' The parameter lists are completed and checked by `GGIR::extract_params()`
@@ -74,8 +83,8 @@
 #' | `overwrite` | whether a file with a meta file is redone | honoured |
 #' | `desiredtz`, `configtz` | `I`, `C`, `M`; `desiredtz_part1` | honoured |
 #' | `print.filename` | prints | honoured |
-#' | `use_trycatch_serial` | whether a file's error stops the run | honoured |
-#' | `do.parallel`, `maxNcores` | GGIR runs files in parallel on 4 or more cores, and then lowers `chunksize` to 0.5 (3-5 metrics) or 0.4 (6 or more), which changes `M` | the files run one after the other; `chunksize` lowered as GGIR would lower it on this machine, so `M` is GGIR's |
+#' | `use_trycatch_serial` | whether a file's error stops the run | honoured (see above) |
+#' | `do.parallel`, `maxNcores` | GGIR runs files in parallel on 4 or more cores, and then lowers `chunksize` to 0.5 (3-5 metrics) or 0.4 (6 or more), which changes `M` | the files run on the session's future plan (see above); `chunksize` lowered as GGIR would lower it on this machine, so `M` is GGIR's |
 #' | `recordingEndSleepHour` (`expand_tail_max_hours`), `dayborder` | `M` expanded past the recording's end to 8 hours past the next day border when the recording ends late enough; `tail_expansion_log` | honoured |
 #' | `myfun` | an external function's values in `M` | refused: an error (g.getmeta()) |
 #' | `dataFormat`, `maxRecordingInterval`, `recording_split_*` | read by `GGIR::GGIR()` around part 1, not by g.part1() | no effect |
@@ -231,26 +240,42 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
             ". GGIR::GGIR(mode = 1, overwrite = FALSE, ...) makes theirs and keeps these.",
             call. = FALSE)
   }
+  # the files on the session's future plan (run_cohort(), R/cohort.R: one
+  # future per file, progress through progressr, a worker that dies
+  # reported), each file's message and time in a slot file beside the meta
+  # files, gathered here
+  slots <- file.path(metadatadir, "meta", ".gravcal-part1")
+  if (length(todo)) dir.create(slots, showWarnings = FALSE, recursive = TRUE)
+  on.exit(unlink(slots, recursive = TRUE), add = TRUE)
+  slot <- function(i) file.path(slots, paste0(i, ".rds"))
+  worker <- function(i, p) {
+    if (verbose) cat(paste0(i, " "))
+    t0 <- proc.time()[["elapsed"]]
+    res <- part1_one(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose)
+    saveRDS(list(message = res, seconds = proc.time()[["elapsed"]] - t0), slot(i))
+    if (!is.null(p)) p(message = fnames[i])
+    invisible(NULL)
+  }
+  failures <- run_cohort(todo, worker, stats::setNames(fnames, seq_along(fnames)))
   errors <- list()
   for (i in todo) {
-    if (verbose) cat(paste0(i, " "))
     k <- match(fnames[i], tab$file)
-    t0 <- proc.time()[["elapsed"]]
-    res <- if (isTRUE(pg[["use_trycatch_serial"]])) {
-      tryCatch(part1_one(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose),
-               error = function(e) e)
-    } else {
-      part1_one(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose)
-    }
-    tab$seconds[k] <- proc.time()[["elapsed"]] - t0
-    if (inherits(res, "error")) {
-      errors[[fnames[i]]] <- conditionMessage(res)
-      tab$status[k] <- "failed"
-      tab$message[k] <- conditionMessage(res)
-    } else {
+    why <- failures[[as.character(i)]]
+    if (is.null(why) && file.exists(slot(i))) {
+      r <- readRDS(slot(i))
       tab$status[k] <- "written"
-      tab$message[k] <- res
+      tab$message[k] <- r$message
+      tab$seconds[k] <- r$seconds
+    } else {
+      if (is.null(why)) why <- "no result (the worker gave none)"
+      errors[[fnames[i]]] <- why
+      tab$status[k] <- "failed"
+      tab$message[k] <- why
     }
+  }
+  if (length(errors) && !isTRUE(pg[["use_trycatch_serial"]])) {
+    abort("g.part1() failed for ", names(errors)[1], ": ", errors[[1]],
+          if (length(errors) > 1) paste0(" (and ", length(errors) - 1, " other file(s))"))
   }
   if (length(errors) && verbose) {
     cat("\n\nErrors in part 1... for:")

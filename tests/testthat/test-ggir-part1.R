@@ -295,3 +295,39 @@ test_that("GGIR's chunksize when it would run files in parallel", {
   expect_identical(gravcal:::part1_parallel_chunksize(utils::modifyList(pm, list(do.mad = TRUE)),
                                                       pr, pg, 1, 2, 8), 1)
 })
+
+test_that("g.part1() runs its files on the session's future plan, as calibrate_files() does", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("future")
+  d <- tempfile("part1-plan-")
+  dir.create(d)
+  for (k in 1:2) {
+    rec <- simulate_recording(hours = 3, sf = 25, seed = 40 + k,
+                              start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+    gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file.path(d, sprintf("p%d.cwa", k)),
+                        sf = 25, start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  }
+  run <- function(md) {
+    p1_quiet0(gravcal::g.part1(d, md, minimumFileSizeMB = 0, verbose = FALSE))
+  }
+  seq_md <- file.path(tempfile("part1-seq-"), "output_x")
+  tab_seq <- run(seq_md)
+  old <- future::plan(future::multisession, workers = 2)
+  on.exit(future::plan(old), add = TRUE)
+  par_md <- file.path(tempfile("part1-par-"), "output_x")
+  tab_par <- run(par_md)
+  future::plan(old)
+  expect_identical(tab_par$status, c("written", "written"))
+  expect_identical(tab_par$message, tab_seq$message)
+  expect_true(all(tab_par$seconds > 0))
+  # the same meta files, made in other R processes
+  expect_identical(p1_objects(file.path(par_md, "meta", "basic")),
+                   p1_objects(file.path(seq_md, "meta", "basic")))
+  # nothing of the run left beside the meta files
+  expect_identical(dir(file.path(par_md, "meta"), all.files = TRUE, no.. = TRUE), "basic")
+  # without use_trycatch_serial, a file's error ends the run naming it
+  writeBin(as.raw(rep(0, 3000)), file.path(d, "p3.cwa"))
+  expect_error(p1_quiet0(gravcal::g.part1(d, seq_md, minimumFileSizeMB = 0, overwrite = TRUE,
+                                          use_trycatch_serial = FALSE, verbose = FALSE)),
+               "g.part1\\(\\) failed for p3.cwa")
+})
