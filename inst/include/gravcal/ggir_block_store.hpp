@@ -10,10 +10,11 @@
 // blocks), the store does what they ask.
 //
 // Memory, about the block's x, y and z and no more:
-// * a block is read in parts of a fixed size, then put together in one
-//   array per axis of exactly its length, each part freed as it is copied;
-//   after the block only the carry is kept. Nothing is sized by a number
-//   read from the file.
+// * the first block is read in parts of a fixed size, then put together in
+//   one array per axis of exactly its length (and room for two reads more),
+//   each part freed as it is copied; the next blocks are read into those
+//   arrays (their carry moved to the front), in parts again only beyond
+//   them. Nothing is sized by a number read from the file.
 // * temperature and light (a value per page in .cwa and GENEActiv files)
 //   are kept as runs of one value (RunColumn), as plain values only when
 //   their runs are short.
@@ -214,9 +215,10 @@ class RunColumn {
 class BlockStore {
  public:
   static constexpr int kX = 0, kY = 1, kZ = 2, kT = 3, kTime = 4, kLight = 5, kCols = 6;
-  // rows of a part a block is read into: 40 MB a column, above the size
-  // from which allocators map memory of its own (glibc: 32 MB at most), so
-  // that a part freed is memory given back, not kept in the heap
+  // rows of a part a block is read into when the columns have no room: 40
+  // MB a column, above the size from which allocators map memory of its
+  // own (glibc: 32 MB at most), so that a part freed is memory given back,
+  // not kept in the heap
   static constexpr std::size_t kPartRows = std::size_t{5} << 20;
 
   BlockStore(bool temperature, bool time, bool light) {
@@ -228,9 +230,9 @@ class BlockStore {
 
   bool has(int c) const { return has_[c]; }
   std::size_t size() const { return n_; }
-  // x, y, z and time: plain arrays of size() values
-  double* col(int c) { return has_[c] && !is_run(c) ? cols_[c].data() : nullptr; }
-  const double* col(int c) const { return has_[c] && !is_run(c) ? cols_[c].data() : nullptr; }
+  // x, y, z and time: arrays of size() values
+  double* col(int c) { return has_[c] && !is_run(c) ? cols_[c].get() : nullptr; }
+  const double* col(int c) const { return has_[c] && !is_run(c) ? cols_[c].get() : nullptr; }
   // temperature and light (nullptr when not kept)
   const RunColumn* runs(int c) const { return has_[c] && is_run(c) ? &runs_[c == kT ? 0 : 1] : nullptr; }
   double value(int c, std::size_t i) const { return is_run(c) ? runs(c)->at(i) : cols_[c][i]; }
@@ -248,7 +250,11 @@ class BlockStore {
   // One block from `d`: reads of at most `chunk` samples, appended, until
   // `units` units are read and the last read left room, or the decoder
   // gives nothing more (g.getmeta()'s rule for a native decoder). Returns
-  // the rows read. `want_time`: ask the decoder for time stamps.
+  // the rows read. `want_time`: ask the decoder for time stamps. The
+  // decoder writes into the columns while they have room (from the second
+  // block on: they keep the first block's length and two reads more), then
+  // into parts, put together with the columns at the block's exact length
+  // (and room for two reads more).
   std::size_t read(Decoder& d, std::int64_t units, std::size_t chunk, bool want_time) {
     if (chunk == 0) throw std::invalid_argument("chunk must be positive");
     const std::size_t before = n_;
@@ -257,40 +263,48 @@ class BlockStore {
     const bool ask_time = want_time && d.info().has_time;
     const bool ask_t = has_[kT] && d.info().has_temperature;
     const bool ask_light = has_[kLight] && d.info().has_light;
-    // the decoder writes into parts of kPartRows rows (each column's part a
-    // single allocation large enough to be the system's own mapping, given
-    // back when freed), a new part when the one being filled has less room
-    // than a read
+    const bool col_time = ask_time && has_[kTime];
     const std::size_t part_rows = std::max(kPartRows, chunk);
     // (not zeroed: the pages a part does not use are never touched)
     std::vector<std::unique_ptr<double[]>> parts[kCols];
     std::vector<std::size_t> used;  // rows in each part
-    std::vector<double> t_buf, light_buf, time_buf;
-    if (ask_t) t_buf.resize(chunk);
-    if (ask_light) light_buf.resize(chunk);
-    if (ask_time && !has_[kTime]) time_buf.resize(chunk);
-    const bool part_time = ask_time && has_[kTime];
+    std::vector<double> t_buf(ask_t ? chunk : 0), light_buf(ask_light ? chunk : 0),
+        time_buf(ask_time && !col_time ? chunk : 0);
     std::size_t got_all = 0;
     for (;;) {
-      if (used.empty() || part_rows - used.back() < chunk) {
-        for (int c = 0; c < kCols; ++c) {
-          if (c <= kZ || (c == kTime && part_time)) parts[c].emplace_back(new double[part_rows]);
-        }
-        used.push_back(0);
-      }
-      const std::size_t at = used.back();
       SampleBuffer out;
-      out.x = parts[kX].back().get() + at;
-      out.y = parts[kY].back().get() + at;
-      out.z = parts[kZ].back().get() + at;
+      double* dst[kCols] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+      if (used.empty() && cap_ - n_ >= chunk) {
+        for (int c = 0; c < kCols; ++c) {
+          if (cols_[c]) dst[c] = cols_[c].get() + n_;
+        }
+      } else {
+        if (used.empty() || part_rows - used.back() < chunk) {
+          for (int c = 0; c < kCols; ++c) {
+            if (c <= kZ || (c == kTime && has_[kTime])) parts[c].emplace_back(new double[part_rows]);
+          }
+          used.push_back(0);
+        }
+        for (int c = 0; c < kCols; ++c) {
+          if (!parts[c].empty()) dst[c] = parts[c].back().get() + used.back();
+        }
+      }
+      out.x = dst[kX];
+      out.y = dst[kY];
+      out.z = dst[kZ];
       if (ask_t) out.t = t_buf.data();
       if (ask_light) out.light = light_buf.data();
-      if (ask_time) out.time = part_time ? parts[kTime].back().get() + at : time_buf.data();
+      if (ask_time) out.time = col_time ? dst[kTime] : time_buf.data();
       out.capacity = chunk;
       const std::int64_t u = d.read(out, left);
       const std::size_t got = out.n;
       if (got > 0) {
-        used.back() += got;
+        if (has_[kTime] && !col_time) std::fill(dst[kTime], dst[kTime] + got, nan());
+        if (used.empty()) {
+          n_ += got;
+        } else {
+          used.back() += got;
+        }
         if (has_[kT]) push_or_nan(runs_[0], out.t, got);
         if (has_[kLight]) push_or_nan(runs_[1], out.light, got);
         if (out.time != nullptr) {
@@ -304,16 +318,7 @@ class BlockStore {
       if (left <= 0 && got < chunk) break;
       if (d.done()) break;
     }
-    for (int c = 0; c < kCols; ++c) {
-      if (!has_[c] || is_run(c)) continue;
-      if (c == kTime && parts[c].empty()) {
-        cols_[c].resize(before);
-        cols_[c].resize(before + got_all, nan());
-        continue;
-      }
-      assemble(c, before, parts[c], used);
-    }
-    n_ = before + got_all;
+    if (!used.empty()) assemble(parts, used, 2 * chunk);
     return got_all;
   }
 
@@ -321,20 +326,16 @@ class BlockStore {
   // Absent columns (nullptr) of a kept kind are NaN.
   void append(const double* const src[kCols], std::size_t k) {
     first_time_ = nan();
+    if (n_ + k > cap_) grow(n_ + k);
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
       if (is_run(c)) {
         push_or_nan(runs_[c == kT ? 0 : 1], src[c], k);
-        continue;
-      }
-      std::vector<std::unique_ptr<double[]>> one;
-      one.emplace_back(new double[std::max<std::size_t>(k, 1)]);
-      if (src[c] != nullptr) {
-        std::copy(src[c], src[c] + k, one[0].get());
+      } else if (src[c] != nullptr) {
+        std::copy(src[c], src[c] + k, cols_[c].get() + n_);
       } else {
-        std::fill(one[0].get(), one[0].get() + k, nan());
+        std::fill(cols_[c].get() + n_, cols_[c].get() + n_ + k, nan());
       }
-      assemble(c, n_, one, std::vector<std::size_t>(1, k));
     }
     if (k > 0 && src[kTime] != nullptr) {
       first_time_ = src[kTime][0];
@@ -343,17 +344,11 @@ class BlockStore {
     n_ += k;
   }
 
-  // Rows [from, n) replaced by `k` rows of `src` (R's imputation of the
-  // rows read).
+  // Rows [from, n) replaced by `k` rows of `src`.
   void replace_tail(std::size_t from, const double* const src[kCols], std::size_t k) {
     if (from > n_) throw std::out_of_range("replace_tail beyond the block");
-    for (int c = 0; c < kCols; ++c) {
-      if (!has_[c]) continue;
-      if (is_run(c)) {
-        runs_[c == kT ? 0 : 1].keep(0, from);
-      } else {
-        cols_[c].resize(from);
-      }
+    for (int c = kT; c <= kLight; c += kLight - kT) {
+      if (has_[c]) runs_[c == kT ? 0 : 1].keep(0, from);
     }
     n_ = from;
     tail_time_[0] = tail_time_[1] = nan();
@@ -375,22 +370,24 @@ class BlockStore {
     const double norm = std::sqrt(static_cast<double>(s));
     for (int c = kX; c <= kZ; ++c) cols_[c][last] = cols_[c][last] / norm;
     if (reps == 0) return;
+    if (n_ + reps > cap_) grow(n_ + reps);
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
       if (is_run(c)) {
         runs_[c == kT ? 0 : 1].repeat_row(last, reps);
         continue;
       }
-      std::vector<double>& v = cols_[c];
-      const double val = v[last];
-      v.insert(v.begin() + static_cast<std::ptrdiff_t>(last + 1), reps, val);
+      double* v = cols_[c].get();
+      std::copy_backward(v + last + 1, v + n_, v + n_ + reps);
+      std::fill(v + last + 1, v + last + 1 + reps, v[last]);
     }
     if (last + 1 == n_) tail_time_[1] = tail_time_[0];  // the repeated row is the last now
     n_ += reps;
   }
 
   // Rows [from, from + count) become the store (the start's shift, or the
-  // carry after a block), the rest dropped and its memory freed.
+  // carry after a block), moved to the front; the columns keep their room
+  // for the next block.
   void keep(std::size_t from, std::size_t count) {
     if (from > n_ || count > n_ - from) throw std::out_of_range("keep beyond the block");
     if (from + count < n_) {
@@ -405,11 +402,9 @@ class BlockStore {
       if (!has_[c]) continue;
       if (is_run(c)) {
         runs_[c == kT ? 0 : 1].keep(from, count);
-        continue;
+      } else if (from > 0 && count > 0) {
+        std::memmove(cols_[c].get(), cols_[c].get() + from, count * sizeof(double));
       }
-      std::vector<double> v(cols_[c].begin() + static_cast<std::ptrdiff_t>(from),
-                            cols_[c].begin() + static_cast<std::ptrdiff_t>(from + count));
-      cols_[c].swap(v);
     }
     n_ = count;
     if (n_ == 0) tail_time_[0] = tail_time_[1] = nan();
@@ -423,27 +418,44 @@ class BlockStore {
     if (p != nullptr) {
       r.push(p, k);
     } else {
-      const double na = nan();
-      for (std::size_t i = 0; i < k; ++i) r.push(&na, 1);
+      r.push_repeat(nan(), k);
     }
   }
 
-  // column c: its first `keep` rows, then the first used[k] rows of each
-  // part k, in one array of exactly that length; each part freed once
-  // copied
-  void assemble(int c, std::size_t keep, std::vector<std::unique_ptr<double[]>>& parts,
-                const std::vector<std::size_t>& used) {
-    std::size_t total = keep;
-    for (std::size_t k = 0; k < parts.size(); ++k) total += used[k];
-    std::vector<double> v;
-    v.reserve(total);
-    v.insert(v.end(), cols_[c].begin(), cols_[c].begin() + static_cast<std::ptrdiff_t>(keep));
-    std::vector<double>().swap(cols_[c]);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      v.insert(v.end(), parts[k].get(), parts[k].get() + used[k]);
-      parts[k].reset();
+  // room for `rows` in every array column, exactly, one column at a time
+  void grow(std::size_t rows) {
+    for (int c = 0; c < kCols; ++c) {
+      if (!has_[c] || is_run(c)) continue;
+      std::unique_ptr<double[]> v(new double[std::max<std::size_t>(rows, 1)]);
+      if (n_ > 0) std::copy(cols_[c].get(), cols_[c].get() + n_, v.get());
+      cols_[c] = std::move(v);
     }
-    cols_[c].swap(v);
+    cap_ = rows;
+  }
+
+  // the columns' n_ rows, then the first used[k] rows of each part k, in
+  // arrays of exactly that length and `room` rows more; one column at a
+  // time, each part freed once copied
+  void assemble(std::vector<std::unique_ptr<double[]>> parts[kCols],
+                const std::vector<std::size_t>& used, std::size_t room) {
+    std::size_t total = n_;
+    for (std::size_t k = 0; k < used.size(); ++k) total += used[k];
+    for (int c = 0; c < kCols; ++c) {
+      if (!has_[c] || is_run(c)) continue;
+      std::unique_ptr<double[]> v(new double[total + room]);
+      if (n_ > 0) std::copy(cols_[c].get(), cols_[c].get() + n_, v.get());
+      cols_[c].reset();
+      std::size_t at = n_;
+      for (std::size_t k = 0; k < parts[c].size(); ++k) {
+        std::copy(parts[c][k].get(), parts[c][k].get() + used[k], v.get() + at);
+        at += used[k];
+        parts[c][k].reset();
+      }
+      if (parts[c].empty()) std::fill(v.get() + n_, v.get() + total, nan());  // a time column the decoder did not fill
+      cols_[c] = std::move(v);
+    }
+    n_ = total;
+    cap_ = total + room;
   }
 
   // the last two times of the rows just written (t[0..k))
@@ -458,9 +470,9 @@ class BlockStore {
   }
 
   bool has_[kCols] = {false, false, false, false, false, false};
-  std::vector<double> cols_[kCols];  // x, y, z, time (temperature and light: runs_)
-  RunColumn runs_[2];                // temperature, light
-  std::size_t n_ = 0;
+  std::unique_ptr<double[]> cols_[kCols];  // x, y, z, time (temperature and light: runs_)
+  RunColumn runs_[2];                      // temperature, light
+  std::size_t n_ = 0, cap_ = 0;
   double first_time_ = nan();
   // tail_time_[0]: the last row's time, [1]: the one before
   double tail_time_[2] = {nan(), nan()};

@@ -572,9 +572,24 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       // x, z; angle_z: z over x, y
       const RollMed& p = axis == 1 ? c : b;  // first in the sum
       const RollMed& q = axis == 1 ? b : c;
-      out[k] = per_epoch_of<Acc>(n, by, true, [&a, &p, &q, deg](std::size_t i) {
+      auto angle = [&a, &p, &q, deg](std::size_t i) {
         const double pi = p[i], qi = q[i];
         return std::atan(a[i] / (std::sqrt(pi * pi + qi * qi))) / deg;
+      };
+      // the medians hold for `step` samples (10 Hz): their angle is taken
+      // once per subsample value (the same inputs, the same result)
+      const bool held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr &&
+                        a.step == p.step && a.step == q.step && a.LN == p.LN && a.LN == q.LN;
+      std::size_t last = static_cast<std::size_t>(-1);
+      double value = 0;
+      out[k] = per_epoch_of<Acc>(n, by, true, [&](std::size_t i) {
+        if (!held || i >= a.LN) return angle(i);
+        const std::size_t j = i / a.step;
+        if (j != last) {
+          last = j;
+          value = angle(i);
+        }
+        return value;
       });
     } else if (nm == "ENMO") {
       out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) {
