@@ -36,6 +36,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -161,7 +162,22 @@ void apply_calibration(const Calibration& c, double* x, double* y, double* z, T&
     for (std::size_t i = 0; i < n; ++i) p[i] = (p[i] + o) / s;
     if (c.temp && have_t) {
       const double m = c.meantemp, to = c.inv_tempoffset[a];
-      for (std::size_t i = 0; i < n; ++i) p[i] = p[i] + (t(i) - m) / to;
+      // a temperature holds for a page: its term is computed once per value
+      // (the same operands, the same bits)
+      std::uint64_t last = 0;
+      bool have = false;
+      double term = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double ti = t(i);
+        std::uint64_t bits;
+        std::memcpy(&bits, &ti, sizeof bits);
+        if (!have || bits != last) {
+          term = (ti - m) / to;
+          last = bits;
+          have = true;
+        }
+        p[i] = p[i] + term;
+      }
     }
   }
 }
@@ -201,12 +217,31 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
     auto it = std::lower_bound(win.begin(), win.end(), a);
     win.erase(it);
   };
+  // the window slides: the value leaving is found (the first equal, as
+  // drop() finds it) and the one entering takes its place, moved to where
+  // add() would put it (after its equals): the same window, one shift
+  auto slide = [&](double o, double a) {
+    if (std::isnan(o) || std::isnan(a)) {
+      drop(o);
+      add(a);
+      return;
+    }
+    std::size_t pos = static_cast<std::size_t>(std::lower_bound(win.begin(), win.end(), o) - win.begin());
+    while (pos > 0 && win[pos - 1] > a) {
+      win[pos] = win[pos - 1];
+      --pos;
+    }
+    while (pos + 1 < win.size() && win[pos + 1] <= a) {
+      win[pos] = win[pos + 1];
+      ++pos;
+    }
+    win[pos] = a;
+  };
   for (std::size_t i = 0; i < k; ++i) add(v[i]);
   for (std::size_t c = m;; ++c) {
     out[c] = nans ? kNaN : win[m];
     if (c + m + 1 >= N) break;
-    drop(v[c - m]);
-    add(v[c + m + 1]);
+    slide(v[c - m], v[c + m + 1]);
   }
 }
 
@@ -368,6 +403,14 @@ struct NonwearResult {
 // blocks of at least one window `ws`.
 template <class F>
 inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
+  if (!c.down && c.from >= 1 && c.from == std::floor(c.from) && c.from < 9007199254740992.0) {
+    // a whole start counting up: the indices are from, from + 1, ... (the
+    // sums are exact), those within 1..n
+    const std::int64_t first = static_cast<std::int64_t>(c.from);
+    const std::int64_t last = std::min<std::int64_t>(first + c.n - 1, static_cast<std::int64_t>(n));
+    for (std::int64_t j = first; j <= last; ++j) f(static_cast<std::size_t>(j - 1));
+    return;
+  }
   for (std::int64_t k = 0; k < c.n; ++k) {
     const double d = c.at(k);
     if (d < 0) throw std::runtime_error("negative index in GGIR's non-wear window");
