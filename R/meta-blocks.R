@@ -1,0 +1,472 @@
+# g.getmeta()'s block loop (GGIR's g.getmeta() read block by block): the
+# source with its time-gap filling (meta_source(), meta_clock_table()), the
+# block held in the core (meta_store(), ggir_block_store.hpp), GGIR's
+# decisions per block in R (meta_run()), the first block's start
+# (meta_start(), and the starts of the formats whose first time is in a
+# header: ActiGraph csv, Movisens). The drop-in and its parameters are in
+# R/ggir-part1.R.
+
+# g.getmeta()'s source: the file's native decoder, and for a format whose
+# time gaps GGIR's g.getmeta() fills (with imputeTimegaps) the filling in
+# the decoder (decode_ggir_timegaps.hpp, g.getmeta's mode): with the limit
+# beyond which GGIR imputes whole epochs instead and, for a clock read per
+# sample in a time zone, the zone's shifts of the file's clock
+# (meta_clock_table()), which GGIR's reader applies before the gaps are
+# seen. The file is opened once to learn its start, then again with these.
+meta_source <- function(datafile, p, sf, arg, read_opts) {
+  open <- function(ro) {
+    open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
+                read_opts = ro, arg = arg, part = "getmeta")
+  }
+  src <- open(read_opts)
+  fe <- format_entry(src$format)
+  if (is.null(src$native) || !isTRUE(p$imputeTimegaps) || !isTRUE(fe$ggir_timegaps)) {
+    return(src)
+  }
+  ro <- c(read_opts, list(getmeta_timegaps = 1,
+                          getmeta_gap_limit = max(c(((p$windowsizes[2] / 60) * 6), 90))))
+  zone <- if (length(p$configtz)) p$configtz else p$desiredtz
+  start <- src$info$start_time
+  tab <- if (identical(fe$local_clock, "sample") && !isFALSE(fe$ggir_time) &&
+             is.numeric(start) && length(start) == 1 && is.finite(start)) {
+    meta_clock_table(zone, start)
+  }
+  if (!is.null(tab)) {
+    ro$clock <- tab$text
+    ro$clock_until <- tab$until
+  }
+  gc_decoder_close(src$native$ptr)
+  src <- open(ro)
+  src$getmeta_timegaps <- TRUE
+  src$clock_shifted <- !is.null(tab)
+  src
+}
+
+# The shift GGIR's reader adds to each time of a per-sample clock (the
+# file's clock, read as UTC, read again as the clock time in `zone`), as a
+# table of its changes over `days` from two days before `start`: the zone's
+# offset changes found to the second (UTC instants, at every 10 minutes,
+# then halved), each taking effect at the clock time where the zone's
+# clock first shows it: a clock time that occurs twice (the hour a clock
+# goes back) is read as the later one, a clock time that does not occur
+# (the hour a clock goes forward) with the new offset, as GGIR's .gt3x
+# times show. NULL in UTC. list(text = "second shift ...", until = the
+# table's last second).
+meta_clock_table <- function(zone, start, days = 400) {
+  if (!length(zone) || !nzchar(zone) || zone %in% c("UTC", "GMT")) return(NULL)
+  off <- function(t) {
+    as.POSIXlt(as.POSIXct(t, origin = "1970-01-01", tz = "UTC"), tz = zone)$gmtoff
+  }
+  from <- floor(start / 600) * 600 - 2 * 86400
+  until <- from + (days + 2) * 86400
+  g <- seq(from, until, by = 600)
+  o <- off(g)
+  if (anyNA(o)) abort("The time zone \"", zone, "\" gives no offsets from UTC.")
+  ch <- which(o[-1] != o[-length(o)])
+  at <- vapply(ch, function(i) {
+    lo <- g[i]
+    hi <- g[i + 1]
+    while (hi - lo > 1) {
+      mid <- floor((lo + hi) / 2)
+      if (off(mid) == o[i + 1]) hi <- mid else lo <- mid
+    }
+    hi + min(o[i], o[i + 1])
+  }, 0)
+  list(text = paste(sprintf("%.0f %.0f", c(from, at), -c(o[1], o[ch + 1])), collapse = " "),
+       until = until)
+}
+
+# The block store of meta_run() (gc_meta_store(), ggir_block_store.hpp)
+# and its reader: one of GGIR's blocks appended to it, from a native
+# decoder or from samples in memory (`units` rows a block). `time`: keep a
+# time column (GGIR's time-gap imputation reads it).
+meta_store <- function(src, time) {
+  cols <- if (!is.null(src$native)) {
+    c(temperature = isTRUE(src$native$info$temperature),
+      light = isTRUE(src$native$info$light))
+  } else {
+    c(temperature = !is.null(src$samples$temperature), light = !is.null(src$samples$light))
+  }
+  store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]])
+  want_time <- !isFALSE(format_entry(src$format)$ggir_time)
+  if (!is.null(src$native)) {
+    read <- function() gc_meta_store_read(store, src$native$ptr, src$units, 2^20, want_time)
+  } else {
+    s <- src$samples[!vapply(src$samples, is.null, TRUE)]
+    if (!want_time) s$time <- NULL
+    from <- 0
+    read <- function() {
+      n <- length(s$x)
+      i <- if (from < n) (from + 1):min(n, from + src$units) else integer(0)
+      from <<- from + length(i)
+      gc_meta_store_put(store, meta_rows(s, i), -1)
+    }
+  }
+  list(store = store, read = read, temperature = cols[["temperature"]],
+       light = cols[["light"]], keep_time = time, want_time = want_time)
+}
+
+# Rows `i` of a block (a list of equal-length columns).
+meta_rows <- function(d, i) lapply(d, function(v) v[i])
+
+# g.getmeta()'s loop over the blocks of an open native source (or samples
+# in memory), each block held in the core (meta_store()): R decides what
+# GGIR decides per block (the last block, the start, the gap to the carry,
+# the carry), the core reads, fills, calibrates and computes. `model`: a
+# calibration GGIR's coefficients cannot hold, applied before the epoch
+# signals instead of `cal`: list(K, offset and, for a temperature term,
+# tempoffset and meantemp), the linear model as apply_model() applies it,
+# list(fun) a function of a block's columns giving them calibrated, or
+# list(ggir) a calibration as meta_calibration() gives it, in place of
+# `cal`. With `gradient` (outcome_gradient_spec(): the fit's linear
+# model), also each short epoch's ENMO gradient with respect to the fit's
+# coefficients, from
+# the raw samples of each block (M$enmo_gradient, a matrix; epoch_signals()
+# only: g.getmeta()'s M never has it).
+meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL) {
+  sf <- src$sf
+  ws3 <- p$windowsizes[1]
+  ws2 <- p$windowsizes[2]
+  ws <- p$windowsizes[3]
+  nwc <- meta_nonwear(src, p)
+  tab <- meta_metric_table()
+  asked <- tab$name[vapply(meta_do_name(tab$name), function(nm) isTRUE(p[[nm]]), TRUE)]
+  metnames <- sub("angle_", "angle", asked, fixed = TRUE)
+  filters <- NULL
+  fused <- list(conv = FALSE, rec = FALSE)
+  if (any(asked %in% tab$name[tab$filtered])) {
+    filters <- ggir_filter_coefs(sf, n = p$n, lb = p$lb, hb = p$hb, zc.lb = p$zc.lb,
+                                 zc.hb = p$zc.hb, zc.sb = p$zc.sb, zc.order = p$zc.order)
+    fused <- stats_filter_fused()
+  }
+  fe <- format_entry(src$format)
+  # the time gaps filled by the decoder (meta_source()); its counters, per
+  # block, give GGIR's QClog
+  impute <- isTRUE(src$getmeta_timegaps)
+  counters <- function() {
+    k <- src$report()$counters
+    g <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+    c(read = g("timegap_rows_read"), gaps = g("timegaps_imputed"), rows = g("timegap_rows"),
+      over = g("timegaps_over_limit"), longest = g("timegap_longest_rows"),
+      missing = g("clock_time_missing"), exceeded = g("clock_table_exceeded"))
+  }
+  before <- if (impute) counters()
+  ms <- meta_store(src, time = FALSE)
+  store <- ms$store
+  short <- list()   # per metric, the blocks' rounded epoch values
+  grads <- list()
+  long <- list()
+  filetooshort <- filecorrupt <- FALSE
+  carry <- 0        # rows carried from the block before
+  carry_time <- NA_real_  # the carry's last time stamp (desiredtz's clock)
+  starttime <- NULL
+  wday <- wdayname <- NULL
+  light.available <- use.temp <- FALSE
+  metricnames_long <- NULL
+  short_rows <- src$short_rows %||% 0
+  zone <- if (length(p$configtz)) p$configtz else p$desiredtz
+  clock <- fe$local_clock
+  i <- 1
+  LD <- 2
+  QClog <- NULL
+  while (LD > 1) {
+    if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
+    info <- ms$read()
+    nr <- info$n
+    if (impute) {
+      # GGIR's decisions below take the rows read, before the gaps are filled
+      now <- counters()
+      step <- now - before
+      before <- now
+      nr <- step[["read"]]
+      if (step[["over"]] > 0) {
+        limit <- max(c(((ws2 / 60) * 6), 90))
+        abort("\"", basename(src$filename), "\" has a time gap of ",
+              format(round(now[["longest"]] / sf / 60, 1)),
+              " minutes (idle sleep or no data), longer than GGIR's limit of ", format(limit),
+              " minutes, beyond which GGIR's g.getmeta() imputes whole epochs; gravcal's ",
+              "g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it in R before ",
+              "4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
+      }
+      if (step[["missing"]] > 0) {
+        abort("The recording's clock passes through times that do not exist in the time zone \"",
+              zone, "\" (`configtz`/`desiredtz`).")
+      }
+      if (step[["exceeded"]] > 0) {
+        abort("\"", basename(src$filename), "\" runs more than 400 days from its start: ",
+              "gravcal's g.getmeta() reads a per-sample clock in a time zone for 400 days.")
+      }
+    }
+    # the times GGIR's logic reads: the first read, the last two of the
+    # block, in the zone's clock as GGIR's reader gives them
+    times <- c(info$first_time, info$tail_time[2], info$tail_time[1])
+    if (!ms$want_time || info$n == 0) times[] <- NA_real_
+    if (!is.null(clock) && !is.na(times[1]) && !isTRUE(src$clock_shifted)) {
+      times <- meta_zone_shift(times, zone, per_sample = identical(clock, "sample"))
+    }
+    isLastBlock <- FALSE
+    have <- TRUE
+    if (nr == 0) {
+      isLastBlock <- TRUE
+      if (i == 1) {
+        warning("\nFile empty, possibly corrupt.\n", call. = FALSE)
+        filetooshort <- filecorrupt <- TRUE
+      }
+      have <- FALSE
+    } else if (nr < sf * ws * 2 + 1) {
+      isLastBlock <- TRUE
+      if (i == 1) {
+        have <- FALSE
+        filetooshort <- TRUE
+      }
+    } else if (nr < short_rows) {
+      isLastBlock <- TRUE
+    }
+    if (have && impute) {
+      # GGIR's QClog of the block: its start (the clock's when the file has
+      # no time stamps, as GGIR's), its start plus its rows as its end
+      start <- if (!is.na(times[1])) times[1] else as.numeric(Sys.time())
+      end <- start + info$n
+      QClog <- rbind(QClog, data.frame(imputed = step[["gaps"]] > 0, start = start, end = end,
+                                       blockLengthSeconds = (end - start) / sf,
+                                       timegaps_n = as.integer(step[["gaps"]]),
+                                       timegaps_min = step[["rows"]] / sf / 60))
+    }
+    if (have) {
+      if (i == 1) {
+        light.available <- ms$light
+        use.temp <- ms$temperature
+        if (use.temp && mean(info$head_temp[1:10], na.rm = TRUE) > 50) {
+          warning("temperature value is unreaslistically high (> 50 Celcius) and will not be used.",
+                  call. = FALSE)
+          use.temp <- FALSE
+        }
+        metricnames_long <- c("timestamp", "nonwearscore", "clippingscore",
+                              if (light.available) c("lightmean", "lightpeak"),
+                              if (use.temp) "temperaturemean", "EN")
+      }
+      if (carry > 0 && !is.na(times[1]) && !is.na(carry_time)) {
+        gap <- as.numeric(times[1] - carry_time)
+        if (gap > 3600 * sf) {
+          abort("Time gap observed of more than 1 hour between data chunks for ",
+                basename(src$filename), " (GGIR's g.getmeta() stops here too).")
+        } else if (gap > 3 / sf && gap <= 60 * sf) {
+          gc_meta_store_fill_gap(store, carry, round(gap * sf))
+        }
+      }
+      if (i == 1) {
+        sw <- meta_start(list(time = if (!is.na(times[1])) times[1]), src, p, sf, ws2)
+        starttime <- sw$starttime
+        wday <- sw$wday
+        wdayname <- sw$wdayname
+        if (sw$shift > 1) {
+          k <- min(sw$shift, info$size)
+          gc_meta_store_keep(store, k, info$size - k)
+        }
+      }
+      LD <- gc_meta_store_size(store)
+      if (LD < ws * sf && i == 1) {
+        warning("\nWarning data too short for doing non-wear detection 3\n", call. = FALSE)
+        isLastBlock <- TRUE
+        LD <- 0
+      }
+      if (LD >= ws * sf) {
+        use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
+        # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
+        # may not be whole)
+        n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
+        if (!is.null(gradient)) {
+          grads[[length(grads) + 1]] <- gc_meta_store_gradient(
+            store, n_use, sf, ws3, gradient,
+            gradient$temp && (use.temp || !is.null(model)))
+        }
+        lin <- NULL
+        cal_b <- cal
+        if (!is.null(model$fun)) {
+          d <- model$fun(gc_meta_store_rows(store, 0, n_use))
+          gc_meta_store_set_xyz(store, d$x, d$y, d$z)
+        } else if (!is.null(model$ggir)) {
+          cal_b <- model$ggir
+        } else if (!is.null(model)) {
+          lin <- model
+        }
+        r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
+                                  filters, fused$conv, fused$rec, n_use)
+        for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
+        blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
+        if (light.available) {
+          blk$lightmean <- round(r$lightmean, 4)
+          blk$lightpeak <- round(r$lightpeak, 4)
+        }
+        if (use.temp) blk$temperaturemean <- round(r$temperature, 4)
+        blk$EN <- round(r$en, 4)
+        long[[length(long) + 1]] <- blk
+        # the carry: GGIR's data[(use + 1):LD, ] when more than one row is
+        # left (R's `:` and its index truncation on a use that may not be
+        # whole); its last time stamp for the next block's gap
+        if ((LD - use) > 1) {
+          from <- floor(use + 1) - 1
+          count <- floor(abs(LD - (use + 1)) + 1 + 1.1920928955078125e-07)
+        } else {
+          from <- LD
+          count <- 0
+        }
+        back <- LD - (from + count)
+        carry_time <- if (count > 0 && back < 2) times[3 - back] else NA_real_
+        carry <- gc_meta_store_keep(store, from, count)
+        if (ms$keep_time && carry > 0) {
+          carry_time <- gc_meta_store_rows(store, carry - 1, 1)$time
+        }
+      }
+    } else {
+      LD <- 0
+    }
+    if (isLastBlock) LD <- 0
+    if (ceiling(daylimit) != FALSE && i == ceiling(daylimit)) {
+      LD <- 0
+      if (verbose) cat(paste0("\nstopped reading data because this analysis is limited to ",
+                              ceiling(daylimit), " days\n"))
+    }
+    i <- i + 1
+  }
+  rep <- if (!is.null(src$report)) src$report() else list()
+  if (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0)) {
+    warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
+            unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
+            "reproduced (M$QClog is NULL).", call. = FALSE)
+  }
+  M <- meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
+                   filetooshort, filecorrupt, p, ws3, ws2, QClog)
+  if (!is.null(gradient)) M$enmo_gradient <- do.call(rbind, grads)
+  invisible(M)
+}
+
+# A block's time stamps, from a decoder that reads the file's clock as UTC,
+# as GGIR's reader gives them when it reads that clock in `zone`: moved by
+# the zone's offset at the block's first time (GGIRread converts each
+# block's first time in the zone and counts the samples from there). A
+# whole number of seconds added to times in one binade: the same bits as
+# GGIR's sums.
+# With `per_sample` (lubridate::force_tz() on each time), the offset at
+# each sample: computed for the block's first and last, and for every
+# sample only when those differ (a change of offset within the block).
+meta_zone_shift <- function(time, zone, per_sample = FALSE) {
+  if (!length(time) || identical(zone, "UTC") || identical(zone, "GMT")) return(time)
+  shift <- function(t) {
+    t1 <- floor(t)
+    wall <- format(as.POSIXct(t1, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
+    local <- as.numeric(as.POSIXct(wall, tz = zone))
+    if (anyNA(local)) {
+      abort("The recording's clock time ", wall[is.na(local)][1], " does not exist in the ",
+            "time zone \"", zone, "\" (`configtz`/`desiredtz`).")
+    }
+    local - t1
+  }
+  d <- shift(time[1])
+  if (per_sample && shift(time[length(time)]) != d) d <- shift(time)
+  time + d
+}
+
+# The first block's start: GGIR's get_starttime_weekday_truncdata(), which
+# starts the analysis at the next whole long epoch (the start's seconds
+# rounded up to the next minute).
+meta_start <- function(data, src, p, sf, ws2) {
+  start_meas <- ws2 / 60
+  st <- if (!is.null(data$time)) {
+    as.POSIXlt(data$time[1], tz = p$desiredtz, origin = "1970-01-01")
+  } else if (!is.null(start <- format_entry(src$format)$ggir_start)) {
+    start(src$path, p)
+  } else {
+    abort("\"", basename(src$filename), "\" has no time stamps to start from.")
+  }
+  wday <- st$wday + 1
+  wdayname <- c("Sunday", "Monday", "Tuesday", "Wednesday", "Thursday", "Friday",
+                "Saturday")[wday]
+  secshift <- 60 - st$sec
+  if (secshift == 60) {
+    secshift <- 0
+  } else {
+    st$min <- st$min + 1
+  }
+  minshift <- start_meas - (st$min %% start_meas)
+  if (minshift == start_meas) minshift <- 0
+  shift <- floor((minshift * 60 * sf) + (secshift * sf))
+  st$min <- st$min + minshift
+  st$sec <- 0
+  list(starttime = st, wday = wday, wdayname = wdayname, shift = shift)
+}
+
+# The start of an ActiGraph csv export, as GGIR's g.getstarttime() reads
+# it: "Start Time" and "Start Date" from the header lines below the first,
+# their date order from the first line's "date format" (as read.csv()
+# makes it a column name), read in configtz and given in desiredtz.
+actigraph_csv_start <- function(file, p) {
+  lines <- utils::read.csv(file, nrows = 8, skip = 1)[[1]]
+  field <- function(key) {
+    for (v in vapply(lines[seq_len(min(7, length(lines)))], format, "")) {
+      parts <- strsplit(v, key, fixed = TRUE)[[1]]
+      if (length(parts) > 1) return(gsub(" ", "", parts[2], fixed = TRUE))
+    }
+    abort(key, " not found in the header of \"", basename(file), "\".")
+  }
+  when <- paste0(field("Start Date"), " ", field("Start Time"))
+  top <- colnames(as.matrix(utils::read.csv(file, nrows = 1, skip = 0)))[1]
+  order <- actigraph_date_order(top)
+  if (is.na(order)) abort("The date format of \"", basename(file), "\" is not recognised.")
+  sep <- if (grepl("/", when, fixed = TRUE)) "/" else if (grepl("-", when, fixed = TRUE)) "-" else "."
+  sp <- strsplit(order, "")[[1]]
+  fmt <- paste0("%", sp[1], sep, "%", sp[2], sep, "%", sp[3], " %H:%M:%S")
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  as.POSIXlt(as.POSIXct(when, format = fmt, tz = ctz), tz = p$desiredtz)
+}
+
+# The order of day, month and year that an ActiGraph header's "date format"
+# (M/d/yyyy, dd.MM.yy, yyyy-MMM-d, ...; separators read as dots) gives, in
+# strptime letters ("mdY", "dbY", ...), by GGIR's rules: each order tested
+# by its patterns, the two-digit year given up where the four-digit one
+# matches, the abbreviated month preferred to the numeric. NA when none.
+actigraph_date_order <- function(top) {
+  has <- function(...) as.numeric(length(grep(paste(c(...), collapse = "|"), top)) > 0)
+  f <- c(
+    mdY = has("MM[.]dd[.]yyyy", "M[.]d[.]yyyy", "M[.]dd[.]yyyy", "MM[.]d[.]yyyy"),
+    mdy = has("MM[.]dd[.]yy", "M[.]d[.]yy", "M[.]dd[.]yy", "MM[.]d[.]yy"),
+    bdY = has("MMM[.]dd[.]yyyy", "MMM[.]d[.]yyyy"), bdy = has("MMM[.]dd[.]yy", "MMM[.]d[.]yy"),
+    dmY = has("d[.]M[.]yyyy", "d[.]MM[.]yyyy"), dmy = has("d[.]M[.]yy", "d[.]MM[.]yy"),
+    dbY = has("d[.]MMM[.]yyyy"), dby = has("d[.]MMM[.]yy"),
+    Ymd = has("yyyy[.]M[.]d", "yyyy[.]MM[.]d"), ymd = has("yy[.]M[.]d", "yy[.]MM[.]d"),
+    Ybd = has("yyyy[.]MMM[.]d"), ybd = has("yy[.]MMM[.]d"),
+    Ydm = has("yyyy[.]dd[.]MM", "yyyy[.]d[.]M", "yyyy[.]d[.]MM", "yyyy[.]dd[.]M"),
+    ydm = has("yy[.]dd[.]MM", "yy[.]d[.]M", "yy[.]d[.]MM", "yy[.]dd[.]M"),
+    Ydb = has("yyyy[.]dd[.]MMM", "yyyy[.]d[.]MMM"), ydb = has("yy[.]dd[.]MMM", "yy[.]d[.]MMM"))
+  # for each group of four (numeric and month-name, four- and two-digit
+  # year): drop the two-digit year where the four-digit matches, then the
+  # numeric month where the name matches
+  for (g in list(c("mdY", "mdy", "bdY", "bdy"), c("dmY", "dmy", "dbY", "dby"),
+                 c("Ymd", "ymd", "Ybd", "ybd"), c("Ydm", "ydm", "Ydb", "ydb"))) {
+    if (f[[g[1]]] == 1 && f[[g[2]]] == 1) f[[g[2]]] <- 0
+    if (f[[g[3]]] == 1 && f[[g[4]]] == 1) f[[g[4]]] <- 0
+    if (f[[g[1]]] == 1 && f[[g[3]]] == 1) f[[g[1]]] <- 0
+    if (f[[g[2]]] == 1 && f[[g[4]]] == 1) f[[g[2]]] <- 0
+  }
+  names(f)[which(f == 1)[1]]
+}
+
+# The start of a Movisens recording as GGIR's g.getstarttime() takes it:
+# unisens.xml's timestampStart as unisensR reads it, its clock moved into
+# configtz where given (as lubridate::force_tz() moves it: the same
+# calendar time, read in that zone), given in desiredtz.
+movisens_start <- function(file, p) {
+  if (!requireNamespace("unisensR", quietly = TRUE)) {
+    abort("The start of a Movisens recording as GGIR reads it needs the unisensR ",
+          "package: install.packages(\"unisensR\").")
+  }
+  st <- unisensR::readUnisensStartTime(dirname(file))
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  if (!identical(ctz, "")) {
+    whole <- floor(as.numeric(st))
+    wall <- format(as.POSIXct(whole, origin = "1970-01-01", tz = attr(st, "tzone") %||% ""),
+                   "%Y-%m-%d %H:%M:%S")
+    st <- as.POSIXct(wall, tz = ctz) + (as.numeric(st) - whole)
+  }
+  as.POSIXlt(st, tz = p$desiredtz)
+}
