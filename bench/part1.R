@@ -66,7 +66,10 @@ run <- function(code, file, folder) {
   script <- tempfile(fileext = ".R")
   out <- tempfile("part1-out-")
   writeLines(c(sprintf("f <- %s", deparse(file)), sprintf("d <- %s", deparse(folder)),
-               sprintf("md <- %s", deparse(file.path(out, "output_folder"))), code), script)
+               sprintf("md <- %s", deparse(file.path(out, "output_folder"))),
+               # the folders GGIR::GGIR() makes before it calls g.part1()
+               "for (s in c('meta/basic', 'results/QC')) dir.create(file.path(md, s), recursive = TRUE)",
+               code), script)
   on.exit(unlink(out, recursive = TRUE))
   for (i in 1:2) invisible(readBin(file, "raw", 1))  # in the page cache
   tm <- tempfile()
