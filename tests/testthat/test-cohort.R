@@ -199,20 +199,23 @@ test_that("on Windows a lock's process is looked up in tasklist, never signalled
     lock_stale(owner(pid), host, os = "windows", run = run, signal = signal)
   }
   row <- function(pid) sprintf('"Rterm.exe","%d","Console","1","102,400 K"', pid)
+  # a process id other than this test's own (which is never looked up: a
+  # fresh machine's test process can be 4242)
+  pid <- if (Sys.getpid() == 4242L) 4243L else 4242L
   # running: the lock is kept
-  expect_false(stale(4242L, answer(row(4242L))))
+  expect_false(stale(pid, answer(row(pid))))
   expect_identical(calls[[1]]$command, "tasklist")
-  expect_true("\"PID eq 4242\"" %in% calls[[1]]$args)
+  expect_true(paste0("\"PID eq ", pid, "\"") %in% calls[[1]]$args)
   expect_true(isTRUE(calls[[1]]$stdout))
   # gone: tasklist's message (in any language), or only other processes'
   # rows (4242 is not 42420)
-  expect_true(stale(4242L, answer("INFO: No tasks are running which match the specified criteria.")))
-  expect_true(stale(4242L, answer("INFORMATION: Es werden keine Aufgaben mit den angegebenen Kriterien ausgef\u00fchrt.")))
-  expect_true(stale(4242L, answer(row(42420L))))
+  expect_true(stale(pid, answer("INFO: No tasks are running which match the specified criteria.")))
+  expect_true(stale(pid, answer("INFORMATION: Es werden keine Aufgaben mit den angegebenen Kriterien ausgef\u00fchrt.")))
+  expect_true(stale(pid, answer(row(pid * 10L))))
   # tasklist cannot tell: the lock is kept
-  expect_false(stale(4242L, function(...) stop("'tasklist' not found")))
-  expect_false(stale(4242L, answer("ERROR: Invalid argument/option", status = 1L)))
-  expect_false(stale(4242L, answer(character(0))))
+  expect_false(stale(pid, function(...) stop("'tasklist' not found")))
+  expect_false(stale(pid, answer("ERROR: Invalid argument/option", status = 1L)))
+  expect_false(stale(pid, answer(character(0))))
   # another host's lock, or this process's: tasklist is not asked
   n <- length(calls)
   expect_false(lock_stale(c(pid = "4242", host = "elsewhere"), host, os = "windows",
