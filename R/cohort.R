@@ -202,7 +202,7 @@
 #' dir <- tempfile("cohort")
 #' dir.create(dir)
 #' for (i in 1:2) {
-#'   rec <- simulate_recording(hours = 12, sf = 10, seed = i)
+#'   rec <- simulate_recording(hours = 6, sf = 10, seed = i)
 #'   saveRDS(rec, file.path(dir, sprintf("p%02d.rds", i)))
 #' }
 #' res <- calibrate_files(dir, method = "lightweight",
