@@ -93,7 +93,9 @@ if (length(still)) stop("noLD-R: could not install ", paste(still, collapse = ",
 "$rbin/Rscript" --vanilla -e '
 a <- commandArgs(TRUE)
 if (as.character(utils::packageVersion("testthat")) != a[1]) {
-  install.packages("ellipsis", repos = a[2], quiet = TRUE)  # a dependency of 3.1
+  # dependencies of 3.1 that current testthat no longer imports (a failed
+  # install of the archived version removes the installed testthat)
+  install.packages(c("ellipsis", "digest"), repos = a[2], quiet = TRUE)
   install.packages(sprintf("%s/src/contrib/Archive/testthat/testthat_%s.tar.gz", a[2], a[1]),
                    repos = NULL, type = "source", quiet = TRUE)
 }
