@@ -22,11 +22,15 @@ jobs="${GRAVCAL_NOLD_JOBS:-2}"
 here="$(cd "$(dirname "$0")" && pwd)"
 rbin="$prefix/bin"
 
-if [ ! -x "$rbin/Rscript" ]; then
+# png() is needed (GGIR's part 2 draws its QC plots with it, and so do the
+# epoch tests); built --without-x, R has it only through cairo: an R built
+# here earlier without cairo is rebuilt in place (its library is kept)
+png_ok() { [ "$("$rbin/Rscript" -e 'cat(capabilities("png"))' 2>/dev/null)" = TRUE ]; }
+if [ ! -x "$rbin/Rscript" ] || ! png_ok; then
   start=$(date +%s)
   if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
     need="gfortran libreadline-dev libpcre2-dev libbz2-dev liblzma-dev
-zlib1g-dev libcurl4-openssl-dev libicu-dev make"
+zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev"
     missing=""
     for p in $need; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
     if [ -n "$missing" ]; then
@@ -63,6 +67,10 @@ zlib1g-dev libcurl4-openssl-dev libicu-dev make"
   echo "noLD-R: R $rver built in $(( $(date +%s) - start )) s"
 fi
 
+if ! png_ok; then
+  echo "noLD-R: $rbin/R has no png() device (configure found no cairo: $prefix.src/configure.log)" >&2
+  exit 1
+fi
 ld=$("$rbin/Rscript" -e 'cat(capabilities("long.double"))')
 if [ "$ld" != "FALSE" ]; then
   echo "noLD-R: $rbin/R has long double (capabilities(\"long.double\") is $ld)" >&2
