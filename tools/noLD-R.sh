@@ -23,14 +23,19 @@ here="$(cd "$(dirname "$0")" && pwd)"
 rbin="$prefix/bin"
 
 # png() is needed (GGIR's part 2 draws its QC plots with it, and so do the
-# epoch tests); built --without-x, R has it only through cairo: an R built
-# here earlier without cairo is rebuilt in place (its library is kept)
-png_ok() { [ "$("$rbin/Rscript" -e 'cat(capabilities("png"))' 2>/dev/null)" = TRUE ]; }
+# epoch tests); built --without-x, R has it only through cairo, and png()'s
+# default type (the option bitmapType) is "cairo" only with pango's cairo
+# (else "Xlib": "X11 is not available", though capabilities("png") is
+# TRUE): an R built here earlier without them is rebuilt in place (its
+# library is kept)
+png_ok() {
+  [ "$("$rbin/Rscript" --vanilla -e 'p <- tempfile(fileext = ".png"); ok <- !inherits(try(grDevices::png(p), silent = TRUE), "try-error"); if (ok) invisible(grDevices::dev.off()); cat(ok)' 2>/dev/null)" = TRUE ]
+}
 if [ ! -x "$rbin/Rscript" ] || ! png_ok; then
   start=$(date +%s)
   if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
     need="gfortran libreadline-dev libpcre2-dev libbz2-dev liblzma-dev
-zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev"
+zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev libpango1.0-dev"
     missing=""
     for p in $need; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
     if [ -n "$missing" ]; then
@@ -68,7 +73,7 @@ zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev"
 fi
 
 if ! png_ok; then
-  echo "noLD-R: $rbin/R has no png() device (configure found no cairo: $prefix.src/configure.log)" >&2
+  echo "noLD-R: png() fails in $rbin/R (configure found no cairo or pango: $prefix.src/configure.log)" >&2
   exit 1
 fi
 ld=$("$rbin/Rscript" -e 'cat(capabilities("long.double"))')
