@@ -274,8 +274,9 @@ clean:
 # GGIR's own numbers (NOLD_TESTS, tools/run-tests.R's filter)
 NOLD_TESTS ?= ggir|ggir-params|ggir-interpolation|ggir-stress|ggir-getmeta|ggir-filters|ggir-part1|epochs|meta-store|fit-icp|decode-.*|windows|adhoc-csv|axivity-csv|read|simd|fp-build|noLD
 test-noLD:
-	@bin=$$(bash tools/noLD-R.sh | tail -1) && \
-	mkdir -p $(BUILD)/lib-noLD && \
+	@mkdir -p $(BUILD)/lib-noLD && \
+	bin=$$(bash tools/noLD-R.sh | tee $(BUILD)/noLD-R.log | tail -1) && \
+	{ [ -x "$$bin/Rscript" ] || { echo "test-noLD: tools/noLD-R.sh failed (its output: $(BUILD)/noLD-R.log)" >&2; exit 1; }; } && \
 	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-noLD . > $(BUILD)/install-noLD.log 2>&1 || \
 	  { cat $(BUILD)/install-noLD.log; exit 1; }; } && \
 	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-noLD)" R_LIBS_USER="$(abspath $(BUILD)/lib-noLD)" \

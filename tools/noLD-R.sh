@@ -22,11 +22,20 @@ jobs="${GRAVCAL_NOLD_JOBS:-2}"
 here="$(cd "$(dirname "$0")" && pwd)"
 rbin="$prefix/bin"
 
-if [ ! -x "$rbin/Rscript" ]; then
+# png() is needed (GGIR's part 2 draws its QC plots with it, and so do the
+# epoch tests); built --without-x, R has it only through cairo, and png()'s
+# default type (the option bitmapType) is "cairo" only with pango's cairo
+# (else "Xlib": "X11 is not available", though capabilities("png") is
+# TRUE): an R built here earlier without them is rebuilt in place (its
+# library is kept)
+png_ok() {
+  [ "$("$rbin/Rscript" --vanilla -e 'p <- tempfile(fileext = ".png"); ok <- !inherits(try(grDevices::png(p), silent = TRUE), "try-error"); if (ok) invisible(grDevices::dev.off()); cat(ok)' 2>/dev/null)" = TRUE ]
+}
+if [ ! -x "$rbin/Rscript" ] || ! png_ok; then
   start=$(date +%s)
   if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
     need="gfortran libreadline-dev libpcre2-dev libbz2-dev liblzma-dev
-zlib1g-dev libcurl4-openssl-dev libicu-dev make"
+zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev libpango1.0-dev"
     missing=""
     for p in $need; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
     if [ -n "$missing" ]; then
@@ -63,6 +72,10 @@ zlib1g-dev libcurl4-openssl-dev libicu-dev make"
   echo "noLD-R: R $rver built in $(( $(date +%s) - start )) s"
 fi
 
+if ! png_ok; then
+  echo "noLD-R: png() fails in $rbin/R (configure found no cairo or pango: $prefix.src/configure.log)" >&2
+  exit 1
+fi
 ld=$("$rbin/Rscript" -e 'cat(capabilities("long.double"))')
 if [ "$ld" != "FALSE" ]; then
   echo "noLD-R: $rbin/R has long double (capabilities(\"long.double\") is $ld)" >&2
@@ -93,7 +106,9 @@ if (length(still)) stop("noLD-R: could not install ", paste(still, collapse = ",
 "$rbin/Rscript" --vanilla -e '
 a <- commandArgs(TRUE)
 if (as.character(utils::packageVersion("testthat")) != a[1]) {
-  install.packages("ellipsis", repos = a[2], quiet = TRUE)  # a dependency of 3.1
+  # dependencies of 3.1 that current testthat no longer imports (a failed
+  # install of the archived version removes the installed testthat)
+  install.packages(c("ellipsis", "digest"), repos = a[2], quiet = TRUE)
   install.packages(sprintf("%s/src/contrib/Archive/testthat/testthat_%s.tar.gz", a[2], a[1]),
                    repos = NULL, type = "source", quiet = TRUE)
 }
