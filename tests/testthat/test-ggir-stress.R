@@ -483,7 +483,13 @@ test_that("temperature check: sd within rounding of 0.01, first values at 120", 
       expect_lt(abs(s - thr), if (is.null(cs$centre)) 6 * u else 40 * u,
                 label = nm)
       if (!identical(cs$runs, 0) && is.null(cs$centre)) {
-        expect_identical(s, cs$target, label = nm)
+        if (capabilities("long.double")) {
+          expect_identical(s, cs$target, label = nm)
+        } else {
+          # R's double accumulator cannot reach every ulp near 0.01: the
+          # case stays on its side of the threshold
+          expect_identical(sign(s - thr), sign(cs$target - thr), label = nm)
+        }
       }
     } else {
       m <- mean(tt[cs$first - 1 + 1:10])
