@@ -257,7 +257,6 @@ class BlockStore {
   // (and room for two reads more).
   std::size_t read(Decoder& d, std::int64_t units, std::size_t chunk, bool want_time) {
     if (chunk == 0) throw std::invalid_argument("chunk must be positive");
-    const std::size_t before = n_;
     first_time_ = nan();
     std::int64_t left = units;
     const bool ask_time = want_time && d.info().has_time;
