@@ -25,6 +25,9 @@
 #   reader gives no time stamps (as POSIXlt in desiredtz);
 # * ggir_time: FALSE where GGIR's reader gives no time stamps although the
 #   native decoder does (g.getmeta() drops them);
+# * ggir_inspect(file, tz): GGIR's g.inspectfile() result for the file,
+#   built without GGIR's whole-file reads (R/ggir-inspect.R), or NULL where
+#   GGIR's own function must give it;
 # * ggir_timegaps: GGIR's g.getmeta() fills the recording's time gaps
 #   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
 # * own_rate: TRUE for a device format whose file records its sampling
@@ -115,6 +118,7 @@ recording_formats <- list(
     ext = c(gt3x = ".gt3x"), detect = NULL,
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     local_clock = "sample", ggir_timegaps = TRUE,
+    ggir_inspect = function(file, tz) ggir_inspect_gt3x(file, tz),
     block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),

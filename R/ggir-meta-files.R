@@ -3,8 +3,9 @@
 # parts 2-5 read, with the objects GGIR 3.3-9's g.part1() saves. The
 # calibration is gravcal's g.calibrate() (R/ggir-drop-in.R), the epoch
 # signals gravcal's g.getmeta() (R/ggir-part1.R); `I` is GGIR's own
-# g.inspectfile() (exported), so GGIR must be installed, as it must be for
-# parts 2-5.
+# g.inspectfile() (exported), or its result built by gravcal where GGIR's
+# reads the whole file (R/ggir-inspect.R), so GGIR must be installed, as it
+# must be for parts 2-5.
 
 #' GGIR part 1 on gravcal's core: the meta files for GGIR's parts 2-5
 #'
@@ -18,7 +19,11 @@
 #'
 #' * `I`: `GGIR::g.inspectfile()`'s result for the file (GGIR's own function,
 #'   called with `desiredtz`, `params_rawdata` and `configtz` as GGIR's
-#'   part 1 calls it);
+#'   part 1 calls it). For a `.gt3x` file gravcal builds the same list itself:
+#'   GGIR's function unzips and decodes the whole file for it (on a week at
+#'   100 Hz, 15 s and 1.9 GB of memory), gravcal reads only its `info.txt`
+#'   and hands it to `read.gt3x::parse_gt3x_info()`. Unlike GGIR's, it
+#'   never renames a `.GT3X` file to `.gt3x`;
 #' * `C`: the calibration, [g.calibrate()] (gravcal's, identical to GGIR's
 #'   but for the wall-clock record `bsc_qc`) when `do.cal = TRUE`, no
 #'   coefficients are retrieved and `I` has a sampling rate; else GGIR's
@@ -407,9 +412,7 @@ part1_retrieve <- function(C, file, fname) {
 part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose) {
   if (isTRUE(pg[["print.filename"]]) && verbose) cat(paste0("\nFile name: ", fnames[i]))
   datafile <- as.character(fnamesfull[i])
-  I <- keep_warn_option(GGIR::g.inspectfile(datafile, desiredtz = pg[["desiredtz"]],
-                                            params_rawdata = pr,
-                                            configtz = pg[["configtz"]]))
+  I <- part1_inspect(datafile, pg[["desiredtz"]], pr, pg[["configtz"]])
   if (verbose) cat(paste0("\nP1 file ", i))
   # backup.cal.coef: "retrieve" is part 2's report when there is one,
   # "redo" none; a path is the file

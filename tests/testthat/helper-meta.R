@@ -20,7 +20,10 @@ write_meta_recording <- function(file, format, sf, hours, seed, start) {
     rec$z[i] <- 0.99 + stats::rnorm(length(i), 0, 0.001)
   }
   rec$x[round(0.8 * n) + 0:40] <- 7.9
-  if (format == "cwa") {
+  if (format == "gt3x") {
+    gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), file, sf = sf,
+                         start = as.POSIXct(start, tz = "UTC"))
+  } else if (format == "cwa") {
     gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file, sf = sf,
                         start = as.numeric(rec$time[1]), temperature = rec$temperature)
   } else {

@@ -40,6 +40,18 @@ p1_folder <- function() {
   p1_state$dir
 }
 
+# A folder of one ActiGraph .gt3x recording of 26 hours at 30 Hz, of the
+# same kind. Made once a session.
+p1_folder_gt3x <- function() {
+  if (is.null(p1_state$gt3x) || !dir.exists(p1_state$gt3x)) {
+    d <- tempfile("part1-gt3x-")
+    dir.create(d)
+    write_meta_recording(file.path(d, "g01.gt3x"), "gt3x", 30, 26, 23, "2024-03-06 11:00:00")
+    p1_state$gt3x <- d
+  }
+  p1_state$gt3x
+}
+
 # The objects of the meta files (or ms2.out files) in `folder`, by file,
 # with M's and C's bsc_qc (wall-clock times and memory) replaced by their
 # column names.
@@ -82,9 +94,9 @@ p1_run <- function(fun, datadir, outputdir, args) {
 # GGIR's part 1 (then part 2 and part 1 again, which retrieves the
 # coefficients from part 2's report, when `then_part2`) and gravcal's on the
 # folder with the same arguments.
-p1_both <- function(args, then_part2 = FALSE, backup = NULL) {
+p1_both <- function(args, then_part2 = FALSE, backup = NULL, folder = p1_folder) {
   skip_if_not_installed("GGIR")
-  d <- p1_folder()
+  d <- folder()
   files <- file.path(d, dir(d))
   # a coefficient file given as its rows: the cache key holds them, not a
   # temporary path
@@ -160,6 +172,22 @@ test_that("g.part1() writes GGIR's meta files; GGIR's part 2 gives the same on t
   expect_same_objects(b$gravcal$again, b$ggir$again, "part 1 again")
   # (through the csv's 15 significant digits)
   expect_equal(b$gravcal$again[["meta_p01.cwa.RData"]]$C$scale, obj$C$scale, tolerance = 1e-14)
+})
+
+test_that("g.part1() on a .gt3x file: GGIR's meta file (its I without GGIR's whole-file reads)", {
+  skip_if_quick()
+  skip_if_not_installed("read.gt3x")
+  b <- p1_both(list(do.parallel = FALSE, desiredtz = "Europe/Amsterdam", f1 = 1),
+               then_part2 = TRUE, folder = p1_folder_gt3x)
+  expect_identical(names(b$ggir$part1), "meta_g01.gt3x.RData")
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  obj <- b$gravcal$part1[[1]]
+  expect_identical(obj$I$sf, 30)
+  expect_gt(obj$C$npoints, 1000)
+  expect_true(any(obj$M$metalong$nonwearscore > 0))
+  expect_same_objects(b$gravcal$part2$ms2, b$ggir$part2$ms2, "part 2 ms2.out")
+  expect_identical(b$gravcal$part2$csv, b$ggir$part2$csv)
+  expect_same_objects(b$gravcal$again, b$ggir$again, "part 1 again")
 })
 
 test_that("g.part1() is GGIR's with backup.cal.coef (a file with one recording), desiredtz", {

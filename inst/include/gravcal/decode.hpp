@@ -211,6 +211,9 @@ struct DeviceInfo {
   // and GENEActiv .bin; its units are the format decoder's (see there)
   bool has_light = false;
   double range_g = std::numeric_limits<double>::quiet_NaN();  // +- full scale, g
+  // the file's own text header, as stored, where the format has one (.gt3x:
+  // info.txt; at most gt3x::kMaxInfo bytes); "" otherwise
+  std::string header_text;
 };
 
 // What was read and what was skipped, and why. Counters have names chosen by

@@ -597,6 +597,7 @@ class Gt3xDecoder : public Decoder {
     gt3x::Info info;
     info.parse(text);
     if (!take_info(info)) return false;
+    info_.header_text = text;
     const bool use_activity =
         z.activity.found && (old_ || !z.log.found);
     if (!use_activity && !z.log.found) {
