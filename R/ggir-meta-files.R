@@ -91,7 +91,7 @@
 #' | `use_trycatch_serial` | whether a file's error stops the run | honoured (see above) |
 #' | `do.parallel`, `maxNcores` | GGIR runs files in parallel on 4 or more cores, and then lowers `chunksize` to 0.5 (3-5 metrics) or 0.4 (6 or more), which changes `M` | the files run on the session's future plan (see above); `chunksize` lowered as GGIR would lower it on this machine, so `M` is GGIR's |
 #' | `recordingEndSleepHour` (`expand_tail_max_hours`), `dayborder` | `M` expanded past the recording's end to 8 hours past the next day border when the recording ends late enough; `tail_expansion_log` | honoured |
-#' | `myfun` | an external function's values in `M` | refused: an error (g.getmeta()) |
+#' | `myfun` | an external function's values in `M` | honoured (see [g.getmeta()]) |
 #' | `dataFormat`, `maxRecordingInterval`, `recording_split_*` | read by `GGIR::GGIR()` around part 1, not by g.part1() | no effect |
 #'
 #' Beyond GGIR's g.part1(): when `metadatadir` is not given, it is
@@ -105,7 +105,8 @@
 #' @param f0,f1 The first and last file (by their place in the list) to
 #'   do; `f1 = c()` or 0: up to the last (GGIR's g.part1() warns on 0, as
 #'   this does).
-#' @param myfun Not supported: an error when given.
+#' @param myfun GGIR's external function object: its values become columns
+#'   of `M$metashort` (see [g.getmeta()]).
 #' @param params_metrics,params_rawdata,params_cleaning,params_general
 #'   GGIR's parameter lists (as from `GGIR::load_params()`); missing entries
 #'   take GGIR's defaults.
@@ -134,10 +135,6 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
         "its g.inspectfile() makes the meta file's `I`, and its parts 2-5 read the files"
       } else "GGIR reads coefficient files with it", "): install.packages(\"", pkg, "\").")
     }
-  }
-  if (length(myfun)) {
-    abort("`myfun`: an external function per block is not supported by gravcal's ",
-          "g.part1() yet; use GGIR::g.part1() for it.")
   }
   outputdir <- input$outputdir
   studyname <- input$studyname
@@ -174,7 +171,8 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
   pg <- p$params_general
   if (length(f1) && isTRUE(f1 == 0)) warning("\nWarning: f1 = 0 is not a meaningful value")
   # the parameters g.getmeta() reads, checked before any file is read
-  meta_params(pm, pr, pg, pc, list())
+  mp <- meta_params(pm, pr, pg, pc, list())
+  myfun <- if (length(myfun)) meta_myfun_check(myfun, mp$windowsizes[1])
 
   files <- part1_files(datadir, filelist)
   fnames <- files$fnames
@@ -256,7 +254,7 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
   worker <- function(i, p) {
     if (verbose) cat(paste0(i, " "))
     t0 <- proc.time()[["elapsed"]]
-    res <- part1_one(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose)
+    res <- part1_one(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose, myfun)
     saveRDS(list(message = res, seconds = proc.time()[["elapsed"]] - t0), slot(i))
     if (!is.null(p)) p(message = fnames[i])
     invisible(NULL)
@@ -409,7 +407,8 @@ part1_retrieve <- function(C, file, fname) {
 # One recording: I, C, M, then the meta file (written to a hidden name in
 # the folder and renamed, so that an interrupted run leaves no half file).
 # Returns the calibration's QC message.
-part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose) {
+part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbose,
+                      myfun = NULL) {
   if (isTRUE(pg[["print.filename"]]) && verbose) cat(paste0("\nFile name: ", fnames[i]))
   datafile <- as.character(fnamesfull[i])
   I <- part1_inspect(datafile, pg[["desiredtz"]], pr, pg[["configtz"]])
@@ -466,7 +465,7 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
   M <- g.getmeta(datafile, params_metrics = pm, params_rawdata = pr, params_general = pg,
                  params_cleaning = pc, daylimit = FALSE, tempoffset = tempoffset,
                  scale = C$scale, offset = C$offset, meantempcal = C$meantempcal,
-                 inspectfileobject = I, verbose = verbose)
+                 myfun = myfun, inspectfileobject = I, verbose = verbose)
   tail_expansion_log <- NULL
   if (!is.null(pg[["recordingEndSleepHour"]])) {
     ex <- part1_expand_tail(M, pg[["recordingEndSleepHour"]], pg[["dayborder"]],

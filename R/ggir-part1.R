@@ -29,8 +29,18 @@
 #' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
 #' LFEN, the per-axis filtered signals and zero crossings) need the signal
 #' package, as GGIR does. Non-wear: `nonwear_approach` "2013" and "2023".
-#' Anything else GGIR's g.getmeta() would compute (`myfun`, another
-#' format) is an error naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
+#' `myfun` (GGIR's external function object: `FUN`, `parameters`,
+#' `expected_sample_rate`, `expected_unit`, `colnames`, `minlength`,
+#' `outputres`, `outputtype`, `aggfunction`, `timestamp`): run in R on each
+#' block's calibrated samples as GGIR runs it (in the unit and at the rate it
+#' expects, resampled by GGIRread's resampler; time stamps from the
+#' recording's start, as GGIR gives them to every block; its output
+#' aggregated with `aggfunction` or repeated to the short epoch), its
+#' columns added to `metashort` through R's text as GGIR adds them; blocks
+#' cut to a whole `minlength`. `outputtype` must be "numeric" or
+#' "character" (GGIR stops without it).
+#' Anything else GGIR's g.getmeta() would compute (another format) is an
+#' error naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
 #' wall-clock times and memory); GGIR shrinks its blocks when its own R
 #' session holds over 4000 MB, which gravcal's reading never makes it do.
 #'
@@ -41,7 +51,8 @@
 #' @param daylimit Stop after this many blocks (GGIR's; `FALSE`: none).
 #' @param offset,scale,tempoffset,meantempcal The calibration, as
 #'   [g.calibrate()] returns it (`meantempcal`: its `meantempcal`).
-#' @param myfun Not supported yet: an error when given.
+#' @param myfun GGIR's external function object (see "What this version
+#'   covers"), or empty.
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
 #'   `sf` must agree with the file.
 #' @param verbose Print the blocks read, as GGIR does.
@@ -59,10 +70,7 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   p <- meta_params(params_metrics, params_rawdata, params_general, params_cleaning,
                    list(...))
   check_flag(verbose, "verbose")
-  if (length(myfun)) {
-    abort("`myfun`: an external function per block is not supported by gravcal's ",
-          "g.getmeta() yet; use GGIR::g.getmeta() for it.")
-  }
+  myfun <- if (length(myfun)) meta_myfun_check(myfun, p$windowsizes[1])
   cal <- meta_calibration(offset, scale, tempoffset, meantempcal)
   check_fp_build("`g.getmeta()`")
   tz <- if (length(p$configtz)) p$configtz else p$desiredtz
@@ -86,7 +94,7 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
-  meta_run(src, p, cal, daylimit, verbose)
+  meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
 }
 
 # The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).
@@ -254,7 +262,8 @@ meta_nonwear <- function(src, p) {
 # matrices hold them (R's text of each number, read back), time stamps in
 # desiredtz.
 meta_result <- function(short, long, metnames, metricnames_long, starttime, wday, wdayname,
-                        filetooshort, filecorrupt, p, ws3, ws2, QClog) {
+                        filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun = NULL,
+                        myfun_acc = NULL) {
   via_text <- function(v) as.numeric(as.character(v))
   bsc_qc <- data.frame(time = format(Sys.time()), size = gc()[2, 2], stringsAsFactors = FALSE)
   if (filecorrupt || filetooshort) {
@@ -275,6 +284,10 @@ meta_result <- function(short, long, metnames, metricnames_long, starttime, wday
   ms <- data.frame(timestamp = stamp(n_short, ws3, 1), stringsAsFactors = FALSE)
   for (k in seq_along(metnames)) {
     ms[[metnames[k]]] <- via_text(unlist(short[[k]], use.names = FALSE))
+  }
+  if (!is.null(myfun)) {
+    cols <- meta_myfun_columns(myfun_acc, n_short, myfun)
+    for (nm in names(cols)) ms[[nm]] <- cols[[nm]]
   }
   cols_long <- metricnames_long[-1]
   n_long <- sum(vapply(long, function(b) length(b$nonwearscore), 0))

@@ -123,7 +123,8 @@ meta_rows <- function(d, i) lapply(d, function(v) v[i])
 # coefficients, from
 # the raw samples of each block (M$enmo_gradient, a matrix; epoch_signals()
 # only: g.getmeta()'s M never has it).
-meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL) {
+meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL,
+                     myfun = NULL) {
   sf <- src$sf
   ws3 <- p$windowsizes[1]
   ws2 <- p$windowsizes[2]
@@ -154,6 +155,8 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   ms <- meta_store(src, time = FALSE)
   store <- ms$store
   short <- list()   # per metric, the blocks' rounded epoch values
+  n_short <- 0      # short epochs so far
+  myfun_acc <- NULL # the myfun columns as GGIR's metashort text (meta_myfun_put())
   grads <- list()
   long <- list()
   filetooshort <- filecorrupt <- FALSE
@@ -271,7 +274,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         LD <- 0
       }
       if (LD >= ws * sf) {
-        use <- (floor(LD / (ws2 * sf))) * (ws2 * sf)
+        use <- meta_myfun_use((floor(LD / (ws2 * sf))) * (ws2 * sf), myfun)
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
         # may not be whole)
         n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
@@ -290,9 +293,17 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         } else if (!is.null(model)) {
           lin <- model
         }
+        if (!is.null(myfun)) {
+          xyz <- meta_myfun_xyz(gc_meta_store_rows(store, 0, n_use), cal, use.temp)
+          myfun_acc <- meta_myfun_put(myfun_acc, n_short + 1,
+                                      meta_myfun_block(xyz, myfun, sf, ws3, starttime,
+                                                       p$interpolationType))
+          rm(xyz)
+        }
         r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
                                   filters, fused$conv, fused$rec, n_use)
         for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
+        n_short <- n_short + length(r$short[[1]])
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
         if (light.available) {
           blk$lightmean <- round(r$lightmean, 4)
@@ -336,7 +347,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
             "reproduced (M$QClog is NULL).", call. = FALSE)
   }
   M <- meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
-                   filetooshort, filecorrupt, p, ws3, ws2, QClog)
+                   filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun, myfun_acc)
   if (!is.null(gradient)) M$enmo_gradient <- do.call(rbind, grads)
   invisible(M)
 }

@@ -21,7 +21,13 @@ meta_both <- function(file, args = list()) {
     nm <- paste0("params_", k)
     args[[nm]] <- utils::modifyList(defaults[[nm]], args[[nm]] %||% list())
   }
-  R <- ggir_cached("g.getmeta", file, args, {
+  # a myfun's functions enter the cache key as their text (a closure's
+  # serialization holds its environment)
+  key <- args
+  if (!is.null(key$myfun)) {
+    key$myfun <- lapply(key$myfun, function(v) if (is.function(v)) deparse(v) else v)
+  }
+  R <- ggir_cached("g.getmeta", file, key, {
     I <- meta_quiet(GGIR::g.inspectfile(file, params_rawdata = args$params_rawdata,
                                         params_general = args$params_general))
     meta_quiet(do.call(GGIR::g.getmeta, c(list(datafile = file, inspectfileobject = I,
@@ -110,9 +116,82 @@ test_that("g.getmeta() is GGIR's without calibration, for a daylimit, and on a f
   expect_true(b$gravcal$filetooshort)
 })
 
+# Three external functions of GGIR's myfun kind: a mean norm per second in
+# mg, averaged to the epoch; two axes every 15 s at 10 Hz (resampled from
+# the file's 25), with time stamps, repeated over the epochs; a posture as
+# text per epoch, in m/s^2.
+meta_myfuns <- function() {
+  list(
+    per_second = list(
+      FUN = function(data, parameters) {
+        en <- sqrt(rowSums(data[, 1:3]^2))
+        n <- floor(length(en) / 25)
+        matrix(colMeans(matrix(en[seq_len(n * 25)], 25)) * parameters, ncol = 1)
+      },
+      parameters = 2, expected_sample_rate = 25, expected_unit = "mg", colnames = "meanEN",
+      minlength = 1, outputres = 1, outputtype = "numeric", aggfunction = mean),
+    stamped = list(
+      FUN = function(data, parameters) {
+        i <- seq(1, floor(nrow(data) / 150) * 150, by = 150)
+        cbind(a = data[i, 2] / 3, b = data[i, 1] - data[1, 1])
+      },
+      parameters = NULL, expected_sample_rate = 10, expected_unit = "g",
+      colnames = c("t3", "dt"), minlength = 15, outputres = 15, outputtype = "numeric",
+      timestamp = TRUE),
+    posture = list(
+      FUN = function(data, parameters) {
+        i <- seq(1, floor(nrow(data) / 125) * 125, by = 125)
+        ifelse(data[i, 3] > 0.5, "up", "down")
+      },
+      parameters = NULL, expected_sample_rate = 25, expected_unit = "ms2", colnames = "pos",
+      minlength = 5, outputres = 5, outputtype = "character"))
+}
+
+test_that("g.getmeta() runs an external function (myfun) as GGIR runs it", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  # two blocks (30 hours), calibrated with a temperature term
+  f <- meta_recording("cwa", 25, 30, seed = 13)
+  fns <- meta_myfuns()
+  got <- list()
+  for (nm in names(fns)) {
+    b <- meta_both(f, c(cal_args, list(myfun = fns[[nm]])))
+    got[[nm]] <- b$gravcal
+    expect_same_meta(b)
+    cols <- fns[[nm]]$colnames
+    expect_identical(utils::tail(names(b$gravcal$metashort), length(cols)), cols)
+    v <- b$gravcal$metashort[[cols[1]]]
+    expect_true(sum(!is.na(v)) > 300, label = paste(nm, "has values"))
+  }
+  # dt: the time stamps the function was given, from its block's first, one
+  # value every 15 s repeated over the three 5 s epochs
+  expect_identical(got$stamped$metashort$dt[1:7], c(0, 0, 0, 15, 15, 15, 30))
+  expect_identical(typeof(got$posture$metashort$pos), "character")
+  expect_setequal(unique(got$posture$metashort$pos), c("up", "down"))
+})
+
+test_that("a myfun GGIR would stop on is an error naming what is wrong", {
+  f <- meta_recording("cwa", 25, 3, seed = 12)
+  mf <- meta_myfuns()$per_second
+  bad <- function(...) utils::modifyList(mf, list(...))
+  expect_error(gravcal::g.getmeta(f, myfun = list(FUN = mean), verbose = FALSE),
+               "`myfun`: lacks `parameters`")
+  expect_error(gravcal::g.getmeta(f, myfun = c(mf, list(extra = 1)), verbose = FALSE),
+               "unexpected element `extra`")
+  expect_error(gravcal::g.getmeta(f, myfun = bad(expected_unit = "kg"), verbose = FALSE),
+               "expected_unit")
+  expect_error(gravcal::g.getmeta(f, myfun = bad(outputres = 3), verbose = FALSE),
+               "multiples")
+  expect_error(gravcal::g.getmeta(f, myfun = bad(outputtype = NULL), verbose = FALSE),
+               "outputtype")
+  expect_error(gravcal::g.getmeta(f, myfun = bad(aggfunction = NULL), verbose = FALSE),
+               "aggfunction")
+  expect_error(gravcal::g.getmeta(f, myfun = bad(colnames = c("a", "b")), verbose = FALSE),
+               "gave 1 column but `colnames` names 2")
+})
+
 test_that("g.getmeta() refuses what it does not compute, naming it", {
   f <- meta_recording("cwa", 25, 3, seed = 12)
-  expect_error(gravcal::g.getmeta(f, myfun = list(FUN = mean), verbose = FALSE), "myfun")
   expect_error(gravcal::g.getmeta(f, do.neishabouricounts = TRUE, verbose = FALSE),
                "do.neishabouricounts")
   expect_error(gravcal::g.getmeta(f, windowsizes = c(5, 900), verbose = FALSE), "windowsizes")

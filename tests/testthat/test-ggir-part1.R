@@ -107,6 +107,11 @@ p1_both <- function(args, then_part2 = FALSE, backup = NULL, folder = p1_folder)
     c(args, list(backup.cal.coef = f))
   }
   key <- c(args, list(backup = backup, then_part2 = then_part2))
+  # a myfun's functions enter the key as their text (a closure's
+  # serialization holds its environment)
+  if (!is.null(key$myfun)) {
+    key$myfun <- lapply(key$myfun, function(v) if (is.function(v)) deparse(v) else v)
+  }
   ggir <- ggir_cached("g.part1", files, key, {
     out <- tempfile("part1-ggir-")
     dir.create(out)
@@ -218,6 +223,21 @@ test_that("g.part1() is GGIR's without calibration, for f0 and f1", {
   C <- b$gravcal$part1[[1]]$C
   expect_identical(C$QCmessage, "Autocalibration not done")
   expect_identical(C$scale, c(1, 1, 1))
+})
+
+test_that("g.part1() passes myfun to g.getmeta() as GGIR's does", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  mf <- list(FUN = function(data, parameters) {
+    i <- seq(1, floor(nrow(data) / 125) * 125, by = 125)
+    round(data[i, 1] * parameters, 3)
+  }, parameters = 10, expected_sample_rate = 25, expected_unit = "g", colnames = "x10",
+  minlength = 5, outputres = 5, outputtype = "numeric")
+  b <- p1_both(list(do.parallel = FALSE, do.cal = FALSE, f0 = 2, f1 = 2, myfun = mf))
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  ms <- b$gravcal$part1[[1]]$M$metashort
+  expect_identical(names(ms)[ncol(ms)], "x10")
+  expect_gt(sum(!is.na(ms$x10)), 1000)
 })
 
 test_that("g.part1() is GGIR's with recordingEndSleepHour (M's tail expanded)", {
