@@ -37,6 +37,10 @@ gc_decoder_report <- function(ptr) {
     .Call(`_gravcal_gc_decoder_report`, ptr)
 }
 
+gc_decoder_epoch_gaps <- function(ptr) {
+    .Call(`_gravcal_gc_decoder_epoch_gaps`, ptr)
+}
+
 gc_decoder_close <- function(ptr) {
     invisible(.Call(`_gravcal_gc_decoder_close`, ptr))
 }

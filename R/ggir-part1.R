@@ -22,8 +22,12 @@
 #'
 #' @section What this version covers:
 #' Formats: Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x` and csv
-#' exports (their time gaps and idle-sleep zeros filled as GGIR fills them, up
-#' to GGIR's 90-minute limit: a longer gap is an error), Movisens. Metrics:
+#' exports (their time gaps and idle-sleep zeros filled as GGIR fills them; a
+#' gap over GGIR's limit, 90 minutes or 6 long epochs, filled up to the next
+#' long epoch and the rest imputed as whole epochs, non-wear, as GGIR 3.3-9
+#' does on R 4.3 or later, which reads the gap's time of day in the session's
+#' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
+#' gives on R 4.3), Movisens. Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too) and
 #' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
@@ -261,9 +265,9 @@ meta_nonwear <- function(src, p) {
 # GGIR's M from the blocks' values: the columns as GGIR's character
 # matrices hold them (R's text of each number, read back), time stamps in
 # desiredtz.
-meta_result <- function(short, long, metnames, metricnames_long, starttime, wday, wdayname,
-                        filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun = NULL,
-                        myfun_acc = NULL) {
+meta_result <- function(short, long, asked, metnames, metricnames_long, starttime, wday,
+                        wdayname, filetooshort, filecorrupt, p, ws3, ws2, QClog,
+                        myfun = NULL) {
   via_text <- function(v) as.numeric(as.character(v))
   bsc_qc <- data.frame(time = format(Sys.time()), size = gc()[2, 2], stringsAsFactors = FALSE)
   if (filecorrupt || filetooshort) {
@@ -272,8 +276,7 @@ meta_result <- function(short, long, metnames, metricnames_long, starttime, wday
                           wday = c(), wdayname = c(), windowsizes = c(),
                           bsc_qc = bsc_qc, QClog = QClog)))
   }
-  n_short <- if (length(short)) length(unlist(short[[1]], use.names = FALSE)) else 0
-  if (!length(short)) n_short <- 0
+  n_short <- short$count - 1
   stamp <- function(n, by, min_rows) {
     if (n <= min_rows) return(rep(" ", n))
     t0 <- round(as.numeric(starttime))
@@ -283,17 +286,19 @@ meta_result <- function(short, long, metnames, metricnames_long, starttime, wday
   }
   ms <- data.frame(timestamp = stamp(n_short, ws3, 1), stringsAsFactors = FALSE)
   for (k in seq_along(metnames)) {
-    ms[[metnames[k]]] <- via_text(unlist(short[[k]], use.names = FALSE))
+    ms[[metnames[k]]] <- via_text(sheet_column(short, asked[k]))
   }
   if (!is.null(myfun)) {
-    cols <- meta_myfun_columns(myfun_acc, n_short, myfun)
-    for (nm in names(cols)) ms[[nm]] <- cols[[nm]]
+    for (nm in myfun$colnames) {
+      v <- sheet_column(short, nm)
+      ms[[nm]] <- if (identical(myfun$outputtype, "numeric")) suppressWarnings(as.numeric(v)) else v
+    }
   }
   cols_long <- metricnames_long[-1]
-  n_long <- sum(vapply(long, function(b) length(b$nonwearscore), 0))
+  n_long <- if (is.null(long)) 0 else long$count - 1
   ml <- data.frame(timestamp = stamp(n_long, ws2, 2), stringsAsFactors = FALSE)
   for (nm in cols_long) {
-    ml[[nm]] <- via_text(unlist(lapply(long, `[[`, nm), use.names = FALSE))
+    ml[[nm]] <- via_text(if (is.null(long)) numeric(0) else sheet_column(long, nm))
   }
   invisible(list(filecorrupt = filecorrupt, filetooshort = filetooshort,
                  NFilePagesSkipped = 0, metalong = ml, metashort = ms, wday = wday,

@@ -24,9 +24,14 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
     return(src)
   }
   ro <- c(read_opts, list(getmeta_timegaps = 1,
-                          getmeta_gap_limit = max(c(((p$windowsizes[2] / 60) * 6), 90))))
+                          getmeta_gap_limit = max(c(((p$windowsizes[2] / 60) * 6), 90)),
+                          getmeta_epoch_gaps = 1, short_epoch = p$windowsizes[1],
+                          long_epoch = p$windowsizes[2]))
   zone <- if (length(p$configtz)) p$configtz else p$desiredtz
   start <- src$info$start_time
+  if (is.numeric(start) && length(start) == 1 && is.finite(start)) {
+    ro$local_zone <- meta_local_zone(start)
+  }
   tab <- if (identical(fe$local_clock, "sample") && !isFALSE(fe$ggir_time) &&
              is.numeric(start) && length(start) == 1 && is.finite(start)) {
     meta_clock_table(zone, start)
@@ -38,22 +43,33 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
   gc_decoder_close(src$native$ptr)
   src <- open(ro)
   src$getmeta_timegaps <- TRUE
+  src$epoch_gaps <- TRUE
   src$clock_shifted <- !is.null(tab)
   src
 }
 
-# The shift GGIR's reader adds to each time of a per-sample clock (the
-# file's clock, read as UTC, read again as the clock time in `zone`), as a
-# table of its changes over `days` from two days before `start`: the zone's
-# offset changes found to the second (UTC instants, at every 10 minutes,
-# then halved), each taking effect at the clock time where the zone's
-# clock first shows it: a clock time that occurs twice (the hour a clock
-# goes back) is read as the later one, a clock time that does not occur
-# (the hour a clock goes forward) with the new offset, as GGIR's .gt3x
-# times show. NULL in UTC. list(text = "second shift ...", until = the
-# table's last second).
-meta_clock_table <- function(zone, start, days = 400) {
-  if (!length(zone) || !nzchar(zone) || zone %in% c("UTC", "GMT")) return(NULL)
+# The zone in which GGIR 3.3-9's g.imputeTimegaps() reads the time of day
+# of a gap longer than its limit, as "second offset ..." from two days
+# before `start` for 400 days (the offset from each UTC second on): on R 4.3
+# or later data.table::hour() of a number, R's session zone (TZ); on R 4.1
+# and 4.2.0 the number read in GMT (""); on R 4.2.1 to 4.2.3 GGIR stops
+# there (as.POSIXlt() wants an origin), and gravcal gives what GGIR gives on
+# the R versions users have now, the session zone's.
+meta_local_zone <- function(start, days = 400,
+                            version = c(R.version$major, R.version$minor)) {
+  if (!(as.numeric(version[1]) >= 4 && as.numeric(version[2]) > 2)) return("")
+  z <- zone_offsets("", start, days)
+  z$offset[is.na(z$offset)] <- 0
+  if (all(z$offset == 0)) return("")
+  paste(sprintf("%.0f %.0f", z$at, z$offset), collapse = " ")
+}
+
+# A zone's offsets from UTC (`zone`: "" the session's) over `days` from two
+# days before `start`: `at`, the table's first second then each change's
+# UTC second (found at every 10 minutes, then halved to the second);
+# `offset`, the offset from there on; `before`, the offset before each
+# change; `until`, the table's last second.
+zone_offsets <- function(zone, start, days) {
   off <- function(t) {
     as.POSIXlt(as.POSIXct(t, origin = "1970-01-01", tz = "UTC"), tz = zone)$gmtoff
   }
@@ -61,19 +77,37 @@ meta_clock_table <- function(zone, start, days = 400) {
   until <- from + (days + 2) * 86400
   g <- seq(from, until, by = 600)
   o <- off(g)
-  if (anyNA(o)) abort("The time zone \"", zone, "\" gives no offsets from UTC.")
   ch <- which(o[-1] != o[-length(o)])
   at <- vapply(ch, function(i) {
     lo <- g[i]
     hi <- g[i + 1]
     while (hi - lo > 1) {
       mid <- floor((lo + hi) / 2)
-      if (off(mid) == o[i + 1]) hi <- mid else lo <- mid
+      if (isTRUE(off(mid) == o[i + 1])) hi <- mid else lo <- mid
     }
-    hi + min(o[i], o[i + 1])
+    hi
   }, 0)
-  list(text = paste(sprintf("%.0f %.0f", c(from, at), -c(o[1], o[ch + 1])), collapse = " "),
-       until = until)
+  list(at = c(from, at), offset = c(o[1], o[ch + 1]), before = o[ch], until = until)
+}
+
+# The shift GGIR's reader adds to each time of a per-sample clock (the
+# file's clock, read as UTC, read again as the clock time in `zone`), as a
+# table of its changes over `days` from two days before `start`: the zone's
+# offset changes found to the second (zone_offsets()), each taking effect
+# at the clock time where the zone's clock first shows it: a clock time
+# that occurs twice (the hour a clock goes back) is read as the later one,
+# a clock time that does not occur (the hour a clock goes forward) with the
+# new offset, as GGIR's .gt3x times show. NULL in UTC. list(text = "second
+# shift ...", until = the table's last second).
+meta_clock_table <- function(zone, start, days = 400) {
+  if (!length(zone) || !nzchar(zone) || zone %in% c("UTC", "GMT")) return(NULL)
+  z <- zone_offsets(zone, start, days)
+  if (anyNA(z$offset)) abort("The time zone \"", zone, "\" gives no offsets from UTC.")
+  n <- length(z$at)
+  clock <- z$at
+  if (n > 1) clock[-1] <- z$at[-1] + pmin(z$before, z$offset[-1])
+  list(text = paste(sprintf("%.0f %.0f", clock, -z$offset), collapse = " "),
+       until = z$until)
 }
 
 # The block store of meta_run() (gc_meta_store(), ggir_block_store.hpp)
@@ -149,16 +183,26 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     g <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
     c(read = g("timegap_rows_read"), gaps = g("timegaps_imputed"), rows = g("timegap_rows"),
       over = g("timegaps_over_limit"), longest = g("timegap_longest_rows"),
-      missing = g("clock_time_missing"), exceeded = g("clock_table_exceeded"))
+      missing = g("clock_time_missing"), exceeded = g("clock_table_exceeded"),
+      not_filled = g("timegaps_not_filled"))
   }
   before <- if (impute) counters()
   ms <- meta_store(src, time = FALSE)
   store <- ms$store
-  short <- list()   # per metric, the blocks' rounded epoch values
-  n_short <- 0      # short epochs so far
-  myfun_acc <- NULL # the myfun columns as GGIR's metashort text (meta_myfun_put())
-  grads <- list()
-  long <- list()
+  # GGIR's metashort and metalong (R/meta-sheet.R): the metrics (by
+  # `asked`), a myfun's columns as text and the ENMO gradient's columns
+  # (epoch_signals()); metalong's columns once the first block says which
+  grad_cols <- NULL
+  short <- sheet_new(asked, myfun$colnames)
+  long <- NULL
+  # GGIR's long gaps imputed as whole epochs (epoch_gaps): the rows of the
+  # store that carry GGIR's remaining_epochs (0-based) and their values,
+  # whether GGIR's block has that column, and its last value (GGIR's
+  # remaining_epochs, which outlives the block it was read in)
+  marks <- data.frame(pos = numeric(0), remaining = numeric(0))
+  marked_prev <- FALSE
+  last_marks <- NULL
+  given <- 0        # rows the decoder has given
   filetooshort <- filecorrupt <- FALSE
   carry <- 0        # rows carried from the block before
   carry_time <- NA_real_  # the carry's last time stamp (desiredtz's clock)
@@ -174,8 +218,17 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   QClog <- NULL
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
+    size_before <- gc_meta_store_size(store)
     info <- ms$read()
     nr <- info$n
+    marked <- FALSE
+    if (isTRUE(src$epoch_gaps)) {
+      eg <- gc_decoder_epoch_gaps(src$native$ptr)
+      new <- data.frame(pos = size_before + (eg$row - given), remaining = eg$remaining)
+      marked <- nrow(new) > 0 || (carry > 0 && marked_prev)
+      marks <- rbind(marks[marks$pos < size_before, , drop = FALSE], new)
+    }
+    given <- given + info$n
     if (impute) {
       # GGIR's decisions below take the rows read, before the gaps are filled
       now <- counters()
@@ -190,6 +243,10 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
               " minutes, beyond which GGIR's g.getmeta() imputes whole epochs; gravcal's ",
               "g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it in R before ",
               "4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
+      }
+      if (step[["not_filled"]] > 0) {
+        abort("\"", basename(src$filename), "\" has a time gap of more than 400 days (idle ",
+              "sleep or a damaged time stamp); gravcal's g.getmeta() does not impute it.")
       }
       if (step[["missing"]] > 0) {
         abort("The recording's clock passes through times that do not exist in the time zone \"",
@@ -254,7 +311,17 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
           abort("Time gap observed of more than 1 hour between data chunks for ",
                 basename(src$filename), " (GGIR's g.getmeta() stops here too).")
         } else if (gap > 3 / sf && gap <= 60 * sf) {
-          gc_meta_store_fill_gap(store, carry, round(gap * sf))
+          k <- round(gap * sf)
+          gc_meta_store_fill_gap(store, carry, k)
+          # the rows put in copy the carry's last, its mark too
+          at <- marks$pos >= carry
+          marks$pos[at] <- marks$pos[at] + k
+          last <- marks[marks$pos == carry - 1, , drop = FALSE]
+          if (nrow(last)) {
+            marks <- rbind(marks, data.frame(pos = carry - 1 + seq_len(k),
+                                             remaining = last$remaining[1]))
+            marks <- marks[order(marks$pos), , drop = FALSE]
+          }
         }
       }
       if (i == 1) {
@@ -265,6 +332,8 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         if (sw$shift > 1) {
           k <- min(sw$shift, info$size)
           gc_meta_store_keep(store, k, info$size - k)
+          marks$pos <- marks$pos - k
+          marks <- marks[marks$pos >= 0, , drop = FALSE]
         }
       }
       LD <- gc_meta_store_size(store)
@@ -278,10 +347,17 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
         # may not be whole)
         n_use <- floor(abs(use - 1) + 1 + 1.1920928955078125e-07)
+        # GGIR's remaining_epochs of this block: its marks in the rows used
+        # (1-based), or the last block's where this block has no such column
+        if (marked) last_marks <- marks[marks$pos < n_use, , drop = FALSE]
+        fill <- last_marks
+        grad <- NULL
         if (!is.null(gradient)) {
-          grads[[length(grads) + 1]] <- gc_meta_store_gradient(
-            store, n_use, sf, ws3, gradient,
-            gradient$temp && (use.temp || !is.null(model)))
+          grad <- gc_meta_store_gradient(store, n_use, sf, ws3, gradient,
+                                         gradient$temp && (use.temp || !is.null(model)))
+          grad_names <- colnames(grad)
+          grad_cols <- paste0(".gradient", seq_len(ncol(grad)))
+          colnames(grad) <- grad_cols
         }
         lin <- NULL
         cal_b <- cal
@@ -293,17 +369,21 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         } else if (!is.null(model)) {
           lin <- model
         }
+        out_fun <- NULL
         if (!is.null(myfun)) {
           xyz <- meta_myfun_xyz(gc_meta_store_rows(store, 0, n_use), cal, use.temp)
-          myfun_acc <- meta_myfun_put(myfun_acc, n_short + 1,
-                                      meta_myfun_block(xyz, myfun, sf, ws3, starttime,
-                                                       p$interpolationType))
+          out_fun <- meta_myfun_block(xyz, myfun, sf, ws3, starttime, p$interpolationType)
           rm(xyz)
         }
         r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
                                   filters, fused$conv, fused$rec, n_use)
-        for (nm in asked) short[[nm]] <- c(short[[nm]], list(round(r$short[[nm]], 4)))
-        n_short <- n_short + length(r$short[[1]])
+        n_block <- if (length(asked)) length(r$short[[1]]) else 0
+        short <- sheet_put(short, lapply(r$short[asked], round, 4))
+        if (!is.null(grad)) short <- sheet_put(short, grad)
+        if (!is.null(out_fun)) {
+          colnames(out_fun) <- myfun$colnames
+          short <- sheet_put(short, out_fun)
+        }
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
         if (light.available) {
           blk$lightmean <- round(r$lightmean, 4)
@@ -311,7 +391,22 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         }
         if (use.temp) blk$temperaturemean <- round(r$temperature, 4)
         blk$EN <- round(r$en, 4)
-        long[[length(long) + 1]] <- blk
+        if (is.null(long)) long <- sheet_new(names(blk))
+        long <- sheet_put(long, blk)
+        if (!is.null(fill) && nrow(fill)) {
+          # GGIR's epoch-level imputation: the long epoch of each mark
+          # non-wear (3), the short epoch's metrics 0 (EN 1), each repeated
+          pos1 <- fill$pos + 1
+          long <- sheet_impute(long, floor(pos1 / (ws2 * sf)) + long$count,
+                               floor(fill$remaining * (ws3 / ws2)) + 1, list(nonwearscore = 3))
+          zero <- c(grep("time|angle", asked, invert = TRUE, value = TRUE), grad_cols)
+          set <- stats::setNames(rep(list(0), length(zero)), zero)
+          if ("EN" %in% asked) set$EN <- 1
+          short <- sheet_impute(short, floor(pos1 / (ws3 * sf)) + short$count,
+                                fill$remaining, set)
+        }
+        long <- sheet_advance(long, length(blk$nonwearscore))
+        short <- sheet_advance(short, n_block)
         # the carry: GGIR's data[(use + 1):LD, ] when more than one row is
         # left (R's `:` and its index truncation on a use that may not be
         # whole); its last time stamp for the next block's gap
@@ -325,6 +420,9 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         back <- LD - (from + count)
         carry_time <- if (count > 0 && back < 2) times[3 - back] else NA_real_
         carry <- gc_meta_store_keep(store, from, count)
+        marks <- marks[marks$pos >= from & marks$pos < from + count, , drop = FALSE]
+        marks$pos <- marks$pos - from
+        marked_prev <- marked
         if (ms$keep_time && carry > 0) {
           carry_time <- gc_meta_store_rows(store, carry - 1, 1)$time
         }
@@ -346,9 +444,12 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
             unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
             "reproduced (M$QClog is NULL).", call. = FALSE)
   }
-  M <- meta_result(short, long, metnames, metricnames_long, starttime, wday, wdayname,
-                   filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun, myfun_acc)
-  if (!is.null(gradient)) M$enmo_gradient <- do.call(rbind, grads)
+  M <- meta_result(short, long, asked, metnames, metricnames_long, starttime, wday, wdayname,
+                   filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun)
+  if (!is.null(gradient)) {
+    M$enmo_gradient <- do.call(cbind, lapply(grad_cols, function(nm) sheet_column(short, nm)))
+    if (!is.null(M$enmo_gradient)) colnames(M$enmo_gradient) <- grad_names
+  }
   invisible(M)
 }
 

@@ -151,29 +151,3 @@ meta_myfun_block <- function(xyz, myfun, sf, ws3, start, interpolation) {
   }
   out
 }
-
-# GGIR's metashort as text for the myfun columns: values written at rows
-# `at` onwards (a block's first short epoch) into a character matrix that
-# grows as GGIR's does, later blocks writing over what an earlier one wrote
-# past its own epochs.
-meta_myfun_put <- function(acc, at, out) {
-  need <- at - 1 + nrow(out)
-  if (is.null(acc)) acc <- matrix(" ", 0, ncol(out))
-  if (nrow(acc) < need) acc <- rbind(acc, matrix(" ", need - nrow(acc), ncol(acc)))
-  if (nrow(out)) acc[at:need, ] <- out
-  acc
-}
-
-# The myfun columns of metashort, `n` rows, as data frame columns: text
-# read back as numbers for outputtype "numeric" (R's as.numeric() of GGIR's
-# text), kept as text for "character".
-meta_myfun_columns <- function(acc, n, myfun) {
-  if (is.null(acc)) acc <- matrix(" ", 0, length(myfun$colnames))
-  if (nrow(acc) < n) acc <- rbind(acc, matrix(" ", n - nrow(acc), ncol(acc)))
-  acc <- acc[seq_len(n), , drop = FALSE]
-  cols <- lapply(seq_len(ncol(acc)), function(j) {
-    v <- acc[, j]
-    if (identical(myfun$outputtype, "numeric")) suppressWarnings(as.numeric(v)) else v
-  })
-  stats::setNames(cols, myfun$colnames)
-}

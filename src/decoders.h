@@ -181,19 +181,13 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
   return f;
 }
 
-// g.getmeta()'s time-gap imputation over a decoder (option getmeta_timegaps
-// = 1; GgirTimegapsOf's carry mode): getmeta_gap_limit (minutes), and
-// clock, GGIR's reader's clock shifts as text "second shift second shift
-// ..." (shift NaN: the clock time does not exist), up to clock_until.
-inline DecoderPtr getmeta_timegaps(DecoderPtr d, const gravcal::Options& opts) {
-  gravcal::GgirTimegapsMode m;
-  m.carry = true;
-  m.limit_minutes = opts.num("getmeta_gap_limit", 0);
-  const std::string clock = opts.str("clock", "");
+// Numbers in text, "a b a b ..." ("NaN" for NaN), as pairs.
+inline std::vector<double> number_pairs(const std::string& text, const char* what) {
+  std::vector<double> out;
   std::size_t at = 0;
-  while (at < clock.size()) {
+  while (at < text.size()) {
     std::size_t used = 0;
-    const std::string rest = clock.substr(at);
+    const std::string rest = text.substr(at);
     double v = 0;
     if (rest.compare(0, 3, "NaN") == 0) {
       v = std::numeric_limits<double>::quiet_NaN();
@@ -201,11 +195,30 @@ inline DecoderPtr getmeta_timegaps(DecoderPtr d, const gravcal::Options& opts) {
     } else {
       v = std::stod(rest, &used);
     }
-    m.clock.push_back(v);
+    out.push_back(v);
     at += used;
-    while (at < clock.size() && clock[at] == ' ') ++at;
+    while (at < text.size() && text[at] == ' ') ++at;
   }
-  if (m.clock.size() % 2 != 0) throw std::invalid_argument("clock: pairs of second and shift");
+  if (out.size() % 2 != 0) throw std::invalid_argument(std::string(what) + ": pairs of numbers");
+  return out;
+}
+
+// g.getmeta()'s time-gap imputation over a decoder (option getmeta_timegaps
+// = 1; GgirTimegapsOf's carry mode): getmeta_gap_limit (minutes), and
+// clock, GGIR's reader's clock shifts as text "second shift second shift
+// ..." (shift NaN: the clock time does not exist), up to clock_until; with
+// getmeta_epoch_gaps = 1 the gaps over the limit imputed at epoch level
+// (short_epoch, long_epoch seconds; local_zone: "second offset ..." of the
+// zone their times of day are read in).
+inline DecoderPtr getmeta_timegaps(DecoderPtr d, const gravcal::Options& opts) {
+  gravcal::GgirTimegapsMode m;
+  m.carry = true;
+  m.limit_minutes = opts.num("getmeta_gap_limit", 0);
+  m.clock = number_pairs(opts.str("clock", ""), "clock");
+  m.epoch_gaps = opts.num("getmeta_epoch_gaps", 0) != 0;
+  m.short_epoch = opts.num("short_epoch", 5);
+  m.long_epoch = opts.num("long_epoch", 900);
+  m.local = number_pairs(opts.str("local_zone", ""), "local_zone");
   m.clock_until = opts.num("clock_until", std::numeric_limits<double>::infinity());
   if (r_long_double()) {
     using Gaps = gravcal::GgirTimegapsOf<gravcal::Decoder, long double>;

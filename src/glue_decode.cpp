@@ -192,6 +192,20 @@ Rcpp::List gc_decoder_report(SEXP ptr) {
       Rcpp::Named("notes_total") = static_cast<double>(r.notes_total));
 }
 
+// The time gaps imputed at epoch level since the last call (g.getmeta();
+// Decoder::take_epoch_gaps()): list(row, remaining), rows 0-based over
+// every sample the decoder has given.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_epoch_gaps(SEXP ptr) {
+  const std::vector<gravcal::Decoder::EpochGap> g = get(ptr)->decoder->take_epoch_gaps();
+  Rcpp::NumericVector row(g.size()), remaining(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    row[static_cast<R_xlen_t>(i)] = static_cast<double>(g[i].row);
+    remaining[static_cast<R_xlen_t>(i)] = g[i].remaining;
+  }
+  return Rcpp::List::create(Rcpp::Named("row") = row, Rcpp::Named("remaining") = remaining);
+}
+
 // Closes the file now (the finalizer would, later).
 // [[Rcpp::export(rng = false)]]
 void gc_decoder_close(SEXP ptr) {

@@ -9,7 +9,11 @@
 // samples those given, no zero sample (x = y = z = 0) given, and within a
 // block no step of k = max(0.25, 2 / sf) s or more left unfilled after a
 // sample whose copies would fit (steps backwards and beyond the fill limit
-// excepted).
+// excepted). When the last byte's high bit is set (and no resampling),
+// g.getmeta()'s mode instead: the previous block carried, a 1-minute limit
+// beyond which gaps are imputed as whole epochs (checked: each reported at
+// a sample given, with more than one epoch left), times of day read in a
+// zone whose offset changes.
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -58,9 +62,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (mode & 4) o.set("col_temp", 5.0);
   o.set("buffer", 64.0 + 61.0 * (mode >> 5));
   std::unique_ptr<gravcal::CsvDecoder> csv(new gravcal::CsvDecoder(src, o, "adhoc_csv"));
-  std::unique_ptr<Gaps> gaps(new Gaps(std::move(csv), sf));
-  std::unique_ptr<gravcal::Decoder> dec;
   const bool resample = (mode & 8) != 0;
+  const bool epochs = !resample && (data[size - 1] & 0x80) != 0;
+  gravcal::GgirTimegapsMode gm;
+  if (epochs) {
+    gm.carry = true;
+    gm.limit_minutes = 1;
+    gm.epoch_gaps = true;
+    gm.short_epoch = 5;
+    gm.long_epoch = (mode & 32) ? 60 : 900;
+    gm.local = {0, 3600, 1679792400, 7200, 1698541200, 3600};
+  }
+  std::unique_ptr<Gaps> gaps(new Gaps(std::move(csv), sf, gm));
+  std::unique_ptr<gravcal::Decoder> dec;
   if (resample) {
     dec.reset(new gravcal::GgirResamplerOf<Gaps>(std::move(gaps), sf, (mode & 16) ? 2 : 1, true));
   } else {
@@ -86,7 +100,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const double step = tm[i] - last;
       // a filled gap leaves steps of 1 / sf; one of k or more only where its
       // fill would pass the limit (1e8 samples) or the times are not finite
-      if (!resample && std::isfinite(step) && step >= k && step * sf <= 1e7 &&
+      if (!resample && !epochs && std::isfinite(step) && step >= k && step * sf <= 1e7 &&
           std::fabs(last) < 1e12 && std::fabs(tm[i]) < 1e12) {
         __builtin_trap();
       }
@@ -94,6 +108,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     if (u > 0) last = std::nan("");  // a block ended: its gap to the next stays
     given += static_cast<std::int64_t>(b.n);
+    for (const auto& g : dec->take_epoch_gaps()) {
+      // reported when queued, so at most one block of runs ahead of `given`
+      if (!epochs || g.row < 0 || !(g.remaining > 1) || !std::isfinite(g.remaining)) __builtin_trap();
+    }
   }
   if (given < 1000000 && dec->done() && dec->report().samples != given) __builtin_trap();
   return 0;

@@ -297,12 +297,84 @@ test_that("the date order of an ActiGraph header, by GGIR's rules", {
   expect_identical(gravcal:::actigraph_date_order(top("none")), NA_character_)
 })
 
-test_that("a time gap longer than GGIR's epoch-level limit is an error saying so", {
-  rec <- simulate_recording(hours = 8, sf = 10, seed = 14)
-  f <- tempfile(fileext = ".gt3x")
-  gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = 10, start = rec$time[1],
-                       idle = 3600 * 3 + 0:(2 * 3600))
-  expect_error(gravcal::g.getmeta(f, verbose = FALSE), "time gap of 120")
+# GGIR 3.3-9 imputes a time gap over its limit (90 minutes) at epoch level,
+# reading the gap's time of day with data.table::hour() of a number: R
+# before 4.3 stops there (as.POSIXlt() wants an origin). On such an R,
+# GGIR's result is computed with as.POSIXlt() of a number given R 4.3's
+# default (read from 1970, in the session's zone), put back afterwards.
+with_r43_posixlt <- function(expr) {
+  if (getRversion() >= "4.3.0") return(expr)
+  base <- baseenv()
+  old <- get("as.POSIXlt.numeric", envir = base)
+  put <- function(f) {
+    unlockBinding("as.POSIXlt.numeric", base)
+    assign("as.POSIXlt.numeric", f, envir = base)
+    lockBinding("as.POSIXlt.numeric", base)
+    registerS3method("as.POSIXlt", "numeric", f, envir = base)
+  }
+  put(function(x, tz = "", origin, ...) {
+    if (missing(origin)) return(as.POSIXlt(.POSIXct(x, tz), tz = tz))
+    as.POSIXlt(as.POSIXct(origin, tz = "GMT", ...) + x, tz = tz)
+  })
+  on.exit(put(old), add = TRUE)
+  expr
+}
+
+test_that("time gaps over GGIR's limit are imputed as whole epochs, as GGIR does", {
+  skip_if_quick()
+  skip_if_not_installed("GGIR")
+  # .gt3x weeks' nights of idle sleep: two gaps in a block, one a few
+  # seconds after the other; a gap across a block's end; across a change of
+  # clock (Amsterdam, New York); other windowsizes; a zone off the hour
+  cases <- list(
+    list(h = 60, sf = 10, start = "2024-03-30 20:13:07", tz = "Europe/Amsterdam",
+         ws = c(5, 900, 3600), idle = c(3600 * 3 + 0:(2 * 3600 + 123), 3600 * 10 + 0:(95 * 60),
+                                        3600 * 10 + 95 * 60 + 30 + 0:(100 * 60))),
+    list(h = 50, sf = 30, start = "2024-11-02 22:00:03", tz = "America/New_York",
+         ws = c(5, 900, 3600), idle = c(3600 * 20 + 0:(5 * 3600 + 17), 3600 * 30 + 0:(91 * 60 + 1))),
+    list(h = 40, sf = 10, start = "2024-06-01 10:00:00", tz = "", ws = c(10, 600, 3600),
+         idle = 3600 * 23 + 0:(3 * 3600 + 7)),
+    list(h = 40, sf = 10, start = "2024-06-01 10:00:00", tz = "Asia/Kolkata",
+         ws = c(5, 900, 3600), idle = 3600 * 23.9 + 0:(3 * 3600 + 7)))
+  for (k in seq_along(cases)) {
+    cc <- cases[[k]]
+    rec <- simulate_recording(hours = cc$h, sf = cc$sf, seed = 20 + k)
+    f <- tempfile(fileext = ".gt3x")
+    gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), f, sf = cc$sf,
+                         start = as.POSIXct(cc$start, tz = "UTC"), idle = cc$idle)
+    args <- list(desiredtz = cc$tz, windowsizes = cc$ws, do.en = TRUE, do.mad = TRUE)
+    G <- ggir_cached("g.getmeta", f, c(args, list(posixlt = "R 4.3")), {
+      I <- meta_quiet(GGIR::g.inspectfile(f, desiredtz = cc$tz))
+      with_r43_posixlt(meta_quiet(do.call(GGIR::g.getmeta, c(list(f, inspectfileobject = I,
+                                                                  verbose = FALSE), args))))
+    })
+    R <- meta_quiet(do.call(gravcal::g.getmeta, c(list(f, verbose = FALSE), args)))
+    expect_same_meta(list(ggir = G, gravcal = R))
+    # what the comparison saw: the gaps' long epochs non-wear (3), their
+    # short epochs' ENMO 0 and EN 1
+    gaps <- R$metalong$nonwearscore == 3
+    expect_gt(sum(gaps), 6)
+    expect_true(all(R$QClog$timegaps_min[R$QClog$imputed] > 90))
+    expect_gt(sum(R$metashort$EN == 1 & R$metashort$ENMO == 0), 0.5 * sum(gaps) * cc$ws[2] / cc$ws[1])
+  }
+})
+
+test_that("the zone GGIR reads a long gap's time of day in, by R version", {
+  start <- as.numeric(as.POSIXct("2024-03-30 12:00:00", tz = "UTC"))
+  expect_identical(gravcal:::meta_local_zone(start, version = c("4", "1.3")), "")
+  expect_identical(gravcal:::meta_local_zone(start, version = c("4", "2.0")), "")
+  withr_tz <- function(tz, expr) {
+    old <- Sys.getenv("TZ", unset = NA)
+    Sys.setenv(TZ = tz)
+    on.exit(if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old))
+    expr
+  }
+  expect_identical(withr_tz("UTC", gravcal:::meta_local_zone(start, version = c("4", "3.1"))), "")
+  z <- withr_tz("Europe/Amsterdam", gravcal:::meta_local_zone(start, 10, c("4", "4.0")))
+  v <- as.numeric(strsplit(z, " ", fixed = TRUE)[[1]])
+  # 1 h before the change (Sunday 31 March, 01:00 UTC), 2 h from it
+  expect_identical(v[c(2, 4)], c(3600, 7200))
+  expect_identical(v[3], as.numeric(as.POSIXct("2024-03-31 01:00:00", tz = "UTC")))
 })
 
 test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml)", {

@@ -403,6 +403,16 @@ class Decoder {
   // An upper bound on the samples one unit gives, fixed by the format (not
   // read from the file); for sizing a block of `max_units` units.
   virtual std::size_t max_samples_per_unit() const = 0;
+  // GGIR's epoch-level imputation of time gaps longer than its limit
+  // (g.getmeta(); decode_ggir_timegaps.hpp): for each such gap in the
+  // samples given since the last call, the sample (0-based, over every
+  // sample this decoder has given) that carries GGIR's remaining_epochs,
+  // and that number of short epochs. Empty for a decoder that imputes none.
+  struct EpochGap {
+    std::int64_t row;
+    double remaining;
+  };
+  virtual std::vector<EpochGap> take_epoch_gaps() { return {}; }
   const DeviceInfo& info() const { return info_; }
   const Report& report() const { return report_; }
   const std::string& error() const { return error_; }

@@ -60,11 +60,26 @@ namespace gravcal {
 // not exist in the zone, counted as "clock_time_missing"); before the first
 // change, or empty: none. Times beyond the table's last change + its span
 // are counted as "clock_table_exceeded".
+//
+// With `epoch_gaps`, a gap of more rows than the limit is imputed as GGIR
+// 3.3-9 imputes it: the sample before it is repeated only up to the long
+// epoch after it (short epochs from the sample's time of day to the next
+// long epoch boundary, plus those from the boundary before the next
+// sample's time of day; a fraction of a short epoch moved to a delay), and
+// the rest of the gap, in short epochs, is reported by take_epoch_gaps() at
+// the sample GGIR marks (the last repeat, less the delay) for g.getmeta() to
+// impute as whole epochs. The times of day are read in the zone `local`
+// (pairs: from this UTC second, this offset in seconds; empty: UTC), as R's
+// as.POSIXlt() reads a number in the session's zone (GGIR's
+// data.table::hour() on R 4.3 or later).
 struct GgirTimegapsMode {
   bool carry = false;
   double limit_minutes = 0;  // > 0: gaps of more rows than limit_minutes * 60 * sf
   std::vector<double> clock;
   double clock_until = 0;    // the table holds up to this second
+  bool epoch_gaps = false;
+  double short_epoch = 5, long_epoch = 900;  // seconds (GGIR's windowsizes[1:2])
+  std::vector<double> local;
 };
 
 template <class Inner, class Acc = long double>
@@ -119,6 +134,11 @@ class GgirTimegapsOf : public Decoder {
     return inner_->done() && !in_call_ && !pending() && raw_at_ >= raw_n_;
   }
   std::size_t max_samples_per_unit() const override { return 2 * inner_->max_samples_per_unit(); }
+  std::vector<EpochGap> take_epoch_gaps() override {
+    std::vector<EpochGap> out;
+    out.swap(epoch_gaps_);
+    return out;
+  }
   // (GgirResamplerOf's interface: a call goes on until its units are read)
   void continue_call(bool) {}
 
@@ -126,6 +146,9 @@ class GgirTimegapsOf : public Decoder {
   static constexpr std::size_t kRawChunk = 4096;
   static constexpr std::size_t kCols = 5;  // x, y, z, t, time
   static constexpr double kMaxGapRows = 1e8;
+  // an epoch-level gap longer than this is not imputed (GGIR would build
+  // its epochs in memory): 400 days
+  static constexpr double kMaxEpochGapSeconds = 400 * 86400.0;
   struct Run {
     double v[kCols];
     std::int64_t n, j;  // copies to give, copies given
@@ -228,6 +251,61 @@ class GgirTimegapsOf : public Decoder {
     have_held_ = true;
   }
 
+  void push(const Run& r) {
+    runs_.push_back(r);
+    queued_ += r.n;
+  }
+
+  // The zone's offset at UTC second t (GgirTimegapsMode::local).
+  double local_offset(double t) {
+    const std::vector<double>& z = mode_.local;
+    if (z.empty() || t < z[0]) return 0;
+    if (!(local_at_ < z.size() && z[local_at_] <= t && (local_at_ + 2 >= z.size() || t < z[local_at_ + 2]))) {
+      std::size_t lo = 0, hi = z.size() / 2;
+      while (hi - lo > 1) {
+        const std::size_t mid = (lo + hi) / 2;
+        if (z[2 * mid] <= t) lo = mid;
+        else hi = mid;
+      }
+      local_at_ = 2 * lo;
+    }
+    return z[local_at_ + 1];
+  }
+
+  // GGIR's seconds into the day of time t, plus one (hour * 3600 + minute *
+  // 60 + whole seconds + 1, in the zone `local`).
+  double day_seconds(double t) {
+    const double f = std::floor(t + local_offset(t));
+    return f - 86400 * std::floor(f / 86400) + 1;
+  }
+
+  // A gap of `n` rows over the limit, after the held sample and before the
+  // sample at time `next`: the rows GGIR repeats the held sample for; the
+  // rest reported as whole short epochs at the sample GGIR marks.
+  double epoch_gap_rows(double n, double next) {
+    const double S = mode_.short_epoch, L = mode_.long_epoch;
+    const double s1 = day_seconds(held_[4]);
+    const double add1 = (L - (s1 - std::floor(s1 / L) * L)) / S;
+    const double s2 = day_seconds(next);
+    const double add2 = ((s2 - std::floor(s2 / L) * L) - 1) / S;
+    const double add = add1 + add2;
+    const double time2add = (add * sf_ * S) + 1;
+    double remaining = ((n - time2add) / (sf_ * S)) + 1;
+    double gap = time2add, delay = 0;
+    const double decs = remaining - std::floor(remaining);
+    if (decs > 0) {
+      delay = decs * (sf_ * S);
+      gap = gap + delay;
+      remaining = remaining - (delay / (sf_ * S));
+    }
+    gap = std::nearbyint(gap);
+    delay = std::nearbyint(delay);
+    if (remaining > 1) {
+      epoch_gaps_.push_back({queued_ + static_cast<std::int64_t>(gap - delay) - 1, remaining});
+    }
+    return gap;
+  }
+
   // The held sample, repeated up to the time `next` of the sample after it.
   void release(double next) {
     Run r;
@@ -237,10 +315,11 @@ class GgirTimegapsOf : public Decoder {
     const double dt = next - held_[4];
     if (dt >= k_) {
       const double n = std::nearbyint(dt * sf_);
-      if (limit_rows_ > 0 && n > limit_rows_) {
+      if (limit_rows_ > 0 && n > limit_rows_ && !mode_.epoch_gaps) {
         ++over_limit_;
         if (n > longest_) longest_ = n;
-      } else if (n > kMaxGapRows) {
+      } else if ((n > kMaxGapRows && !(limit_rows_ > 0 && n > limit_rows_)) ||
+                 (limit_rows_ > 0 && n > limit_rows_ && dt > kMaxEpochGapSeconds)) {
         ++gaps_not_filled_;
         if (gap_notes_.size() < 5) {
           gap_notes_.push_back("time stamps jump by " + std::to_string(dt) +
@@ -248,9 +327,10 @@ class GgirTimegapsOf : public Decoder {
         }
       } else {
         ++gaps_;
-        rows_added_ += static_cast<std::int64_t>(n) - 1;
         gap_rows_ += static_cast<std::int64_t>(n);
-        r.n = static_cast<std::int64_t>(n);
+        const double rows = (limit_rows_ > 0 && n > limit_rows_) ? epoch_gap_rows(n, next) : n;
+        rows_added_ += static_cast<std::int64_t>(rows) - 1;
+        r.n = static_cast<std::int64_t>(rows);
         const Acc ss = static_cast<Acc>(r.v[0] * r.v[0]) + static_cast<Acc>(r.v[1] * r.v[1]) +
                        static_cast<Acc>(r.v[2] * r.v[2]);
         const double en = std::sqrt(static_cast<double>(ss));
@@ -259,7 +339,7 @@ class GgirTimegapsOf : public Decoder {
         }
       }
     }
-    runs_.push_back(r);
+    push(r);
     have_held_ = false;
   }
 
@@ -275,7 +355,7 @@ class GgirTimegapsOf : public Decoder {
         for (int c = 0; c < 3; ++c) r.v[c] = runs_.back().v[c];
         r.n = 1;
         r.j = 0;
-        runs_.push_back(r);
+        push(r);
       } else {
         release(held_[4]);
       }
@@ -345,7 +425,9 @@ class GgirTimegapsOf : public Decoder {
   double limit_rows_ = 0, longest_ = 0;
   std::int64_t gap_rows_ = 0, over_limit_ = 0, clock_missing_ = 0, clock_exceeded_ = 0;
   std::int64_t rows_read_ = 0;
-  std::size_t clock_at_ = 0;
+  std::size_t clock_at_ = 0, local_at_ = 0;
+  std::int64_t queued_ = 0;  // rows put in runs_ so far (all calls)
+  std::vector<EpochGap> epoch_gaps_;
 };
 
 }  // namespace gravcal
