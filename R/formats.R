@@ -75,7 +75,8 @@ recording_formats <- list(
   # y, z; GGIR resamples each block onto the rate it finds from the first
   # 100000 time stamps (R/axivity-csv.R)
   axivity_csv = list(
-    ggir_monitor = "axivity",
+    ggir_getmeta = TRUE,
+    ggir_monitor = "axivity", ggir_timegaps = TRUE, local_clock = "sample",
     ext = c(csv = NA, csv.gz = NA), detect = function(file) is_axivity_csv(file),
     label = "an Axivity csv export", unit = "line",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,

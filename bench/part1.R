@@ -16,7 +16,10 @@
 #                                installed; about 40 minutes)
 #
 # GRAVCAL_BENCH_DATA: where the week files are written and kept (default: a
-# folder beside tempdir()). Writes bench/results/part1.md and part1.csv.
+# folder beside tempdir()). GRAVCAL_BENCH_FORMATS ("cwa,bin,gt3x") and
+# GRAVCAL_BENCH_CONTENDERS (a regular expression on the contenders' names)
+# run some of them; GRAVCAL_BENCH_NAME names the results (default "part1":
+# bench/results/part1.md and part1.csv).
 suppressPackageStartupMessages(library(gravcal))
 sf <- 100
 days <- as.numeric(Sys.getenv("GRAVCAL_BENCH_DAYS", "7"))
@@ -93,6 +96,9 @@ contenders[["GGIR g.part1, every metric"]] <- c(quiet, every,
   "q(GGIR::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE, params_metrics = pm))")
 contenders[["gravcal g.part1, every metric"]] <- c(quiet, every,
   "q(gravcal::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE, params_metrics = pm))")
+pick <- Sys.getenv("GRAVCAL_BENCH_CONTENDERS")
+if (nzchar(pick)) contenders <- contenders[grepl(pick, names(contenders))]
+name <- Sys.getenv("GRAVCAL_BENCH_NAME", "part1")
 rows <- list()
 for (fmt in names(files)) {
   for (nm in names(contenders)) {
@@ -112,7 +118,7 @@ same <- vapply(files, function(f) {
   M <- q(gravcal::g.getmeta(f, verbose = FALSE))
   all(vapply(setdiff(names(G), "bsc_qc"), function(k) identical(G[[k]], M[[k]]), TRUE))
 }, TRUE)
-utils::write.csv(res, file.path(out_dir, "part1.csv"), row.names = FALSE)
+utils::write.csv(res, file.path(out_dir, paste0(name, ".csv")), row.names = FALSE)
 ratio <- function(fmt, a, b) {
   r <- res$seconds[res$format == fmt & res$contender == a] / res$seconds[res$format == fmt & res$contender == b]
   if (length(r)) sprintf("%.1fx", r) else "-"
@@ -134,5 +140,5 @@ md <- c("# GGIR part 1's epoch signals: GGIR against gravcal (bench/part1.R)", "
                   ratio(fmt, "GGIR g.part1, every metric", "gravcal g.part1, every metric"),
                   same[[fmt]])
         }, ""))
-writeLines(md, file.path(out_dir, "part1.md"))
+writeLines(md, file.path(out_dir, paste0(name, ".md")))
 cat(md, sep = "\n")
