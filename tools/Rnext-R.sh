@@ -15,7 +15,11 @@
 #                         GRAVCAL_RNEXT_DEBIAN_SRC: Debian 13's r-base 4.5.0,
 #                         whose version is GRAVCAL_RNEXT_DEBIAN_R)
 #   GRAVCAL_RNEXT_PINS    "package=version ..." installed at exactly that
-#                         version (CRAN's current source or its archive)
+#                         version (its source from GRAVCAL_RNEXT_SOURCES,
+#                         CRAN's current or CRAN's archive; where none has
+#                         it, CRAN's current version, said "NOT PINNED")
+#   GRAVCAL_RNEXT_SOURCES a folder of <package>_<version>.tar.gz sources
+#                         tried first (default $prefix.src/sources)
 #   GRAVCAL_CRAN          CRAN mirror (default https://cloud.r-project.org)
 #   GRAVCAL_RNEXT_JOBS    make -j (default 2)
 #
@@ -105,12 +109,15 @@ if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && ! dpkg -s libuv1-
 fi
 start=$(date +%s)
 # the pinned packages, in order (a package after those it needs): its
-# source from CRAN where that is its current version, else from CRAN's
-# archive; first what that version's DESCRIPTION needs and is missing,
-# at CRAN's current versions. Then MASS (signal's dependency; R's
-# recommended packages are not built here) and future.
-"$rbin/Rscript" --vanilla - "$cran" $pins <<'RSCRIPT'
-a <- commandArgs(TRUE); cran <- a[1]; pins <- a[-1]
+# source from GRAVCAL_RNEXT_SOURCES (a folder of <package>_<version>.tar.gz,
+# default $prefix.src/sources), else CRAN's where that is its current
+# version, else CRAN's archive's; first what that version's DESCRIPTION
+# needs and is missing, at CRAN's current versions. A pinned version found
+# nowhere: CRAN's current instead, said on a line "Rnext-R: NOT PINNED".
+# Then MASS (signal's dependency; R's recommended packages are not built
+# here) and future.
+"$rbin/Rscript" --vanilla - "$cran" "${GRAVCAL_RNEXT_SOURCES:-$prefix.src/sources}" $pins <<'RSCRIPT'
+a <- commandArgs(TRUE); cran <- a[1]; local <- a[2]; pins <- a[-(1:2)]
 options(repos = cran, Ncpus = 2)
 base <- rownames(installed.packages(priority = "base"))
 have <- function(p) tryCatch(as.character(packageVersion(p)), error = function(e) NA_character_)
@@ -129,18 +136,46 @@ for (pv in pins) {
   p <- sub("=.*", "", pv); v <- sub(".*=", "", pv)
   if (identical(have(p), as.character(package_version(v)))) next
   if (p == "GGIR") next  # tools/install-ggir.sh, below
+  tgz <- file.path(work, sprintf("%s_%s.tar.gz", p, v))
+  where <- file.path(local, basename(tgz))
   cur <- if (p %in% rownames(avail)) avail[p, "Version"] else ""
-  url <- if (identical(cur, v)) sprintf("%s/src/contrib/%s_%s.tar.gz", cran, p, v) else
-    sprintf("%s/src/contrib/Archive/%s/%s_%s.tar.gz", cran, p, p, v)
-  tgz <- file.path(work, basename(url))
-  download.file(url, tgz, quiet = TRUE)
+  if (file.exists(where)) {
+    file.copy(where, tgz)
+  } else {
+    url <- if (identical(cur, v)) sprintf("%s/src/contrib/%s", cran, basename(tgz)) else
+      sprintf("%s/src/contrib/Archive/%s/%s", cran, p, basename(tgz))
+    where <- url
+    if (inherits(try(download.file(url, tgz, quiet = TRUE), silent = TRUE), "try-error")) {
+      unlink(tgz)
+      message("Rnext-R: NOT PINNED: ", p, " ", v, " is not in ", local, " nor at ", url,
+              "; CRAN's current ", cur, " instead")
+      get_missing(p)
+      next
+    }
+  }
   utils::untar(tgz, files = paste0(p, "/DESCRIPTION"), exdir = work)
   d <- read.dcf(file.path(work, p, "DESCRIPTION"))
   f <- intersect(c("Depends", "Imports", "LinkingTo"), colnames(d))
   deps <- unlist(lapply(d[1, f], function(s) trimws(sub("\\(.*", "", strsplit(s, ",")[[1]]))))
   get_missing(deps[nzchar(deps)])
-  message("Rnext-R: ", p, " ", v)
+  message("Rnext-R: ", p, " ", v, " from ", where)
   install.packages(tgz, repos = NULL, type = "source", quiet = TRUE)
+  if (!identical(have(p), as.character(package_version(v)))) {
+    # R 4.5 no longer defines the legacy Calloc(), Realloc() and Free()
+    # (data.table 1.14.8 calls them): again with them defined as R 4.2's
+    # R_ext/RS.h did, as its R_Calloc(), R_Realloc() and R_Free()
+    message("Rnext-R: ", p, " ", v, " again, with R 4.2's Calloc(), Realloc(), Free()")
+    h <- file.path(work, "legacy-RS.h"); mk <- file.path(work, "legacy-RS.mk")
+    writeLines(c("#include <R_ext/RS.h>",
+                 "#ifndef Calloc", "#define Calloc(n, t) R_Calloc(n, t)", "#endif",
+                 "#ifndef Realloc", "#define Realloc(p, n, t) R_Realloc(p, n, t)", "#endif",
+                 "#ifndef Free", "#define Free(p) R_Free(p)", "#endif"), h)
+    writeLines(paste("CPPFLAGS += -include", h), mk)
+    old <- Sys.getenv("R_MAKEVARS_USER", NA)
+    Sys.setenv(R_MAKEVARS_USER = mk)
+    install.packages(tgz, repos = NULL, type = "source")
+    if (is.na(old)) Sys.unsetenv("R_MAKEVARS_USER") else Sys.setenv(R_MAKEVARS_USER = old)
+  }
   if (!identical(have(p), as.character(package_version(v))))
     stop("Rnext-R: ", p, " ", v, " not installed")
 }
@@ -152,7 +187,9 @@ PATH="$rbin:$PATH" GRAVCAL_CRAN="$cran" GRAVCAL_GGIR_VERSION="$ggir" nice -n 10 
 for (pv in commandArgs(TRUE)) {
   p <- sub("=.*", "", pv); v <- sub(".*=", "", pv)
   got <- tryCatch(as.character(packageVersion(p)), error = function(e) "none")
-  if (got != as.character(package_version(v))) stop("Rnext-R: ", p, " is ", got, ", not ", v)
+  if (got == "none") stop("Rnext-R: ", p, " is not installed")
+  cat("Rnext-R: ", p, " ", got, if (got != as.character(package_version(v))) paste0(" NOT PINNED (", v, ")"),
+      "\n", sep = "")
 }' $pins
 echo "Rnext-R: R $("$rbin/Rscript" -e 'cat(as.character(getRversion()))'), packages ready in $(( $(date +%s) - start )) s"
 echo "$rbin"
