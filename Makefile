@@ -10,6 +10,8 @@
 #               headless Chromium
 #   make test-noLD  (not part of make test) the tests that compare with
 #               R's and GGIR's numbers, on an R built without long double
+#   make test-Rnext  (not part of make test) the same tests on a newer R
+#               (4.4 or 4.5) built from source, with GGIR 3.3-9
 #   make test-arm64  the slow platform check, not part of make test (run
 #               before resolving): Debian's arm64 R in a chroot under qemu,
 #               GGIR from CRAN sources there, the GGIR-identity tests
@@ -32,7 +34,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -282,6 +284,28 @@ test-noLD:
 	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-noLD)" R_LIBS_USER="$(abspath $(BUILD)/lib-noLD)" \
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true GRAVCAL_TEST_FILTER='^($(NOLD_TESTS))$$' \
 	  $$bin/Rscript ../../tools/run-tests.R
+
+# GGIR's numbers on a newer R than the system's 4.2 (GGIR behaves
+# differently on R >= 4.3 in places; not part of make test): builds R 4.4.3
+# once (or, where CRAN's R sources are not reachable, Debian's R 4.5.0;
+# tools/Rnext-R.sh, into GRAVCAL_RNEXT_PREFIX, default
+# ~/.cache/gravcal/R-next: about 5 minutes on 2 cores), with GGIR and the
+# test packages from CRAN at the system library's versions (about 12 more),
+# or reuses it, installs gravcal into it and runs RNEXT_TESTS. GGIR's
+# results are cached per R version: the first run on that R computes them
+# all, about 15 minutes (RNEXT_GGIR_CACHE, default tests/ggir-cache).
+RNEXT_TESTS ?= $(NOLD_TESTS)
+RNEXT_GGIR_CACHE ?= $(GGIR_CACHE)
+test-Rnext:
+	@mkdir -p $(BUILD)/lib-Rnext && \
+	bin=$$(bash tools/Rnext-R.sh | tee $(BUILD)/Rnext-R.log | tail -1) && \
+	{ [ -x "$$bin/Rscript" ] || { echo "test-Rnext: tools/Rnext-R.sh failed (its output: $(BUILD)/Rnext-R.log)" >&2; exit 1; }; } && \
+	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-Rnext . > $(BUILD)/install-Rnext.log 2>&1 || \
+	  { cat $(BUILD)/install-Rnext.log; exit 1; }; } && \
+	rm -f src/*.o src/*.so && \
+	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-Rnext)" R_LIBS_USER="$(abspath $(BUILD)/lib-Rnext)" \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(abspath $(RNEXT_GGIR_CACHE)) NOT_CRAN=true \
+	  GRAVCAL_TEST_FILTER='^($(RNEXT_TESTS))$$' $$bin/Rscript ../../tools/run-tests.R
 
 # calibrate_files() through future.batchtools on a real Slurm: starts a
 # single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort

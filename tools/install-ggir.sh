@@ -11,6 +11,9 @@
 # neither (g.calibrate, g.inspectfile, GGIR parts 1-2). So GGIR is installed
 # from its unmodified CRAN source with those two moved to Suggests in
 # DESCRIPTION; no code of GGIR's is changed.
+#
+#   GRAVCAL_GGIR_VERSION  that version of GGIR (CRAN's current source, or
+#                         else its archive's); default: CRAN's current
 set -euo pipefail
 cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
@@ -35,8 +38,8 @@ fi
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-Rscript --vanilla - "$cran" "$work" <<'RSCRIPT'
-args <- commandArgs(TRUE); cran <- args[1]; work <- args[2]
+Rscript --vanilla - "$cran" "$work" "${GRAVCAL_GGIR_VERSION:-}" <<'RSCRIPT'
+args <- commandArgs(TRUE); cran <- args[1]; work <- args[2]; ver <- args[3]
 deps <- c("data.table", "foreach", "doParallel", "signal", "zoo", "unisensR",
           "ineq", "psych", "irr", "lubridate", "GGIRread", "read.gt3x")
 miss <- setdiff(deps, rownames(installed.packages()))
@@ -46,8 +49,14 @@ if (length(miss)) {
 }
 still <- setdiff(deps, rownames(installed.packages()))
 if (length(still)) stop("install-ggir: could not install ", paste(still, collapse = ", "))
-tgz <- download.packages("GGIR", destdir = work, repos = cran, type = "source",
-                         quiet = TRUE)[1, 2]
+cur <- available.packages(repos = cran, type = "source")["GGIR", "Version"]
+if (is.na(ver) || !nzchar(ver) || identical(ver, cur)) {
+  tgz <- download.packages("GGIR", destdir = work, repos = cran, type = "source",
+                           quiet = TRUE)[1, 2]
+} else {
+  tgz <- file.path(work, sprintf("GGIR_%s.tar.gz", ver))
+  download.file(sprintf("%s/src/contrib/Archive/GGIR/GGIR_%s.tar.gz", cran, ver), tgz, quiet = TRUE)
+}
 utils::untar(tgz, exdir = work)
 pkg <- file.path(work, "GGIR")
 d <- read.dcf(file.path(pkg, "DESCRIPTION"))
