@@ -27,7 +27,9 @@
 #' long epoch and the rest imputed as whole epochs, non-wear, as GGIR 3.3-9
 #' does on R 4.3 or later, which reads the gap's time of day in the session's
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
-#' gives on R 4.3), Movisens. Metrics:
+#' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
+#' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
+#' recording refused, as for gravcal's g.calibrate()). Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too) and
 #' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,

@@ -200,10 +200,34 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
   expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.firstrow.acc")
   expect_warning(gravcal::g.getmeta(f, do.enmoo = TRUE, verbose = FALSE), "`do.enmoo`")
-  csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
-  if (nzchar(csv)) {
-    expect_error(gravcal::g.getmeta(csv, verbose = FALSE), "does not read an Axivity csv export")
+})
+
+test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  skip_if_not_installed("data.table")
+  rec <- simulate_recording(hours = 30, sf = 10, seed = 21, temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  # clocks off the 10 Hz GGIR takes them for: every block resampled onto it
+  for (true_sf in c(10.03, 13.1)) {
+    gravcal:::write_axivity_csv(rec, f, true_sf = true_sf)
+    b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
+    expect_same_meta(b)
+    expect_identical(b$gravcal$metashort$timestamp[1], "2024-01-01T00:00:00+0100")
   }
+  # 10 minutes and 3 hours of lines missing: GGIR's resampling bridges them
+  # within a block
+  L <- readLines(f)
+  n <- length(L)
+  writeLines(L[-c(round(0.3 * n) + 0:6000, round(0.6 * n) + 0:108000)], f)
+  b <- meta_both(f, cal_args[c("offset", "scale")])
+  expect_same_meta(b)
+  expect_lt(nrow(b$gravcal$metashort), 30 * 720)
+  # GGIR's own test file: too short for GGIR, and for gravcal
+  csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
+  b <- meta_both(csv)
+  expect_same_meta(b)
+  expect_true(b$gravcal$filetooshort)
 })
 
 test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps imputed)", {
