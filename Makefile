@@ -274,7 +274,7 @@ clean:
 # test packages from CRAN into its library, about 20 more) or reuses it,
 # installs gravcal into it and runs the test files that compare with R's or
 # GGIR's own numbers (NOLD_TESTS, tools/run-tests.R's filter)
-NOLD_TESTS ?= ggir|ggir-params|ggir-interpolation|ggir-stress|ggir-getmeta|ggir-filters|ggir-part1|epochs|meta-store|fit-icp|decode-.*|windows|adhoc-csv|axivity-csv|read|simd|fp-build|noLD
+NOLD_TESTS ?= ggir|ggir-params|ggir-interpolation|ggir-stress|ggir-getmeta|ggir-filters|ggir-part1|ggir-inspect|epochs|meta-store|fit-icp|decode-.*|windows|adhoc-csv|axivity-csv|read|simd|fp-build|noLD
 test-noLD:
 	@mkdir -p $(BUILD)/lib-noLD && \
 	bin=$$(bash tools/noLD-R.sh | tee $(BUILD)/noLD-R.log | tail -1) && \
