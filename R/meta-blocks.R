@@ -235,15 +235,6 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       step <- now - before
       before <- now
       nr <- step[["read"]]
-      if (step[["over"]] > 0) {
-        limit <- max(c(((ws2 / 60) * 6), 90))
-        abort("\"", basename(src$filename), "\" has a time gap of ",
-              format(round(now[["longest"]] / sf / 60, 1)),
-              " minutes (idle sleep or no data), longer than GGIR's limit of ", format(limit),
-              " minutes, beyond which GGIR's g.getmeta() imputes whole epochs; gravcal's ",
-              "g.getmeta() does not reproduce that yet (GGIR 3.3-9 stops on it in R before ",
-              "4.3). Use GGIR::g.getmeta() on R 4.3 or later.")
-      }
       if (step[["not_filled"]] > 0) {
         abort("\"", basename(src$filename), "\" has a time gap of more than 400 days (idle ",
               "sleep or a damaged time stamp); gravcal's g.getmeta() does not impute it.")
