@@ -275,11 +275,17 @@ clean:
 # installs gravcal into it and runs the test files that compare with R's or
 # GGIR's own numbers (NOLD_TESTS, tools/run-tests.R's filter)
 NOLD_TESTS ?= ggir|ggir-params|ggir-interpolation|ggir-stress|ggir-getmeta|ggir-filters|ggir-part1|ggir-inspect|epochs|meta-store|fit-icp|decode-.*|windows|adhoc-csv|axivity-csv|read|simd|fp-build|noLD
+# The package's sources copied to `$(1)` to install from, so that a build
+# in the working tree at the same time (make install, R CMD INSTALL .)
+# cannot mix its object files into another R's library
+pkg_copy = rm -rf $(1) && mkdir -p $(1) && cp -R DESCRIPTION NAMESPACE LICENSE R src inst man $(1)/ && \
+	rm -f $(1)/src/*.o $(1)/src/*.so $(1)/src/*.dll
+
 test-noLD:
-	@mkdir -p $(BUILD)/lib-noLD && \
+	@mkdir -p $(BUILD)/lib-noLD && $(call pkg_copy,$(BUILD)/src-noLD) && \
 	bin=$$(bash tools/noLD-R.sh | tee $(BUILD)/noLD-R.log | tail -1) && \
 	{ [ -x "$$bin/Rscript" ] || { echo "test-noLD: tools/noLD-R.sh failed (its output: $(BUILD)/noLD-R.log)" >&2; exit 1; }; } && \
-	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-noLD . > $(BUILD)/install-noLD.log 2>&1 || \
+	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-noLD $(BUILD)/src-noLD > $(BUILD)/install-noLD.log 2>&1 || \
 	  { cat $(BUILD)/install-noLD.log; exit 1; }; } && \
 	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-noLD)" R_LIBS_USER="$(abspath $(BUILD)/lib-noLD)" \
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) NOT_CRAN=true GRAVCAL_TEST_FILTER='^($(NOLD_TESTS))$$' \
@@ -297,12 +303,11 @@ test-noLD:
 RNEXT_TESTS ?= $(NOLD_TESTS)
 RNEXT_GGIR_CACHE ?= $(GGIR_CACHE)
 test-Rnext:
-	@mkdir -p $(BUILD)/lib-Rnext && \
+	@mkdir -p $(BUILD)/lib-Rnext && $(call pkg_copy,$(BUILD)/src-Rnext) && \
 	bin=$$(bash tools/Rnext-R.sh | tee $(BUILD)/Rnext-R.log | tail -1) && \
 	{ [ -x "$$bin/Rscript" ] || { echo "test-Rnext: tools/Rnext-R.sh failed (its output: $(BUILD)/Rnext-R.log)" >&2; exit 1; }; } && \
-	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-Rnext . > $(BUILD)/install-Rnext.log 2>&1 || \
+	{ $$bin/R CMD INSTALL --preclean --no-multiarch -l $(BUILD)/lib-Rnext $(BUILD)/src-Rnext > $(BUILD)/install-Rnext.log 2>&1 || \
 	  { cat $(BUILD)/install-Rnext.log; exit 1; }; } && \
-	rm -f src/*.o src/*.so && \
 	cd tests/testthat && R_LIBS="$(abspath $(BUILD)/lib-Rnext)" R_LIBS_USER="$(abspath $(BUILD)/lib-Rnext)" \
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(abspath $(RNEXT_GGIR_CACHE)) NOT_CRAN=true \
 	  GRAVCAL_TEST_FILTER='^($(RNEXT_TESTS))$$' $$bin/Rscript ../../tools/run-tests.R
