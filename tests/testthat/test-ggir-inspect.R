@@ -7,15 +7,21 @@ inspect_ggir <- function(f, tz) {
   keep_warn(suppressWarnings(GGIR::g.inspectfile(f, desiredtz = tz)))
 }
 
+# A fresh folder for a test's files (under the session's tempdir(), which
+# R removes at its end).
+inspect_dir <- function() {
+  d <- tempfile("inspect-")
+  dir.create(d)
+  d
+}
+
 test_that("a .gt3x file's I is GGIR's g.inspectfile()'s, without reading the log", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("read.gt3x")
   files <- c(system.file("extdata", "TAS1H30182785_2019-09-17.gt3x", package = "read.gt3x"),
              system.file("testfiles", "actigraph_testfile.gt3x", package = "GGIR"))
   expect_true(all(file.exists(files)))
-  d <- tempfile("inspect-")
-  dir.create(d)
-  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  d <- inspect_dir()
   # 2 h at 30 Hz across New York's change back to standard time, and an old
   # NEO file (activity.bin, no scale in info.txt)
   x <- simulate_recording(hours = 2, sf = 30, seed = 3)[, c("x", "y", "z")]
@@ -47,9 +53,7 @@ test_that("a .gt3x file's I is GGIR's g.inspectfile()'s, without reading the log
 test_that("what gravcal's I does not cover goes to GGIR's g.inspectfile()", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("read.gt3x")
-  d <- tempfile("inspect-")
-  dir.create(d)
-  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  d <- inspect_dir()
   src <- system.file("testfiles", "actigraph_testfile.gt3x", package = "GGIR")
   # a zip without info.txt: not gravcal's to say; GGIR warns and has no rate
   broken <- file.path(d, "noinfo.gt3x")
@@ -73,9 +77,7 @@ test_that("what gravcal's I does not cover goes to GGIR's g.inspectfile()", {
 test_that("an upper-case .GT3X is read in place, never renamed as GGIR renames it", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("read.gt3x")
-  d <- tempfile("inspect-")
-  dir.create(d)
-  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  d <- inspect_dir()
   src <- system.file("testfiles", "actigraph_testfile.gt3x", package = "GGIR")
   up <- file.path(d, "A.GT3X")
   low <- file.path(d, "b.gt3x")
