@@ -31,8 +31,10 @@
 #' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
 #' recording refused, as for gravcal's g.calibrate()). Metrics:
 #' every `do.*` of
-#' `params_metrics` but `do.brondcounts` (GGIR stops on it too) and
-#' `do.neishabouricounts`; the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
+#' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
+#' `do.neishabouricounts` from the actilifecounts package, called in R on
+#' each block's calibrated samples as GGIR calls it (with `actilife_LFE`);
+#' the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
 #' LFEN, the per-axis filtered signals and zero crossings) need the signal
 #' package, as GGIR does. Non-wear: `nonwear_approach` "2013" and "2023".
 #' `myfun` (GGIR's external function object: `FUN`, `parameters`,
@@ -189,10 +191,14 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
   for (nm in c("n", "lb", "hb", "zc.lb", "zc.hb", "zc.sb", "zc.order")) {
     check_number(p[[nm]], nm, min = 0, min_inclusive = FALSE)
   }
-  for (nm in c("do.brondcounts", "do.neishabouricounts")) {
-    if (isTRUE(p[[nm]])) {
-      abort("`", nm, "` = TRUE: not supported by gravcal's g.getmeta(); use GGIR::g.getmeta().")
-    }
+  if (isTRUE(p$do.brondcounts)) {
+    abort("`do.brondcounts` = TRUE: GGIR has withdrawn Brond's counts (its g.getmeta() stops ",
+          "on them); use `do.neishabouricounts`.")
+  }
+  check_flag(p$actilife_LFE, "actilife_LFE")
+  if (isTRUE(p$do.neishabouricounts) && !requireNamespace("actilifecounts", quietly = TRUE)) {
+    abort("`do.neishabouricounts` = TRUE needs the actilifecounts package (the counts GGIR ",
+          "takes from it): install.packages(\"actilifecounts\").")
   }
   ws <- p$windowsizes
   if (!is.numeric(ws) || length(ws) != 3 || anyNA(ws) || any(ws <= 0)) {

@@ -166,7 +166,11 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   nwc <- meta_nonwear(src, p)
   tab <- meta_metric_table()
   asked <- tab$name[vapply(meta_do_name(tab$name), function(nm) isTRUE(p[[nm]]), TRUE)]
-  metnames <- sub("angle_", "angle", asked, fixed = TRUE)
+  # Neishabouri's counts (actilifecounts, in R on each block) after the
+  # metrics, as GGIR names them; `cols`: the sheet's metric columns
+  neish <- if (isTRUE(p$do.neishabouricounts)) paste0("NeishabouriCount_", c("x", "y", "z", "vm"))
+  cols <- c(asked, neish)
+  metnames <- c(sub("angle_", "angle", asked, fixed = TRUE), neish)
   filters <- NULL
   fused <- list(conv = FALSE, rec = FALSE)
   if (any(asked %in% tab$name[tab$filtered])) {
@@ -193,7 +197,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   # `asked`), a myfun's columns as text and the ENMO gradient's columns
   # (epoch_signals()); metalong's columns once the first block says which
   grad_cols <- NULL
-  short <- sheet_new(asked, myfun$colnames)
+  short <- sheet_new(cols, myfun$colnames)
   long <- NULL
   # GGIR's long gaps imputed as whole epochs (epoch_gaps): the rows of the
   # store that carry GGIR's remaining_epochs (0-based) and their values,
@@ -360,19 +364,36 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         } else if (!is.null(model)) {
           lin <- model
         }
-        out_fun <- NULL
-        if (!is.null(myfun)) {
+        out_fun <- counts <- NULL
+        if (!is.null(myfun) || length(neish)) {
+          # what runs in R takes the block's samples calibrated in R, as GGIR
+          # calibrates them
           xyz <- meta_myfun_xyz(gc_meta_store_rows(store, 0, n_use), cal, use.temp)
-          out_fun <- meta_myfun_block(xyz, myfun, sf, ws3, starttime, p$interpolationType)
+          if (length(neish)) counts <- meta_counts_block(xyz, sf, ws3, p$actilife_LFE, neish)
+          if (!is.null(myfun)) {
+            out_fun <- meta_myfun_block(xyz, myfun, sf, ws3, starttime, p$interpolationType)
+          }
           rm(xyz)
         }
         r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
                                   filters, fused$conv, fused$rec, n_use)
-        n_block <- if (length(asked)) length(r$short[[1]]) else 0
+        n_block <- if (length(asked)) length(r$short[[1]]) else NROW(counts)
+        if (!is.null(counts) && length(asked) && nrow(counts) != n_block) {
+          abort("actilifecounts::get_counts() gave ", nrow(counts), " epochs for a block of ",
+                n_block, " (GGIR's g.getmeta() stops on such a block too).")
+        }
         short <- sheet_put(short, lapply(r$short[asked], round, 4))
+        if (!is.null(counts)) short <- sheet_put(short, counts)
         if (!is.null(grad)) short <- sheet_put(short, grad)
         if (!is.null(out_fun)) {
-          colnames(out_fun) <- myfun$colnames
+          # GGIR's columns after the counts start one too early (its column
+          # index moves on by 3 for their 4): the function's first column
+          # lands on NeishabouriCount_vm, its last stays blank
+          colnames(out_fun) <- if (length(neish)) {
+            c(neish[4], myfun$colnames)[seq_len(ncol(out_fun))]
+          } else {
+            myfun$colnames
+          }
           short <- sheet_put(short, out_fun)
         }
         blk <- list(nonwearscore = r$nonwear, clippingscore = r$clipping)
@@ -390,7 +411,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
           pos1 <- fill$pos + 1
           long <- sheet_impute(long, floor(pos1 / (ws2 * sf)) + long$count,
                                floor(fill$remaining * (ws3 / ws2)) + 1, list(nonwearscore = 3))
-          zero <- c(grep("time|angle", asked, invert = TRUE, value = TRUE), grad_cols)
+          zero <- c(grep("time|angle", cols, invert = TRUE, value = TRUE), grad_cols)
           set <- stats::setNames(rep(list(0), length(zero)), zero)
           if ("EN" %in% asked) set$EN <- 1
           short <- sheet_impute(short, floor(pos1 / (ws3 * sf)) + short$count,
@@ -435,7 +456,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
             unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
             "reproduced (M$QClog is NULL).", call. = FALSE)
   }
-  M <- meta_result(short, long, asked, metnames, metricnames_long, starttime, wday, wdayname,
+  M <- meta_result(short, long, cols, metnames, metricnames_long, starttime, wday, wdayname,
                    filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun)
   if (!is.null(gradient)) {
     M$enmo_gradient <- do.call(cbind, lapply(grad_cols, function(nm) sheet_column(short, nm)))

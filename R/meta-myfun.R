@@ -151,3 +151,18 @@ meta_myfun_block <- function(xyz, myfun, sf, ws3, start, interpolation) {
   }
   out
 }
+
+# GGIR's do.neishabouricounts for one block: actilifecounts::get_counts() on
+# the block's calibrated samples (`xyz`), per short epoch, rounded as GGIR
+# rounds its metrics; columns named `names` (x, y, z, vector magnitude).
+meta_counts_block <- function(xyz, sf, ws3, lfe, names) {
+  m <- actilifecounts::get_counts(raw = xyz, sf = sf, epoch = ws3, lfe_select = lfe,
+                                  verbose = FALSE)
+  if (sf < 30) {
+    warning("Neishabouri's counts (actilifecounts) assume a rate of 30 Hz or more, not ", sf,
+            " Hz (GGIR warns of this too).", call. = FALSE)
+  }
+  m <- round(matrix(as.numeric(m[, 1:4]), ncol = 4), 4)
+  colnames(m) <- names
+  m
+}

@@ -30,7 +30,7 @@ Rscript --vanilla - "$cran" <<'RSCRIPT'
 cran <- commandArgs(TRUE)[1]
 need <- c("Rcpp", "RcppEigen", "testthat", "knitr", "rmarkdown", "read.gt3x",
           "tibble", "data.table", "future", "future.apply", "progressr",
-          "DEoptim", "signal", "batchtools", "future.batchtools")
+          "DEoptim", "signal", "batchtools", "future.batchtools", "actilifecounts")
 have <- rownames(installed.packages())
 miss <- setdiff(need, have)
 if (length(miss)) {

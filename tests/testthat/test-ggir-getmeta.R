@@ -170,6 +170,37 @@ test_that("g.getmeta() runs an external function (myfun) as GGIR runs it", {
   expect_setequal(unique(got$posture$metashort$pos), c("up", "down"))
 })
 
+test_that("g.getmeta() gives Neishabouri's counts as GGIR does (actilifecounts per block)", {
+  skip_if_quick()
+  skip_if_not_installed("actilifecounts")
+  # 8 hours at 50 Hz in blocks of 3.6 hours (chunksize 0.3): the counts'
+  # filters restart in each block, as GGIR's call does
+  f <- meta_recording("cwa", 50, 8, seed = 21)
+  pm <- list(do.neishabouricounts = TRUE, do.enmo = TRUE, do.anglez = TRUE)
+  b <- meta_both(f, c(cal_args, list(params_metrics = pm,
+                                     params_rawdata = list(chunksize = 0.3))))
+  expect_same_meta(b)
+  ms <- b$gravcal$metashort
+  cn <- paste0("NeishabouriCount_", c("x", "y", "z", "vm"))
+  expect_identical(names(ms), c("timestamp", "anglez", "ENMO", cn))
+  expect_true(sum(ms$NeishabouriCount_vm > 0, na.rm = TRUE) > 100)
+  # the low-frequency extension, and the counts alone (no other metric)
+  pm2 <- list(do.neishabouricounts = TRUE, do.enmo = FALSE, do.anglez = FALSE,
+              actilife_LFE = TRUE)
+  b2 <- meta_both(f, list(params_metrics = pm2, params_rawdata = list(chunksize = 0.3)))
+  expect_same_meta(b2)
+  expect_identical(names(b2$gravcal$metashort), c("timestamp", cn))
+  expect_false(identical(b2$gravcal$metashort$NeishabouriCount_vm, ms$NeishabouriCount_vm))
+  # with a myfun: GGIR writes the function's first column over
+  # NeishabouriCount_vm and leaves its own last column blank
+  skip_if_not_installed("GGIRread")
+  mf <- meta_myfuns()$per_second
+  b3 <- meta_both(f, c(cal_args, list(params_metrics = pm, myfun = mf,
+                                      params_rawdata = list(chunksize = 0.3))))
+  expect_same_meta(b3)
+  expect_true(all(is.na(b3$gravcal$metashort[[mf$colnames]])))
+})
+
 test_that("a myfun GGIR would stop on is an error naming what is wrong", {
   f <- meta_recording("cwa", 25, 3, seed = 12)
   mf <- meta_myfuns()$per_second
@@ -192,8 +223,9 @@ test_that("a myfun GGIR would stop on is an error naming what is wrong", {
 
 test_that("g.getmeta() refuses what it does not compute, naming it", {
   f <- meta_recording("cwa", 25, 3, seed = 12)
-  expect_error(gravcal::g.getmeta(f, do.neishabouricounts = TRUE, verbose = FALSE),
-               "do.neishabouricounts")
+  expect_error(gravcal::g.getmeta(f, do.brondcounts = TRUE, verbose = FALSE),
+               "do.brondcounts")
+  expect_error(gravcal::g.getmeta(f, actilife_LFE = NA, verbose = FALSE), "actilife_LFE")
   expect_error(gravcal::g.getmeta(f, windowsizes = c(5, 900), verbose = FALSE), "windowsizes")
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")

@@ -292,8 +292,9 @@ test_that("g.part1() skips done files, leaves others' formats to GGIR, refuses w
   expect_true(file.exists(file.path(out, paste0("output_", basename(d)), "meta", "basic",
                                     "meta_a.cwa.RData")))
   expect_error(gravcal::g.part1(d, md, myfun = list(FUN = mean), verbose = FALSE), "myfun")
-  expect_error(gravcal::g.part1(d, md, do.neishabouricounts = TRUE, verbose = FALSE),
-               "do.neishabouricounts")
+  # GGIR's own parameter check stops on Brond's counts here
+  expect_error(gravcal::g.part1(d, md, do.brondcounts = TRUE, verbose = FALSE),
+               "brondcounts")
   expect_error(gravcal::g.part1(d, verbose = FALSE), "metadatadir")
   expect_error(gravcal::g.part1(file.path(d, "a.cwa"), outputdir = out, verbose = FALSE),
                "studyname")
