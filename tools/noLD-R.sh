@@ -22,73 +22,17 @@ jobs="${GRAVCAL_NOLD_JOBS:-2}"
 here="$(cd "$(dirname "$0")" && pwd)"
 rbin="$prefix/bin"
 
-# png() is needed (GGIR's part 2 draws its QC plots with it, and so do the
-# epoch tests); built --without-x, R has it only through cairo, and png()'s
-# default type (the option bitmapType) is "cairo" only with pango's cairo
-# (else "Xlib": "X11 is not available", though capabilities("png") is
-# TRUE): an R built here earlier without them is rebuilt in place (its
-# library is kept)
-png_ok() {
-  [ "$("$rbin/Rscript" --vanilla -e 'p <- tempfile(fileext = ".png"); ok <- !inherits(try(grDevices::png(p), silent = TRUE), "try-error"); if (ok) invisible(grDevices::dev.off()); cat(ok)' 2>/dev/null)" = TRUE ]
-}
-if [ ! -x "$rbin/Rscript" ] || ! png_ok; then
-  start=$(date +%s)
-  if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
-    need="gfortran libreadline-dev libpcre2-dev libbz2-dev liblzma-dev
-zlib1g-dev libcurl4-openssl-dev libicu-dev make pkg-config libcairo2-dev libpango1.0-dev"
-    missing=""
-    for p in $need; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
-    if [ -n "$missing" ]; then
-      echo "noLD-R: Debian packages:$missing"
-      export DEBIAN_FRONTEND=noninteractive
-      apt-get update -qq -o DPkg::Lock::Timeout=600 >/dev/null
-      apt-get install -y -qq -o DPkg::Lock::Timeout=600 --no-install-recommends $missing >/dev/null
-    fi
-  fi
-  src="$prefix.src"
-  mkdir -p "$src"
-  tgz="$src/R-$rver.tar.gz"
-  major="${rver%%.*}"
-  deb="${GRAVCAL_NOLD_DEBIAN_SRC:-http://deb.debian.org/debian/pool/main/r/r-base/r-base_4.2.2.20221110.orig.tar.gz}"
-  if [ ! -s "$tgz" ]; then
-    curl -fsSL -o "$tgz" "$cran/src/base/R-$major/R-$rver.tar.gz" ||
-      { echo "noLD-R: R's sources not on $cran; Debian's: $deb"; curl -fsSL -o "$tgz" "$deb"; }
-  fi
-  if [ ! -d "$src/R-$rver" ]; then
-    mkdir -p "$src/R-$rver"
-    tar -xzf "$tgz" -C "$src/R-$rver" --strip-components=1
-  fi
-  cd "$src/R-$rver"
-  if [ ! -f Makeconf ]; then
-    ./configure --prefix="$prefix" --disable-long-double --without-x \
-      --with-readline=no --with-recommended-packages=no --disable-java \
-      --enable-R-shlib=no > "$src/configure.log" 2>&1 ||
-      { tail -30 "$src/configure.log"; exit 1; }
-  fi
-  nice -n 10 make -j"$jobs" > "$src/make.log" 2>&1 || { tail -30 "$src/make.log"; exit 1; }
-  make install > "$src/install.log" 2>&1 || { tail -30 "$src/install.log"; exit 1; }
-  cd "$here/.."
-  rm -rf "$src/R-$rver"
-  echo "noLD-R: R $rver built in $(( $(date +%s) - start )) s"
-fi
-
-if ! png_ok; then
-  echo "noLD-R: png() fails in $rbin/R (configure found no cairo or pango: $prefix.src/configure.log)" >&2
-  exit 1
-fi
+# R itself (tools/build-R.sh), then its check
+. "$here/build-R.sh"
+build_r noLD-R "$prefix" "$rver" "$jobs" \
+  "${GRAVCAL_NOLD_DEBIAN_SRC:-http://deb.debian.org/debian/pool/main/r/r-base/r-base_4.2.2.20221110.orig.tar.gz}" \
+  "$rver" --disable-long-double
 ld=$("$rbin/Rscript" -e 'cat(capabilities("long.double"))')
 if [ "$ld" != "FALSE" ]; then
   echo "noLD-R: $rbin/R has long double (capabilities(\"long.double\") is $ld)" >&2
   exit 1
 fi
 
-# packages, into this R's own library (R_LIBS unset: nothing from the
-# system R's libraries); testthat's dependency fs needs libuv's headers
-unset R_LIBS R_LIBS_USER R_LIBS_SITE
-if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && ! dpkg -s libuv1-dev >/dev/null 2>&1; then
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get install -y -qq -o DPkg::Lock::Timeout=600 --no-install-recommends libuv1-dev >/dev/null
-fi
 start=$(date +%s)
 "$rbin/Rscript" --vanilla -e '
 pk <- c("Rcpp", "RcppEigen", "testthat")
