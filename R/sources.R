@@ -96,7 +96,6 @@ reference_source <- function(src) {
     }
     gc_source_blocks(first, function() {
       first <<- NULL
-      invisible(gc(full = TRUE))
       i <<- i + 1
       columns(read(i))
     })
@@ -401,11 +400,11 @@ unisens_r_numbers <- function(file) {
 }
 
 # GGIR's own reading of a Movisens recording, block by block: unisensR for
-# the acceleration, GGIR's g.readtemp_movisens for the temperature.
+# the acceleration, movisens_temperature() for the temperature.
 source_movisens <- function(file) {
   if (!requireNamespace("unisensR", quietly = TRUE) ||
-      !requireNamespace("GGIR", quietly = TRUE)) {
-    abort("Reading Movisens recordings by GGIR's reader needs the unisensR and GGIR packages.")
+      !requireNamespace("GGIRread", quietly = TRUE)) {
+    abort("Reading Movisens recordings by GGIR's reader needs the unisensR and GGIRread packages.")
   }
   dir <- dirname(file)
   n <- tryCatch(unisensR::getUnisensSignalSampleCount(dir, "acc.bin"),
@@ -423,12 +422,30 @@ source_movisens <- function(file) {
                                               endIndex = to)
          d <- as.data.frame(d)
          names(d) <- c("x", "y", "z")
-         tt <- tryCatch(utils::getFromNamespace("g.readtemp_movisens", "GGIR")(file, from = from, to = to,
-                                                    acc_sf = 64, acc_length = nrow(d)),
+         tt <- tryCatch(movisens_temperature(dir, from, to, 64, nrow(d)),
                         error = function(e) NULL)
          if (!is.null(tt)) d$temperature <- as.vector(tt)
          list(data = d, last = to >= n)
        })
+}
+
+# The temperature of a Movisens block (acceleration samples `from` to `to`
+# at `acc_sf`), as GGIR's part 1 takes it from temp.bin: the temperature
+# samples over the same span (their indices rounded up, first as if
+# temp.bin held 1 sample a second, then again at its own rate when that
+# differs), stretched over the block's `n` samples by GGIRread's linear
+# resampling. An error where temp.bin cannot be read.
+movisens_temperature <- function(dir, from, to, acc_sf, n) {
+  span <- function(rate) ceiling(c(from, to) / acc_sf * rate)
+  read <- function(i) unisensR::readUnisensSignalEntry(dir, "temp.bin", startIndex = i[1],
+                                                       endIndex = i[2])
+  tt <- read(span(1))
+  rate <- attr(tt, "sampleRate")
+  if (rate != 1) tt <- read(span(rate))
+  v <- as.matrix(tt$temp)
+  k <- nrow(v)
+  at <- seq_len(k)
+  GGIRread::resample(v, at, seq(from = 1, to = at[k], length.out = n), k, type = 1)
 }
 
 source_gt3x <- function(file, chunksize) {

@@ -46,6 +46,17 @@ test_that("the decoder gives unisensR's samples and g.readtemp_movisens' tempera
     gravcal:::write_movisens(s * if (cs$lsb == 1) 1000 else 1, d, data_type = cs$type,
                              lsb = cs$lsb, baseline = cs$base, temp_sf = cs$tsf)
     a <- unisensR::readUnisensSignalEntry(d, "acc.bin")
+    # the reference reader's temperature (without GGIR's unexported
+    # function): GGIR's, for the whole recording and for a block within it
+    for (span in list(c(1, n), c(64 * 300 + 1, 64 * 600), c(64 * 900 + 1, n))) {
+      m <- span[2] - span[1] + 1
+      want <- tryCatch(readtemp(file.path(d, "acc.bin"), from = span[1], to = span[2],
+                                acc_sf = 64, acc_length = m), error = function(e) "error")
+      got <- tryCatch(gravcal:::movisens_temperature(d, span[1], span[2], 64, m),
+                      error = function(e) "error")
+      expect_identical(got, want)
+      expect_identical(identical(got, "error"), cs$tsf == 0.5)
+    }
     for (it in 1:2) {
       r <- read_recording(d)  # the folder
       expect_identical(r$data$x, as.double(a[[1]]))
