@@ -46,9 +46,18 @@ coef_names <- function() {
 #' given to [apply_calibration()] (one row) and to [compare_coefs()].
 #'
 #' The tools and the forms read and written:
-#' * `"ggir"`: GGIR's `backup.cal.coef` csv file, one row per recording
-#'   (written by [write_ggir_coefs()]); temperature centred on `meantempcal`,
-#'   the mean temperature of the recording's rest windows.
+#' * `"ggir"`: GGIR's `backup.cal.coef` csv file, one row per recording,
+#'   which `GGIR::GGIR(..., backup.cal.coef = file)` uses instead of
+#'   calibrating those recordings itself (rows matched by file name:
+#'   `filename`, `scale.x` ... `temperature.offset.z`, `cal.error.start`,
+#'   `cal.error.end`, `meantempcal`, `QCmessage`, `n.10sec.windows`,
+#'   `n.hours.considered`, `use.temperature`); temperature centred on
+#'   `meantempcal`, the mean temperature of the recording's rest windows.
+#'   Written only for fits without cross-axis terms (GGIR applies none); a
+#'   fit without a temperature term gets `meantempcal` 0 (GGIR subtracts it
+#'   from the temperature of files that have one), and one with temperature
+#'   offsets but no mean temperature is an error (GGIR would move every
+#'   sample by `temperature.offset * meantemp`).
 #' * `"actipy"`: actipy's calibration info (the dict
 #'   `actipy.processing.calibrate_gravity()` returns, saved as json),
 #'   keys `CalibxIntercept`, `CalibxSlope`, `CalibxSlopeT` (and `y`, `z`),
@@ -104,7 +113,7 @@ coef_names <- function() {
 #'   `meantemp` (degree C; 0 for the uncentred tools, `NA` when there is no
 #'   temperature term) and `source` (the file read). `write_coefs()`: that
 #'   data frame for what was written, invisibly.
-#' @seealso [compare_coefs()], [write_ggir_coefs()].
+#' @seealso [compare_coefs()], [calibrate_files()].
 #' @export
 #' @examples
 #' rec <- simulate_recording(hours = 30, sf = 10, seed = 4,
@@ -166,17 +175,24 @@ write_coefs <- function(fits, file, format = c("ggir", "actipy", "ukb",
       any(!nzchar(file))) {
     abort("`file` must be file paths, not ", describe(file), ".")
   }
-  cf <- as_coefs(fits, "fits", ggir = format == "ggir")
+  # GGIR's file names each row by its recording and has its own rules on
+  # what it can hold: those said first, in its words (ggir_coef_table())
+  by_fit <- inherits(fits, "gravcal_fit") || is_ggir_result(fits) ||
+    (is.list(fits) && !is.data.frame(fits))
+  cf <- if (format == "ggir" && by_fit) {
+    ggir_frame_coefs(ggir_coef_table(fits), "fits")
+  } else {
+    as_coefs(fits, "fits", ggir = format == "ggir")
+  }
   if (format == "ggir") {
     if (length(file) != 1) {
       abort("`file` must be one path for format \"ggir\" (one csv file for ",
             "all recordings), not ", length(file), ".")
     }
-    if (inherits(fits, "gravcal_fit") || is_ggir_result(fits) ||
-        (is.list(fits) && !is.data.frame(fits))) {
-      write_ggir_coefs(fits, file)
+    if (by_fit) {
+      write_ggir_file(fits, file)
     } else {
-      write_ggir_coefs(stats::setNames(lapply(seq_len(nrow(cf)), function(i) {
+      write_ggir_file(stats::setNames(lapply(seq_len(nrow(cf)), function(i) {
         r <- cf[i, ]
         to <- unlist(r[coef_names()[7:9]])
         list(scale = unlist(r[coef_names()[1:3]]),

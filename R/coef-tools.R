@@ -48,6 +48,12 @@ read_ggir_file <- function(f) {
           "column(s) ", paste0("`", miss, "`", collapse = ", "), ".")
   }
   if (!nrow(d)) abort("`file`: \"", f, "\" holds no recordings.")
+  ggir_frame_coefs(d, f)
+}
+
+# The coefficients of the rows of a GGIR coefficient table `d` (read from
+# the file `f`, or written by write_coefs()).
+ggir_frame_coefs <- function(d, f) {
   rows <- lapply(seq_len(nrow(d)), function(i) {
     v <- suppressWarnings(vapply(coef_names(),
                                  function(n) as.double(d[[n]][i]), 0))

@@ -41,7 +41,7 @@
 #'
 #' Written to `outdir`: `calibration.csv` (the table below) and, for
 #' `method = "ggir"`, `calibration_ggir_coefs.csv`, the coefficients in
-#' GGIR's `backup.cal.coef` format ([write_ggir_coefs()]) of exactly the
+#' GGIR's `backup.cal.coef` format ([write_coefs()]) of exactly the
 #' recordings of this table that were calibrated (status `"ok"`,
 #' `"high_error"` or `"given"`; only the header when there are none). A run with the
 #' lightweight method removes a `calibration_ggir_coefs.csv` an earlier run

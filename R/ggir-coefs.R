@@ -1,42 +1,26 @@
 # GGIR's coefficient file (backup.cal.coef): what GGIR reads to use
 # coefficients instead of calibrating a file itself.
 
-#' Write calibration coefficients in GGIR's backup.cal.coef format
+#' Write calibration coefficients in GGIR's format (deprecated)
 #'
-#' Writes a csv file that `GGIR::GGIR(..., backup.cal.coef = file)` reads:
-#' for every recording listed, GGIR then uses these coefficients instead of
-#' calibrating the file itself. One row per recording, with the columns GGIR
-#' looks for: `filename` (the recording's file name, as GGIR lists it),
-#' `scale.x`, `scale.y`, `scale.z`, `offset.x`, `offset.y`, `offset.z`,
-#' `temperature.offset.x`, `temperature.offset.y`, `temperature.offset.z`,
-#' `cal.error.start`, `cal.error.end`, `meantempcal`, `QCmessage`,
-#' `n.10sec.windows`, `n.hours.considered`, `use.temperature`.
+#' Deprecated: use [write_coefs()] with `format = "ggir"` (its default),
+#' which writes the same file and also takes a data frame of coefficients.
+#' `write_ggir_coefs()` still writes the file, with a deprecation warning.
 #'
-#' GGIR applies them per sample as `(xyz + offset) * scale + (T -
-#' meantempcal) * temperature.offset`, the model of `method = "ggir"`. Only
-#' fits of that model (diagonal `K`) can be written; a 9-parameter fit from
-#' the lightweight method has cross-axis terms GGIR cannot apply. When a
-#' fit has no temperature term, `meantempcal` is written as 0, because GGIR
-#' subtracts it from the temperature of files that have one (a missing value
-#' there would turn every sample into NA). A fit with temperature offsets
-#' but no mean temperature (`meantemp`, or a `g.calibrate()` result's
-#' `meantempcal`) is an error: written as 0, GGIR would move every
-#' calibrated sample by `temperature.offset * meantemp`.
-#'
-#' @param fits A `gravcal_fit` from `calibrate(..., method = "ggir")` or
-#'   [fit_icp()], a `g.calibrate()` result, or a named list of either: the
-#'   names are the recordings' file names. A fit made by `calibrate()` on a
-#'   file path already knows its file name.
-#' @param file Path of the csv file to write.
-#' @return The data frame written, invisibly.
+#' @param fits,file As for [write_coefs()].
+#' @return The rows written (GGIR's columns), invisibly.
+#' @keywords internal
 #' @export
-#' @examples
-#' rec <- simulate_recording(hours = 30, sf = 10, seed = 4)
-#' fit <- calibrate(rec, sf = 10, method = "ggir")
-#' out <- tempfile(fileext = ".csv")
-#' write_ggir_coefs(list(participant01.bin = fit), out)
-#' read.csv(out)[, 1:7]
 write_ggir_coefs <- function(fits, file) {
+  .Deprecated("write_coefs", package = "gravcal",
+              msg = paste0("write_ggir_coefs() is deprecated: use write_coefs(fits, file) ",
+                           "(format = \"ggir\", the default), which writes the same file."))
+  write_ggir_file(fits, file)
+}
+
+# GGIR's coefficient file (backup.cal.coef) for a fit or a named list of
+# fits, written atomically; the rows written returned (write_coefs()).
+write_ggir_file <- function(fits, file) {
   if (!is.character(file) || length(file) != 1 || is.na(file) || !nzchar(file)) {
     abort("`file` must be a single file path, not ", describe(file), ".")
   }
@@ -160,7 +144,7 @@ ggir_coef_row <- function(f, name) {
 # cannot be written or converted, since a missing mean temperature taken as
 # 0 (GGIR reads it so) moves every calibrated sample by tempoffset *
 # meantemp. `field`: the fit's name for it; `ggir`: the message is about
-# GGIR's coefficient file (write_ggir_coefs()), else about coefficients in
+# GGIR's coefficient file (write_coefs()), else about coefficients in
 # general (as_coefs()).
 check_meantemp <- function(to, mt, name, field, arg = "fits", ggir = TRUE) {
   if (length(to) && all(is.finite(to)) && any(to != 0) &&

@@ -125,7 +125,7 @@
 #'   reports it, as on Linux, else R's heap; GGIR records R's heap). Invisibly,
 #'   as GGIR.
 #' @seealso [calibrate()] (`method = "ggir"`) for a `gravcal_fit`,
-#'   [write_ggir_coefs()] to hand coefficients to GGIR.
+#'   [write_coefs()] to hand coefficients to GGIR.
 #' @export
 #' @examples
 #' rec <- simulate_recording(hours = 30, sf = 10, seed = 4)

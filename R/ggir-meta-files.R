@@ -31,7 +31,7 @@
 #'   not done"). When the calibration ends with a larger error than it started
 #'   with, or without errors, its scale, offset and temperature offset are set
 #'   to 1, 0 and 0, as GGIR sets them. With `backup.cal.coef` (a csv file of
-#'   GGIR's coefficient format, as [write_ggir_coefs()] writes it; or
+#'   GGIR's coefficient format, as [write_coefs()] writes it; or
 #'   `"retrieve"`, GGIR's default: `<metadatadir>/results/QC/data_quality_report.csv`
 #'   when part 2's report is there), a row for the file replaces the
 #'   coefficients, errors, `meantempcal`, `QCmessage`, `npoints`,
@@ -118,7 +118,7 @@
 #'   `"not read"`: a format gravcal's g.getmeta() does not read; `"failed"`,
 #'   with `use_trycatch_serial = TRUE`), `message`, `meta_file` and
 #'   `seconds`. (GGIR's returns nothing of use.)
-#' @seealso [g.calibrate()], [g.getmeta()], [write_ggir_coefs()],
+#' @seealso [g.calibrate()], [g.getmeta()], [write_coefs()],
 #'   [calibrate_cli()] (its `part1` verb).
 #' @export
 g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = c(),

@@ -4,7 +4,7 @@
 
 rec <- simulate_recording(hours = 30, sf = 10, seed = 4)
 
-test_that("write_ggir_coefs() refuses a target that is not a regular file", {
+test_that("write_coefs() refuses a target that is not a regular file", {
   skip_on_os("windows")  # no named pipes
   fit <- calibrate(rec, sf = 10, method = "ggir")
   dir <- tempfile("coefs")
@@ -14,13 +14,13 @@ test_that("write_ggir_coefs() refuses a target that is not a regular file", {
   skip_if_not(system2("mkfifo", pipe) == 0, "mkfifo is not available")
   # writing would replace the pipe by a regular file, or (a device such as
   # /dev/full) end in the device's error
-  expect_error(write_ggir_coefs(list(a.bin = fit), pipe),
+  expect_error(write_coefs(list(a.bin = fit), pipe),
                "`file` must be a regular file, not a named pipe: .*coefs.csv")
   expect_identical(gravcal:::file_kind(pipe), "fifo")
   expect_length(list.files(dir, all.files = TRUE, no.. = TRUE), 1)
 })
 
-test_that("write_ggir_coefs() on a really full disk: an error naming the file, no file left", {
+test_that("write_coefs() on a really full disk: an error naming the file, no file left", {
   skip_on_os(c("windows", "mac"))
   mnt <- tempfile("tmpfs")
   dir.create(mnt)
@@ -37,11 +37,11 @@ test_that("write_ggir_coefs() on a really full disk: an error naming the file, n
   # 400 rows of about 300 bytes: more than the 16 kB the disk holds
   fits <- stats::setNames(rep(list(fit), 400), sprintf("p%04d.bin", 1:400))
   coefs <- file.path(mnt, "coefs.csv")
-  expect_error(write_ggir_coefs(fits, coefs), paste0("Could not write \"", coefs, "\""),
+  expect_error(write_coefs(fits, coefs), paste0("Could not write \"", coefs, "\""),
                fixed = TRUE)
   expect_length(list.files(mnt, all.files = TRUE, no.. = TRUE), 0)
   # a small file still fits: it is written whole
-  write_ggir_coefs(fits[1], coefs)
+  write_coefs(fits[1], coefs)
   expect_identical(read.csv(coefs)$filename, "p0001.bin")
 })
 

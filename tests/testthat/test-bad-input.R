@@ -295,12 +295,12 @@ test_that("apply_calibration() refuses fits that are not fits", {
   }
 })
 
-test_that("write_ggir_coefs() refuses what GGIR cannot use", {
+test_that("write_coefs() refuses what GGIR cannot use", {
   fit <- calibrate(base, sf = 10)
   f <- tempfile(fileext = ".csv")
-  expect_error(write_ggir_coefs(fit, f), "`fits` must be named")
-  expect_error(write_ggir_coefs(list(rec.csv = fit), f), "cross-axis|GGIR")
-  expect_error(write_ggir_coefs(list(rec.csv = "x"), f), "gravcal_fit|g.calibrate")
+  expect_error(write_coefs(fit, f), "`fits` must be named")
+  expect_error(write_coefs(list(rec.csv = fit), f), "cross-axis|GGIR")
+  expect_error(write_coefs(list(rec.csv = "x"), f), "gravcal_fit|g.calibrate")
   expect_false(file.exists(f))
 })
 

@@ -71,7 +71,7 @@ test_that("calibrate_cli part1: files with a study name, coefficients from a fil
   dir.create(d)
   f <- cli_small_cwa(d, "a.cwa", 3)
   coefs <- tempfile(fileext = ".csv")
-  write_ggir_coefs(list(a.cwa = list(scale = c(1.01, 0.99, 1), offset = c(0.01, 0, -0.02),
+  write_coefs(list(a.cwa = list(scale = c(1.01, 0.99, 1), offset = c(0.01, 0, -0.02),
                                      tempoffset = c(0, 0, 0), QCmessage = "given",
                                      meantempcal = 0)), coefs)
   out <- tempfile("cli-out-")

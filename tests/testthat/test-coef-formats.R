@@ -109,19 +109,19 @@ test_that("temperature offsets without meantemp are refused, never written as me
                 "temperature they are centred on")
   no_mt <- fx$fit
   no_mt$meantemp <- NA_real_
-  expect_error(write_ggir_coefs(list(p01.bin = no_mt), out), msg, fixed = TRUE)
+  expect_error(write_coefs(list(p01.bin = no_mt), out), msg, fixed = TRUE)
   expect_error(write_coefs(list(p01.bin = no_mt), out, format = "ggir"), msg,
                fixed = TRUE)
   gone <- fx$fit
   gone["meantemp"] <- list(NULL)
   expect_null(gone$meantemp)
-  expect_error(write_ggir_coefs(list(p01.bin = gone), out), msg, fixed = TRUE)
+  expect_error(write_coefs(list(p01.bin = gone), out), msg, fixed = TRUE)
   expect_false(file.exists(out))
   # a g.calibrate() result names it meantempcal
   g <- fx$fit[["ggir"]]
   expect_true(any(g$tempoffset != 0))
   g["meantempcal"] <- list(NULL)
-  for (w in list(function() write_ggir_coefs(list(p01.bin = g), out),
+  for (w in list(function() write_coefs(list(p01.bin = g), out),
                  function() write_coefs(list(p01.bin = g), out, "ggir"))) {
     expect_error(w(), paste0("the fit for \"p01.bin\" has temperature ",
                              "offsets but no `meantempcal`: GGIR's"),
@@ -136,15 +136,15 @@ test_that("temperature offsets without meantemp are refused, never written as me
   nt <- fx$fit_nt
   expect_true(all(nt$tempoffset == 0))
   expect_identical(nt$meantemp, NA_real_)
-  write_ggir_coefs(list(p01.bin = nt), out)
+  write_coefs(list(p01.bin = nt), out)
   expect_identical(utils::read.csv(out)$meantempcal, 0L)
   write_coefs(list(p01.bin = nt), out, "ggir")
   expect_identical(utils::read.csv(out)$meantempcal, 0L)
   nt["meantemp"] <- list(NULL)
-  write_ggir_coefs(list(p01.bin = nt), out)
+  write_coefs(list(p01.bin = nt), out)
   expect_identical(utils::read.csv(out)$meantempcal, 0L)
   # with it: written, and GGIR's formula on the file is gravcal's calibration
-  write_ggir_coefs(list(p01.bin = fx$fit), out)
+  write_coefs(list(p01.bin = fx$fit), out)
   cf <- utils::read.csv(out)
   expect_equal(cf$meantempcal, fx$fit$meantemp, tolerance = 1e-14)
   rec <- fx$rec
@@ -155,7 +155,7 @@ test_that("temperature offsets without meantemp are refused, never written as me
 
 test_that("GGIR's backup.cal.coef written by hand is read to its coefficients", {
   # columns as GGIR's g.calibrate() output / backup.cal.coef (the ones
-  # write_ggir_coefs() documents); GGIR applies (v + offset) * scale +
+  # write_coefs() documents); GGIR applies (v + offset) * scale +
   # (T - meantempcal) * temperature.offset
   d <- snap_dir("coefs-3")
   f <- file.path(d, "cal.csv")
@@ -498,4 +498,17 @@ test_that("calibrate_files(coefs = ) applies another tool's coefficients to each
                                outdir = file.path(d, "x"), sf = 10,
                                coefs = data.frame(file = "p01")),
                "`coefs` lacks the column")
+})
+
+test_that("write_ggir_coefs() is deprecated and writes what write_coefs() writes", {
+  rec <- simulate_recording(hours = 30, sf = 10, seed = 4,
+                            tempoffset = c(0.002, -0.001, 0.001))
+  fit <- calibrate(rec, sf = 10, method = "ggir")
+  a <- tempfile(fileext = ".csv")
+  b <- tempfile(fileext = ".csv")
+  write_coefs(list(p01.bin = fit), a)
+  expect_warning(out <- write_ggir_coefs(list(p01.bin = fit), b), "write_coefs")
+  expect_identical(readBin(b, "raw", 1e5), readBin(a, "raw", 1e5))
+  expect_identical(out$filename, "p01.bin")
+  expect_identical(out$scale.x, unname(diag(fit$K))[1])
 })

@@ -148,11 +148,11 @@ test_that("a full disk is an error naming the file; nothing written is lost", {
   expect_match(tab$message[2], "Could not write .*p02[.]rds-.*is it full")
   expect_tidy(out)
   expect_identical(strip(run(dir, out)), clean)
-  # write_ggir_coefs()
+  # write_coefs()
   fit <- calibrate(simulate_recording(hours = 30, sf = 10, seed = 4), sf = 10,
                    method = "ggir")
   coefs <- file.path(dir, "coefs.csv")
-  expect_error(with_fault("write:coefs", write_ggir_coefs(list(a.bin = fit), coefs)),
+  expect_error(with_fault("write:coefs", write_coefs(list(a.bin = fit), coefs)),
                "Could not write \".*coefs.csv\"")
   expect_false(file.exists(coefs))
   expect_length(list.files(dir, pattern = "part$", all.files = TRUE), 0)

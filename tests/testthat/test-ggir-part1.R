@@ -201,7 +201,7 @@ test_that("g.part1() is GGIR's with backup.cal.coef (a file with one recording),
   d <- p1_folder()
   C <- p1_quiet(gravcal::g.calibrate(file.path(d, "p01.cwa"), verbose = FALSE))
   f <- tempfile(fileext = ".csv")
-  write_ggir_coefs(list(p01.cwa = C), f)
+  write_coefs(list(p01.cwa = C), f)
   backup <- utils::read.csv(f, stringsAsFactors = FALSE)
   b <- p1_both(list(do.parallel = FALSE, desiredtz = "Europe/Amsterdam"), backup = backup)
   expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")

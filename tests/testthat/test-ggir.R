@@ -368,7 +368,7 @@ test_that("calibrate(method = 'ggir') gives a usable gravcal_fit", {
   expect_error(calibrate(rec, sf = 10, method = "ggir", bogus = 1), "bogus")
 })
 
-test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
+test_that("write_coefs() writes what GGIR reads, and GGIR uses it", {
   skip_if_quick()
   skip_if_not_installed("GGIR")
   # GGIR's part 2 draws its QC plots with png(), which an R built without
@@ -384,7 +384,8 @@ test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
   gravcal:::write_actigraph_csv(rec, f, sf = 20)
   fit <- calibrate(f, method = "ggir")   # gravcal's converged fit
   coefs <- file.path(dir, "coefs.csv")
-  out <- write_ggir_coefs(fit, coefs)
+  write_coefs(fit, coefs)
+  out <- utils::read.csv(coefs)
   expect_identical(out$filename, "rec01.csv")
   expect_identical(names(out)[1:10], c(
     "filename", "scale.x", "scale.y", "scale.z", "offset.x", "offset.y",
@@ -404,13 +405,13 @@ test_that("write_ggir_coefs writes what GGIR reads, and GGIR uses it", {
   own <- gravcal::g.calibrate(f, verbose = FALSE)
   expect_gt(abs(q$offset.x - own$offset[1]), 1e-7)
   # a g.calibrate result needs a name; lightweight fits are refused
-  expect_error(write_ggir_coefs(own, coefs), "named")
-  expect_silent(write_ggir_coefs(list(rec01.csv = own), coefs))
+  expect_error(write_coefs(own, coefs), "named")
+  expect_silent(write_coefs(list(rec01.csv = own), coefs))
   # (a lightweight fit with cross-axis terms; the default leaves them out
   # of a device without them, and such a fit can be written)
   lw <- calibrate(rec, sf = 20, model = "full")
-  expect_error(write_ggir_coefs(list(a.csv = lw), coefs), "cross-axis")
-  expect_error(write_ggir_coefs(fit, NA), "file")
+  expect_error(write_coefs(list(a.csv = lw), coefs), "cross-axis")
+  expect_error(write_coefs(fit, NA), "file")
 })
 
 test_that("bad input: clear errors or GGIR's QC outcome, never a crash", {
@@ -575,13 +576,13 @@ test_that("from a file, calibrate(method = 'ggir') fits the rest windows rest_wi
                    unname(as.matrix(rest)))
 })
 
-test_that("write_ggir_coefs() takes a fit_icp() fit (no `$ggir` partial match)", {
+test_that("write_coefs() takes a fit_icp() fit (no `$ggir` partial match)", {
   rec <- simulate_recording(hours = 24, sf = 10, seed = 2,
                             params = c(1.02, 0.98, 1.01, 0, 0, 0, 0.03, -0.02, 0.01))
   fi <- fit_icp(rest_windows(rec, sf = 10, method = "ggir"))
   f <- tempfile(fileext = ".csv")
   on.exit(unlink(f))
-  write_ggir_coefs(list(rec.csv = fi), f)
+  write_coefs(list(rec.csv = fi), f)
   out <- utils::read.csv(f)
   expect_equal(out$cal.error.start, fi$error_before)
   expect_equal(out$cal.error.end, fi$error_after)
