@@ -1,7 +1,7 @@
 # The other tools' coefficient files, one reader and one writer each
 # (read_coefs() and write_coefs() in R/coef-formats.R choose them): GGIR's
 # csv, actipy's and the UK Biobank pipeline's JSON and csv, omconvert's
-# and scikit-digital-health's output, and the JSON helpers they share.
+# and scikit-digital-health's output (their JSON read by R/json.R).
 
 read_text <- function(f) {
   bytes <- readBin(f, "raw", n = file.size(f))
@@ -69,42 +69,44 @@ ggir_frame_coefs <- function(d, f) {
   do.call(rbind, rows)
 }
 
-# The value of "key" in json text: numbers (a number or an array, flattened),
-# NULL when the key is absent.
-json_numbers <- function(text, key, f) {
-  pat <- paste0("\"", gsub("([][{}()+*^$|\\\\?.])", "\\\\\\1", key),
-                "\"\\s*:\\s*")
-  m <- regexpr(pat, text, perl = TRUE)
-  if (m < 0) return(NULL)
-  rest <- substring(text, m + attr(m, "match.length"))
-  val <- regmatches(rest, regexpr(
-    "^(\\[[^]]*\\]+|\"[^\"]*\"|[^,}\\s]+)", rest, perl = TRUE))
-  if (!length(val)) {
-    abort("`file`: in \"", f, "\", the value of \"", key, "\" cannot be read.")
+# The value of "key" in parsed JSON (json_parse(), R/json.R) as numbers (a
+# number or an array of them, flattened; null is NA; a string is read as a
+# number), NULL when the key is absent.
+json_numbers <- function(obj, key, f) {
+  v <- json_find(obj, key)
+  if (is.null(v)) return(NULL)
+  # the array's values, depth first; NULL where it holds an object
+  flat <- function(x) {
+    if (!is.list(x)) return(list(x))
+    if (!is.null(names(x))) return(NULL)
+    parts <- lapply(x, flat)
+    if (any(vapply(parts, is.null, TRUE))) NULL else do.call(c, parts)
   }
-  toks <- regmatches(val, gregexpr("[^][,\\s]+", val, perl = TRUE))[[1]]
-  toks <- gsub("\"", "", toks)
-  toks[toks == "null"] <- NA
-  out <- suppressWarnings(as.double(toks))
-  bad <- is.na(out) & !is.na(toks) & toks != "NaN"
-  if (any(bad)) {
+  vals <- flat(v)
+  num <- function(x) {
+    if (is.numeric(x)) return(x)
+    if (is.logical(x)) return(if (is.na(x)) NA_real_ else NULL)
+    if (x == "NaN") return(NaN)
+    r <- suppressWarnings(as.double(x))
+    if (is.na(r)) NULL else r
+  }
+  out <- lapply(vals, num)
+  if (!length(vals) || any(vapply(out, is.null, TRUE))) {
     abort("`file`: in \"", f, "\", the value of \"", key, "\" is not a ",
-          "number: ", val, ".")
+          "number or an array of numbers.")
   }
-  out
+  unlist(out)
 }
 
-json_string <- function(text, key) {
-  pat <- paste0("\"", gsub("([][{}()+*^$|\\\\?.])", "\\\\\\1", key),
-                "\"\\s*:\\s*\"([^\"]*)\"")
-  m <- regmatches(text, regexec(pat, text, perl = TRUE))[[1]]
-  if (length(m) < 2) NULL else m[2]
+json_string <- function(obj, key) {
+  v <- json_find(obj, key)
+  if (is.character(v) && length(v) == 1) v else NULL
 }
 
 # Three values of keys named by axis, e.g. "Calib%sSlope".
-json_axes <- function(text, fmt, f, required = TRUE) {
+json_axes <- function(obj, fmt, f, required = TRUE) {
   v <- lapply(c("x", "y", "z"),
-              function(a) json_numbers(text, sprintf(fmt, a), f))
+              function(a) json_numbers(obj, sprintf(fmt, a), f))
   present <- !vapply(v, is.null, TRUE)
   if (!any(present) && !required) return(NULL)
   if (!all(present)) {
@@ -130,6 +132,7 @@ flag_status <- function(v) {
 }
 
 read_actipy <- function(text, f) {
+  text <- json_parse(text, f)
   intercept <- json_axes(text, "Calib%sIntercept", f)
   slope <- json_axes(text, "Calib%sSlope", f)
   slope_t <- json_axes(text, "Calib%sSlopeT", f, required = FALSE)
@@ -140,6 +143,7 @@ read_actipy <- function(text, f) {
 
 read_ukb <- function(text, f) {
   if (!grepl("^\\s*\\{", text)) return(read_ukb_files_csv(f))
+  text <- json_parse(text, f)
   id <- json_string(text, "file-name")
   id <- if (is.null(id)) file_id(f) else basename(id)
   status <- flag_status(json_numbers(text, "quality-goodCalibration", f))
@@ -214,6 +218,7 @@ read_omconvert <- function(text, f) {
 }
 
 read_skdh <- function(text, f, meantemp) {
+  text <- json_parse(text, f)
   get3 <- function(key, required = TRUE) {
     v <- json_numbers(text, key, f)
     if (is.null(v) && !required) return(NULL)

@@ -512,3 +512,51 @@ test_that("write_ggir_coefs() is deprecated and writes what write_coefs() writes
   expect_identical(out$filename, "p01.bin")
   expect_identical(out$scale.x, unname(diag(fit$K))[1])
 })
+
+test_that("the JSON of other tools is parsed, not searched as text", {
+  d <- snap_dir("coefs-json")
+  f <- file.path(d, "p09-summary.json")
+  # Python's json module writes NaN and Infinity for missing values (the UK
+  # Biobank pipeline's summary of a file it could not calibrate holds
+  # them); a key's name inside another value's text is no key; escaped
+  # quotes and \u escapes in the file name
+  writeLines(c("{",
+               '  "file-name": "/data/p\\"09\\u00e9.cwa",',
+               '  "note": "\\"calibration-xOffset(g)\\": 5",',
+               '  "calibration-errsBefore(mg)": NaN, "calibration-errsAfter(mg)": Infinity,',
+               '  "calibration-xOffset(g)": -0.0123, "calibration-yOffset(g)": 0.0204,',
+               '  "calibration-zOffset(g)": 0.0066,',
+               '  "calibration-xSlope": 1.0078, "calibration-ySlope": 0.9952,',
+               '  "calibration-zSlope": 1.0011,',
+               '  "quality-goodCalibration": 1, "nested": {"calibration-xSlope": 7}',
+               "}"), f)
+  cf <- read_coefs(f)
+  expect_identical(cf$file, "p\"09\u00e9.cwa")
+  expect_identical(cf$offset.x, -0.0123 / 1.0078)
+  expect_identical(cf$scale.x, 1.0078)
+  # results nested in an object of their own (skdh saved by a script)
+  g <- file.path(d, "p10.json")
+  writeLines('{"CalibrateAccelerometer": {"offset": [0.011, -0.004, 0.02], "scale": [1.004, 0.997, 1.01], "temperature scale": [[0, 0, 0]]}}', g)
+  expect_identical(read_coefs(g)$scale.y, 0.997)
+  # a value Python wrote as NaN is not a finite coefficient: said so
+  writeLines('{"CalibxIntercept": 0, "CalibyIntercept": 0, "CalibzIntercept": 0, "CalibxSlope": NaN, "CalibySlope": 1, "CalibzSlope": 1}', g)
+  expect_error(read_coefs(g), "not 3 finite")
+  # text that is not JSON: an error naming the file and what is wrong
+  for (bad in c('{"CalibxSlope": 1,, "CalibySlope": 1}', '{"CalibxSlope": 1',
+                '{"CalibxSlope": 1} extra', '{"CalibxSlope": tru}',
+                '{"CalibxSlope": "a\\q"}')) {
+    writeLines(bad, g)
+    expect_error(read_coefs(g, "actipy"), "p10.json\" is not valid JSON")
+  }
+  writeLines('{"CalibxIntercept": {"a": 1}, "CalibyIntercept": 0, "CalibzIntercept": 0, "CalibxSlope": 1, "CalibySlope": 1, "CalibzSlope": 1}', g)
+  expect_error(read_coefs(g), "\"CalibxIntercept\" is not a number")
+  # what gravcal writes, it reads back (file names with quotes included)
+  fx <- coef_fixture()
+  out <- file.path(d, "p\"11-summary.json")
+  write_coefs(list("p\"11.cwa" = fx$fit), out, "ukb")
+  back <- read_coefs(out)
+  expect_identical(back$file, "p\"11.cwa")
+  v <- data.frame(x = 0.4, y = -0.7, z = 0.55, temperature = 29)
+  expect_equal(unlist(apply_calibration(v, back)), unlist(apply_calibration(v, fx$fit)),
+               tolerance = 1e-12)
+})
