@@ -13,7 +13,8 @@
 # writes them) are read from <file>.params.rds, or <folder>.params.rds for
 # a Movisens acc.bin, where that exists.
 # Prints, per file, the median CPU seconds of each and B's time over A's,
-# and whether the two gave the same coefficients (exact hexadecimal).
+# and whether the two gave the same coefficients (exact hexadecimal) and
+# status (for g.getmeta: the md5 of its epochs).
 set -euo pipefail
 libA=$1; libB=$2; runs=$3; contender=$4; shift 4
 here=$(cd "$(dirname "$0")" && pwd)
@@ -28,7 +29,7 @@ for f in "$@"; do
     la=$(env ${AB_ENV_A:-} R_LIBS=$libA Rscript "$here/files-one.R" "$contender" "$f" "$params" | grep "^RESULT")
     lb=$(env ${AB_ENV_B:-} R_LIBS=$libB Rscript "$here/files-one.R" "$contender" "$f" "$params" | grep "^RESULT")
     ta+=("$(cut -f 8 <<< "$la")"); tb+=("$(cut -f 8 <<< "$lb")")
-    ca=$(cut -f 6 <<< "$la"); cb=$(cut -f 6 <<< "$lb")
+    ca=$(cut -f 6,7 <<< "$la"); cb=$(cut -f 6,7 <<< "$lb")
   done
   ma=$(printf "%s\n" "${ta[@]}" | median); mb=$(printf "%s\n" "${tb[@]}" | median)
   same=no; [ "$ca" = "$cb" ] && same=yes

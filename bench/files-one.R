@@ -58,6 +58,15 @@ run <- switch(contender,
     }
     list(coef = c(r$scale, r$offset, r$tempoffset), status = r$QCmessage, result = r)
   },
+  # GGIR part 1's epoch signals (uncalibrated: the calibration is another
+  # contender's); `coef`: the epochs, and the md5 of metashort and metalong
+  # (so that two builds are compared on every value)
+  "gravcal::g.getmeta" = function() {
+    M <- quiet(gravcal::g.getmeta(file, verbose = FALSE))
+    f <- tempfile()
+    saveRDS(list(M$metashort, M$metalong), f, compress = FALSE)
+    list(coef = nrow(M$metashort), status = unname(tools::md5sum(f)))
+  },
   "calibrate(method = \"ggir\")" = function() {
     f <- if (length(rmc)) {
       quiet(gravcal::calibrate(file, method = "ggir", rmc = rmc))

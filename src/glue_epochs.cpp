@@ -231,7 +231,11 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   const gravcal::ggir_part1::RunColumn* tcol = s->runs(Store::kT);
   const gravcal::ggir_part1::RunColumn* t = use_temp ? tcol : nullptr;
   const gravcal::ggir_part1::RunColumn* li = s->runs(Store::kLight);
-  auto temp_at = [tcol](std::size_t i) { return tcol->at(i); };
+  // readers of the temperature and light for passes in increasing order
+  // (none where the column is absent: never read then)
+  gravcal::ggir_part1::RunColumn empty;
+  gravcal::ggir_part1::RunColumn::Cursor tcur(tcol ? *tcol : empty);
+  auto temp_at = [&tcur](std::size_t i) { return tcur(i); };
   if (model.isNotNull()) {
     const p1::LinearModel m = linear_model(Rcpp::List(model.get()), tcol != nullptr);
     try {
@@ -293,7 +297,8 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   gravcal::RFilterArith arith;
   arith.conv_fused = conv_fused;
   arith.rec_fused = rec_fused;
-  auto light_at = [li](std::size_t i) { return li->at(i); };
+  gravcal::ggir_part1::RunColumn::Cursor lcur(li ? *li : empty);
+  auto light_at = [&lcur](std::size_t i) { return lcur(i); };
   Rcpp::List shorts(metrics.size());
   Rcpp::List out;
   try {
@@ -343,6 +348,8 @@ Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, do
   const std::size_t n = rows_used(*s, n_use);
   if (!(sf > 0) || !(ws3 > 0)) Rcpp::stop("sf and ws3 must be positive");
   const p1::RunColumn* t = temperature ? s->runs(Store::kT) : nullptr;
+  p1::RunColumn empty;
+  p1::RunColumn::Cursor tcur(t ? *t : empty);
   const p1::LinearModel lm = linear_model(cal, t != nullptr);
   p1::LinearCalibration m;
   for (int r = 0; r < 3; ++r) {
@@ -355,7 +362,7 @@ Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, do
   std::vector<double> g;
   try {
     g = p1::enmo_gradient(s->col(Store::kX), s->col(Store::kY), s->col(Store::kZ),
-                          [t](std::size_t i) { return t->at(i); }, m.temp, n, sf * ws3, m);
+                          [&tcur](std::size_t i) { return tcur(i); }, m.temp, n, sf * ws3, m);
   } catch (const std::exception& e) {
     Rcpp::stop(e.what());
   }

@@ -122,6 +122,40 @@ class RunColumn {
     return v_[hint_];
   }
 
+  // A reader of the column's rows for a pass in increasing order: the run
+  // last read is held in the reader (not in the column), so that a row of
+  // the same run costs two comparisons; any other row is found by the next
+  // run or a binary search.
+  class Cursor {
+   public:
+    explicit Cursor(const RunColumn& c) : c_(&c) {}
+    double operator()(std::size_t i) {
+      if (c_->plain_) return c_->v_[i];
+      if (i >= lo_ && i < hi_) return val_;
+      seek(i);
+      return val_;
+    }
+
+   private:
+    void seek(std::size_t i) {
+      const std::vector<std::size_t>& end = c_->end_;
+      std::size_t r;
+      // the next run (hi_ is 0 until a run is held)
+      if (hi_ > 0 && i >= hi_ && r_ + 1 < end.size() && i < end[r_ + 1]) {
+        r = r_ + 1;
+      } else {
+        r = static_cast<std::size_t>(std::upper_bound(end.begin(), end.end(), i) - end.begin());
+      }
+      r_ = r;
+      lo_ = r ? end[r - 1] : 0;
+      hi_ = end[r];
+      val_ = c_->v_[r];
+    }
+    const RunColumn* c_;
+    std::size_t r_ = 0, lo_ = 1, hi_ = 0;
+    double val_ = 0;
+  };
+
   // rows [from, from + count) kept
   void keep(std::size_t from, std::size_t count) {
     RunColumn c;
