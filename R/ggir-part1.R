@@ -102,6 +102,13 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
+  stops <- format_entry(src$format)$ggir_stops
+  why <- if (!is.null(stops)) stops(src)
+  if (!is.null(why)) {
+    abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's reader fails on ",
+          "it, so GGIR's g.getmeta() gives no result to reproduce; gravcal's g.getmeta() ",
+          "refuses it too (calibrate() reads the rest of the file).")
+  }
   meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
 }
 
@@ -264,6 +271,8 @@ meta_nonwear <- function(src, p) {
     }
   }
   mon <- format_entry(src$format)$ggir_monitor
+  # a Parmay Matrix's range from its header, whatever dynrange says
+  if (identical(mon, "parmay_mtx")) dynrange <- src$info$range_g
   clipthres <- if (length(dynrange)) dynrange - 0.5 else if (identical(mon, "movisens")) 15.5 else 7.5
   list(clipthres = clipthres, sdcriter = 0.013,
        racriter = p$nonwear_range_threshold / 1000,
