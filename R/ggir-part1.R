@@ -29,7 +29,13 @@
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
 #' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
 #' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
-#' recording refused, as for gravcal's g.calibrate()). Metrics:
+#' recording refused, as for gravcal's g.calibrate()), Parmay Matrix
+#' `.bin`/`.BIN` (the whole file one block, as GGIRread's reader gives it,
+#' a packet with a bad checksum kept as it keeps it; the dynamic range from
+#' the file's header, whatever `dynrange` says; `configtz` changes nothing,
+#' as in GGIR; `QClog` GGIRread's log of the packets; a file GGIRread's
+#' reader fails on, with a packet cut inside its header, a negative sample
+#' count or a header that declares no packet, refused naming why). Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
