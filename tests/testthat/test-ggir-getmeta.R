@@ -519,6 +519,11 @@ test_that("g.getmeta() is GGIR's on hours written as a Parmay Matrix file: calib
                                                             windowsizes = c(5, 600, 1200)))))
   expect_same_meta(b2)
   expect_identical(b2$gravcal$metashort$timestamp[1], "2024-03-31T01:10:00+0100")
+  # an external function with time stamps (the one block's, from its start)
+  mf <- meta_myfuns()$stamped
+  b3 <- meta_both(f, list(myfun = mf, params_general = list(windowsizes = c(5, 600, 1200))))
+  expect_same_meta(b3)
+  expect_gt(sum(!is.na(b3$gravcal$metashort$t3)), 1000)
 })
 
 test_that("g.getmeta() takes a Parmay Matrix's dynamic range from its header, as GGIR", {
