@@ -619,6 +619,13 @@ test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, s
   writeBin(b3, g)
   expect_error(ggir())
   expect_error(grav(), "declares 0 packets")
+  # no accelerometer sample in any packet: GGIR's "file empty" result
+  b4 <- b
+  for (at in starts) b4[at + 20:23] <- as.raw(0)
+  writeBin(b4, g)
+  m <- list(ggir = ggir(), gravcal = meta_quiet(grav()))
+  expect_same_meta(m)
+  expect_true(m$gravcal$filecorrupt)
   # and the file itself is GGIR's
   writeBin(b, g)
   expect_same_meta(list(ggir = ggir(), gravcal = meta_quiet(grav())))
