@@ -111,9 +111,9 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   stops <- format_entry(src$format)$ggir_stops
   why <- if (!is.null(stops)) stops(src)
   if (!is.null(why)) {
-    abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's reader fails on ",
-          "it, so GGIR's g.getmeta() gives no result to reproduce; gravcal's g.getmeta() ",
-          "refuses it too (calibrate() reads the rest of the file).")
+    abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's g.getmeta() ",
+          "gives no result to reproduce there, so gravcal's refuses the file (calibrate() ",
+          "reads the rest of it).")
   }
   meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
 }

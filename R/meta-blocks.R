@@ -635,14 +635,29 @@ parmay_qclog <- function(src) {
 }
 
 # Why GGIR's reader of Parmay Matrix files (GGIRread's readParmayMatrix())
-# fails on the file where gravcal's decoder reads on, or NULL: a packet too
-# short for its header (a file cut inside one), a negative sample count, a
-# header that declares no packet.
+# gives no result to reproduce where gravcal's decoder reads on, or NULL:
+# a packet too short for its header (at the file's end, a file cut inside
+# one: the reader fails; within the file the reader takes the next packet's
+# bytes for its own), a negative sample count, a header that declares no
+# packet.
 parmay_ggir_stops <- function(src) {
-  k <- src$report()$counters
-  if (isTRUE(k["short_packet"] > 0)) return("a packet too short for its header (cut inside it)")
-  if (isTRUE(k["bad_packet_counts"] > 0)) return("a packet with a negative sample count")
+  rep <- src$report()
+  k <- rep$counters
+  short <- if ("short_packet" %in% names(k)) k[["short_packet"]] else 0
+  if (short == 1 && isTRUE(rep$truncated)) {
+    return("a packet cut inside its header at its end (GGIR's reader fails on it)")
+  }
+  if (short > 0) {
+    return(paste0("a packet too short for its header within it (GGIR's reader takes the next ",
+                  "packet's bytes for its own)"))
+  }
+  if (isTRUE(k["bad_packet_counts"] > 0)) {
+    return("a packet with a negative sample count (GGIR's reader fails on it)")
+  }
   declared <- parmay_declared(src$path)
-  if (!isTRUE(declared >= 1)) return(paste0("a header that declares ", declared, " packets"))
+  if (!isTRUE(declared >= 1)) {
+    return(paste0("a header that declares ", declared, " packets (GGIR's reader gives ",
+                  "nothing, and GGIR's g.getmeta() fails)"))
+  }
   NULL
 }

@@ -606,19 +606,22 @@ test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, s
   # cut inside the second packet's header
   writeBin(b[seq_len(starts[2] + 20)], g)
   expect_error(ggir())
-  expect_error(grav(), "`datafile`\\) has a packet too short for its header")
+  expect_error(grav(), "`datafile`\\) has a packet cut inside its header at its end")
+  # a short packet within the file (GGIR's reader reads on into the next)
+  writeBin(c(b[seq_len(starts[2] + 20)], b[starts[2]:length(b)]), g)
+  expect_error(grav(), "too short for its header within it")
   # a negative sample count
   b2 <- b
   b2[starts[2] + 20:23] <- as.raw(0xff)
   writeBin(b2, g)
   expect_error(ggir())
-  expect_error(grav(), "a negative sample count.*GGIR's reader fails on it")
+  expect_error(grav(), "a negative sample count \\(GGIR's reader fails on it")
   # a header that declares no packet
   b3 <- b
   b3[517:520] <- as.raw(0)
   writeBin(b3, g)
   expect_error(ggir())
-  expect_error(grav(), "declares 0 packets")
+  expect_error(grav(), "declares 0 packets.*gravcal's refuses the file")
   # no accelerometer sample in any packet: GGIR's "file empty" result
   b4 <- b
   for (at in starts) b4[at + 20:23] <- as.raw(0)
