@@ -41,6 +41,10 @@ gc_decoder_epoch_gaps <- function(ptr) {
     .Call(`_gravcal_gc_decoder_epoch_gaps`, ptr)
 }
 
+gc_decoder_unit_log <- function(ptr) {
+    .Call(`_gravcal_gc_decoder_unit_log`, ptr)
+}
+
 gc_decoder_close <- function(ptr) {
     invisible(.Call(`_gravcal_gc_decoder_close`, ptr))
 }

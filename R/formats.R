@@ -30,6 +30,10 @@
 #   GGIR's own function must give it;
 # * ggir_timegaps: GGIR's g.getmeta() fills the recording's time gaps
 #   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
+# * ggir_qclog(src): the QClog GGIR's reader gives with the first block
+#   (g.getmeta() returns it in M$QClog), from the open native source;
+# * ggir_stops(src): why GGIR's reader stops on the file (g.getmeta() then
+#   refuses it, saying so), or NULL;
 # * own_rate: TRUE for a device format whose file records its sampling
 #   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
@@ -159,9 +163,16 @@ recording_formats <- list(
     source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize)),
   # Parmay Matrix: "MDTC" at byte 512. GGIRread's reader reads from the
   # block's first packet to the end of the file whatever end it is given, so
-  # GGIR's first block is the whole file (and its last)
+  # GGIR's first block is the whole file (and its last). Its times are the
+  # packets' UTC seconds, read in no zone (no local_clock); GGIR's
+  # g.getmeta() takes the dynamic range from the header (meta_nonwear())
+  # and returns the reader's log of the packets as M$QClog
+  # (parmay_qclog())
   parmay = list(
+    ggir_getmeta = TRUE,
     ggir_monitor = "parmay_mtx",
+    ggir_qclog = function(src) parmay_qclog(src),
+    ggir_stops = function(src) parmay_ggir_stops(src),
     ext = c(bin = "Parmay Matrix .bin"), detect = function(file) is_parmay_bin(file),
     label = "a Parmay Matrix .bin file", unit = "packet", own_rate = TRUE,
     block_units = function(sf, chunksize) 2^52,
@@ -206,6 +217,16 @@ is_parmay_bin <- function(file) {
   on.exit(close(con))
   b <- readBin(con, "raw", n = 516)
   length(b) == 516 && identical(b[513:516], charToRaw("MDTC"))
+}
+
+# The number of packets a Parmay Matrix file's header declares (int32 at
+# byte 516), NA when the file is shorter.
+parmay_declared <- function(file) {
+  con <- file(file, "rb")
+  on.exit(close(con))
+  b <- readBin(con, "raw", n = 520)
+  if (length(b) < 520) return(NA_integer_)
+  readBin(b[517:520], "integer", size = 4, endian = "little")
 }
 
 # The `sf` a cohort's setting gives `file`: none for a file that records

@@ -29,7 +29,13 @@
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
 #' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
 #' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
-#' recording refused, as for gravcal's g.calibrate()). Metrics:
+#' recording refused, as for gravcal's g.calibrate()), Parmay Matrix
+#' `.bin`/`.BIN` (the whole file one block, as GGIRread's reader gives it,
+#' a packet with a bad checksum kept as it keeps it; the dynamic range from
+#' the file's header, whatever `dynrange` says; `configtz` changes nothing,
+#' as in GGIR; `QClog` GGIRread's log of the packets; a file GGIRread's
+#' reader fails on, with a packet cut inside its header, a negative sample
+#' count or a header that declares no packet, refused naming why). Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
@@ -102,6 +108,13 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
+  stops <- format_entry(src$format)$ggir_stops
+  why <- if (!is.null(stops)) stops(src)
+  if (!is.null(why)) {
+    abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's g.getmeta() ",
+          "gives no result to reproduce there, so gravcal's refuses the file (calibrate() ",
+          "reads the rest of it).")
+  }
   meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
 }
 
@@ -264,6 +277,8 @@ meta_nonwear <- function(src, p) {
     }
   }
   mon <- format_entry(src$format)$ggir_monitor
+  # a Parmay Matrix's range from its header, whatever dynrange says
+  if (identical(mon, "parmay_mtx")) dynrange <- src$info$range_g
   clipthres <- if (length(dynrange)) dynrange - 0.5 else if (identical(mon, "movisens")) 15.5 else 7.5
   list(clipthres = clipthres, sdcriter = 0.013,
        racriter = p$nonwear_range_threshold / 1000,

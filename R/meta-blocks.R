@@ -289,6 +289,8 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     }
     if (have) {
       if (i == 1) {
+        # the log GGIR's reader gives with its first block (Parmay Matrix)
+        if (!is.null(fe$ggir_qclog)) QClog <- rbind(QClog, fe$ggir_qclog(src))
         light.available <- ms$light
         use.temp <- ms$temperature
         if (use.temp && mean(info$head_temp[1:10], na.rm = TRUE) > 50) {
@@ -451,7 +453,10 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     i <- i + 1
   }
   rep <- if (!is.null(src$report)) src$report() else list()
-  if (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0)) {
+  # (a format whose reader's log is M$QClog keeps its damaged units as
+  # GGIR's reader keeps them, and logs them there)
+  if (is.null(fe$ggir_qclog) &&
+      (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0))) {
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
             unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
             "reproduced (M$QClog is NULL).", call. = FALSE)
@@ -593,4 +598,66 @@ movisens_start <- function(file, p) {
     st <- as.POSIXct(wall, tz = ctz) + (as.numeric(st) - whole)
   }
   as.POSIXlt(st, tz = p$desiredtz)
+}
+
+# GGIR's M$QClog for a Parmay Matrix file: GGIRread's readParmayMatrix() log
+# of the packets, which GGIR's g.getmeta() keeps from its one block. A row
+# per packet in the file's order: whether its checksum matched (imputed
+# when not: GGIRread keeps such a packet as (0, 0, 1) g), its number, its
+# first and last sample's time as the reader spreads its samples (a packet
+# that starts a second or more after the previous one ended moved back to
+# that end, by the gap; the last one period before the header's end), the
+# span between, the rate set and the rate observed (the count over the
+# header's span), the gap and the move, the packets the header declares
+# and the file holds. From the decoder's packet table (unit_log()), the
+# arithmetic R's.
+parmay_qclog <- function(src) {
+  log <- gc_decoder_unit_log(src$native$ptr)
+  n <- length(log$t0)
+  sf <- src$sf
+  t0 <- log$t0
+  t1 <- log$t1
+  gap <- numeric(n)
+  if (n > 1) gap[-1] <- t0[-1] - t1[-n]
+  late <- which(gap >= 1)
+  moved <- numeric(n)
+  moved[late] <- gap[late]
+  start <- t0
+  start[late] <- t0[late] - gap[late]
+  end <- t1 - 1 / sf
+  pass <- log$checksum_pass == 1
+  data.frame(checksum_pass = pass, blockID = seq_len(n), start = start, end = end,
+             blockLengthSeconds = end - start, frequency_set = rep(sf, n),
+             frequency_observed = log$n_acc / (t1 - t0), imputed = !pass,
+             gap_with_previous_block_secs = moved, start_time_adjustment_secs = -moved,
+             declared_packets = rep(parmay_declared(src$path), n),
+             observed_packets = rep(n, n), acc_recorded = rep(TRUE, n))
+}
+
+# Why GGIR's reader of Parmay Matrix files (GGIRread's readParmayMatrix())
+# gives no result to reproduce where gravcal's decoder reads on, or NULL:
+# a packet too short for its header (at the file's end, a file cut inside
+# one: the reader fails; within the file the reader takes the next packet's
+# bytes for its own), a negative sample count, a header that declares no
+# packet.
+parmay_ggir_stops <- function(src) {
+  rep <- src$report()
+  k <- rep$counters
+  short <- if ("short_packet" %in% names(k)) k[["short_packet"]] else 0
+  if (short == 1 && isTRUE(rep$truncated)) {
+    return("a packet cut inside its header at its end (GGIR's reader fails on it)")
+  }
+  if (short > 0) {
+    return(paste0("a packet too short for its header within it (GGIR's reader takes the next ",
+                  "packet's bytes for its own)"))
+  }
+  if (isTRUE(k["bad_packet_counts"] > 0)) {
+    return("a packet with a negative sample count (GGIR's reader fails on it)")
+  }
+  declared <- parmay_declared(src$path)
+  if (!isTRUE(declared >= 1)) {
+    return(paste0("a header that declares ", declared, " packets (GGIR's reader gives ",
+                  "nothing, and GGIR's g.getmeta() fails)"))
+  }
+  NULL
 }

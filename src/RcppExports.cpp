@@ -123,6 +123,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_decoder_unit_log
+Rcpp::List gc_decoder_unit_log(SEXP ptr);
+RcppExport SEXP _gravcal_gc_decoder_unit_log(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_decoder_unit_log(ptr));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_decoder_close
 void gc_decoder_close(SEXP ptr);
 RcppExport SEXP _gravcal_gc_decoder_close(SEXP ptrSEXP) {
@@ -512,6 +522,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_read", (DL_FUNC) &_gravcal_gc_decoder_read, 6},
     {"_gravcal_gc_decoder_report", (DL_FUNC) &_gravcal_gc_decoder_report, 1},
     {"_gravcal_gc_decoder_epoch_gaps", (DL_FUNC) &_gravcal_gc_decoder_epoch_gaps, 1},
+    {"_gravcal_gc_decoder_unit_log", (DL_FUNC) &_gravcal_gc_decoder_unit_log, 1},
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},

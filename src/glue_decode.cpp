@@ -206,6 +206,20 @@ Rcpp::List gc_decoder_epoch_gaps(SEXP ptr) {
   return Rcpp::List::create(Rcpp::Named("row") = row, Rcpp::Named("remaining") = remaining);
 }
 
+// The file's units as the decoder logs them (Decoder::unit_log(); a
+// Parmay Matrix file's packets): a named list of numeric columns, empty for
+// a decoder that keeps no log.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List gc_decoder_unit_log(SEXP ptr) {
+  const gravcal::Decoder::UnitLog log = get(ptr)->decoder->unit_log();
+  Rcpp::List out(log.columns.size());
+  for (std::size_t i = 0; i < log.columns.size(); ++i) {
+    out[static_cast<R_xlen_t>(i)] = Rcpp::wrap(log.columns[i]);
+  }
+  out.attr("names") = Rcpp::wrap(log.names);
+  return out;
+}
+
 // Closes the file now (the finalizer would, later).
 // [[Rcpp::export(rng = false)]]
 void gc_decoder_close(SEXP ptr) {

@@ -5,7 +5,8 @@
 // fuzzer reaches the samples of packets that pass their check. Checks: no
 // crash, no write past the buffer, progress on every call, finite times
 // (and finite acceleration in gravcal's own reading, compat = 0), report
-// counts consistent with what was given, nothing after the end; and the
+// counts consistent with what was given, nothing after the end, a packet
+// table of one row a packet (unit_log()); and the
 // same samples, bit for bit, and the same counts from the decoder's
 // point-by-point path alone (option run_loop = 0, one big buffer, no block
 // limit): the grid's fast loop must not change a bit. A packet's
@@ -54,6 +55,16 @@ static Decoded decode_all(const std::vector<unsigned char>& bytes, std::uint8_t 
     return res;
   }
   res.opened = true;
+  // the packet table (GGIR's QClog of the packets, built in R): a column
+  // each, one value a packet, counts not negative, checksums 0 or 1 (all 1
+  // where damaged packets are skipped)
+  const gravcal::Decoder::UnitLog log = dec.unit_log();
+  CHECK(log.names.size() == 4 && log.columns.size() == 4);
+  for (const auto& c : log.columns) CHECK(c.size() == log.columns[0].size() && !c.empty());
+  for (std::size_t i = 0; i < log.columns[0].size(); ++i) {
+    CHECK(log.columns[2][i] >= 0);
+    CHECK(log.columns[3][i] == 1 || (compat && log.columns[3][i] == 0));
+  }
   CHECK(dec.info().sf == 12.5 || dec.info().sf == 25 || dec.info().sf == 50 ||
         dec.info().sf == 100);
   const std::int64_t max_units = !run_loop || (mode & 4) ? -1 : 1 + ((mode >> 4) & 1);

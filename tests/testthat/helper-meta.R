@@ -1,10 +1,12 @@
 # Recordings for GGIR part 1's tests (test-ggir-getmeta.R, test-ggir-part1.R):
 # simulate_recording() of `hours` with temperature offsets, two stretches at
 # rest on a table (flat, 1 mg noise: GGIR's non-wear) and 41 samples at 7.9
-# g (clipping), written to `file` as a .cwa ("cwa") or GENEActiv .bin
-# ("bin"). The bytes depend only on the arguments (the cached GGIR results
-# are keyed by them); the session's random numbers are left as they were.
-write_meta_recording <- function(file, format, sf, hours, seed, start) {
+# g (clipping), written to `file` as a .cwa ("cwa"), GENEActiv .bin ("bin"),
+# .gt3x ("gt3x") or Parmay Matrix .bin ("parmay": packets of 2 minutes, a
+# range of `range` g). The bytes depend only on the arguments (the cached
+# GGIR results are keyed by them); the session's random numbers are left as
+# they were.
+write_meta_recording <- function(file, format, sf, hours, seed, start, range = 8) {
   rec <- simulate_recording(hours = hours, sf = sf, seed = seed,
                             start = as.POSIXct(start, tz = "UTC"),
                             tempoffset = c(0.001, -0.002, 0.0005))
@@ -23,6 +25,9 @@ write_meta_recording <- function(file, format, sf, hours, seed, start) {
   if (format == "gt3x") {
     gravcal:::write_gt3x(as.matrix(rec[, c("x", "y", "z")]), file, sf = sf,
                          start = as.POSIXct(start, tz = "UTC"))
+  } else if (format == "parmay") {
+    gravcal:::write_parmay_bin(rec, file, sf = sf, start = as.numeric(rec$time[1]),
+                               range = range, packet_seconds = 120)
   } else if (format == "cwa") {
     gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), file, sf = sf,
                         start = as.numeric(rec$time[1]), temperature = rec$temperature)

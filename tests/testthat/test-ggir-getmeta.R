@@ -451,3 +451,185 @@ test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml
   expect_identical(b2$gravcal$metashort$timestamp[1], "2024-03-04T09:15:00+0100")
   expect_true("temperaturemean" %in% names(b$gravcal$metalong))
 })
+
+# Parmay Matrix: GGIRread's reader gives the whole file as GGIR's one block,
+# its time stamps the packets' UTC seconds (configtz changes nothing), the
+# dynamic range from the header (the clipping threshold, whatever dynrange
+# says), and its log of the packets, which GGIR keeps as M$QClog.
+mtx_test_files <- function() {
+  skip_if_not_installed("GGIRread")
+  td <- system.file("testfiles", package = "GGIRread")
+  f <- list.files(td, pattern = "^mtx_.*Hz.*[.]BIN$", full.names = TRUE)
+  f <- c(f, file.path(td, "mtx_corrupted.bin"))
+  f <- f[file.exists(f)]
+  if (length(f) < 5) skip("GGIRread has not its Matrix test files")
+  f
+}
+
+test_that("g.getmeta() is GGIR's on GGIRread's Parmay Matrix test files", {
+  skip_if_not_installed("GGIR")
+  n <- 0
+  for (f in mtx_test_files()) {
+    for (it in 1:2) {
+      # minutes of data: 1-minute long epochs, a 2-minute non-wear window
+      b <- meta_both(f, list(params_general = list(windowsizes = c(5, 60, 120)),
+                             params_rawdata = list(interpolationType = it)))
+      expect_same_meta(b)
+      n <- n + 1
+    }
+  }
+  expect_identical(n, 10)
+  # what the comparison saw: epochs (but for the file of under 4 minutes,
+  # too short for GGIR), the temperature column, the packets' log with the
+  # damaged one (its checksum failed, GGIR's reader keeps it as (0, 0, 1) g)
+  M <- meta_both(mtx_test_files()[1], list(params_general = list(windowsizes = c(5, 60, 120))))$gravcal
+  expect_gt(nrow(M$metashort), 50)
+  expect_true("temperaturemean" %in% names(M$metalong))
+  expect_identical(nrow(M$QClog), 4L)
+  short <- meta_both(grep("gyro", mtx_test_files(), value = TRUE),
+                     list(params_general = list(windowsizes = c(5, 60, 120))))$gravcal
+  expect_true(short$filetooshort)
+  expect_null(short$QClog)
+  bad <- meta_both(grep("corrupted", mtx_test_files(), value = TRUE),
+                   list(params_general = list(windowsizes = c(5, 60, 120))))$gravcal
+  expect_identical(bad$QClog$checksum_pass, c(FALSE, TRUE, TRUE, TRUE))
+})
+
+test_that("g.getmeta() is GGIR's on hours written as a Parmay Matrix file: calibrated, in a zone, across a clock change", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  # 24 hours at 25 Hz from 2024-03-31 00:07:23 UTC: Amsterdam's clock
+  # moves forward at 01:00 UTC; rest on a table for over 1.5 hours
+  # (non-wear) and samples at 7.9 g (clipping)
+  f <- meta_recording("parmay", 25, 24, seed = 31, start = "2024-03-31 00:07:23")
+  b <- meta_both(f, c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam"))))
+  expect_same_meta(b)
+  M <- b$gravcal
+  expect_identical(M$metashort$timestamp[1], "2024-03-31T01:15:00+0100")
+  expect_match(M$metashort$timestamp[nrow(M$metashort)], "\\+0200$")
+  expect_gt(nrow(M$metashort), 23 * 720)
+  expect_true(any(M$metalong$nonwearscore >= 2))
+  expect_true(any(M$metalong$clippingscore > 0))
+  expect_true("temperaturemean" %in% names(M$metalong))
+  expect_identical(nrow(M$QClog), 720L)
+  expect_true(all(M$QClog$checksum_pass))
+  # configtz: GGIR's reader of these files reads no clock in a zone
+  b2 <- meta_both(f, c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam",
+                                                            configtz = "America/New_York",
+                                                            windowsizes = c(5, 600, 1200)))))
+  expect_same_meta(b2)
+  expect_identical(b2$gravcal$metashort$timestamp[1], "2024-03-31T01:10:00+0100")
+  # an external function with time stamps (the one block's, from its start)
+  mf <- meta_myfuns()$stamped
+  b3 <- meta_both(f, list(myfun = mf, params_general = list(windowsizes = c(5, 600, 1200))))
+  expect_same_meta(b3)
+  expect_gt(sum(!is.na(b3$gravcal$metashort$t3)), 1000)
+})
+
+test_that("g.getmeta() takes a Parmay Matrix's dynamic range from its header, as GGIR", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  # a range of 4 g: the 7.9 g samples stored as 4 g, over GGIR's 3.5 g
+  # threshold (clipping), under 7.5 (dynrange's, which GGIR sets aside)
+  f <- tempfile(fileext = ".BIN")
+  write_meta_recording(f, "parmay", 12.5, 5, 32, "2024-03-04 09:07:23", range = 4)
+  b <- meta_both(f, list(params_rawdata = list(dynrange = 8, interpolationType = 2)))
+  expect_same_meta(b)
+  expect_true(any(b$gravcal$metalong$clippingscore > 0))
+})
+
+# `b` with packet k's header times moved by `by` seconds from packet k on
+# and their checksums made again (a device that paused between packets).
+mtx_shift_packets <- function(b, k, by) {
+  starts <- grepRaw("MDTCPACK", b, fixed = TRUE, all = TRUE)
+  ends <- c(starts[-1] - 1, length(b))
+  for (i in k:length(starts)) {
+    at <- starts[i]
+    for (o in c(12, 16)) {
+      v <- readBin(b[at + o + 0:3], "integer", size = 4, endian = "little")
+      b[at + o + 0:3] <- gravcal:::parmay_le(v + by, 4)
+    }
+    b[at + 8:11] <- gravcal:::parmay_le(gravcal:::gc_crc32(b[(at + 12):ends[i]]), 4)
+  }
+  b
+}
+
+test_that("g.getmeta() on damaged Parmay Matrix files: GGIR's result where GGIR gives one", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  f <- meta_recording("parmay", 25, 8, seed = 33, start = "2024-05-06 10:00:03")
+  b <- readBin(f, raw(), file.size(f))
+  starts <- grepRaw("MDTCPACK", b, fixed = TRUE, all = TRUE)
+  args <- c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam",
+                                                 windowsizes = c(5, 600, 1200))))
+  g <- tempfile(fileext = ".BIN")
+  on.exit(unlink(g))
+  put <- function(bytes) {
+    writeBin(bytes, g)
+    g
+  }
+  # a byte of packet 100 changed: its checksum fails, GGIR's reader keeps
+  # its samples as (0, 0, 1) g and its temperature from its neighbours
+  b1 <- b
+  b1[starts[100] + 500] <- xor(b1[starts[100] + 500], as.raw(0x5a))
+  m <- meta_both(put(b1), args)
+  expect_same_meta(m)
+  expect_identical(which(!m$gravcal$QClog$checksum_pass), 100L)
+  expect_identical(which(m$gravcal$QClog$imputed), 100L)
+  # cut inside packet 200's samples: the rest of that packet as GGIR's
+  # reader reads what the file holds
+  m <- meta_both(put(b[seq_len(starts[200] + 1000)]), args)
+  expect_same_meta(m)
+  expect_identical(nrow(m$gravcal$QClog), 200L)
+  # a pause of 7 s before packet 150: GGIR's reader moves that packet's
+  # start back to the end of the one before (its log says by how much)
+  m <- meta_both(put(mtx_shift_packets(b, 150, 7)), args)
+  expect_same_meta(m)
+  q <- m$gravcal$QClog
+  expect_identical(q$gap_with_previous_block_secs[150], 7)
+  expect_identical(q$start_time_adjustment_secs[150], -7)
+  expect_identical(sum(q$gap_with_previous_block_secs != 0), 1L)
+})
+
+test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, saying why", {
+  skip_if_not_installed("GGIR")
+  f <- grep("12.5Hz_acc[.]BIN", mtx_test_files(), value = TRUE)
+  b <- readBin(f, raw(), file.size(f))
+  starts <- grepRaw("MDTCPACK", b, fixed = TRUE, all = TRUE)
+  g <- tempfile(fileext = ".BIN")
+  on.exit(unlink(g))
+  ggir <- function() {
+    meta_quiet(GGIR::g.getmeta(g, inspectfileobject = meta_quiet(GGIR::g.inspectfile(g)),
+                               verbose = FALSE, windowsizes = c(5, 60, 120)))
+  }
+  grav <- function() gravcal::g.getmeta(g, verbose = FALSE, windowsizes = c(5, 60, 120))
+  # cut inside the second packet's header
+  writeBin(b[seq_len(starts[2] + 20)], g)
+  expect_error(ggir())
+  expect_error(grav(), "`datafile`\\) has a packet cut inside its header at its end")
+  # a short packet within the file (GGIR's reader reads on into the next)
+  writeBin(c(b[seq_len(starts[2] + 20)], b[starts[2]:length(b)]), g)
+  expect_error(grav(), "too short for its header within it")
+  # a negative sample count
+  b2 <- b
+  b2[starts[2] + 20:23] <- as.raw(0xff)
+  writeBin(b2, g)
+  expect_error(ggir())
+  expect_error(grav(), "a negative sample count \\(GGIR's reader fails on it")
+  # a header that declares no packet
+  b3 <- b
+  b3[517:520] <- as.raw(0)
+  writeBin(b3, g)
+  expect_error(ggir())
+  expect_error(grav(), "declares 0 packets.*gravcal's refuses the file")
+  # no accelerometer sample in any packet: GGIR's "file empty" result
+  b4 <- b
+  for (at in starts) b4[at + 20:23] <- as.raw(0)
+  writeBin(b4, g)
+  m <- list(ggir = ggir(), gravcal = meta_quiet(grav()))
+  expect_same_meta(m)
+  expect_true(m$gravcal$filecorrupt)
+  # and the file itself is GGIR's
+  writeBin(b, g)
+  expect_same_meta(list(ggir = ggir(), gravcal = meta_quiet(grav())))
+})

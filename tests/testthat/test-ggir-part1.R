@@ -40,17 +40,22 @@ p1_folder <- function() {
   p1_state$dir
 }
 
-# A folder of one ActiGraph .gt3x recording of 26 hours at 30 Hz, of the
-# same kind. Made once a session.
-p1_folder_gt3x <- function() {
-  if (is.null(p1_state$gt3x) || !dir.exists(p1_state$gt3x)) {
-    d <- tempfile("part1-gt3x-")
+# A folder of one recording of 26 hours of the same kind, named `name`:
+# `format` (write_meta_recording()'s) at `sf` Hz. Made once a session.
+p1_folder_of <- function(name, format, sf, seed, start) {
+  d <- p1_state[[name]]
+  if (is.null(d) || !dir.exists(d)) {
+    d <- tempfile(paste0("part1-", format, "-"))
     dir.create(d)
-    write_meta_recording(file.path(d, "g01.gt3x"), "gt3x", 30, 26, 23, "2024-03-06 11:00:00")
-    p1_state$gt3x <- d
+    write_meta_recording(file.path(d, name), format, sf, 26, seed, start)
+    p1_state[[name]] <- d
   }
-  p1_state$gt3x
+  d
 }
+
+# an ActiGraph .gt3x at 30 Hz; a Parmay Matrix .BIN at 25 Hz
+p1_folder_gt3x <- function() p1_folder_of("g01.gt3x", "gt3x", 30, 23, "2024-03-06 11:00:00")
+p1_folder_parmay <- function() p1_folder_of("m01.BIN", "parmay", 25, 24, "2024-03-06 11:00:00")
 
 # The objects of the meta files (or ms2.out files) in `folder`, by file,
 # with M's and C's bsc_qc (wall-clock times and memory) replaced by their
@@ -179,20 +184,38 @@ test_that("g.part1() writes GGIR's meta files; GGIR's part 2 gives the same on t
   expect_equal(b$gravcal$again[["meta_p01.cwa.RData"]]$C$scale, obj$C$scale, tolerance = 1e-14)
 })
 
-test_that("g.part1() on a .gt3x file: GGIR's meta file (its I without GGIR's whole-file reads)", {
-  skip_if_quick()
-  skip_if_not_installed("read.gt3x")
+# g.part1() on the folder of one recording `name` at `sf` Hz against
+# GGIR's, then part 2 and part 1 again: the meta files and what part 2
+# makes of them the same. Returns gravcal's meta file's objects.
+p1_expect_single <- function(folder, name, sf) {
   b <- p1_both(list(do.parallel = FALSE, desiredtz = "Europe/Amsterdam", f1 = 1),
-               then_part2 = TRUE, folder = p1_folder_gt3x)
-  expect_identical(names(b$ggir$part1), "meta_g01.gt3x.RData")
+               then_part2 = TRUE, folder = folder)
+  expect_identical(names(b$ggir$part1), paste0("meta_", name, ".RData"))
   expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
   obj <- b$gravcal$part1[[1]]
-  expect_identical(obj$I$sf, 30)
+  # what the comparison saw: a calibration, non-wear
+  expect_identical(obj$I$sf, sf)
   expect_gt(obj$C$npoints, 1000)
   expect_true(any(obj$M$metalong$nonwearscore > 0))
   expect_same_objects(b$gravcal$part2$ms2, b$ggir$part2$ms2, "part 2 ms2.out")
   expect_identical(b$gravcal$part2$csv, b$ggir$part2$csv)
   expect_same_objects(b$gravcal$again, b$ggir$again, "part 1 again")
+  obj
+}
+
+test_that("g.part1() on a .gt3x file: GGIR's meta file (its I without GGIR's whole-file reads)", {
+  skip_if_quick()
+  skip_if_not_installed("read.gt3x")
+  p1_expect_single(p1_folder_gt3x, "g01.gt3x", 30)
+})
+
+test_that("g.part1() on a Parmay Matrix file: GGIR's meta file (I from GGIR's g.inspectfile())", {
+  skip_if_quick()
+  skip_if_not_installed("GGIRread")
+  obj <- p1_expect_single(p1_folder_parmay, "m01.BIN", 25)
+  expect_identical(obj$I$monn, "parmay_mtx")
+  # GGIRread's log of the file's packets, of 2 minutes each
+  expect_identical(nrow(obj$M$QClog), 780L)
 })
 
 test_that("g.part1() is GGIR's with backup.cal.coef (a file with one recording), desiredtz", {

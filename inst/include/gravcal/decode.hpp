@@ -413,6 +413,15 @@ class Decoder {
     double remaining;
   };
   virtual std::vector<EpochGap> take_epoch_gaps() { return {}; }
+  // The file's units as they are stored, for a format whose reference
+  // reader logs them (GGIRread's readParmayMatrix(): its QClog, a row per
+  // packet): named columns of numbers, one value a unit, in the file's
+  // order. Empty for a decoder that keeps no such log.
+  struct UnitLog {
+    std::vector<std::string> names;
+    std::vector<std::vector<double>> columns;
+  };
+  virtual UnitLog unit_log() const { return {}; }
   const DeviceInfo& info() const { return info_; }
   const Report& report() const { return report_; }
   const std::string& error() const { return error_; }

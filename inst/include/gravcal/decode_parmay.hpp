@@ -207,6 +207,26 @@ class ParmayDecoder : public Decoder {
 
   std::size_t max_samples_per_unit() const override { return kMaxSamplesPerUnit; }
 
+  // The packets as stored, for GGIR's QClog of them (readParmayMatrix()'s,
+  // built in R): each one's times t0 and t1 (its header's, before any
+  // move), its count of accelerometer samples and whether its checksum
+  // matched (1, 0). The packets the decoder keeps: with compat = 0 not the
+  // damaged ones, never those too short for a header or with a negative
+  // count (GGIRread stops on those).
+  UnitLog unit_log() const override {
+    UnitLog log;
+    log.names = {"t0", "t1", "n_acc", "checksum_pass"};
+    log.columns.assign(4, std::vector<double>());
+    for (auto& c : log.columns) c.reserve(packets_.size());
+    for (const Packet& p : packets_) {
+      log.columns[0].push_back(p.t0);
+      log.columns[1].push_back(p.t1);
+      log.columns[2].push_back(static_cast<double>(p.n_acc));
+      log.columns[3].push_back(p.ok ? 1.0 : 0.0);
+    }
+    return log;
+  }
+
  private:
   struct Packet {
     std::int64_t at = 0, end = 0;  // bytes [at, end) of the file
