@@ -1,0 +1,142 @@
+# What g.getmeta() takes from a format's own header or log, as GGIR's
+# readers take it (the registry's ggir_start, ggir_qclog and ggir_stops in
+# R/formats.R point here): the start of an ActiGraph csv export and of a
+# Movisens recording, a Parmay Matrix file's packet log and the files
+# GGIR's Parmay reader fails on.
+
+# The start of an ActiGraph csv export, as GGIR's g.getstarttime() reads
+# it: "Start Time" and "Start Date" from the header lines below the first,
+# their date order from the first line's "date format" (as read.csv()
+# makes it a column name), read in configtz and given in desiredtz.
+actigraph_csv_start <- function(file, p) {
+  lines <- utils::read.csv(file, nrows = 8, skip = 1)[[1]]
+  field <- function(key) {
+    for (v in vapply(lines[seq_len(min(7, length(lines)))], format, "")) {
+      parts <- strsplit(v, key, fixed = TRUE)[[1]]
+      if (length(parts) > 1) return(gsub(" ", "", parts[2], fixed = TRUE))
+    }
+    abort(key, " not found in the header of \"", basename(file), "\".")
+  }
+  when <- paste0(field("Start Date"), " ", field("Start Time"))
+  top <- colnames(as.matrix(utils::read.csv(file, nrows = 1, skip = 0)))[1]
+  order <- actigraph_date_order(top)
+  if (is.na(order)) abort("The date format of \"", basename(file), "\" is not recognised.")
+  sep <- if (grepl("/", when, fixed = TRUE)) "/" else if (grepl("-", when, fixed = TRUE)) "-" else "."
+  sp <- strsplit(order, "")[[1]]
+  fmt <- paste0("%", sp[1], sep, "%", sp[2], sep, "%", sp[3], " %H:%M:%S")
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  as.POSIXlt(as.POSIXct(when, format = fmt, tz = ctz), tz = p$desiredtz)
+}
+
+# The order of day, month and year that an ActiGraph header's "date format"
+# (M/d/yyyy, dd.MM.yy, yyyy-MMM-d, ...; separators read as dots) gives, in
+# strptime letters ("mdY", "dbY", ...), by GGIR's rules: each order tested
+# by its patterns, the two-digit year given up where the four-digit one
+# matches, the abbreviated month preferred to the numeric. NA when none.
+actigraph_date_order <- function(top) {
+  has <- function(...) as.numeric(length(grep(paste(c(...), collapse = "|"), top)) > 0)
+  f <- c(
+    mdY = has("MM[.]dd[.]yyyy", "M[.]d[.]yyyy", "M[.]dd[.]yyyy", "MM[.]d[.]yyyy"),
+    mdy = has("MM[.]dd[.]yy", "M[.]d[.]yy", "M[.]dd[.]yy", "MM[.]d[.]yy"),
+    bdY = has("MMM[.]dd[.]yyyy", "MMM[.]d[.]yyyy"), bdy = has("MMM[.]dd[.]yy", "MMM[.]d[.]yy"),
+    dmY = has("d[.]M[.]yyyy", "d[.]MM[.]yyyy"), dmy = has("d[.]M[.]yy", "d[.]MM[.]yy"),
+    dbY = has("d[.]MMM[.]yyyy"), dby = has("d[.]MMM[.]yy"),
+    Ymd = has("yyyy[.]M[.]d", "yyyy[.]MM[.]d"), ymd = has("yy[.]M[.]d", "yy[.]MM[.]d"),
+    Ybd = has("yyyy[.]MMM[.]d"), ybd = has("yy[.]MMM[.]d"),
+    Ydm = has("yyyy[.]dd[.]MM", "yyyy[.]d[.]M", "yyyy[.]d[.]MM", "yyyy[.]dd[.]M"),
+    ydm = has("yy[.]dd[.]MM", "yy[.]d[.]M", "yy[.]d[.]MM", "yy[.]dd[.]M"),
+    Ydb = has("yyyy[.]dd[.]MMM", "yyyy[.]d[.]MMM"), ydb = has("yy[.]dd[.]MMM", "yy[.]d[.]MMM"))
+  # for each group of four (numeric and month-name, four- and two-digit
+  # year): drop the two-digit year where the four-digit matches, then the
+  # numeric month where the name matches
+  for (g in list(c("mdY", "mdy", "bdY", "bdy"), c("dmY", "dmy", "dbY", "dby"),
+                 c("Ymd", "ymd", "Ybd", "ybd"), c("Ydm", "ydm", "Ydb", "ydb"))) {
+    if (f[[g[1]]] == 1 && f[[g[2]]] == 1) f[[g[2]]] <- 0
+    if (f[[g[3]]] == 1 && f[[g[4]]] == 1) f[[g[4]]] <- 0
+    if (f[[g[1]]] == 1 && f[[g[3]]] == 1) f[[g[1]]] <- 0
+    if (f[[g[2]]] == 1 && f[[g[4]]] == 1) f[[g[2]]] <- 0
+  }
+  names(f)[which(f == 1)[1]]
+}
+
+# The start of a Movisens recording as GGIR's g.getstarttime() takes it:
+# unisens.xml's timestampStart as unisensR reads it, its clock moved into
+# configtz where given (as lubridate::force_tz() moves it: the same
+# calendar time, read in that zone), given in desiredtz.
+movisens_start <- function(file, p) {
+  if (!requireNamespace("unisensR", quietly = TRUE)) {
+    abort("The start of a Movisens recording as GGIR reads it needs the unisensR ",
+          "package: install.packages(\"unisensR\").")
+  }
+  st <- unisensR::readUnisensStartTime(dirname(file))
+  ctz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  if (!identical(ctz, "")) {
+    whole <- floor(as.numeric(st))
+    wall <- format(as.POSIXct(whole, origin = "1970-01-01", tz = attr(st, "tzone") %||% ""),
+                   "%Y-%m-%d %H:%M:%S")
+    st <- as.POSIXct(wall, tz = ctz) + (as.numeric(st) - whole)
+  }
+  as.POSIXlt(st, tz = p$desiredtz)
+}
+
+# GGIR's M$QClog for a Parmay Matrix file: GGIRread's readParmayMatrix() log
+# of the packets, which GGIR's g.getmeta() keeps from its one block. A row
+# per packet in the file's order: whether its checksum matched (imputed
+# when not: GGIRread keeps such a packet as (0, 0, 1) g), its number, its
+# first and last sample's time as the reader spreads its samples (a packet
+# that starts a second or more after the previous one ended moved back to
+# that end, by the gap; the last one period before the header's end), the
+# span between, the rate set and the rate observed (the count over the
+# header's span), the gap and the move, the packets the header declares
+# and the file holds. From the decoder's packet table (unit_log()), the
+# arithmetic R's.
+parmay_qclog <- function(src) {
+  log <- gc_decoder_unit_log(src$native$ptr)
+  n <- length(log$t0)
+  sf <- src$sf
+  t0 <- log$t0
+  t1 <- log$t1
+  gap <- numeric(n)
+  if (n > 1) gap[-1] <- t0[-1] - t1[-n]
+  late <- which(gap >= 1)
+  moved <- numeric(n)
+  moved[late] <- gap[late]
+  start <- t0
+  start[late] <- t0[late] - gap[late]
+  end <- t1 - 1 / sf
+  pass <- log$checksum_pass == 1
+  data.frame(checksum_pass = pass, blockID = seq_len(n), start = start, end = end,
+             blockLengthSeconds = end - start, frequency_set = rep(sf, n),
+             frequency_observed = log$n_acc / (t1 - t0), imputed = !pass,
+             gap_with_previous_block_secs = moved, start_time_adjustment_secs = -moved,
+             declared_packets = rep(parmay_declared(src$path), n),
+             observed_packets = rep(n, n), acc_recorded = rep(TRUE, n))
+}
+
+# Why GGIR's reader of Parmay Matrix files (GGIRread's readParmayMatrix())
+# gives no result to reproduce where gravcal's decoder reads on, or NULL:
+# a packet too short for its header (at the file's end, a file cut inside
+# one: the reader fails; within the file the reader takes the next packet's
+# bytes for its own), a negative sample count, a header that declares no
+# packet.
+parmay_ggir_stops <- function(src) {
+  rep <- src$report()
+  k <- rep$counters
+  short <- if ("short_packet" %in% names(k)) k[["short_packet"]] else 0
+  if (short == 1 && isTRUE(rep$truncated)) {
+    return("a packet cut inside its header at its end (GGIR's reader fails on it)")
+  }
+  if (short > 0) {
+    return(paste0("a packet too short for its header within it (GGIR's reader takes the next ",
+                  "packet's bytes for its own)"))
+  }
+  if (isTRUE(k["bad_packet_counts"] > 0)) {
+    return("a packet with a negative sample count (GGIR's reader fails on it)")
+  }
+  declared <- parmay_declared(src$path)
+  if (!isTRUE(declared >= 1)) {
+    return(paste0("a header that declares ", declared, " packets (GGIR's reader gives ",
+                  "nothing, and GGIR's g.getmeta() fails)"))
+  }
+  NULL
+}
