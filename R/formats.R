@@ -46,6 +46,10 @@
 #   the native one where the reference reads blocks: read_blocks());
 # * source(file, sf, chunksize, arg): the file block by block, without a
 #   native decoder (see open_source()).
+# * write: for write_recording(), list(check(x, sf, start): an error where
+#   the format cannot hold the samples as given, write(x, file, sf, start):
+#   the file; `x` a data frame x, y, z (g), maybe temperature and light,
+#   `start` POSIXct).
 recording_formats <- list(
   actigraph_csv = list(
     ggir_getmeta = TRUE,
@@ -57,6 +61,12 @@ recording_formats <- list(
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    write = list(
+      check = function(x, sf, start) write_check_whole_hz(sf),
+      write = function(x, file, sf, start) {
+        write_actigraph_csv_file(x, file, sf, start = format(start, "%Y-%m-%d %H:%M:%OS3", tz = "UTC"),
+                                 stamps = "actilife")
+      }),
     source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
   # GENEActiv's csv export: refused where GGIR's result is asked for (GGIR
   # reads it no more), else read as the ad hoc csv file its header
@@ -127,6 +137,17 @@ recording_formats <- list(
     block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),
+    write = list(
+      check = function(x, sf, start) {
+        write_check_whole_hz(sf)
+        if (!is.null(x$temperature)) {
+          warning("`x$temperature` is not written: the .gt3x format holds no temperature.",
+                  call. = FALSE)
+        }
+      },
+      write = function(x, file, sf, start) {
+        write_gt3x(x[c("x", "y", "z")], file, sf = sf, start = start)
+      }),
     source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
   cwa = list(
     ggir_getmeta = TRUE,
@@ -137,6 +158,22 @@ recording_formats <- list(
     block_units = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
     decoder = "cwa",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    write = list(
+      check = function(x, sf, start) {
+        k <- log2(3200 / sf)
+        if (!isTRUE(abs(k - round(k)) < 1e-9 && k >= 0 && k <= 9)) {
+          abort("`sf`: an Axivity .cwa file holds 3200 / 2^k Hz (6.25, 12.5, 25, 50, 100, ",
+                "200, ... 3200), not ", sf, ".")
+        }
+        if (!is.null(x$light) && any(x$light < 0 | x$light > 1023)) {
+          abort("`x$light` must be the light sensor's raw value, 0 to 1023.")
+        }
+      },
+      write = function(x, file, sf, start) {
+        write_cwa(as.matrix(x[c("x", "y", "z")]), file, sf = sf, start = start,
+                  temperature = if (is.null(x$temperature)) 25 else x$temperature,
+                  light = if (is.null(x$light)) 0 else x$light)
+      }),
     source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
   # Movisens: a unisens folder (unisens.xml, acc.bin, temp.bin), named by
   # the folder or its acc.bin (GGIR's filename); GGIR reads it in blocks of
@@ -151,6 +188,11 @@ recording_formats <- list(
     block_units = function(sf, chunksize) movisens_block(),
     decoder = "movisens",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    write = list(
+      check = function(x, sf, start) NULL,
+      write = function(x, file, sf, start) {
+        write_movisens(x, file, sf = sf, start = start, temp = !is.null(x$temperature))
+      }),
     source = function(file, sf, chunksize, arg) source_movisens(file)),
   geneactiv = list(
     ggir_getmeta = TRUE,
@@ -160,6 +202,13 @@ recording_formats <- list(
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    write = list(
+      check = function(x, sf, start) {
+        if (nrow(x) < 300) abort("`x` has ", nrow(x), " samples, fewer than one GENEActiv page (300).")
+      },
+      write = function(x, file, sf, start) {
+        write_geneactiv_bin(x, file, sf = sf, start = format(start, "%Y-%m-%d %H:%M:%OS3", tz = "UTC"))
+      }),
     source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize)),
   # Parmay Matrix: "MDTC" at byte 512. GGIRread's reader reads from the
   # block's first packet to the end of the file whatever end it is given, so
@@ -178,6 +227,19 @@ recording_formats <- list(
     block_units = function(sf, chunksize) 2^52,
     decoder = "parmay",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
+    write = list(
+      check = function(x, sf, start) {
+        if (as.numeric(start) != round(as.numeric(start))) {
+          abort("`start`: a Parmay Matrix file's packets start on whole seconds.")
+        }
+        if (sf * 60 != round(sf * 60)) {
+          abort("`sf`: a Parmay Matrix packet of 60 s must hold a whole number of samples (",
+                sf, " Hz).")
+        }
+      },
+      write = function(x, file, sf, start) {
+        write_parmay_bin(x, file, sf = sf, start = as.numeric(start))
+      }),
     source = function(file, sf, chunksize, arg) source_parmay(file))
 )
 
