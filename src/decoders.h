@@ -52,10 +52,9 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
   std::unique_ptr<gravcal::GeneactivDecoder> d(new gravcal::GeneactivDecoder(bytes, opts));
   // GGIR resamples a rate that is not whole onto whole Hz (compat = 1;
   // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
-  if (opts.num("compat", 1) == 0 || opts.num("resample", 1) == 0) return d;
-  const int interpolation = static_cast<int>(opts.num("interpolation", 1));
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, interpolation, false,
-                                               opts.num("resample_fused", 0) != 0));
+  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
+  if (!r.compat || opts.num("resample", 1) == 0) return d;
+  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, r.interpolation, false, r.fused));
 }
 
 // An Axivity csv export: the csv decoder with the layout in the options;
@@ -64,11 +63,10 @@ inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Opti
 inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
                                    const std::string& name) {
   std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
-  if (opts.num("compat", 1) == 0) return d;
+  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
+  if (!r.compat) return d;
   return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), opts.num("grid_sf", opts.num("sf", 0)),
-      static_cast<int>(opts.num("interpolation", 1)), false,
-      opts.num("resample_fused", 0) != 0));
+      std::move(d), opts.num("grid_sf", opts.num("sf", 0)), r.interpolation, false, r.fused));
 }
 
 // GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
@@ -80,10 +78,10 @@ inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Op
 template <class Inner>
 DecoderPtr adhoc_resampled(std::unique_ptr<Inner> d, const gravcal::Options& opts) {
   const double grid = opts.num("grid_sf", 0);
-  if (opts.num("compat", 1) == 0 || !(grid > 0)) return DecoderPtr(d.release());
-  return DecoderPtr(new gravcal::GgirResamplerOf<Inner>(
-      std::move(d), grid, static_cast<int>(opts.num("interpolation", 1)), true,
-      opts.num("resample_fused", 0) != 0));
+  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
+  if (!r.compat || !(grid > 0)) return DecoderPtr(d.release());
+  return DecoderPtr(new gravcal::GgirResamplerOf<Inner>(std::move(d), grid, r.interpolation, true,
+                                                        r.fused));
 }
 
 inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,

@@ -333,6 +333,26 @@ class Options {
   std::vector<std::pair<std::string, std::string>> str_;
 };
 
+// The reading rules every decoder and GGIR's resamplers share, read from
+// the options in this one place: "compat" (1, the default: the reference
+// reader's behaviour, GGIR's; 0 gravcal's own), "interpolation" (GGIR's
+// interpolationType: 1 linear, the default, 2 nearest neighbour) and
+// "resample_fused" (1 where GGIRread's compiled resample() fuses its
+// multiply-adds: R/fp-build.R asks GGIRread).
+struct ReadRules {
+  bool compat = true;
+  int interpolation = 1;
+  bool fused = false;
+  bool nearest() const { return interpolation == 2; }
+  static ReadRules of(const Options& opts) {
+    ReadRules r;
+    r.compat = opts.num("compat", 1) != 0;
+    r.interpolation = static_cast<int>(opts.num("interpolation", 1));
+    r.fused = opts.num("resample_fused", 0) != 0;
+    return r;
+  }
+};
+
 // The UTC offset R's as.POSIXct() gives a calendar time in a zone (GGIR's
 // configtz, else desiredtz: readAxivity's .cwa block times, read.myacc.csv's
 // text time), as seconds to subtract from the calendar read as UTC: a step

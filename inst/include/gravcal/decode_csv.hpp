@@ -125,7 +125,7 @@ class CsvDecoder : public Decoder {
   // tests and fuzzers.
   CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
       : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
-    compat_ = opts.num("compat", 1) != 0;
+    compat_ = ReadRules::of(opts).compat;
     const double fr = opts.num("fread_rule", 1);
     number_rule_ = !compat_ ? csv_text::kCorrectlyRounded
                    : fr == 2 ? csv_text::kFreadDivide : csv_text::kFreadMultiply;

@@ -257,9 +257,9 @@ class CwaDecoder : public Decoder {
  public:
   CwaDecoder(ByteSource& src, const Options& opts)
       : src_(src),
-        compat_(opts.num("compat", 1) != 0),
-        nearest_(opts.num("interpolation", 1) == 2),
-        fused_(opts.num("resample_fused", 0) != 0),
+        compat_(ReadRules::of(opts).compat),
+        nearest_(ReadRules::of(opts).nearest()),
+        fused_(ReadRules::of(opts).fused),
         frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)),
         r_long_double_(opts.num("r_long_double", 1) != 0),
         zone_(opts) {}

@@ -369,8 +369,8 @@ class GeneactivDecoder : public Decoder {
   void continue_call(bool on) { continue_call_ = on; }
   GeneactivDecoder(ByteSource& src, const Options& opts)
       : lines_(src),
-        compat_(opts.num("compat", 1) != 0),
-        fused_(opts.num("resample_fused", 0) != 0) {
+        compat_(ReadRules::of(opts).compat),
+        fused_(ReadRules::of(opts).fused) {
     info_.format = "geneactiv";
     static const char* const keys[3] = {"light_lux", "light_volts", "light_model11"};
     for (int i = 0; i < 3; ++i) {

@@ -569,7 +569,7 @@ class Gt3xDecoder : public Decoder {
   // stored entries can be read). Options: compat (1), impute_zeroes (0).
   Gt3xDecoder(ByteSource& zip, const Options& opts, EntryInflater* inflater = nullptr)
       : zip_(zip), inflater_(inflater) {
-    compat_ = opts.num("compat", 1) != 0;
+    compat_ = ReadRules::of(opts).compat;
     impute_ = opts.num("impute_zeroes", 0) != 0;
   }
 

@@ -361,9 +361,9 @@ class MovisensDecoder : public Decoder {
       : acc_src_(acc),
         temp_src_(std::move(temp)),
         xml_(std::move(xml)),
-        compat_(opts.num("compat", 1) != 0),
-        nearest_(opts.num("interpolation", 1) == 2),
-        fused_(opts.num("resample_fused", 0) != 0),
+        compat_(ReadRules::of(opts).compat),
+        nearest_(ReadRules::of(opts).nearest()),
+        fused_(ReadRules::of(opts).fused),
         block_opt_(opts.num("block_samples", 0)),
         opts_(opts) {}
 

@@ -113,9 +113,9 @@ class ParmayDecoder : public Decoder {
 
   ParmayDecoder(ByteSource& src, const Options& opts)
       : src_(src),
-        compat_(opts.num("compat", 1) != 0),
-        nearest_(opts.num("interpolation", 1) == 2),
-        fused_(opts.num("resample_fused", 0) != 0),
+        compat_(ReadRules::of(opts).compat),
+        nearest_(ReadRules::of(opts).nearest()),
+        fused_(ReadRules::of(opts).fused),
         run_loop_(opts.num("run_loop", 1) != 0) {}
 
   bool open() override {
