@@ -34,7 +34,7 @@
 # rmc.firstrow.acc when its first field is not a number, be it a column
 # name or a text time stamp); FALSE (read_recording()): only a line whose
 # x field is not a number is skipped (a column-name line).
-rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
+rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
   if (is.null(p$rmc.firstrow.acc)) {
     abort("`rmc.firstrow.acc` must be given to read \"", file, "\" as an ad hoc csv file.")
   }
@@ -125,15 +125,36 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   # dropped, as g.imputeTimegaps does (decode_ggir_timegaps.hpp), before
   # any resampling. Both read the time stamps (text time as R's
   # as.POSIXct() reads it: rmc_time_opts())
-  if (gaps || resample) {
-    g <- rmc_time_opts(p, file, skip, tz, if (gaps) "rmc.check4timegaps" else "rmc.doresample")
+  # `stamps` (g.getmeta()): every time stamp read as GGIR reads it (its
+  # start, its gaps, its QClog), each block's gap filling from the block
+  # before (GGIR passes its PreviousLastValue and PreviousLastTime)
+  if (gaps || resample || (stamps && length(p$rmc.col.time))) {
+    what <- if (gaps) "rmc.check4timegaps" else if (resample) "rmc.doresample" else {
+      "g.getmeta()'s time column (`rmc.col.time`)"
+    }
+    g <- rmc_time_opts(p, file, skip, tz, what)
     opts[names(g)] <- g
   }
   if (gaps) opts$timegaps <- as.numeric(sf)
+  if (gaps && stamps) opts$timegaps_carry <- 1
   list(opts = opts, sf = sf, skip = skip, header = header,
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
        })
+}
+
+# `rmc` (the rmc.* parameters) with the zone GGIR reads text time in
+# (attributes tz and tz_arg, the parameter that gave it): configtz, else
+# the deprecated rmc.configtz, else desiredtz ("" gives way to
+# rmc.desiredtz), as read.myacc.csv settles them; `p` holds desiredtz and
+# configtz.
+rmc_with_zone <- function(rmc, p) {
+  desired <- if (nzchar(p$desiredtz %||% "")) p$desiredtz else p$rmc.desiredtz %||% ""
+  attr(rmc, "tz") <- if (length(p$configtz)) p$configtz else p$rmc.configtz %||% desired
+  attr(rmc, "tz_arg") <- if (length(p$configtz)) "configtz" else if (!is.null(p$rmc.configtz)) {
+    "rmc.configtz"
+  } else if (nzchar(p$desiredtz %||% "") || is.null(p$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
+  rmc
 }
 
 # rmc.check4timegaps and rmc.doresample (`what`): what the decoder needs to
@@ -152,8 +173,9 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   lines <- lines[seq_along(lines) > skip]
   stamps <- vapply(lines, function(l) rmc_fields(l)[p$rmc.col.time], "", USE.NAMES = FALSE)
   refuse <- function(why) {
-    abort("`", what, "` = TRUE with `rmc.unit.time` = \"", unit, "\" is not supported by ",
-          "gravcal (", why, "); GGIR::g.calibrate() reads such files.")
+    lead <- if (grepl("^rmc[.]", what)) paste0("`", what, "` = TRUE") else what
+    abort(lead, " with `rmc.unit.time` = \"", unit, "\" is not supported by ",
+          "gravcal (", why, "); GGIR reads such files.")
   }
   if (unit == "ActivPAL") {
     t <- suppressWarnings(as.numeric(stamps)) * 86400 - 25569 * 86400
@@ -197,7 +219,8 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   }
   t0 <- t[!is.na(t)][1]
   if (is.na(t0)) refuse("the time column's first values cannot be read")
-  at <- t0 + (0:25) * 30.44 * 86400
+  # (whole seconds: the text below has none of the first stamp's fraction)
+  at <- floor(t0) + (0:25) * 30.44 * 86400
   txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
   off <- at - as.numeric(as.POSIXct(txt, tz = zone))
   if (!anyNA(off) && all(off == off[1])) {

@@ -162,13 +162,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   # the zone GGIR reads text time in (rmc.check4timegaps): configtz, else
   # the deprecated rmc.configtz, else desiredtz ("" gives way to
   # rmc.desiredtz), as read.myacc.csv settles them
-  if (!is.null(rmc)) {
-    desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
-    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
-    attr(rmc, "tz_arg") <- if (length(pr$configtz)) "configtz" else if (!is.null(pr$rmc.configtz)) {
-      "rmc.configtz"
-    } else if (nzchar(pr$desiredtz %||% "") || is.null(pr$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
-  }
+  if (!is.null(rmc)) rmc <- rmc_with_zone(rmc, pr)
   if (length(inspectfileobject) && is.character(datafile)) {
     ggir_check_inspect(inspectfileobject, datafile, adhoc = !is.null(rmc))
   }

@@ -230,7 +230,7 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
-  expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.firstrow.acc")
+  expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.col.time")
   expect_warning(gravcal::g.getmeta(f, do.enmoo = TRUE, verbose = FALSE), "`do.enmoo`")
 })
 

@@ -80,6 +80,10 @@ struct GgirTimegapsMode {
   bool epoch_gaps = false;
   double short_epoch = 5, long_epoch = 900;  // seconds (GGIR's windowsizes[1:2])
   std::vector<double> local;
+  // put before the names of the counters (but "timegaps_not_filled"): a
+  // filler under another (an ad hoc csv file's own, read.myacc.csv's, under
+  // g.getmeta()'s) keeps its counts apart
+  std::string counter_prefix;
 };
 
 template <class Inner, class Acc = long double>
@@ -388,17 +392,19 @@ class GgirTimegapsOf : public Decoder {
   }
 
   void add_own(Report& r) const {
-    if (gaps_ > 0) r.count("timegaps_imputed", gaps_);
-    if (rows_added_ > 0) r.count("timegap_samples_added", rows_added_);
-    if (zeros_dropped_ > 0) r.count("timegaps_zero_samples_dropped", zeros_dropped_);
+    const std::string& p = mode_.counter_prefix;
+    auto count = [&](const char* name, std::int64_t k) { r.count((p + name).c_str(), k); };
+    if (gaps_ > 0) count("timegaps_imputed", gaps_);
+    if (rows_added_ > 0) count("timegap_samples_added", rows_added_);
+    if (zeros_dropped_ > 0) count("timegaps_zero_samples_dropped", zeros_dropped_);
     if (gaps_not_filled_ > 0) r.count("timegaps_not_filled", gaps_not_filled_);
     if (mode_.carry) {
-      r.count("timegap_rows_read", rows_read_);
-      r.count("timegap_rows", gap_rows_);
-      r.count("timegaps_over_limit", over_limit_);
-      r.count("timegap_longest_rows", static_cast<std::int64_t>(longest_));
-      r.count("clock_time_missing", clock_missing_);
-      r.count("clock_table_exceeded", clock_exceeded_);
+      count("timegap_rows_read", rows_read_);
+      count("timegap_rows", gap_rows_);
+      count("timegaps_over_limit", over_limit_);
+      count("timegap_longest_rows", static_cast<std::int64_t>(longest_));
+      count("clock_time_missing", clock_missing_);
+      count("clock_table_exceeded", clock_exceeded_);
     }
     for (const auto& n : gap_notes_) r.note(n);
   }
