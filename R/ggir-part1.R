@@ -29,7 +29,20 @@
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
 #' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
 #' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
-#' recording refused, as for gravcal's g.calibrate()). Metrics:
+#' recording refused, as for gravcal's g.calibrate()), ad hoc csv files
+#' (`rmc.firstrow.acc` and the other `rmc.*` parameters, as for
+#' [g.calibrate()]; the time column read stamp by stamp as GGIR reads it,
+#' UNIX seconds or milliseconds, or text by `rmc.format.time` in `configtz`,
+#' else `desiredtz`; GGIR's AD_HOC non-wear, sd below `1.2 * rmc.noise`, and
+#' clipping beyond `rmc.dynamic_range`, none without it; time gaps filled by
+#' `imputeTimegaps` and `rmc.check4timegaps`, each block from the block
+#' before, GGIR's times slipping by two rows after a single sample between
+#' two gaps as they do in GGIR; `rmc.doresample`). Refused with an error
+#' naming it: no `rmc.col.time` (GGIR's g.getmeta() stops without time
+#' stamps), `rmc.noise` empty (GGIR stops), `rmc.col.wear`, `rmc.unit.time`
+#' "ActivPAL", `rmc.check4timegaps` with `rmc.doresample`, `rmc.dynamic_range`
+#' naming a header row without `dynrange`, and what [g.calibrate()] refuses
+#' of text time. Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
@@ -62,7 +75,8 @@
 #' @param myfun GGIR's external function object (see "What this version
 #'   covers"), or empty.
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
-#'   `sf` must agree with the file.
+#'   `sf` must agree with the file (for an ad hoc csv file, with the rate the
+#'   `rmc.*` parameters give).
 #' @param verbose Print the blocks read, as GGIR does.
 #' @param ... GGIR's legacy arguments: any parameter of the lists by name.
 #' @return GGIR's list `M`: `filecorrupt`, `filetooshort`,

@@ -451,3 +451,137 @@ test_that("g.getmeta() is GGIR's on a Movisens recording (start from unisens.xml
   expect_identical(b2$gravcal$metashort$timestamp[1], "2024-03-04T09:15:00+0100")
   expect_true("temperaturemean" %in% names(b$gravcal$metalong))
 })
+
+# An ad hoc csv recording (GGIR's rmc.* files) for g.getmeta(): `hours` of
+# simulated samples with 72 minutes flat on a table (GGIR's non-wear) and 41
+# samples at 7.9 g (clipped beyond rmc.dynamic_range = 6), written by
+# write_adhoc_csv() after two free header lines at `true_sf` Hz, lines
+# `drop` left out (time gaps) and samples `zeros` set to 0, 0, 0. Returns
+# the file and its rmc.* list with chunksize 0.1 (at 10 Hz, GGIR's blocks
+# of g.getmeta() are 87000 lines: a recording of 4 hours is two of them).
+meta_adhoc <- function(..., hours = 4, true_sf = 10, seed = 31, drop = integer(),
+                       zeros = integer()) {
+  rec <- simulate_recording(hours = hours, sf = 10, seed = seed,
+                            tempoffset = c(0.001, -0.002, 0.0005))
+  n <- nrow(rec)
+  i <- round(0.3 * n):round(0.6 * n)
+  rec$x[i] <- 0.02 + 0.001 * sin(i)
+  rec$y[i] <- -0.01 + 0.001 * cos(i)
+  rec$z[i] <- 0.99 + 0.001 * sin(i / 3)
+  rec$x[round(0.8 * n) + 0:40] <- 7.9
+  rec[zeros, c("x", "y", "z")] <- 0
+  f <- tempfile(fileext = ".csv")
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = true_sf, header = c("device,sim", "serial,S1"),
+                                  drop = drop, ...)
+  list(file = f, pr = c(pr, list(chunksize = 0.1)))
+}
+
+test_that("g.getmeta() is GGIR's on ad hoc csv files: units, time columns, header, zones", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  # mg after free header lines, UNIX seconds, temperature: calibrated with
+  # a temperature term; GGIR's default rmc.noise (13: non-wear by the range
+  # alone), no clipping threshold (no rmc.dynamic_range: GGIR's clipping
+  # score is 0)
+  a <- meta_adhoc(unit = "mg", time = "UNIXsec")
+  b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
+  expect_same_meta(b)
+  M <- b$gravcal
+  expect_identical(nrow(M$QClog), 2L)
+  expect_true(any(M$metalong$nonwearscore > 0))
+  expect_true(all(M$metalong$clippingscore == 0))
+  expect_true("temperaturemean" %in% names(M$metalong))
+  expect_identical(M$metashort$timestamp[1], "2024-01-01T00:00:00+0000")
+  # GGIR's g.inspectfile() result taken (GGIR's own call needs it)
+  I <- meta_quiet(GGIR::g.inspectfile(a$file, params_rawdata = utils::modifyList(
+    GGIR::load_params()$params_rawdata, a$pr)))
+  G2 <- meta_quiet(do.call(gravcal::g.getmeta, c(list(a$file, inspectfileobject = I,
+                                                      verbose = FALSE, params_rawdata = a$pr),
+                                                 cal_args)))
+  expect_identical(G2$metashort, M$metashort)
+  expect_identical(G2$metalong, M$metalong)
+  # g, text time in %d/%m/%Y %H:%M:%OS (its first line, a text stamp, lost
+  # as GGIR loses it: GGIR starts at the next long epoch) read in
+  # Europe/Amsterdam, no temperature; rmc.noise and rmc.dynamic_range:
+  # GGIR's sd criterion and clipping threshold
+  a <- meta_adhoc(time = "character", temperature = FALSE, colnames = FALSE)
+  pr <- c(a$pr, list(rmc.noise = 0.01, rmc.dynamic_range = 6))
+  b <- meta_both(a$file, list(params_rawdata = pr,
+                              params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  M <- b$gravcal
+  expect_identical(M$metashort$timestamp[1], "2024-01-01T00:15:00+0100")
+  expect_true(any(M$metalong$clippingscore > 0))
+  expect_true(any(M$metalong$nonwearscore > 0))
+  expect_false("temperaturemean" %in% names(M$metalong))
+  # bits (unsigned, 12 over +-8 g), UNIX milliseconds, the rate from the
+  # header (rmc.firstrow.header, rmc.headername.sf), in Asia/Kolkata
+  a <- meta_adhoc(unit = "bit", time = "UNIXmsec", sf_header = TRUE)
+  b <- meta_both(a$file, list(params_rawdata = a$pr,
+                              params_general = list(desiredtz = "Asia/Kolkata"),
+                              params_metrics = list(do.anglex = TRUE, do.mad = TRUE)))
+  expect_same_meta(b)
+  expect_match(b$gravcal$metashort$timestamp[1], "[+]0530$")
+})
+
+test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and resampling", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  skip_if_not_installed("GGIRread")
+  # lines missing (0.3 s and 9.7 s around a single line, a minute, 5 s at
+  # the start of GGIR's second block, 0.4 s): g.getmeta()'s imputeTimegaps
+  # fills them (its QClog counts them; after the single line GGIR's times
+  # slip by two rows, decode_ggir_timegaps.hpp), and without it GGIR's
+  # blocks keep them out
+  drop <- c(5000:5002, 5004:5100, 40000:40600, 87002:87051, 100000:100003)
+  a <- meta_adhoc(time = "UNIXsec", drop = drop)
+  b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(4L, 2L))
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(imputeTimegaps = FALSE))))
+  expect_same_meta(b)
+  expect_null(b$gravcal$QClog)
+  # rmc.check4timegaps (read.myacc.csv fills them first, each block from
+  # the block before), text time, idle-sleep zeros
+  # (g.getmeta()'s own filling then finds one gap: GGIR's slipped times)
+  a <- meta_adhoc(time = "character", drop = drop[drop < 1e5], zeros = 20000:20050)
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.check4timegaps = TRUE))))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
+  # rmc.doresample: a 10.3 Hz clock taken for 10 Hz, each block resampled
+  a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, unit = "mg")
+  pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE))
+  b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(windowsizes = c(5, 600, 3600))))
+  expect_same_meta(b)
+  expect_lt(nrow(b$gravcal$metashort), 4 * 720)
+})
+
+test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an error naming it", {
+  a <- meta_adhoc(hours = 0.2, time = "character")
+  gm <- function(..., I = c()) {
+    gravcal::g.getmeta(a$file, params_rawdata = utils::modifyList(a$pr, list(...)),
+                       inspectfileobject = I, verbose = FALSE)
+  }
+  # GGIR's g.getmeta() stops without time stamps ("Timestamps not found")
+  expect_error(gm(rmc.col.time = NULL, rmc.col.acc = 2:4), "`rmc.col.time` is not given")
+  expect_error(gm(rmc.col.wear = 5), "rmc.col.wear")
+  expect_error(gm(rmc.unit.time = "ActivPAL"), "rmc.unit.time")
+  expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample")
+  expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
+  expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.noise = NULL)),
+                                  verbose = FALSE), "rmc.noise")
+  expect_error(gm(rmc.col.tme = 1), "rmc.col.tme")
+  expect_error(gm(rmc.unit.acc = "G"), "rmc.unit.acc")
+  # a text time its format does not read; ISO 8601 text as "POSIX", which
+  # GGIR reads through fread() without its fractions of a second
+  expect_error(gm(rmc.format.time = "%Y-%m-%d %H:%M:%OS"), "rmc.format.time")
+  iso <- meta_adhoc(hours = 0.2, time = "POSIX")
+  expect_error(gravcal::g.getmeta(iso$file, params_rawdata = iso$pr, verbose = FALSE),
+               "rmc.col.time.*POSIX")
+  # an inspectfileobject of another rate, or of a file read otherwise
+  expect_error(gm(I = list(monc = 0, dformc = 5, sf = 20)), "inspectfileobject\\$sf")
+  expect_error(gm(I = list(monc = 4, dformc = 4, sf = 10)), "inspectfileobject")
+  # a wear column GGIR would take its non-wear from
+  expect_error(gm(rmc.col.wear = 6), "rmc.col.wear")
+  unlink(c(a$file, iso$file))
+})
