@@ -522,6 +522,17 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files: units, time columns, heade
                               params_metrics = list(do.anglex = TRUE, do.mad = TRUE)))
   expect_same_meta(b)
   expect_match(b$gravcal$metashort$timestamp[1], "[+]0530$")
+  # "POSIX" text that fread() reads as text (not ISO 8601): GGIR reads it
+  # as "character"
+  a <- meta_adhoc(time = "character", unit = "mg")
+  pr <- c(a$pr[names(a$pr) != "rmc.unit.time"], list(rmc.unit.time = "POSIX"))
+  expect_same_meta(meta_both(a$file, list(params_rawdata = pr)))
+  # UNIX seconds since rmc.origin (1994 + 2000-01-01: 2024), in New York
+  a <- meta_adhoc(time = "UNIXsec", start = "1994-01-01 00:00:00")
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.origin = "2000-01-01")),
+                              params_general = list(desiredtz = "America/New_York")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2023-12-31T19:00:00-0500")
 })
 
 test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and resampling", {
