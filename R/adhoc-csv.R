@@ -102,6 +102,11 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
     if (unit %in% c("UNIXsec", "UNIXmsec")) {
       opts$time_div <- if (unit == "UNIXmsec") 1000 else 1
       opts$time_offset <- origin
+      # the first stamp, for what needs the start before the samples are
+      # read (g.getmeta()'s zone table of long gaps: meta_source())
+      line <- if (length(first) > skip) first[skip + 1] else NA_character_
+      v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
+      if (length(v) == 1 && is.finite(v)) opts$start_time <- v / opts$time_div + origin
     } else if (unit == "ActivPAL") {
       opts$time_div <- 1 / 86400  # days since 1899-12-30
       opts$time_offset <- as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))

@@ -565,6 +565,34 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(windowsizes = c(5, 600, 3600))))
   expect_same_meta(b)
   expect_lt(nrow(b$gravcal$metashort), 4 * 720)
+  # 100 minutes missing, over GGIR's 90-minute limit: filled to the next
+  # long epoch, the rest imputed as whole epochs (GGIR on R 4.3 or later;
+  # its reference on R 4.2 with R 4.3's as.POSIXlt(), as above)
+  # The gap's time of day is read in the session's zone: in Asia/Kathmandu
+  # (+05:45), with long epochs of 20 minutes, 145 minutes missing end
+  # elsewhere in their epoch than in UTC (the decoder's zone table from the
+  # first time stamp)
+  long_gap <- function(hours, drop, ws, session_tz) {
+    old <- Sys.getenv("TZ", unset = NA)
+    Sys.setenv(TZ = session_tz)
+    on.exit(if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old))
+    a <- meta_adhoc(time = "UNIXsec", hours = hours, drop = drop)
+    pr <- utils::modifyList(GGIR::load_params()$params_rawdata, a$pr)
+    R <- ggir_cached("g.getmeta", a$file, list(params_rawdata = pr, windowsizes = ws,
+                                                posixlt = "R 4.3", session_tz = session_tz), {
+      I <- meta_quiet(GGIR::g.inspectfile(a$file, params_rawdata = pr))
+      with_r43_posixlt(meta_quiet(GGIR::g.getmeta(a$file, params_rawdata = pr,
+                                                  inspectfileobject = I, verbose = FALSE,
+                                                  windowsizes = ws)))
+    })
+    G <- meta_quiet(gravcal::g.getmeta(a$file, params_rawdata = pr, verbose = FALSE,
+                                       windowsizes = ws))
+    expect_same_meta(list(ggir = R, gravcal = G))
+    expect_gt(sum(G$metalong$nonwearscore == 3), 4)
+    expect_true(any(G$QClog$timegaps_min > 90))
+  }
+  long_gap(5, 30000:90000, c(5, 900, 3600), "UTC")
+  long_gap(8, 30000:116999, c(5, 1200, 3600), "Asia/Kathmandu")
 })
 
 test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an error naming it", {
