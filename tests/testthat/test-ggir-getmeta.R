@@ -515,13 +515,15 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files: units, time columns, heade
   expect_true(any(M$metalong$nonwearscore > 0))
   expect_false("temperaturemean" %in% names(M$metalong))
   # bits (unsigned, 12 over +-8 g), UNIX milliseconds, the rate from the
-  # header (rmc.firstrow.header, rmc.headername.sf), in Asia/Kolkata
+  # header (rmc.firstrow.header, rmc.headername.sf), in Asia/Kolkata;
+  # dynrange (clipping beyond 7 - 0.5 g, whatever rmc.dynamic_range)
   a <- meta_adhoc(unit = "bit", time = "UNIXmsec", sf_header = TRUE)
-  b <- meta_both(a$file, list(params_rawdata = a$pr,
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(dynrange = 7)),
                               params_general = list(desiredtz = "Asia/Kolkata"),
                               params_metrics = list(do.anglex = TRUE, do.mad = TRUE)))
   expect_same_meta(b)
   expect_match(b$gravcal$metashort$timestamp[1], "[+]0530$")
+  expect_true(any(b$gravcal$metalong$clippingscore > 0))
   # "POSIX" text that fread() reads as text (not ISO 8601): GGIR reads it
   # as "character"
   a <- meta_adhoc(time = "character", unit = "mg")
