@@ -150,16 +150,32 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
 
 # `rmc` (the rmc.* parameters) with the zone GGIR reads text time in
 # (attributes tz and tz_arg, the parameter that gave it): configtz, else
-# the deprecated rmc.configtz, else desiredtz ("" gives way to
-# rmc.desiredtz), as read.myacc.csv settles them; `p` holds desiredtz and
-# configtz.
+# desiredtz (`p` holds them). GGIR's g.readaccfile() hands read.myacc.csv
+# configtz (desiredtz where it is not given), never NULL, so the deprecated
+# rmc.configtz and rmc.desiredtz never choose the zone there; one that
+# differs from what it is handed stops each of GGIR's reads
+# (rmc_zone_conflict()).
 rmc_with_zone <- function(rmc, p) {
-  desired <- if (nzchar(p$desiredtz %||% "")) p$desiredtz else p$rmc.desiredtz %||% ""
-  attr(rmc, "tz") <- if (length(p$configtz)) p$configtz else p$rmc.configtz %||% desired
-  attr(rmc, "tz_arg") <- if (length(p$configtz)) "configtz" else if (!is.null(p$rmc.configtz)) {
-    "rmc.configtz"
-  } else if (nzchar(p$desiredtz %||% "") || is.null(p$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
+  attr(rmc, "tz") <- if (length(p$configtz)) p$configtz else p$desiredtz %||% ""
+  attr(rmc, "tz_arg") <- if (length(p$configtz)) "configtz" else "desiredtz"
   rmc
+}
+
+# The rmc.* zone parameter on which GGIR 3.3-9's read.myacc.csv() stops
+# when g.readaccfile() calls it, with the reason, or NULL: rmc.desiredtz
+# other than a desiredtz that is not "", rmc.configtz other than configtz
+# (desiredtz where it is not given).
+rmc_zone_conflict <- function(rmc, p) {
+  desired <- p$desiredtz %||% ""
+  config <- if (length(p$configtz)) p$configtz else desired
+  if (!is.null(rmc$rmc.desiredtz) && nzchar(desired) && !identical(rmc$rmc.desiredtz, desired)) {
+    return(list(nm = "rmc.desiredtz", other = "desiredtz", value = desired))
+  }
+  if (!is.null(rmc$rmc.configtz) && !identical(rmc$rmc.configtz, config)) {
+    return(list(nm = "rmc.configtz", other = if (length(p$configtz)) "configtz" else "desiredtz",
+                value = config))
+  }
+  NULL
 }
 
 # rmc.check4timegaps and rmc.doresample (`what`): what the decoder needs to

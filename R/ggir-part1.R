@@ -41,8 +41,10 @@
 #' naming it: no `rmc.col.time` (GGIR's g.getmeta() stops without time
 #' stamps), `rmc.noise` empty (GGIR stops), `rmc.col.wear`, `rmc.unit.time`
 #' "ActivPAL", `rmc.check4timegaps` with `rmc.doresample`, `rmc.dynamic_range`
-#' naming a header row without `dynrange`, and what [g.calibrate()] refuses
-#' of text time. Metrics:
+#' naming a header row without `dynrange`, a deprecated `rmc.configtz` or
+#' `rmc.desiredtz` other than the zone GGIR hands its reader (GGIR's reads
+#' stop on it; text time is read in `configtz`, else `desiredtz`), and what
+#' [g.calibrate()] refuses of text time. Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
@@ -251,6 +253,12 @@ meta_rmc <- function(p) {
   rmc <- rmc_with_zone(rmc_values(given, "params_rawdata"), p)
   refuse <- function(nm, why) {
     abort("`", nm, "` = ", paste(deparse(rmc[[nm]]), collapse = ""), ": ", why, ".")
+  }
+  bad <- rmc_zone_conflict(rmc, p)
+  if (!is.null(bad)) {
+    refuse(bad$nm, paste0("GGIR's reads of the file stop on it with `", bad$other, "` = \"",
+                          bad$value, "\" (read.myacc.csv(): give only `", bad$other,
+                          "`), so GGIR's g.getmeta() finds the file empty"))
   }
   if (!length(rmc$rmc.col.time)) {
     abort("`rmc.col.time` is not given: GGIR's g.getmeta() stops on an ad hoc csv file ",

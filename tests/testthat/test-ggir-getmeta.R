@@ -525,10 +525,14 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files: units, time columns, heade
   expect_match(b$gravcal$metashort$timestamp[1], "[+]0530$")
   expect_true(any(b$gravcal$metalong$clippingscore > 0))
   # "POSIX" text that fread() reads as text (not ISO 8601): GGIR reads it
-  # as "character"
+  # as "character"; in desiredtz, not in the deprecated rmc.desiredtz
+  # (g.readaccfile() hands read.myacc.csv its zone)
   a <- meta_adhoc(time = "character", unit = "mg")
-  pr <- c(a$pr[names(a$pr) != "rmc.unit.time"], list(rmc.unit.time = "POSIX"))
-  expect_same_meta(meta_both(a$file, list(params_rawdata = pr)))
+  pr <- c(a$pr[names(a$pr) != "rmc.unit.time"],
+          list(rmc.unit.time = "POSIX", rmc.desiredtz = "Asia/Kolkata"))
+  b <- meta_both(a$file, list(params_rawdata = pr))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-01-01T00:15:00+0000")
   # UNIX seconds since rmc.origin (1994 + 2000-01-01: 2024), in New York
   a <- meta_adhoc(time = "UNIXsec", start = "1994-01-01 00:00:00")
   b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.origin = "2000-01-01")),
@@ -606,6 +610,12 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   # GGIR's g.getmeta() stops without time stamps ("Timestamps not found")
   expect_error(gm(rmc.col.time = NULL, rmc.col.acc = 2:4), "`rmc.col.time` is not given")
   expect_error(gm(rmc.col.wear = 5), "rmc.col.wear")
+  # GGIR's reads stop on a zone of the deprecated rmc.* parameters other
+  # than the one g.readaccfile() hands read.myacc.csv
+  expect_error(gm(rmc.configtz = "Asia/Kolkata"), "`rmc.configtz` = \"Asia/Kolkata\"")
+  expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.desiredtz = "UTC")),
+                                  params_general = list(desiredtz = "Europe/Amsterdam"),
+                                  verbose = FALSE), "rmc.desiredtz")
   expect_error(gm(rmc.unit.time = "ActivPAL"), "rmc.unit.time")
   expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample")
   expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
