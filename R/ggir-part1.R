@@ -44,7 +44,9 @@
 #' naming a header row without `dynrange`, a deprecated `rmc.configtz` or
 #' `rmc.desiredtz` other than the zone GGIR hands its reader (GGIR's reads
 #' stop on it; text time is read in `configtz`, else `desiredtz`), and what
-#' [g.calibrate()] refuses of text time. Metrics:
+#' [g.calibrate()] refuses of text time (in a zone whose offset changes, a
+#' block of GGIR's starting at a time that exists twice or not at all there).
+#' Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
@@ -124,7 +126,12 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
-  meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  # text time in a zone whose offset changes: a block of GGIR's that starts
+  # at a time that exists twice or not at all there is refused, as by
+  # g.calibrate()
+  if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
+  M
 }
 
 # The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).

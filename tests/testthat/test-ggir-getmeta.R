@@ -565,6 +565,18 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.check4timegaps = TRUE))))
   expect_same_meta(b)
   expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
+  # text time across the autumn change in Europe/Amsterdam (the clock's
+  # hour 02 read as as.POSIXct() reads it, in order); a block of GGIR's
+  # starting within that hour refused, as by g.calibrate()
+  a <- meta_adhoc(time = "character", start = "2024-10-26 23:00:00")
+  b <- meta_both(a$file, list(params_rawdata = a$pr,
+                              params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-10-26T23:15:00+0200")
+  a <- meta_adhoc(time = "character", start = "2024-10-27 00:30:00", hours = 2.6)
+  expect_error(meta_quiet(gravcal::g.getmeta(a$file, params_rawdata = a$pr,
+                                             desiredtz = "Europe/Amsterdam", verbose = FALSE)),
+               "`desiredtz` = \"Europe/Amsterdam\": a block of GGIR's reading")
   # rmc.doresample: a 10.3 Hz clock taken for 10 Hz, each block resampled
   a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, unit = "mg")
   pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE))
