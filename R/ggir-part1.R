@@ -40,7 +40,8 @@
 #' two gaps as they do in GGIR; `rmc.doresample`). Refused with an error
 #' naming it: no `rmc.col.time` (GGIR's g.getmeta() stops without time
 #' stamps), `rmc.noise` empty (GGIR stops), `rmc.col.wear`, `rmc.unit.time`
-#' "ActivPAL", `rmc.check4timegaps` with `rmc.doresample`, `rmc.dynamic_range`
+#' "ActivPAL", `rmc.check4timegaps` with `rmc.doresample` and `imputeTimegaps`
+#' (GGIR fills each block from the resampled block before), `rmc.dynamic_range`
 #' naming a header row without `dynrange`, a deprecated `rmc.configtz` or
 #' `rmc.desiredtz` other than the zone GGIR hands its reader (GGIR's reads
 #' stop on it; text time is read in `configtz`, else `desiredtz`), and what
@@ -285,10 +286,13 @@ meta_rmc <- function(p) {
                                    "lubridate::force_tz()) is not read by gravcal's ",
                                    "g.getmeta(); use GGIR::g.getmeta()"))
   }
-  if (isTRUE(rmc$rmc.check4timegaps) && isTRUE(rmc$rmc.doresample)) {
-    refuse("rmc.doresample", paste0("with `rmc.check4timegaps` = TRUE as well, GGIR fills each ",
-                                    "block's gaps from the resampled block before it, which ",
-                                    "gravcal's g.getmeta() does not reproduce; use one of the two"))
+  # (with imputeTimegaps = FALSE GGIR carries read.myacc.csv's own last
+  # sample, before the resampling, as the decoder does)
+  if (isTRUE(rmc$rmc.check4timegaps) && isTRUE(rmc$rmc.doresample) && isTRUE(p$imputeTimegaps)) {
+    refuse("rmc.doresample", paste0("with `rmc.check4timegaps` = TRUE and `imputeTimegaps` = ",
+                                    "TRUE, GGIR fills each block's gaps from the resampled ",
+                                    "block before it, which gravcal's g.getmeta() does not ",
+                                    "reproduce; use one of the two, or imputeTimegaps = FALSE"))
   }
   # GGIR's clipping threshold without dynrange is rmc.dynamic_range as it
   # is: a header row's name would be compared as text

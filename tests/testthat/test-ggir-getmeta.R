@@ -545,16 +545,18 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   skip_if_quick()
   skip_if_not_installed("data.table")
   skip_if_not_installed("GGIRread")
-  # lines missing (0.3 s and 9.7 s around a single line, a minute, 5 s at
-  # the start of GGIR's second block, 0.4 s): g.getmeta()'s imputeTimegaps
-  # fills them (its QClog counts them; after the single line GGIR's times
-  # slip by two rows, decode_ggir_timegaps.hpp), and without it GGIR's
-  # blocks keep them out
-  drop <- c(5000:5002, 5004:5100, 40000:40600, 87002:87051, 100000:100003)
+  # lines missing (0.3 s and 9.7 s around a single line, a minute, 5 s
+  # between GGIR's first block and its second (its line 87000 is sample
+  # 87701: 701 lines missing before), 0.4 s): g.getmeta()'s imputeTimegaps
+  # fills them, the one between blocks from the first block's last sample
+  # (its QClog counts them; after the single line GGIR's times slip by two
+  # rows, decode_ggir_timegaps.hpp), and without it GGIR's blocks keep them
+  # out
+  drop <- c(5000:5002, 5004:5100, 40000:40600, 87702:87751, 100000:100003)
   a <- meta_adhoc(time = "UNIXsec", drop = drop)
   b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
   expect_same_meta(b)
-  expect_identical(b$gravcal$QClog$timegaps_n, c(4L, 2L))
+  expect_identical(b$gravcal$QClog$timegaps_n, c(3L, 2L))
   b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(imputeTimegaps = FALSE))))
   expect_same_meta(b)
   expect_null(b$gravcal$QClog)
@@ -583,6 +585,12 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(windowsizes = c(5, 600, 3600))))
   expect_same_meta(b)
   expect_lt(nrow(b$gravcal$metashort), 4 * 720)
+  # and rmc.check4timegaps before it (imputeTimegaps = FALSE: GGIR carries
+  # read.myacc.csv's last sample before the resampling to the next block)
+  a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, drop = drop, zeros = 20000:20050)
+  pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE,
+                                     rmc.check4timegaps = TRUE, imputeTimegaps = FALSE))
+  expect_same_meta(meta_both(a$file, list(params_rawdata = pr)))
   # 100 minutes missing, over GGIR's 90-minute limit: filled to the next
   # long epoch, the rest imputed as whole epochs (GGIR on R 4.3 or later;
   # its reference on R 4.2 with R 4.3's as.POSIXlt(), as above)
@@ -629,7 +637,7 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
                                   params_general = list(desiredtz = "Europe/Amsterdam"),
                                   verbose = FALSE), "rmc.desiredtz")
   expect_error(gm(rmc.unit.time = "ActivPAL"), "rmc.unit.time")
-  expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample")
+  expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample.*imputeTimegaps")
   expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
   expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.noise = NULL)),
                                   verbose = FALSE), "rmc.noise")
