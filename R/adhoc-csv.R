@@ -34,7 +34,7 @@
 # rmc.firstrow.acc when its first field is not a number, be it a column
 # name or a text time stamp); FALSE (read_recording()): only a line whose
 # x field is not a number is skipped (a column-name line).
-rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
+rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
   if (is.null(p$rmc.firstrow.acc)) {
     abort("`rmc.firstrow.acc` must be given to read \"", file, "\" as an ad hoc csv file.")
   }
@@ -102,6 +102,11 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
     if (unit %in% c("UNIXsec", "UNIXmsec")) {
       opts$time_div <- if (unit == "UNIXmsec") 1000 else 1
       opts$time_offset <- origin
+      # the first stamp, for what needs the start before the samples are
+      # read (g.getmeta()'s zone table of long gaps: meta_source())
+      line <- if (length(first) > skip) first[skip + 1] else NA_character_
+      v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
+      if (length(v) == 1 && is.finite(v)) opts$start_time <- v / opts$time_div + origin
     } else if (unit == "ActivPAL") {
       opts$time_div <- 1 / 86400  # days since 1899-12-30
       opts$time_offset <- as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))
@@ -125,15 +130,52 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE) {
   # dropped, as g.imputeTimegaps does (decode_ggir_timegaps.hpp), before
   # any resampling. Both read the time stamps (text time as R's
   # as.POSIXct() reads it: rmc_time_opts())
-  if (gaps || resample) {
-    g <- rmc_time_opts(p, file, skip, tz, if (gaps) "rmc.check4timegaps" else "rmc.doresample")
+  # `stamps` (g.getmeta()): every time stamp read as GGIR reads it (its
+  # start, its gaps, its QClog), each block's gap filling from the block
+  # before (GGIR passes its PreviousLastValue and PreviousLastTime)
+  if (gaps || resample || (stamps && length(p$rmc.col.time))) {
+    what <- if (gaps) "rmc.check4timegaps" else if (resample) "rmc.doresample" else {
+      "g.getmeta()'s time column (`rmc.col.time`)"
+    }
+    g <- rmc_time_opts(p, file, skip, tz, what)
     opts[names(g)] <- g
   }
   if (gaps) opts$timegaps <- as.numeric(sf)
+  if (gaps && stamps) opts$timegaps_carry <- 1
   list(opts = opts, sf = sf, skip = skip, header = header,
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
        })
+}
+
+# `rmc` (the rmc.* parameters) with the zone GGIR reads text time in
+# (attributes tz and tz_arg, the parameter that gave it): configtz, else
+# desiredtz (`p` holds them). GGIR's g.readaccfile() hands read.myacc.csv
+# configtz (desiredtz where it is not given), never NULL, so the deprecated
+# rmc.configtz and rmc.desiredtz never choose the zone there; one that
+# differs from what it is handed stops each of GGIR's reads
+# (rmc_zone_conflict()).
+rmc_with_zone <- function(rmc, p) {
+  attr(rmc, "tz") <- if (length(p$configtz)) p$configtz else p$desiredtz %||% ""
+  attr(rmc, "tz_arg") <- if (length(p$configtz)) "configtz" else "desiredtz"
+  rmc
+}
+
+# The rmc.* zone parameter on which GGIR 3.3-9's read.myacc.csv() stops
+# when g.readaccfile() calls it, with the reason, or NULL: rmc.desiredtz
+# other than a desiredtz that is not "", rmc.configtz other than configtz
+# (desiredtz where it is not given).
+rmc_zone_conflict <- function(rmc, p) {
+  desired <- p$desiredtz %||% ""
+  config <- if (length(p$configtz)) p$configtz else desired
+  if (!is.null(rmc$rmc.desiredtz) && nzchar(desired) && !identical(rmc$rmc.desiredtz, desired)) {
+    return(list(nm = "rmc.desiredtz", other = "desiredtz", value = desired))
+  }
+  if (!is.null(rmc$rmc.configtz) && !identical(rmc$rmc.configtz, config)) {
+    return(list(nm = "rmc.configtz", other = if (length(p$configtz)) "configtz" else "desiredtz",
+                value = config))
+  }
+  NULL
 }
 
 # rmc.check4timegaps and rmc.doresample (`what`): what the decoder needs to
@@ -152,8 +194,9 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   lines <- lines[seq_along(lines) > skip]
   stamps <- vapply(lines, function(l) rmc_fields(l)[p$rmc.col.time], "", USE.NAMES = FALSE)
   refuse <- function(why) {
-    abort("`", what, "` = TRUE with `rmc.unit.time` = \"", unit, "\" is not supported by ",
-          "gravcal (", why, "); GGIR::g.calibrate() reads such files.")
+    lead <- if (grepl("^rmc[.]", what)) paste0("`", what, "` = TRUE") else what
+    abort(lead, " with `rmc.unit.time` = \"", unit, "\" is not supported by ",
+          "gravcal (", why, "); GGIR reads such files.")
   }
   if (unit == "ActivPAL") {
     t <- suppressWarnings(as.numeric(stamps)) * 86400 - 25569 * 86400
@@ -197,7 +240,8 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   }
   t0 <- t[!is.na(t)][1]
   if (is.na(t0)) refuse("the time column's first values cannot be read")
-  at <- t0 + (0:25) * 30.44 * 86400
+  # (whole seconds: the text below has none of the first stamp's fraction)
+  at <- floor(t0) + (0:25) * 30.44 * 86400
   txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
   off <- at - as.numeric(as.POSIXct(txt, tz = zone))
   if (!anyNA(off) && all(off == off[1])) {

@@ -108,7 +108,8 @@ recording_formats <- list(
   # rmc.* parameters (rmc.firstrow.acc; R/adhoc-csv.R), which give its
   # layout to the csv decoder (and to `source`, as `layout`)
   adhoc_csv = list(
-    ggir_monitor = "ad_hoc",
+    ggir_getmeta = TRUE,
+    ggir_monitor = "ad_hoc", ggir_timegaps = TRUE,
     ext = c(csv = NA, csv.gz = NA), detect = function(file) FALSE,
     label = "an ad hoc csv file (GGIR's rmc.* parameters)", unit = "line",
     block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,

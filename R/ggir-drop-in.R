@@ -96,7 +96,7 @@
 #' | `rmc.dec` | honoured (`","` with `;` or tab separated fields) |
 #' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
 #' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time, except with `rmc.doresample` and `rmc.check4timegaps`); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
-#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration (`rmc.configtz`, `rmc.desiredtz`: the zone of text time for `rmc.check4timegaps` when `configtz` and `desiredtz` are not given) |
+#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration (text time is read in `configtz`, else `desiredtz`, as GGIR's g.readaccfile() hands them to read.myacc.csv, whatever `rmc.configtz` and `rmc.desiredtz` say) |
 #' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds and for text time (`"character"`, `"POSIX"`, read by `rmc.format.time` as for `rmc.check4timegaps`): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; ActivPAL days, and the text time `rmc.check4timegaps` refuses, refused with an error |
 #' | `rmc.check4timegaps = TRUE` with a time column | honoured: in each block of lines, samples with x = y = z = 0 dropped (the block's first becomes 0, 0, 1, its last takes the values before it) and every step of at least 0.25 s (or 2 / sf) filled by repeating the sample before it (normalised when its norm exceeds 1.005), as GGIR's `g.imputeTimegaps()` does, before `rmc.doresample`; a gap between two blocks stays, as in GGIR. For UNIX seconds or milliseconds, ActivPAL days, and text time read by `rmc.format.time` with `%Y %y %m %d %H %M %S %OS %T` in the zone `configtz`, else `desiredtz` (across changes of its UTC offset too, as for `.cwa`). Refused with an error: other directives, ActivPAL days in a zone with daylight saving, a block of GGIR's reading whose first stamp exists twice or not at all in the zone, ISO 8601 text time as `"POSIX"` with fractions of a second (GGIR reads it through `fread()`, which drops them; `"character"` keeps them), whole-second text stamps that repeat, `reader = "reference"` |
 #'
@@ -160,15 +160,8 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     pr[grepl("^rmc[.]", names(pr))]
   }
   # the zone GGIR reads text time in (rmc.check4timegaps): configtz, else
-  # the deprecated rmc.configtz, else desiredtz ("" gives way to
-  # rmc.desiredtz), as read.myacc.csv settles them
-  if (!is.null(rmc)) {
-    desired <- if (nzchar(pr$desiredtz %||% "")) pr$desiredtz else pr$rmc.desiredtz %||% ""
-    attr(rmc, "tz") <- if (length(pr$configtz)) pr$configtz else pr$rmc.configtz %||% desired
-    attr(rmc, "tz_arg") <- if (length(pr$configtz)) "configtz" else if (!is.null(pr$rmc.configtz)) {
-      "rmc.configtz"
-    } else if (nzchar(pr$desiredtz %||% "") || is.null(pr$rmc.desiredtz)) "desiredtz" else "rmc.desiredtz"
-  }
+  # desiredtz, as g.readaccfile() hands them to read.myacc.csv
+  if (!is.null(rmc)) rmc <- rmc_with_zone(rmc, pr)
   if (length(inspectfileobject) && is.character(datafile)) {
     ggir_check_inspect(inspectfileobject, datafile, adhoc = !is.null(rmc))
   }

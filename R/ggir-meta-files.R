@@ -224,7 +224,9 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
                                           "meta file exists (overwrite = FALSE)", meta)
       next
     }
-    fmt <- tryCatch(file_format(fnamesfull[i]), error = function(e) NA_character_)
+    fmt <- if (!is.null(mp$.rmc)) "adhoc_csv" else {
+      tryCatch(file_format(fnamesfull[i]), error = function(e) NA_character_)
+    }
     if (is.na(fmt) || !fmt %in% meta_formats()) {
       what <- if (is.na(fmt)) "a format gravcal does not know" else format_entry(fmt)$label
       out[[length(out) + 1]] <- part1_row(fnames[i], "not read", what, meta)

@@ -35,7 +35,25 @@
 #' the file's header, whatever `dynrange` says; `configtz` changes nothing,
 #' as in GGIR; `QClog` GGIRread's log of the packets; a file GGIRread's
 #' reader fails on, with a packet cut inside its header, a negative sample
-#' count or a header that declares no packet, refused naming why). Metrics:
+#' count or a header that declares no packet, refused naming why), ad hoc
+#' csv files (`rmc.firstrow.acc` and the other `rmc.*` parameters, as for
+#' [g.calibrate()]; the time column read stamp by stamp as GGIR reads it,
+#' UNIX seconds or milliseconds, or text by `rmc.format.time` in `configtz`,
+#' else `desiredtz`; GGIR's AD_HOC non-wear, sd below `1.2 * rmc.noise`, and
+#' clipping beyond `rmc.dynamic_range`, none without it; time gaps filled by
+#' `imputeTimegaps` and `rmc.check4timegaps`, each block from the block
+#' before, GGIR's times slipping by two rows after a single sample between
+#' two gaps as they do in GGIR; `rmc.doresample`). Refused with an error
+#' naming it: no `rmc.col.time` (GGIR's g.getmeta() stops without time
+#' stamps), `rmc.noise` empty (GGIR stops), `rmc.col.wear`, `rmc.unit.time`
+#' "ActivPAL", `rmc.check4timegaps` with `rmc.doresample` and `imputeTimegaps`
+#' (GGIR fills each block from the resampled block before), `rmc.dynamic_range`
+#' naming a header row without `dynrange`, a deprecated `rmc.configtz` or
+#' `rmc.desiredtz` other than the zone GGIR hands its reader (GGIR's reads
+#' stop on it; text time is read in `configtz`, else `desiredtz`), and what
+#' [g.calibrate()] refuses of text time (in a zone whose offset changes, a
+#' block of GGIR's starting at a time that exists twice or not at all there).
+#' Metrics:
 #' every `do.*` of
 #' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
@@ -68,7 +86,8 @@
 #' @param myfun GGIR's external function object (see "What this version
 #'   covers"), or empty.
 #' @param inspectfileobject Optional: GGIR's `g.inspectfile()` result; its
-#'   `sf` must agree with the file.
+#'   `sf` must agree with the file (for an ad hoc csv file, with the rate the
+#'   `rmc.*` parameters give).
 #' @param verbose Print the blocks read, as GGIR does.
 #' @param ... GGIR's legacy arguments: any parameter of the lists by name.
 #' @return GGIR's list `M`: `filecorrupt`, `filetooshort`,
@@ -97,10 +116,16 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
       abort("`inspectfileobject` must be a list (GGIR's g.inspectfile() result), not ",
             describe(inspectfileobject), ".")
     }
-    ggir_check_inspect(inspectfileobject, datafile, adhoc = FALSE)
+    ggir_check_inspect(inspectfileobject, datafile, adhoc = !is.null(p$.rmc))
     sf <- inspectfileobject$sf
   }
   src <- meta_source(datafile, p, sf, "datafile", read_opts)
+  if (!is.null(p$.rmc) && !is.null(sf) && !isTRUE(all.equal(sf, src$sf, tolerance = 0))) {
+    gc_decoder_close(src$native$ptr)
+    abort("`inspectfileobject$sf` = ", format(sf), " but the rmc.* parameters give \"",
+          basename(datafile), "\" ", format(src$sf), " Hz; give GGIR::g.inspectfile()'s ",
+          "result for this file with the same parameters.")
+  }
   if (!src$format %in% meta_formats() || is.null(src$native)) {
     abort("gravcal's g.getmeta() does not read ", format_entry(src$format)$label %||% src$format,
           " yet (it reads ", paste(vapply(meta_formats(), function(f) format_entry(f)$label, ""),
@@ -115,7 +140,12 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "gives no result to reproduce there, so gravcal's refuses the file (calibrate() ",
           "reads the rest of it).")
   }
-  meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  # text time in a zone whose offset changes: a block of GGIR's that starts
+  # at a time that exists twice or not at all there is refused, as by
+  # g.calibrate()
+  if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
+  M
 }
 
 # The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).
@@ -177,12 +207,9 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
     for (nm in names(v)) p[nm] <- list(v[[nm]])
   }
   for (nm in names(dots)) p[nm] <- list(dots[[nm]])
-  # GGIR's ad hoc csv reading (rmc.*): not read by g.getmeta() yet
-  rmc <- grep("^rmc[.]", names(p), value = TRUE)
-  if (length(rmc) && !is.null(p$rmc.firstrow.acc)) {
-    abort("`rmc.firstrow.acc`: gravcal's g.getmeta() does not read ad hoc csv files yet; ",
-          "use GGIR::g.getmeta() for them.")
-  }
+  # GGIR's ad hoc csv files (rmc.*): the parameters checked, those not
+  # honoured refused (meta_rmc())
+  p$.rmc <- meta_rmc(p)
   # legacy arguments that are no parameter GGIR knows: said, as GGIR's
   # extract_params() would leave them
   known <- c(unlist(lapply(d, names)), ggir_param_known(), "sf")
@@ -235,6 +262,61 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
   p
 }
 
+# The rmc.* parameters of `p` (with rmc.firstrow.acc: an ad hoc csv file)
+# for the reader (rmc_values(), the zone of text time: rmc_with_zone()), or
+# NULL. What g.getmeta() does not reproduce is an error naming it; so is
+# what GGIR's g.getmeta() stops on.
+meta_rmc <- function(p) {
+  if (is.null(p$rmc.firstrow.acc)) return(NULL)
+  given <- p[grep("^rmc[.]", names(p))]
+  # GGIR's default rmc.noise (load_params()) where no list names it
+  if (!"rmc.noise" %in% names(given)) given$rmc.noise <- ggir_constants$rmc_noise
+  rmc <- rmc_with_zone(rmc_values(given, "params_rawdata"), p)
+  refuse <- function(nm, why) {
+    abort("`", nm, "` = ", paste(deparse(rmc[[nm]]), collapse = ""), ": ", why, ".")
+  }
+  bad <- rmc_zone_conflict(rmc, p)
+  if (!is.null(bad)) {
+    refuse(bad$nm, paste0("GGIR's reads of the file stop on it with `", bad$other, "` = \"",
+                          bad$value, "\" (read.myacc.csv(): give only `", bad$other,
+                          "`), so GGIR's g.getmeta() finds the file empty"))
+  }
+  if (!length(rmc$rmc.col.time)) {
+    abort("`rmc.col.time` is not given: GGIR's g.getmeta() stops on an ad hoc csv file ",
+          "without a time column (\"Timestamps not found\"), and so does gravcal's; name ",
+          "the file's time column with `rmc.col.time`.")
+  }
+  if (!length(rmc$rmc.noise)) {
+    abort("`rmc.noise` is not given: GGIR's g.getmeta() stops on an ad hoc csv file ",
+          "without it (its non-wear sd criterion is 1.2 * rmc.noise), and so does gravcal's.")
+  }
+  if (length(rmc$rmc.col.wear)) {
+    refuse("rmc.col.wear", paste0("GGIR's non-wear from a wear column is not reproduced by ",
+                                  "gravcal's g.getmeta(); use GGIR::g.getmeta()"))
+  }
+  if (identical(rmc$rmc.unit.time, "ActivPAL")) {
+    refuse("rmc.unit.time", paste0("ActivPAL time (days, moved into desiredtz by ",
+                                   "lubridate::force_tz()) is not read by gravcal's ",
+                                   "g.getmeta(); use GGIR::g.getmeta()"))
+  }
+  # (with imputeTimegaps = FALSE GGIR carries read.myacc.csv's own last
+  # sample, before the resampling, as the decoder does)
+  if (isTRUE(rmc$rmc.check4timegaps) && isTRUE(rmc$rmc.doresample) && isTRUE(p$imputeTimegaps)) {
+    refuse("rmc.doresample", paste0("with `rmc.check4timegaps` = TRUE and `imputeTimegaps` = ",
+                                    "TRUE, GGIR fills each block's gaps from the resampled ",
+                                    "block before it, which gravcal's g.getmeta() does not ",
+                                    "reproduce; use one of the two, or imputeTimegaps = FALSE"))
+  }
+  # GGIR's clipping threshold without dynrange is rmc.dynamic_range as it
+  # is: a header row's name would be compared as text
+  if (!length(p$dynrange) && is.character(rmc$rmc.dynamic_range)) {
+    refuse("rmc.dynamic_range", paste0("without `dynrange`, GGIR's g.getmeta() takes it for ",
+                                       "its clipping threshold and compares the samples with ",
+                                       "the text; give `dynrange`, or the range as a number"))
+  }
+  rmc
+}
+
 # do.<name> of a metric of g.applymetrics()'s result (GGIR's rule: lower
 # case, "angle_" as "angle").
 meta_do_name <- function(name) sub("angle_", "angle", paste0("do.", tolower(name)), fixed = TRUE)
@@ -280,7 +362,15 @@ meta_nonwear <- function(src, p) {
   # a Parmay Matrix's range from its header, whatever dynrange says
   if (identical(mon, "parmay_mtx")) dynrange <- src$info$range_g
   clipthres <- if (length(dynrange)) dynrange - 0.5 else if (identical(mon, "movisens")) 15.5 else 7.5
-  list(clipthres = clipthres, sdcriter = 0.013,
+  sdcriter <- 0.013
+  if (identical(mon, "ad_hoc")) {
+    # GGIR's AD_HOC monitor: clipping beyond rmc.dynamic_range itself (none
+    # without it: GGIR compares with NULL), sd below 1.2 * rmc.noise
+    rmc <- p$.rmc
+    if (!length(dynrange)) clipthres <- if (length(rmc$rmc.dynamic_range)) rmc$rmc.dynamic_range else Inf
+    sdcriter <- rmc$rmc.noise * 1.2
+  }
+  list(clipthres = as.numeric(clipthres), sdcriter = sdcriter,
        racriter = p$nonwear_range_threshold / 1000,
        approach = p$nonwear_approach)
 }

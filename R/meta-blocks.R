@@ -16,7 +16,7 @@
 meta_source <- function(datafile, p, sf, arg, read_opts) {
   open <- function(ro) {
     open_source(datafile, sf = sf, chunksize = p$chunksize, reader = "native", compat = TRUE,
-                read_opts = ro, arg = arg, part = "getmeta")
+                read_opts = ro, arg = arg, part = "getmeta", rmc = p$.rmc)
   }
   src <- open(read_opts)
   fe <- format_entry(src$format)

@@ -38,7 +38,7 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   shown <- NULL  # the format fits and tables name, where it is read as another
   if (!is.null(rmc$rmc.firstrow.acc)) {
     format <- "adhoc_csv"
-    layout <- rmc_layout(rmc, datafile, ggir = compat)
+    layout <- rmc_layout(rmc, datafile, ggir = compat, stamps = identical(part, "getmeta"))
     sf <- layout$sf
   } else {
     format <- file_format(datafile, arg)

@@ -84,17 +84,27 @@ DecoderPtr adhoc_resampled(std::unique_ptr<Inner> d, const gravcal::Options& opt
                                                         r.fused));
 }
 
+// With timegaps_carry = 1 (g.getmeta()'s reading), each block's filling
+// starts from the previous block's last sample and time, as read.myacc.csv's
+// does when g.readaccfile() hands it GGIR's PreviousLastValue and
+// PreviousLastTime; its counters are named "rmc_..." (g.getmeta()'s own
+// filling, over it, counts GGIR's QClog).
 inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
                                  const std::string& name) {
   std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
   const double gaps = opts.num("timegaps", 0);
   if (!(gaps > 0)) return adhoc_resampled(std::move(d), opts);
+  gravcal::GgirTimegapsMode m;
+  if (opts.num("timegaps_carry", 0) != 0) {
+    m.carry = true;
+    m.counter_prefix = "rmc_";
+  }
   if (r_long_double()) {
     using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, long double>;
-    return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps)), opts);
+    return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps, m)), opts);
   }
   using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, double>;
-  return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps)), opts);
+  return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps, m)), opts);
 }
 
 // .gt3x: the decoder reads the zip's entries itself, zlib inflating

@@ -9,7 +9,8 @@
 // samples those given, no zero sample (x = y = z = 0) given, and within a
 // block no step of k = max(0.25, 2 / sf) s or more left unfilled after a
 // sample whose copies would fit (steps backwards and beyond the fill limit
-// excepted). When the last byte's high bit is set (and no resampling),
+// excepted, and the step right after a step backwards: GGIR's times slip
+// after a single sample between two gaps, two of them put back in). When the last byte's high bit is set (and no resampling),
 // g.getmeta()'s mode instead: the previous block carried, a 1-minute limit
 // beyond which gaps are imputed as whole epochs (checked: each reported at
 // a sample given, with more than one epoch left), times of day read in a
@@ -87,6 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const double k = std::fmax(0.25, 2 / sf);
   std::int64_t given = 0;
   double last = std::nan("");
+  bool back = false;  // the step before went backwards
   for (int calls = 0; calls < 50000 && !dec->done() && given < 200000; ++calls) {
     gravcal::SampleBuffer b;
     b.x = x.data(); b.y = y.data(); b.z = z.data(); b.t = t.data(); b.time = tm.data();
@@ -100,13 +102,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const double step = tm[i] - last;
       // a filled gap leaves steps of 1 / sf; one of k or more only where its
       // fill would pass the limit (1e8 samples) or the times are not finite
-      if (!resample && !epochs && std::isfinite(step) && step >= k && step * sf <= 1e7 &&
+      if (!resample && !epochs && !back && std::isfinite(step) && step >= k && step * sf <= 1e7 &&
           std::fabs(last) < 1e12 && std::fabs(tm[i]) < 1e12) {
         __builtin_trap();
       }
+      back = step < 0;
       last = tm[i];
     }
-    if (u > 0) last = std::nan("");  // a block ended: its gap to the next stays
+    if (u > 0) {
+      last = std::nan("");  // a block ended: its gap to the next stays
+      back = false;
+    }
     given += static_cast<std::int64_t>(b.n);
     for (const auto& g : dec->take_epoch_gaps()) {
       // reported when queued, so at most one block of runs ahead of `given`

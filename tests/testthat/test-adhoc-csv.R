@@ -366,10 +366,13 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
 # each gap filled by repeating the sample before it (normalised when its
 # norm exceeds 1.005), and g.calibrate passes no previous block: a gap
 # between two blocks stays.
-gap_lines <- function(n = 3700, sf = 10, text = FALSE) {
+gap_lines <- function(n = 3700, sf = 10, text = FALSE, single = FALSE) {
   set.seed(7)
   t <- (seq_len(n) - 1) / sf
   t[1001:n] <- t[1001:n] + 0.35  # three samples missing
+  # `single`: three more after the next, which is then alone between two
+  # gaps (GGIR's times slip by two rows there: decode_ggir_timegaps.hpp)
+  if (single) t[1002:n] <- t[1002:n] + 0.35
   t[2001:n] <- t[2001:n] + 250   # a long gap
   t[3001:n] <- t[3001:n] + 0.5
   xyz <- function(m) round(stats::rnorm(n, m, 0.6), 4)
@@ -400,9 +403,12 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
                  list(text = FALSE, B = 185, rs = TRUE, type = 1),
                  list(text = FALSE, B = 370, rs = TRUE, type = 2),
                  list(text = TRUE, B = 185, rs = FALSE, type = 1),
-                 list(text = TRUE, B = 3700, rs = FALSE, type = 1))
+                 list(text = TRUE, B = 3700, rs = FALSE, type = 1),
+                 list(text = FALSE, B = 185, rs = FALSE, type = 1, single = TRUE),
+                 list(text = FALSE, B = 370, rs = TRUE, type = 1, single = TRUE))
   for (cb in combos) {
-    utils::write.table(gap_lines(n, text = cb$text), f, sep = ",", quote = FALSE, row.names = FALSE)
+    utils::write.table(gap_lines(n, text = cb$text, single = isTRUE(cb$single)), f, sep = ",",
+                       quote = FALSE, row.names = FALSE)
     pr <- c(pr0, list(rmc.doresample = cb$rs),
             if (cb$text) list(rmc.unit.time = "character", rmc.format.time = "%d/%m/%Y %H:%M:%OS")
             else list(rmc.unit.time = "UNIXsec"))
@@ -414,7 +420,7 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
                                                  interpolationType = cb$type, desiredtz = "UTC"),
                                             pr[names(pr) != "rmc.sf"], list(rmc.sf = 10)))$data
       g <- gravcal:::native_block(h, max_units = cb$B, time = TRUE, capacity = 10000)
-      lab <- paste(cb$text, cb$B, cb$rs, cb$type, "block", i)
+      lab <- paste(cb$text, cb$B, cb$rs, cb$type, isTRUE(cb$single), "block", i)
       expect_equal(g$to, nrow(G), label = lab)
       for (v in c("x", "y", "z", "temperature")) {
         expect_identical(g$cols[[v]][seq_len(g$to)], G[[v]], label = paste(lab, v))

@@ -230,7 +230,7 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
-  expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.firstrow.acc")
+  expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.col.time")
   expect_warning(gravcal::g.getmeta(f, do.enmoo = TRUE, verbose = FALSE), "`do.enmoo`")
 })
 
@@ -632,4 +632,208 @@ test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, s
   # and the file itself is GGIR's
   writeBin(b, g)
   expect_same_meta(list(ggir = ggir(), gravcal = meta_quiet(grav())))
+
+# An ad hoc csv recording (GGIR's rmc.* files) for g.getmeta(): `hours` of
+# simulated samples with 72 minutes flat on a table (GGIR's non-wear) and 41
+# samples at 7.9 g (clipped beyond rmc.dynamic_range = 6), written by
+# write_adhoc_csv() after two free header lines at `true_sf` Hz, lines
+# `drop` left out (time gaps) and samples `zeros` set to 0, 0, 0. Returns
+# the file and its rmc.* list with chunksize 0.1 (at 10 Hz, GGIR's blocks
+# of g.getmeta() are 87000 lines: a recording of 4 hours is two of them).
+meta_adhoc <- function(..., hours = 4, true_sf = 10, seed = 31, drop = integer(),
+                       zeros = integer()) {
+  rec <- simulate_recording(hours = hours, sf = 10, seed = seed,
+                            tempoffset = c(0.001, -0.002, 0.0005))
+  n <- nrow(rec)
+  i <- round(0.3 * n):round(0.6 * n)
+  rec$x[i] <- 0.02 + 0.001 * sin(i)
+  rec$y[i] <- -0.01 + 0.001 * cos(i)
+  rec$z[i] <- 0.99 + 0.001 * sin(i / 3)
+  rec$x[round(0.8 * n) + 0:40] <- 7.9
+  rec[zeros, c("x", "y", "z")] <- 0
+  f <- tempfile(fileext = ".csv")
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = true_sf, header = c("device,sim", "serial,S1"),
+                                  drop = drop, ...)
+  list(file = f, pr = c(pr, list(chunksize = 0.1)))
+}
+
+test_that("g.getmeta() is GGIR's on ad hoc csv files: units, time columns, header, zones", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  # mg after free header lines, UNIX seconds, temperature: calibrated with
+  # a temperature term; GGIR's default rmc.noise (13: non-wear by the range
+  # alone), no clipping threshold (no rmc.dynamic_range: GGIR's clipping
+  # score is 0)
+  a <- meta_adhoc(unit = "mg", time = "UNIXsec")
+  b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
+  expect_same_meta(b)
+  M <- b$gravcal
+  expect_identical(nrow(M$QClog), 2L)
+  expect_true(any(M$metalong$nonwearscore > 0))
+  expect_true(all(M$metalong$clippingscore == 0))
+  expect_true("temperaturemean" %in% names(M$metalong))
+  expect_identical(M$metashort$timestamp[1], "2024-01-01T00:00:00+0000")
+  # GGIR's g.inspectfile() result taken (GGIR's own call needs it)
+  I <- meta_quiet(GGIR::g.inspectfile(a$file, params_rawdata = utils::modifyList(
+    GGIR::load_params()$params_rawdata, a$pr)))
+  G2 <- meta_quiet(do.call(gravcal::g.getmeta, c(list(a$file, inspectfileobject = I,
+                                                      verbose = FALSE, params_rawdata = a$pr),
+                                                 cal_args)))
+  expect_identical(G2$metashort, M$metashort)
+  expect_identical(G2$metalong, M$metalong)
+  # g, text time in %d/%m/%Y %H:%M:%OS (its first line, a text stamp, lost
+  # as GGIR loses it: GGIR starts at the next long epoch) read in
+  # Europe/Amsterdam, no temperature; rmc.noise and rmc.dynamic_range:
+  # GGIR's sd criterion and clipping threshold
+  a <- meta_adhoc(time = "character", temperature = FALSE, colnames = FALSE)
+  pr <- c(a$pr, list(rmc.noise = 0.01, rmc.dynamic_range = 6))
+  b <- meta_both(a$file, list(params_rawdata = pr,
+                              params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  M <- b$gravcal
+  expect_identical(M$metashort$timestamp[1], "2024-01-01T00:15:00+0100")
+  expect_true(any(M$metalong$clippingscore > 0))
+  expect_true(any(M$metalong$nonwearscore > 0))
+  expect_false("temperaturemean" %in% names(M$metalong))
+  # bits (unsigned, 12 over +-8 g), UNIX milliseconds, the rate from the
+  # header (rmc.firstrow.header, rmc.headername.sf), in Asia/Kolkata;
+  # dynrange (clipping beyond 7 - 0.5 g, whatever rmc.dynamic_range)
+  a <- meta_adhoc(unit = "bit", time = "UNIXmsec", sf_header = TRUE)
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(dynrange = 7)),
+                              params_general = list(desiredtz = "Asia/Kolkata"),
+                              params_metrics = list(do.anglex = TRUE, do.mad = TRUE)))
+  expect_same_meta(b)
+  expect_match(b$gravcal$metashort$timestamp[1], "[+]0530$")
+  expect_true(any(b$gravcal$metalong$clippingscore > 0))
+  # "POSIX" text that fread() reads as text (not ISO 8601): GGIR reads it
+  # as "character"; in desiredtz, not in the deprecated rmc.desiredtz
+  # (g.readaccfile() hands read.myacc.csv its zone)
+  a <- meta_adhoc(time = "character", unit = "mg")
+  pr <- c(a$pr[names(a$pr) != "rmc.unit.time"],
+          list(rmc.unit.time = "POSIX", rmc.desiredtz = "Asia/Kolkata"))
+  b <- meta_both(a$file, list(params_rawdata = pr))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-01-01T00:15:00+0000")
+  # UNIX seconds since rmc.origin (1994 + 2000-01-01: 2024), in New York
+  a <- meta_adhoc(time = "UNIXsec", start = "1994-01-01 00:00:00")
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.origin = "2000-01-01")),
+                              params_general = list(desiredtz = "America/New_York")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2023-12-31T19:00:00-0500")
+})
+
+test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and resampling", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  skip_if_not_installed("GGIRread")
+  # lines missing (0.3 s and 9.7 s around a single line, a minute, 5 s
+  # between GGIR's first block and its second (its line 87000 is sample
+  # 87701: 701 lines missing before), 0.4 s): g.getmeta()'s imputeTimegaps
+  # fills them, the one between blocks from the first block's last sample
+  # (its QClog counts them; after the single line GGIR's times slip by two
+  # rows, decode_ggir_timegaps.hpp), and without it GGIR's blocks keep them
+  # out
+  drop <- c(5000:5002, 5004:5100, 40000:40600, 87702:87751, 100000:100003)
+  a <- meta_adhoc(time = "UNIXsec", drop = drop)
+  b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(3L, 2L))
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(imputeTimegaps = FALSE))))
+  expect_same_meta(b)
+  expect_null(b$gravcal$QClog)
+  # rmc.check4timegaps (read.myacc.csv fills them first, each block from
+  # the block before), text time, idle-sleep zeros
+  # (g.getmeta()'s own filling then finds one gap: GGIR's slipped times)
+  a <- meta_adhoc(time = "character", drop = drop[drop < 1e5], zeros = 20000:20050)
+  b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(rmc.check4timegaps = TRUE))))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
+  # text time across the autumn change in Europe/Amsterdam (the clock's
+  # hour 02 read as as.POSIXct() reads it, in order); a block of GGIR's
+  # starting within that hour refused, as by g.calibrate()
+  a <- meta_adhoc(time = "character", start = "2024-10-26 23:00:00")
+  b <- meta_both(a$file, list(params_rawdata = a$pr,
+                              params_general = list(desiredtz = "Europe/Amsterdam")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-10-26T23:15:00+0200")
+  a <- meta_adhoc(time = "character", start = "2024-10-27 00:30:00", hours = 2.6)
+  expect_error(meta_quiet(gravcal::g.getmeta(a$file, params_rawdata = a$pr,
+                                             desiredtz = "Europe/Amsterdam", verbose = FALSE)),
+               "`desiredtz` = \"Europe/Amsterdam\": a block of GGIR's reading")
+  # rmc.doresample: a 10.3 Hz clock taken for 10 Hz, each block resampled
+  a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, unit = "mg")
+  pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE))
+  b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(windowsizes = c(5, 600, 3600))))
+  expect_same_meta(b)
+  expect_lt(nrow(b$gravcal$metashort), 4 * 720)
+  # and rmc.check4timegaps before it (imputeTimegaps = FALSE: GGIR carries
+  # read.myacc.csv's last sample before the resampling to the next block)
+  a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, drop = drop, zeros = 20000:20050)
+  pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE,
+                                     rmc.check4timegaps = TRUE, imputeTimegaps = FALSE))
+  expect_same_meta(meta_both(a$file, list(params_rawdata = pr)))
+  # 100 minutes missing, over GGIR's 90-minute limit: filled to the next
+  # long epoch, the rest imputed as whole epochs (GGIR on R 4.3 or later;
+  # its reference on R 4.2 with R 4.3's as.POSIXlt(), as above)
+  # The gap's time of day is read in the session's zone: in Asia/Kathmandu
+  # (+05:45), with long epochs of 20 minutes, 145 minutes missing end
+  # elsewhere in their epoch than in UTC (the decoder's zone table from the
+  # first time stamp)
+  long_gap <- function(hours, drop, ws, session_tz) {
+    old <- Sys.getenv("TZ", unset = NA)
+    Sys.setenv(TZ = session_tz)
+    on.exit(if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old))
+    a <- meta_adhoc(time = "UNIXsec", hours = hours, drop = drop)
+    pr <- utils::modifyList(GGIR::load_params()$params_rawdata, a$pr)
+    R <- ggir_cached("g.getmeta", a$file, list(params_rawdata = pr, windowsizes = ws,
+                                                posixlt = "R 4.3", session_tz = session_tz), {
+      I <- meta_quiet(GGIR::g.inspectfile(a$file, params_rawdata = pr))
+      with_r43_posixlt(meta_quiet(GGIR::g.getmeta(a$file, params_rawdata = pr,
+                                                  inspectfileobject = I, verbose = FALSE,
+                                                  windowsizes = ws)))
+    })
+    G <- meta_quiet(gravcal::g.getmeta(a$file, params_rawdata = pr, verbose = FALSE,
+                                       windowsizes = ws))
+    expect_same_meta(list(ggir = R, gravcal = G))
+    expect_gt(sum(G$metalong$nonwearscore == 3), 4)
+    expect_true(any(G$QClog$timegaps_min > 90))
+  }
+  long_gap(5, 30000:90000, c(5, 900, 3600), "UTC")
+  long_gap(8, 30000:116999, c(5, 1200, 3600), "Asia/Kathmandu")
+})
+
+test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an error naming it", {
+  a <- meta_adhoc(hours = 0.2, time = "character")
+  gm <- function(..., I = c()) {
+    gravcal::g.getmeta(a$file, params_rawdata = utils::modifyList(a$pr, list(...)),
+                       inspectfileobject = I, verbose = FALSE)
+  }
+  # GGIR's g.getmeta() stops without time stamps ("Timestamps not found")
+  expect_error(gm(rmc.col.time = NULL, rmc.col.acc = 2:4), "`rmc.col.time` is not given")
+  expect_error(gm(rmc.col.wear = 5), "rmc.col.wear")
+  # GGIR's reads stop on a zone of the deprecated rmc.* parameters other
+  # than the one g.readaccfile() hands read.myacc.csv
+  expect_error(gm(rmc.configtz = "Asia/Kolkata"), "`rmc.configtz` = \"Asia/Kolkata\"")
+  expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.desiredtz = "UTC")),
+                                  params_general = list(desiredtz = "Europe/Amsterdam"),
+                                  verbose = FALSE), "rmc.desiredtz")
+  expect_error(gm(rmc.unit.time = "ActivPAL"), "rmc.unit.time")
+  expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample.*imputeTimegaps")
+  expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
+  expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.noise = NULL)),
+                                  verbose = FALSE), "rmc.noise")
+  expect_error(gm(rmc.col.tme = 1), "rmc.col.tme")
+  expect_error(gm(rmc.unit.acc = "G"), "rmc.unit.acc")
+  # a text time its format does not read; ISO 8601 text as "POSIX", which
+  # GGIR reads through fread() without its fractions of a second
+  expect_error(gm(rmc.format.time = "%Y-%m-%d %H:%M:%OS"), "rmc.format.time")
+  iso <- meta_adhoc(hours = 0.2, time = "POSIX")
+  expect_error(gravcal::g.getmeta(iso$file, params_rawdata = iso$pr, verbose = FALSE),
+               "rmc.col.time.*POSIX")
+  # an inspectfileobject of another rate, or of a file read otherwise
+  expect_error(gm(I = list(monc = 0, dformc = 5, sf = 20)), "inspectfileobject\\$sf")
+  expect_error(gm(I = list(monc = 4, dformc = 4, sf = 10)), "inspectfileobject")
+  # a wear column GGIR would take its non-wear from
+  expect_error(gm(rmc.col.wear = 6), "rmc.col.wear")
+  unlink(c(a$file, iso$file))
 })

@@ -277,6 +277,39 @@ test_that("g.part1() is GGIR's with recordingEndSleepHour (M's tail expanded)", 
   expect_true("nonwear" %in% names(obj$M))
 })
 
+# A folder of one ad hoc csv file (GGIR's rmc.* files) of 8 hours at 10 Hz,
+# in mg with UNIX seconds and temperature, after two free header lines
+# (write_adhoc_csv()); its rmc.* list in p1_state$adhoc_rmc. Made once a
+# session.
+p1_folder_adhoc <- function() {
+  if (is.null(p1_state$adhoc) || !dir.exists(p1_state$adhoc)) {
+    d <- tempfile("part1-adhoc-")
+    dir.create(d)
+    rec <- simulate_recording(hours = 8, sf = 10, seed = 24,
+                              tempoffset = c(0.001, -0.002, 0.0005))
+    p1_state$adhoc_rmc <- gravcal:::write_adhoc_csv(rec, file.path(d, "h01.csv"), sf = 10,
+                                                    unit = "mg", time = "UNIXsec",
+                                                    header = c("device,sim", "serial,S1"))
+    p1_state$adhoc <- d
+  }
+  p1_state$adhoc
+}
+
+test_that("g.part1() on an ad hoc csv file (rmc.*): GGIR's meta file", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  p1_folder_adhoc()
+  args <- c(p1_state$adhoc_rmc, list(do.parallel = FALSE, f1 = 1, chunksize = 0.2,
+                                     desiredtz = "Europe/Amsterdam"))
+  b <- p1_both(args, folder = p1_folder_adhoc)
+  expect_identical(names(b$ggir$part1), "meta_h01.csv.RData")
+  expect_same_objects(b$gravcal$part1, b$ggir$part1, "part 1")
+  obj <- b$gravcal$part1[[1]]
+  expect_identical(obj$I$dformc, 5L)
+  expect_gt(nrow(obj$M$metashort), 8 * 700)
+  expect_identical(b$gravcal$tab$status, "written")
+})
+
 test_that("g.part1() skips done files, leaves others' formats to GGIR, refuses what it does not do", {
   skip_if_not_installed("GGIR")
   d <- tempfile("part1-small-")

@@ -18,6 +18,15 @@
 //   R's rowSums(), summed in R's accumulator: `Acc`); every column repeated,
 //   temperature included.
 //
+// * the times of the filled block as GGIR 3.3-9's imputeRaw() gives them:
+//   each sample's run of copies at t1 + j / sf, except that where two
+//   samples next to each other both start a gap (a single sample between
+//   two gaps), GGIR puts the times of the second and the first sample
+//   (x$time[(i + 1):i]) between their runs, so that every time after them
+//   belongs to the sample two rows earlier, and the block's last times are
+//   cut off (newTime[1:nrow(x)]); the samples' values are not moved. The
+//   next block's PreviousLastTime is the block's last time so given.
+//
 // GgirTimegapsOf does this while the samples stream: one call of read() with
 // max_units is one GGIR block (the call's units are returned once all its
 // samples are given, as GgirResamplerOf does, so that it can sit under the
@@ -31,6 +40,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,6 +90,10 @@ struct GgirTimegapsMode {
   bool epoch_gaps = false;
   double short_epoch = 5, long_epoch = 900;  // seconds (GGIR's windowsizes[1:2])
   std::vector<double> local;
+  // put before the names of the counters (but "timegaps_not_filled"): a
+  // filler under another (an ad hoc csv file's own, read.myacc.csv's, under
+  // g.getmeta()'s) keeps its counts apart
+  std::string counter_prefix;
 };
 
 template <class Inner, class Acc = long double>
@@ -152,6 +166,8 @@ class GgirTimegapsOf : public Decoder {
   struct Run {
     double v[kCols];
     std::int64_t n, j;  // copies to give, copies given
+    bool pair = false;  // GGIR's two extra times before this run (see push())
+    double pair_t[2] = {0, 0};
   };
 
   bool pending() const { return head_ < runs_.size(); }
@@ -165,6 +181,12 @@ class GgirTimegapsOf : public Decoder {
     runs_.clear();
     head_ = 0;
     synth_ = 0;
+    // the block before gave its last time late (GGIR's time slip): that
+    // time is its PreviousLastTime
+    if (slipped_) plt_ = last_given_;
+    slipped_ = false;
+    slip_.clear();
+    last_gap_ = false;
   }
 
   bool refill() {
@@ -251,7 +273,19 @@ class GgirTimegapsOf : public Decoder {
     have_held_ = true;
   }
 
-  void push(const Run& r) {
+  // A row of GGIR's filled block (its run of copies). GGIR's imputeRaw()
+  // builds the times of the rows after a gap row i from x$time[(i + 1):(j -
+  // 1)], j the next gap row: for j = i + 1 that is x$time[c(i + 1, i)], two
+  // times too many, put before row j's run.
+  void push(Run r) {
+    const bool gap = r.n != 1;
+    if (gap && last_gap_) {
+      r.pair = true;
+      r.pair_t[0] = r.v[4];
+      r.pair_t[1] = last_time_;
+    }
+    last_gap_ = gap;
+    last_time_ = r.v[4];
     runs_.push_back(r);
     queued_ += r.n;
   }
@@ -375,8 +409,22 @@ class GgirTimegapsOf : public Decoder {
     while (head_ < runs_.size() && !out.full()) {
       Run& r = runs_[head_];
       while (r.j < r.n && !out.full()) {
+        if (r.j == 0 && r.pair) {
+          slip_.push_back(r.pair_t[0]);
+          slip_.push_back(r.pair_t[1]);
+          slipped_ = true;
+        }
         const double j = static_cast<double>(r.j++);
-        out.put(r.v[0], r.v[1], r.v[2], r.v[3], r.v[4] + j * by_);
+        double t = r.v[4] + j * by_;
+        if (!slip_.empty()) {
+          // the block's times after a slip: each row takes the time two
+          // rows earlier per slip (the extra times queued first)
+          slip_.push_back(t);
+          t = slip_.front();
+          slip_.pop_front();
+        }
+        out.put(r.v[0], r.v[1], r.v[2], r.v[3], t);
+        last_given_ = t;
         ++given_;
       }
       if (r.j == r.n) ++head_;
@@ -388,17 +436,19 @@ class GgirTimegapsOf : public Decoder {
   }
 
   void add_own(Report& r) const {
-    if (gaps_ > 0) r.count("timegaps_imputed", gaps_);
-    if (rows_added_ > 0) r.count("timegap_samples_added", rows_added_);
-    if (zeros_dropped_ > 0) r.count("timegaps_zero_samples_dropped", zeros_dropped_);
+    const std::string& p = mode_.counter_prefix;
+    auto count = [&](const char* name, std::int64_t k) { r.count((p + name).c_str(), k); };
+    if (gaps_ > 0) count("timegaps_imputed", gaps_);
+    if (rows_added_ > 0) count("timegap_samples_added", rows_added_);
+    if (zeros_dropped_ > 0) count("timegaps_zero_samples_dropped", zeros_dropped_);
     if (gaps_not_filled_ > 0) r.count("timegaps_not_filled", gaps_not_filled_);
     if (mode_.carry) {
-      r.count("timegap_rows_read", rows_read_);
-      r.count("timegap_rows", gap_rows_);
-      r.count("timegaps_over_limit", over_limit_);
-      r.count("timegap_longest_rows", static_cast<std::int64_t>(longest_));
-      r.count("clock_time_missing", clock_missing_);
-      r.count("clock_table_exceeded", clock_exceeded_);
+      count("timegap_rows_read", rows_read_);
+      count("timegap_rows", gap_rows_);
+      count("timegaps_over_limit", over_limit_);
+      count("timegap_longest_rows", static_cast<std::int64_t>(longest_));
+      count("clock_time_missing", clock_missing_);
+      count("clock_table_exceeded", clock_exceeded_);
     }
     for (const auto& n : gap_notes_) r.note(n);
   }
@@ -427,6 +477,12 @@ class GgirTimegapsOf : public Decoder {
   std::int64_t rows_read_ = 0;
   std::size_t clock_at_ = 0, local_at_ = 0;
   std::int64_t queued_ = 0;  // rows put in runs_ so far (all calls)
+  // GGIR's time slip (push()): the times queued ahead of the rows, whether
+  // the block has one, the last row pushed (a gap row?, its time), the last
+  // time given
+  std::deque<double> slip_;
+  bool slipped_ = false, last_gap_ = false;
+  double last_time_ = 0, last_given_ = 0;
   std::vector<EpochGap> epoch_gaps_;
 };
 
