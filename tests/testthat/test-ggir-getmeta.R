@@ -632,6 +632,7 @@ test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, s
   # and the file itself is GGIR's
   writeBin(b, g)
   expect_same_meta(list(ggir = ggir(), gravcal = meta_quiet(grav())))
+})
 
 # An ad hoc csv recording (GGIR's rmc.* files) for g.getmeta(): `hours` of
 # simulated samples with 72 minutes flat on a table (GGIR's non-wear) and 41
