@@ -262,6 +262,40 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
   expect_true(b$gravcal$filetooshort)
 })
 
+test_that("g.getmeta() is GGIR's on real free-living data (agcounts' 20.7 h of an ActiGraph)", {
+  skip_if_quick()
+  skip_if_not_installed("signal")
+  # ../shared/data/agcounts: 2,239,620 samples at 30 Hz of a worn
+  # ActiGraph (bhelsel/agcounts), written as the .gt3x the device would
+  # have made (1/256 g counts), calibrated with GGIR's own coefficients for
+  # it (ggirCalibrate.RData: g.calibrate() on these samples), in blocks of
+  # 4.8 h, with the filtered metrics on real movement
+  e <- new.env()
+  for (a in c("X", "Y", "Z")) {
+    load(skip_if_no_shared("agcounts", sprintf("calibration%saxis.RData", a)), envir = e)
+  }
+  load(skip_if_no_shared("agcounts", "ggirCalibrate.RData"), envir = e)
+  f <- tempfile(fileext = ".gt3x")
+  write_recording(data.frame(x = e$X, y = e$Y, z = e$Z), f, sf = 30,
+                  start = "2024-05-06 08:00:00")
+  args <- list(offset = e$C$offset, scale = e$C$scale,
+               params_metrics = list(do.enmo = TRUE, do.anglez = TRUE, do.mad = TRUE,
+                                     do.bfen = TRUE, do.hfenplus = TRUE, do.lfenmo = TRUE),
+               params_rawdata = list(chunksize = 0.4),
+               params_general = list(desiredtz = "America/Chicago"))
+  b <- meta_both(f, args)
+  expect_same_meta(b)
+  # what the comparison saw: a day of real wear, in several blocks, with
+  # movement (ENMO above 100 mg) and rest
+  M <- b$gravcal
+  expect_gt(nrow(M$metashort), 20 * 720)
+  expect_gt(sum(M$metashort$ENMO > 0.1), 100)
+  expect_gt(sum(M$metashort$ENMO < 0.01), 1000)
+  expect_identical(names(M$metashort),
+                   c("timestamp", "BFEN", "LFENMO", "HFENplus", "anglez", "ENMO", "MAD"))
+  unlink(f)
+})
+
 test_that("g.getmeta() is GGIR's on a .gt3x recording with idle sleep (time gaps imputed)", {
   skip_if_quick()
   rec <- simulate_recording(hours = 28, sf = 30, seed = 13,
