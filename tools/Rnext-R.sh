@@ -57,7 +57,7 @@ start=$(date +%s)
 # needs and is missing, at CRAN's current versions. A pinned version found
 # nowhere: CRAN's current instead, said on a line "Rnext-R: NOT PINNED".
 # Then MASS (signal's dependency; R's recommended packages are not built
-# here) and future.
+# here), future and actilifecounts (GGIR's do.neishabouricounts).
 "$rbin/Rscript" --vanilla - "$cran" "${GRAVCAL_RNEXT_SOURCES:-$prefix.src/sources}" $pins <<'RSCRIPT'
 a <- commandArgs(TRUE); cran <- a[1]; local <- a[2]; pins <- a[-(1:2)]
 options(repos = cran, Ncpus = 2)
@@ -121,7 +121,7 @@ for (pv in pins) {
   if (!identical(have(p), as.character(package_version(v))))
     stop("Rnext-R: ", p, " ", v, " not installed")
 }
-get_missing(c("MASS", "future"))
+get_missing(c("MASS", "future", "actilifecounts"))
 RSCRIPT
 ggir=$(printf '%s\n' $pins | sed -n 's/^GGIR=//p')
 PATH="$rbin:$PATH" GRAVCAL_CRAN="$cran" GRAVCAL_GGIR_VERSION="$ggir" nice -n 10 bash "$here/install-ggir.sh" </dev/null

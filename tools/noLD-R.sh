@@ -70,5 +70,12 @@ if (!requireNamespace("MASS", quietly = TRUE)) {
 if (!requireNamespace("MASS", quietly = TRUE)) stop("noLD-R: MASS ", a[1], " not installed")
 ' "${GRAVCAL_NOLD_MASS:-7.3-58.3}" "$cran"
 PATH="$rbin:$PATH" GRAVCAL_CRAN="$cran" nice -n 10 bash "$here/install-ggir.sh" </dev/null
+# actilifecounts (GGIR's do.neishabouricounts; it needs GGIRread, above)
+"$rbin/Rscript" --vanilla -e '
+if (!requireNamespace("actilifecounts", quietly = TRUE)) {
+  install.packages("actilifecounts", repos = commandArgs(TRUE)[1], Ncpus = 2, quiet = TRUE)
+}
+if (!requireNamespace("actilifecounts", quietly = TRUE)) stop("noLD-R: actilifecounts not installed")
+' "$cran"
 echo "noLD-R: packages ready in $(( $(date +%s) - start )) s"
 echo "$rbin"
