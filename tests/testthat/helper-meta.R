@@ -36,3 +36,20 @@ write_meta_recording <- function(file, format, sf, hours, seed, start, range = 8
   }
   invisible(file)
 }
+
+# The objects of the meta files (or ms2.out files) in `folder`, by file,
+# with M's and C's bsc_qc (wall-clock times and memory) replaced by their
+# column names.
+p1_objects <- function(folder) {
+  out <- list()
+  for (f in sort(dir(folder))) {
+    e <- new.env()
+    load(file.path(folder, f), envir = e)
+    v <- mget(sort(ls(e, all.names = TRUE)), envir = e)
+    for (nm in intersect(c("M", "C"), names(v))) {
+      if (!is.null(v[[nm]]$bsc_qc)) v[[nm]]$bsc_qc <- names(v[[nm]]$bsc_qc)
+    }
+    out[[f]] <- v
+  }
+  out
+}

@@ -4,20 +4,6 @@
 # second run writes only the rest, and every meta file ends as an
 # uninterrupted run writes it.
 
-# the objects of each meta file in `basic`, but M's and C's bsc_qc (wall
-# clock and memory)
-resume_objects <- function(basic) {
-  out <- list()
-  for (f in sort(dir(basic))) {
-    e <- new.env()
-    load(file.path(basic, f), envir = e)
-    v <- mget(sort(ls(e, all.names = TRUE)), envir = e)
-    for (nm in intersect(c("M", "C"), names(v))) v[[nm]]$bsc_qc <- NULL
-    out[[f]] <- v
-  }
-  out
-}
-
 test_that("g.part1() killed mid-folder resumes: finished files kept, the rest written, same result", {
   skip_on_os("windows")
   skip_if_quick()
@@ -37,7 +23,7 @@ test_that("g.part1() killed mid-folder resumes: finished files kept, the rest wr
                      do.parallel = FALSE, verbose = FALSE)
   }
   suppressWarnings(utils::capture.output(run(ref)))
-  want <- resume_objects(file.path(ref, "meta", "basic"))
+  want <- p1_objects(file.path(ref, "meta", "basic"))
   expect_identical(names(want), sprintf("meta_r%d.cwa.RData", 1:4))
 
   # the run that is killed once its first meta file is there
@@ -74,5 +60,5 @@ test_that("g.part1() killed mid-folder resumes: finished files kept, the rest wr
   expect_identical(unname(st[sub("^meta_(.*)[.]RData$", "\\1", done)]), rep("exists", length(done)))
   expect_identical(sum(st == "written"), 4L - length(done))
   expect_identical(file.mtime(file.path(basic, done)), kept)
-  expect_identical(resume_objects(basic), want)
+  expect_identical(p1_objects(basic), want)
 })

@@ -57,23 +57,6 @@ p1_folder_of <- function(name, format, sf, seed, start) {
 p1_folder_gt3x <- function() p1_folder_of("g01.gt3x", "gt3x", 30, 23, "2024-03-06 11:00:00")
 p1_folder_parmay <- function() p1_folder_of("m01.BIN", "parmay", 25, 24, "2024-03-06 11:00:00")
 
-# The objects of the meta files (or ms2.out files) in `folder`, by file,
-# with M's and C's bsc_qc (wall-clock times and memory) replaced by their
-# column names.
-p1_objects <- function(folder) {
-  out <- list()
-  for (f in sort(dir(folder))) {
-    e <- new.env()
-    load(file.path(folder, f), envir = e)
-    v <- mget(sort(ls(e, all.names = TRUE)), envir = e)
-    for (nm in intersect(c("M", "C"), names(v))) {
-      if (!is.null(v[[nm]]$bsc_qc)) v[[nm]]$bsc_qc <- names(v[[nm]]$bsc_qc)
-    }
-    out[[f]] <- v
-  }
-  out
-}
-
 # Part 2 (GGIR::GGIR(mode = 2), with its report) on the meta files of
 # outputdir/output_<data folder>: the ms2.out objects and the report's csv
 # files as text.
