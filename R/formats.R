@@ -49,7 +49,7 @@
 # * write: for write_recording(), list(check(x, sf, start): an error where
 #   the format cannot hold the samples as given, write(x, file, sf, start):
 #   the file; `x` a data frame x, y, z (g), maybe temperature and light,
-#   `start` POSIXct).
+#   `start` POSIXct; folder = TRUE where `file` is a folder).
 recording_formats <- list(
   actigraph_csv = list(
     ggir_getmeta = TRUE,
@@ -190,6 +190,7 @@ recording_formats <- list(
     decoder = "movisens",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
+      folder = TRUE,
       check = function(x, sf, start) NULL,
       write = function(x, file, sf, start) {
         write_movisens(x, file, sf = sf, start = start, temp = !is.null(x$temperature))

@@ -93,7 +93,7 @@ write_recording <- function(x, file, sf = NULL, format = NULL, start = NULL,
     abort("`start` must be one time (POSIXct), not ", describe(start), ".")
   }
   if (!dir.exists(dirname(file))) abort("`file`: the folder \"", dirname(file), "\" does not exist.")
-  folder <- identical(format, "movisens")
+  folder <- isTRUE(fe$folder)
   taken <- if (folder) dir.exists(file) && length(dir(file, all.files = TRUE, no.. = TRUE)) else
     file.exists(file)
   if (taken && !overwrite) {
@@ -112,10 +112,14 @@ write_recording <- function(x, file, sf = NULL, format = NULL, start = NULL,
   invisible(file)
 }
 
-# The format a path's extension names, for write_recording().
+# The format a path's extension names, for write_recording(): the first
+# format in the registry with that extension whose writer writes a file
+# (.bin: GENEActiv, before Parmay Matrix; .csv: ActiGraph's export).
 write_format_of <- function(file) {
   ext <- tolower(tools::file_ext(file))
-  f <- switch(ext, cwa = "cwa", bin = "geneactiv", gt3x = "gt3x", csv = "actigraph_csv", NULL)
+  w <- names(Filter(function(e) !isTRUE(e$folder), write_formats()))
+  has <- vapply(w, function(f) ext %in% names(recording_formats[[f]]$ext), TRUE)
+  f <- if (nzchar(ext) && any(has)) w[has][1]
   if (is.null(f)) {
     abort("`format`: \"", basename(file), "\" has no extension that names a format ",
           "(.cwa, .bin, .gt3x, .csv); give `format` (one of ",
