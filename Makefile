@@ -34,7 +34,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -331,3 +331,10 @@ test-slurm: install setup-test
 ARM64_SCOPE ?= identity
 test-arm64:
 	GRAVCAL_SHARED_DATA=$(SHARED_DATA) bash tools/arm64-chroot.sh $(ARM64_SCOPE)
+
+# GGIR's parts 2 to 5 after gravcal's part 1 against GGIR's own parts 1 to 5
+# (.cwa, .bin, .gt3x; every report csv compared cell by cell): slow (GGIR's
+# whole pipeline twice per format), not part of make test; writes
+# bench/results/part2to5.md and fails when a report differs.
+test-part2to5: install setup-test
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/part2to5-check.R 74 bench/results/part2to5.md

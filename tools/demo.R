@@ -16,3 +16,14 @@ plot(fit)
 invisible(grDevices::dev.off())
 cat("\nWhere the recording rested, and each rest window's error before and after",
     "calibration, written to", out, "\n")
+
+# GGIR part 1's calibrated epoch signals of the same recording, with the fit
+ep <- epoch_signals(rec$data, fit)
+cat("\n")
+print(ep)
+out2 <- "gravcal-example-epochs.png"
+grDevices::png(out2, width = 1100, height = 500, res = 100)
+plot(ep)
+invisible(grDevices::dev.off())
+cat("\nThe calibrated epoch signals (ENMO and anglez in 5-s epochs, as GGIR part 1 gives them),",
+    "written to", out2, "\n")
