@@ -95,8 +95,8 @@
 #include <limits>
 #include <string>
 
-#include "decode.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 

@@ -64,8 +64,8 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 
