@@ -124,10 +124,11 @@ class CsvDecoder : public Decoder {
   // line through take_line(), none parsed in place; the same samples) for
   // tests and fuzzers.
   CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
-      : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
-    compat_ = ReadRules::of(opts).compat;
+      : lines_(src, buffer_bytes(opts)),
+        want_actigraph_(format == "actigraph_csv"),
+        rules_(ReadRules::of(opts)) {
     const double fr = opts.num("fread_rule", 1);
-    number_rule_ = !compat_ ? csv_text::kCorrectlyRounded
+    number_rule_ = !rules_.compat ? csv_text::kCorrectlyRounded
                    : fr == 2 ? csv_text::kFreadDivide : csv_text::kFreadMultiply;
     sf_option_ = opts.num("sf", 0);
     fast_ = opts.num("fast", 1) != 0;
@@ -398,7 +399,7 @@ class CsvDecoder : public Decoder {
     csv_text::Field f[kMaxFields];
     csv_text::split(v[0].first, v[0].second, sep_, f, kMaxFields);
     bool names = !is_number(f[0]);
-    if (!compat_ && names && is_time(f[0])) names = false;
+    if (!rules_.compat && names && is_time(f[0])) names = false;
     if (names) {
       csv_text::Line ln;
       lines_.next(ln);
@@ -406,7 +407,7 @@ class CsvDecoder : public Decoder {
     const std::size_t d = names ? 1 : 0;
     const bool stamped = d < v.size() && csv_text::split(v[d].first, v[d].second, sep_, f, kMaxFields) >= 1 &&
                          is_time(f[0]);
-    const int x = compat_ ? (nfields_ > 3 ? 1 : 0) : (stamped ? 1 : 0);
+    const int x = rules_.compat ? (nfields_ > 3 ? 1 : 0) : (stamped ? 1 : 0);
     if (x + 3 > nfields_) return fail("data lines have " + std::to_string(nfields_) + " fields, too few for a time stamp, x, y, z");
     col_x_ = x;
     col_time_ = (x == 1 && stamped) ? 0 : -1;
@@ -994,7 +995,8 @@ class CsvDecoder : public Decoder {
   csv_text::LineReader lines_;
   csv_text::DateTimeParser dt_;
   bool want_actigraph_;
-  bool compat_ = true;
+  // the reading rules (compat, interpolation, resample_fused), read once
+  const ReadRules rules_;
   int number_rule_ = csv_text::kFreadMultiply;  // a csv_text::NumberRule
   bool fast_ = true;
   double sf_option_ = 0;

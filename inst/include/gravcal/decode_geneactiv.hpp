@@ -369,8 +369,7 @@ class GeneactivDecoder : public Decoder {
   void continue_call(bool on) { continue_call_ = on; }
   GeneactivDecoder(ByteSource& src, const Options& opts)
       : lines_(src),
-        compat_(ReadRules::of(opts).compat),
-        fused_(ReadRules::of(opts).fused) {
+        rules_(ReadRules::of(opts)) {
     info_.format = "geneactiv";
     static const char* const keys[3] = {"light_lux", "light_volts", "light_model11"};
     for (int i = 0; i < 3; ++i) {
@@ -424,13 +423,13 @@ class GeneactivDecoder : public Decoder {
   double anchor_time(const geneactiv::Stamp& s) const;
 
   geneactiv::LineReader lines_;
-  bool compat_;
+  // the reading rules (compat, resample_fused), read once
+  const ReadRules rules_;
   // GGIRread's reader is C++ compiled by the R it runs in: where that
   // compiler contracted its ms + s * 1000 into one fused multiply-add
   // (aarch64; option resample_fused, R/fp-build.R), so does ms_after()
-  bool fused_;
   double ms_after(double ms, double seconds) const {
-    return fused_ ? kernels::replay_fma(seconds, 1000.0, ms) : ms + seconds * 1000;
+    return rules_.fused ? kernels::replay_fma(seconds, 1000.0, ms) : ms + seconds * 1000;
   }
   bool done_ = false;
   // calibration: value of each 12-bit count per axis
@@ -596,7 +595,7 @@ inline bool GeneactivDecoder::check_header() {
     for (int u = 0; u < geneactiv::kCountRange; ++u) {
       const int c = u >= geneactiv::kCountSigned ? u - geneactiv::kCountRange : u;
       const double g = (c * geneactiv::kCountScale - static_cast<double>(offset_[a])) / gain_[a];
-      lut_[a][u] = compat_ ? static_cast<double>(static_cast<float>(g)) : g;
+      lut_[a][u] = rules_.compat ? static_cast<double>(static_cast<float>(g)) : g;
     }
   }
   return true;
@@ -635,7 +634,7 @@ inline bool GeneactivDecoder::open() {
   next_unit_ = parse_page();
   have_next_ = true;
   if (next_unit_ == Unit::good) {
-    info_.start_time = compat_ ? anchor_time(next_->stamp) : next_->time_s;
+    info_.start_time = rules_.compat ? anchor_time(next_->stamp) : next_->time_s;
   }
   return true;
 }
@@ -667,7 +666,7 @@ inline bool GeneactivDecoder::page_field(int k, const char* p, std::size_t n) {
       return true;
     case kTemperature:
       if (!parse_number(v, end, d) || std::fabs(d) > 1000) return false;
-      next_->temperature = compat_ ? static_cast<double>(static_cast<float>(d)) : d;
+      next_->temperature = rules_.compat ? static_cast<double>(static_cast<float>(d)) : d;
       return true;
     case kFrequency:
       if (!parse_number(v, end, d) || !(d >= kMinRate) || d > kMaxRate) return false;
@@ -690,7 +689,7 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   s += whole * kDigitsPerSample;
   std::size_t count = whole;
   const std::size_t rest = n - whole * kDigitsPerSample;
-  if (rest >= (compat_ ? kDigitsXyzCompat : kDigitsPerSample)) {
+  if (rest >= (rules_.compat ? kDigitsXyzCompat : kDigitsPerSample)) {
     for (int a = 0; a < 3; ++a) {
       const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
       bad |= d0 | d1 | d2;
@@ -851,7 +850,7 @@ inline void GeneactivDecoder::check_time() {
 inline void GeneactivDecoder::accept(Unit u) {
   if (u == Unit::skipped) {
     ++report_.skipped;
-    if (compat_) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
+    if (rules_.compat) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
     ++pages_seen_;
     return;
   }
@@ -871,7 +870,7 @@ inline void GeneactivDecoder::accept(Unit u) {
   last_good_rate_ = p.freq;
   block_rate_ = p.freq;
   p.base_ms = chain_ms_;
-  if (compat_) advance_chain(p.freq, p.count);
+  if (rules_.compat) advance_chain(p.freq, p.count);
   ++report_.units;
   ++pages_seen_;
   std::swap(next_, cur_);
@@ -899,7 +898,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   if (out.time != nullptr) {
     for (std::size_t j = 0; j < k; ++j) {
       const double i = static_cast<double>(emitted_ + j);
-      if (compat_) {
+      if (rules_.compat) {
         // Unix ms as the reference: truncated to an integer, then / 1000
         const double t = ms_after(static_cast<double>(p.base_ms), i * inv);
         out.time[n + j] = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
@@ -953,7 +952,7 @@ inline void GeneactivDecoder::light_table() {
 // compat 1: the reference adds the first page's time and ((s - 1) * 300) /
 // rate (rate of the call's last page) to its ms count / 1000.
 inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
-  if (!compat_ || out.time == nullptr || out.n == n0) return;
+  if (!rules_.compat || out.time == nullptr || out.n == n0) return;
   double start = anchor_;
   if (block_first_ > 0) {
     start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
@@ -979,7 +978,7 @@ inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_u
   const std::size_t n0 = out.n;
   keep_hex_ = out.light != nullptr;
   std::int64_t units = 0;
-  if (compat_ && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
+  if (rules_.compat && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
     // a new reference call from page pages_seen_ + 1
     block_open_ = true;
     chain_ms_ = 0;
