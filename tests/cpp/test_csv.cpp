@@ -466,14 +466,14 @@ static void test_fread_skip() {
     const std::string padded = std::string(pad, 'x') + text;
     for (int k = 1; k <= 9; ++k) {
       gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(padded.data()), padded.size());
-      csv::LineReader lr(src, buffer);
+      gravcal::LineReader lr(src, buffer);
       CHECK(lr.skip_fread_lines(k) == k, "skip " + std::to_string(k));
       CHECK(lr.offset() == static_cast<std::int64_t>(pad) + ends[k - 1],
             "after " + std::to_string(k) + " lines, buffer " + std::to_string(buffer));
     }
   }
   gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(text.data()), text.size());
-  csv::LineReader lr(src);
+  gravcal::LineReader lr(src);
   CHECK(lr.skip_fread_lines(20) == 9, "lines at the end of the input");
 }
 

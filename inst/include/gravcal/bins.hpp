@@ -21,7 +21,7 @@
 #ifndef GRAVCAL_BINS_HPP
 #define GRAVCAL_BINS_HPP
 
-#include "model.hpp"
+#include "gravcal/model.hpp"
 
 namespace gravcal {
 

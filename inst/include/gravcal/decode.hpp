@@ -23,7 +23,7 @@
 #ifndef GRAVCAL_DECODE_HPP
 #define GRAVCAL_DECODE_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -106,6 +106,7 @@
 
 #include "gravcal/decode.hpp"
 #include "gravcal/decode_csv_text.hpp"
+#include "gravcal/line_reader.hpp"
 
 namespace gravcal {
 
@@ -124,10 +125,11 @@ class CsvDecoder : public Decoder {
   // line through take_line(), none parsed in place; the same samples) for
   // tests and fuzzers.
   CsvDecoder(ByteSource& src, const Options& opts, const std::string& format = "csv")
-      : lines_(src, buffer_bytes(opts)), want_actigraph_(format == "actigraph_csv") {
-    compat_ = ReadRules::of(opts).compat;
+      : lines_(src, buffer_bytes(opts)),
+        want_actigraph_(format == "actigraph_csv"),
+        rules_(ReadRules::of(opts)) {
     const double fr = opts.num("fread_rule", 1);
-    number_rule_ = !compat_ ? csv_text::kCorrectlyRounded
+    number_rule_ = !rules_.compat ? csv_text::kCorrectlyRounded
                    : fr == 2 ? csv_text::kFreadDivide : csv_text::kFreadMultiply;
     sf_option_ = opts.num("sf", 0);
     fast_ = opts.num("fast", 1) != 0;
@@ -174,7 +176,7 @@ class CsvDecoder : public Decoder {
 
   // the first line: an ActiGraph export's header or a plain csv's names
   bool open_header() {
-    csv_text::Line ln;
+    Line ln;
     if (!lines_.next(ln)) return fail(lines_.read_failed() ? "the file cannot be read" : "the file is empty");
     std::string first(ln.p, ln.n);
     if (first.compare(0, 3, "\xEF\xBB\xBF") == 0) first.erase(0, 3);  // UTF-8 BOM
@@ -189,7 +191,7 @@ class CsvDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     if (!opened_) return 0;
     std::int64_t used = 0;
-    csv_text::Line ln;
+    Line ln;
     while ((max_units < 0 || used < max_units) && !out.full()) {
       // the lines of the common shape where they lie, then one line of
       // another shape (or one that needs more input) line by line
@@ -218,9 +220,9 @@ class CsvDecoder : public Decoder {
 
  private:
   static std::size_t buffer_bytes(const Options& opts) {
-    const double b = opts.num("buffer", static_cast<double>(csv_text::LineReader::kBuffer));
-    return b >= 1 && b <= static_cast<double>(csv_text::LineReader::kBuffer)
-               ? static_cast<std::size_t>(b) : csv_text::LineReader::kBuffer;
+    const double b = opts.num("buffer", static_cast<double>(LineReader::kBuffer));
+    return b >= 1 && b <= static_cast<double>(LineReader::kBuffer)
+               ? static_cast<std::size_t>(b) : LineReader::kBuffer;
   }
 
   // ---- opening -----------------------------------------------------------
@@ -299,7 +301,7 @@ class CsvDecoder : public Decoder {
 
   bool open_actigraph(const std::string& first) {
     parse_first_line(first);
-    csv_text::Line ln;
+    Line ln;
     for (int i = 2; i <= kActiGraphHeaderLines; ++i) {
       if (!lines_.next(ln) || !ln.has_end) {
         return fail("header truncated at line " + std::to_string(i) + " (byte " +
@@ -398,15 +400,15 @@ class CsvDecoder : public Decoder {
     csv_text::Field f[kMaxFields];
     csv_text::split(v[0].first, v[0].second, sep_, f, kMaxFields);
     bool names = !is_number(f[0]);
-    if (!compat_ && names && is_time(f[0])) names = false;
+    if (!rules_.compat && names && is_time(f[0])) names = false;
     if (names) {
-      csv_text::Line ln;
+      Line ln;
       lines_.next(ln);
     }
     const std::size_t d = names ? 1 : 0;
     const bool stamped = d < v.size() && csv_text::split(v[d].first, v[d].second, sep_, f, kMaxFields) >= 1 &&
                          is_time(f[0]);
-    const int x = compat_ ? (nfields_ > 3 ? 1 : 0) : (stamped ? 1 : 0);
+    const int x = rules_.compat ? (nfields_ > 3 ? 1 : 0) : (stamped ? 1 : 0);
     if (x + 3 > nfields_) return fail("data lines have " + std::to_string(nfields_) + " fields, too few for a time stamp, x, y, z");
     col_x_ = x;
     col_time_ = (x == 1 && stamped) ? 0 : -1;
@@ -668,7 +670,7 @@ class CsvDecoder : public Decoder {
     const std::int64_t pos = lines_.offset(), line = lines_.line_number();
     std::vector<double> t;
     t.reserve(std::min<std::size_t>(kSfLines, 4096));
-    csv_text::Line ln;
+    Line ln;
     csv_text::Field f[kMaxFields];
     while (t.size() < kSfLines && lines_.next(ln)) {
       if (ln.too_long || csv_text::split(ln.p, ln.n, sep_, f, kMaxFields) != nfields_) continue;
@@ -764,7 +766,7 @@ class CsvDecoder : public Decoder {
       if (!kXyz && number_time_) {
         t = number_stamp(v[kTimeNumber], line0 + static_cast<std::int64_t>(i - first) + 1, offset0 + (q - p0));
       } else if (!kXyz && col_time_ >= 0) {
-        csv_text::Line ln;
+        Line ln;
         ln.number = line0 + static_cast<std::int64_t>(i - first) + 1;
         ln.offset = offset0 + (q - p0);
         t = stamp_time(tf, ln);
@@ -808,7 +810,7 @@ class CsvDecoder : public Decoder {
     if (std::isfinite(last_time_)) {
       const double dt = s - last_time_;
       if (dt > kGapSteps * step_ + 0.0 || dt < -(step_ / 2 + 0.0)) {
-        csv_text::Line ln;
+        Line ln;
         ln.number = number;
         ln.offset = offset;
         check_step(dt, 0, ln);
@@ -881,7 +883,7 @@ class CsvDecoder : public Decoder {
     return *p == '\n' ? p : nullptr;
   }
 
-  void skip_line(const csv_text::Line& ln, const char* kind, const char* what) {
+  void skip_line(const Line& ln, const char* kind, const char* what) {
     ++report_.skipped;
     const char* counter = kind;
     if (!ln.has_end) {
@@ -894,14 +896,14 @@ class CsvDecoder : public Decoder {
                  csv_text::excerpt(ln.p, ln.n) + "\"");
   }
 
-  static bool blank(const csv_text::Line& ln) {
+  static bool blank(const Line& ln) {
     for (std::size_t i = 0; i < ln.n; ++i) {
       if (ln.p[i] != ' ' && ln.p[i] != '\t') return false;
     }
     return true;
   }
 
-  void take_line(const csv_text::Line& ln, SampleBuffer& out) {
+  void take_line(const Line& ln, SampleBuffer& out) {
     if (ln.too_long) return skip_line(ln, "overlong_lines", "longer than 64 KiB");
     if (blank(ln)) return skip_line(ln, "blank_lines", "blank line");
     csv_text::Field f[kMaxFields];
@@ -933,7 +935,7 @@ class CsvDecoder : public Decoder {
 
   // The time of a stamped line: its stamp (plus k / sf for the k-th line of
   // a stamp coarser than a sample period), checked against the last one.
-  double stamp_time(const csv_text::Field& f, const csv_text::Line& ln) {
+  double stamp_time(const csv_text::Field& f, const Line& ln) {
     double s;
     int fd = 0;
     const bool ok = time_of(f, s, fd);
@@ -965,7 +967,7 @@ class CsvDecoder : public Decoder {
     return t;
   }
 
-  void check_step(double dt, double res, const csv_text::Line& ln) {
+  void check_step(double dt, double res, const Line& ln) {
     if (dt > kGapSteps * step_ + res) {
       gap(dt, ln);
     } else if (dt < -(step_ / 2 + res)) {
@@ -976,7 +978,7 @@ class CsvDecoder : public Decoder {
 #if defined(__GNUC__)
   __attribute__((noinline))
 #endif
-  void gap(double dt, const csv_text::Line& ln) {
+  void gap(double dt, const Line& ln) {
     ++report_.gaps;
     report_.gap_seconds += dt - step_;
     report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
@@ -985,16 +987,17 @@ class CsvDecoder : public Decoder {
 #if defined(__GNUC__)
   __attribute__((noinline))
 #endif
-  void backwards(double dt, const csv_text::Line& ln) {
+  void backwards(double dt, const Line& ln) {
     report_.count("time_backwards");
     report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) +
                  "): time goes back " + std::to_string(-dt) + " s");
   }
 
-  csv_text::LineReader lines_;
+  LineReader lines_;
   csv_text::DateTimeParser dt_;
   bool want_actigraph_;
-  bool compat_ = true;
+  // the reading rules (compat, interpolation, resample_fused), read once
+  const ReadRules rules_;
   int number_rule_ = csv_text::kFreadMultiply;  // a csv_text::NumberRule
   bool fast_ = true;
   double sf_option_ = 0;

@@ -257,9 +257,7 @@ class CwaDecoder : public Decoder {
  public:
   CwaDecoder(ByteSource& src, const Options& opts)
       : src_(src),
-        compat_(ReadRules::of(opts).compat),
-        nearest_(ReadRules::of(opts).nearest()),
-        fused_(ReadRules::of(opts).fused),
+        rules_(ReadRules::of(opts)),
         frequency_tol_(opts.num("frequency_tol", cwa::frequency_tol)),
         r_long_double_(opts.num("r_long_double", 1) != 0),
         zone_(opts) {}
@@ -298,9 +296,9 @@ class CwaDecoder : public Decoder {
   double grid(std::int64_t k) const;
 
   ByteSource& src_;
-  bool compat_;
-  bool nearest_;                   // interpolationType = 2
-  bool fused_;                     // GGIRread's resample() fused (option resample_fused)
+  // the reading rules (compat, interpolation = 2: nearest, resample_fused),
+  // read once
+  const ReadRules rules_;
   double frequency_tol_;
   bool r_long_double_;  // R's accumulator: long double, else double
   ZoneTable zone_;  // GGIR's zone (compat = 1 only)
@@ -493,14 +491,14 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
   }
   b.index = index;
   b.cal = T;
-  b.rtc = compat_ ? T - zone_.offset(T) : T;
+  b.rtc = rules_.compat ? T - zone_.offset(T) : T;
   b.frequency = b.h.rate == 0 ? b.h.offset26 : use.frequency;
   b.start = cwa::block_start(b.rtc, b.h, use);
   if (keep_bytes) {  // the caller scales the samples (scale_columns())
     std::memcpy(b.bytes, raw, cwa::block_bytes);
     return true;
   }
-  const double packed_scale = compat_ ? use.accel_scale : 1.0 / 256;
+  const double packed_scale = rules_.compat ? use.accel_scale : 1.0 / 256;
   cwa::scale_columns(raw, b.h, use, packed_scale, 0, b.h.count, b.xyz[0] + 1, b.xyz[1] + 1,
                      b.xyz[2] + 1);
   return true;
@@ -551,7 +549,7 @@ inline void CwaDecoder::check_time(const cwa::Block& b) {
 
 inline std::int64_t CwaDecoder::read(SampleBuffer& out, std::int64_t max_units) {
   if (done_) return 0;
-  return compat_ ? read_compat(out, max_units) : read_raw(out, max_units);
+  return rules_.compat ? read_compat(out, max_units) : read_raw(out, max_units);
 }
 
 // ---------------------------------------------------------------------------
@@ -717,7 +715,7 @@ inline bool CwaDecoder::start_window(std::int64_t max_units) {
 // its calendar minute is one whose offset in GGIR's zone depends on R's
 // earlier conversions, counted ("zone_ambiguous"; R refuses the result).
 inline void CwaDecoder::zone_check(const cwa::Block& b) {
-  if (!compat_ || zone_.empty() || !zone_.ambiguous(b.cal)) return;
+  if (!rules_.compat || zone_.empty() || !zone_.ambiguous(b.cal)) return;
   report_.count("zone_ambiguous");
   report_.note("block " + std::to_string(b.index + 1) +
                ": its calendar time exists twice or not at all in GGIR's zone and starts or ends a "
@@ -898,12 +896,13 @@ inline bool CwaDecoder::emit_span(SampleBuffer& out) {
     sp.step = step_;
     sp.end = end_ts_;
     sp.temp = p.h.temperature;
-    sp.nearest = nearest_;
-    sp.fused = fused_;
+    sp.nearest = rules_.nearest();
+    sp.fused = rules_.fused;
     // nearest neighbour (interpolationType = 2) or GGIRread's fused
     // multiply-add: the scalar reference only
-    given = nearest_ || fused_ ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
-                     : kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
+    given = sp.nearest || sp.fused
+                ? kernels::cwa_interp_scalar(sp, pos_, stop, source_, o, anchor_, anchor_t_)
+                : kernels::active().cwa_interp(sp, pos_, stop, source_, o, anchor_, anchor_t_);
   }
   // light: the block's value on every point of its span, as temperature
   if (out.light != nullptr) std::fill(out.light + out.n, out.light + out.n + given, p.h.light);

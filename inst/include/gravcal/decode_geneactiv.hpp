@@ -95,8 +95,9 @@
 #include <limits>
 #include <string>
 
-#include "decode.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/kernels.hpp"
+#include "gravcal/line_reader.hpp"
 
 namespace gravcal {
 
@@ -109,7 +110,7 @@ constexpr std::size_t kDigitsXyz = 9;
 constexpr std::size_t kDigitsXyzCompat = 10;  // the reference needs 1 light digit
 constexpr int kPageHeaderLines = 8;           // between "Recorded Data" and hex
 constexpr std::size_t kMaxLine = 8192;        // longer lines are cut (and counted)
-constexpr std::size_t kBufferBytes = 1u << 16;
+constexpr std::size_t kBufferBytes = 1u << 16;  // the line reader's buffer
 constexpr int kMaxHeaderLines = 256;          // real headers have 59
 constexpr double kMinRate = 0.1;              // Hz; real devices: 10..100
 constexpr double kMaxRate = 10000.0;
@@ -202,104 +203,6 @@ inline bool parse_leading(const char* p, const char* end, double& out) {
   return stop != tmp && std::isfinite(out);
 }
 
-// Lines of a byte stream through a fixed buffer. A line is valid until the
-// next call; '\r' before '\n' is dropped; lines over kMaxLine are cut.
-class LineReader {
- public:
-  explicit LineReader(ByteSource& src) : src_(src) {}
-  // The next line; false at the end of the input.
-  bool next() {
-    if (again_) {
-      again_ = false;
-      return true;
-    }
-    if (skip_rest_ && !skip_to_newline()) return false;
-    for (;;) {
-      const unsigned char* s = buf_ + beg_;
-      const void* nl = std::memchr(s, '\n', end_ - beg_);
-      if (nl != nullptr) {
-        const std::size_t len = static_cast<std::size_t>(static_cast<const unsigned char*>(nl) - s);
-        set_line(len, true, false);
-        beg_ += len + 1;
-        return true;
-      }
-      if (end_ - beg_ >= kMaxLine) {
-        set_line(kMaxLine, true, true);
-        beg_ += kMaxLine;
-        skip_rest_ = true;
-        return true;
-      }
-      if (!fill()) {
-        if (beg_ == end_) return false;
-        set_line(end_ - beg_, false, false);
-        beg_ = end_;
-        return true;
-      }
-    }
-  }
-  void unread() { again_ = true; }
-  // No byte left (tries to read more).
-  bool at_end() {
-    if (again_) return false;
-    if (skip_rest_ && !skip_to_newline()) return true;
-    return beg_ == end_ && !fill();
-  }
-  const char* data = nullptr;
-  std::size_t size = 0;
-  std::int64_t offset = 0;  // of the line's first byte
-  bool complete = true;     // ended by '\n' (false: the input ended first)
-  bool cut = false;         // longer than kMaxLine
-  bool read_error() const { return src_.failed(); }
-  // The first bytes that follow the start of the input (open() checks them).
-  std::size_t peek(const unsigned char*& p, std::size_t want) {
-    while (end_ - beg_ < want && fill()) {
-    }
-    p = buf_ + beg_;
-    return end_ - beg_;
-  }
-
- private:
-  void set_line(std::size_t len, bool ended, bool cut_now) {
-    data = reinterpret_cast<const char*>(buf_ + beg_);
-    offset = base_ + static_cast<std::int64_t>(beg_);
-    size = len;
-    if (size > 0 && data[size - 1] == '\r') --size;
-    complete = ended;
-    cut = cut_now;
-  }
-  // Moves what is left to the front and reads more; false when nothing came.
-  bool fill() {
-    if (eof_) return false;
-    if (beg_ > 0) {
-      std::memmove(buf_, buf_ + beg_, end_ - beg_);
-      base_ += static_cast<std::int64_t>(beg_);
-      end_ -= beg_;
-      beg_ = 0;
-    }
-    const std::size_t got = src_.read(buf_ + end_, kBufferBytes - end_);
-    if (got == 0) eof_ = true;
-    end_ += got;
-    return got > 0;
-  }
-  bool skip_to_newline() {
-    for (;;) {
-      const void* nl = std::memchr(buf_ + beg_, '\n', end_ - beg_);
-      if (nl != nullptr) {
-        beg_ = static_cast<std::size_t>(static_cast<const unsigned char*>(nl) - buf_) + 1;
-        skip_rest_ = false;
-        return true;
-      }
-      beg_ = end_;
-      if (!fill()) return false;
-    }
-  }
-  ByteSource& src_;
-  unsigned char buf_[kBufferBytes];
-  std::size_t beg_ = 0, end_ = 0;
-  std::int64_t base_ = 0;
-  bool eof_ = false, again_ = false, skip_rest_ = false;
-};
-
 inline bool starts_with(const char* p, std::size_t n, const char* key) {
   const std::size_t k = std::strlen(key);
   return n >= k && std::memcmp(p, key, k) == 0;
@@ -368,9 +271,8 @@ class GeneactivDecoder : public Decoder {
   // several chunks (GgirResampler in decode_ggir_resample.hpp does).
   void continue_call(bool on) { continue_call_ = on; }
   GeneactivDecoder(ByteSource& src, const Options& opts)
-      : lines_(src),
-        compat_(ReadRules::of(opts).compat),
-        fused_(ReadRules::of(opts).fused) {
+      : lines_(src, geneactiv::kBufferBytes, geneactiv::kMaxLine),
+        rules_(ReadRules::of(opts)) {
     info_.format = "geneactiv";
     static const char* const keys[3] = {"light_lux", "light_volts", "light_model11"};
     for (int i = 0; i < 3; ++i) {
@@ -423,14 +325,15 @@ class GeneactivDecoder : public Decoder {
   void note_at(const char* what, std::int64_t offset);
   double anchor_time(const geneactiv::Stamp& s) const;
 
-  geneactiv::LineReader lines_;
-  bool compat_;
+  LineReader lines_;
+  Line line_;  // the line lines_ gave last
+  // the reading rules (compat, resample_fused), read once
+  const ReadRules rules_;
   // GGIRread's reader is C++ compiled by the R it runs in: where that
   // compiler contracted its ms + s * 1000 into one fused multiply-add
   // (aarch64; option resample_fused, R/fp-build.R), so does ms_after()
-  bool fused_;
   double ms_after(double ms, double seconds) const {
-    return fused_ ? kernels::replay_fma(seconds, 1000.0, ms) : ms + seconds * 1000;
+    return rules_.fused ? kernels::replay_fma(seconds, 1000.0, ms) : ms + seconds * 1000;
   }
   bool done_ = false;
   // calibration: value of each 12-bit count per axis
@@ -479,10 +382,10 @@ class GeneactivDecoder : public Decoder {
 // Header
 
 inline bool GeneactivDecoder::recognise() {
-  const unsigned char* p = nullptr;
-  const std::size_t n = lines_.peek(p, 600);
+  const char* c = nullptr;
+  const std::size_t n = lines_.peek_at_least(c, 600);
   if (n == 0) return fail("empty file");
-  const char* c = reinterpret_cast<const char*>(p);
+  const unsigned char* p = reinterpret_cast<const unsigned char*>(c);
   if (n >= 516 && std::memcmp(p + 512, "MDTC", 4) == 0) {
     return fail("not a GENEActiv file: it looks like a Matrix/Parmay file (\"MDTC\" at byte 512)");
   }
@@ -515,7 +418,7 @@ inline bool GeneactivDecoder::calibration_line(const char* p, std::size_t n) {
                           : std::fabs(v) <= geneactiv::kMaxOffset);
     if (!ok) {
       return fail(std::string("bad calibration line \"") + key + "\" at byte " +
-                  std::to_string(lines_.offset));
+                  std::to_string(line_.offset));
     }
     if (gain) {
       gain_[a] = v;
@@ -596,7 +499,7 @@ inline bool GeneactivDecoder::check_header() {
     for (int u = 0; u < geneactiv::kCountRange; ++u) {
       const int c = u >= geneactiv::kCountSigned ? u - geneactiv::kCountRange : u;
       const double g = (c * geneactiv::kCountScale - static_cast<double>(offset_[a])) / gain_[a];
-      lut_[a][u] = compat_ ? static_cast<double>(static_cast<float>(g)) : g;
+      lut_[a][u] = rules_.compat ? static_cast<double>(static_cast<float>(g)) : g;
     }
   }
   return true;
@@ -606,17 +509,17 @@ inline bool GeneactivDecoder::open() {
   if (!recognise()) return false;
   int k = 0;
   for (;; ++k) {
-    if (!lines_.next()) {
-      if (lines_.read_error()) return fail("read error in the header");
+    if (!lines_.next(line_)) {
+      if (lines_.read_failed()) return fail("read error in the header");
       if (!have_pages_line_) {
-        return fail("header truncated at byte " + std::to_string(lines_.offset + static_cast<std::int64_t>(lines_.size)));
+        return fail("header truncated at byte " + std::to_string(line_.offset + static_cast<std::int64_t>(line_.n)));
       }
       break;
     }
-    if (!lines_.complete && !have_pages_line_) {
-      return fail("header truncated at byte " + std::to_string(lines_.offset + static_cast<std::int64_t>(lines_.size)));
+    if (!line_.has_end && !have_pages_line_) {
+      return fail("header truncated at byte " + std::to_string(line_.offset + static_cast<std::int64_t>(line_.n)));
     }
-    if (geneactiv::is_line(lines_.data, lines_.size, geneactiv::kPageStart)) {
+    if (geneactiv::is_line(line_.p, line_.n, geneactiv::kPageStart)) {
       lines_.unread();
       break;
     }
@@ -624,8 +527,8 @@ inline bool GeneactivDecoder::open() {
       return fail("no \"Recorded Data\" page within the first " +
                   std::to_string(geneactiv::kMaxHeaderLines) + " lines");
     }
-    light_header_.line(lines_.data, lines_.size);
-    if (!header_line(lines_.data, lines_.size)) return false;
+    light_header_.line(line_.p, line_.n);
+    if (!header_line(line_.p, line_.n)) return false;
   }
   if (!check_header()) return false;
   light_table();
@@ -635,7 +538,7 @@ inline bool GeneactivDecoder::open() {
   next_unit_ = parse_page();
   have_next_ = true;
   if (next_unit_ == Unit::good) {
-    info_.start_time = compat_ ? anchor_time(next_->stamp) : next_->time_s;
+    info_.start_time = rules_.compat ? anchor_time(next_->stamp) : next_->time_s;
   }
   return true;
 }
@@ -667,7 +570,7 @@ inline bool GeneactivDecoder::page_field(int k, const char* p, std::size_t n) {
       return true;
     case kTemperature:
       if (!parse_number(v, end, d) || std::fabs(d) > 1000) return false;
-      next_->temperature = compat_ ? static_cast<double>(static_cast<float>(d)) : d;
+      next_->temperature = rules_.compat ? static_cast<double>(static_cast<float>(d)) : d;
       return true;
     case kFrequency:
       if (!parse_number(v, end, d) || !(d >= kMinRate) || d > kMaxRate) return false;
@@ -690,7 +593,7 @@ inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool comp
   s += whole * kDigitsPerSample;
   std::size_t count = whole;
   const std::size_t rest = n - whole * kDigitsPerSample;
-  if (rest >= (compat_ ? kDigitsXyzCompat : kDigitsPerSample)) {
+  if (rest >= (rules_.compat ? kDigitsXyzCompat : kDigitsPerSample)) {
     for (int a = 0; a < 3; ++a) {
       const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
       bad |= d0 | d1 | d2;
@@ -721,37 +624,37 @@ inline GeneactivDecoder::Unit GeneactivDecoder::skip(const char* counter, const 
 inline GeneactivDecoder::Unit GeneactivDecoder::parse_page() {
   using namespace geneactiv;
   for (;;) {  // to the next "Recorded Data"
-    if (!lines_.next()) return Unit::none;
-    if (is_line(lines_.data, lines_.size, kPageStart)) break;
+    if (!lines_.next(line_)) return Unit::none;
+    if (is_line(line_.p, line_.n, kPageStart)) break;
     bool blank = true;
-    for (std::size_t i = 0; i < lines_.size && blank; ++i) {
-      blank = lines_.data[i] == ' ' || lines_.data[i] == '\0';
+    for (std::size_t i = 0; i < line_.n && blank; ++i) {
+      blank = line_.p[i] == ' ' || line_.p[i] == '\0';
     }
     if (!blank) {
       report_.count("stray_lines");
-      if (report_.get("stray_lines") <= 3) note_at("line outside any page skipped", lines_.offset);
+      if (report_.get("stray_lines") <= 3) note_at("line outside any page skipped", line_.offset);
     }
   }
-  next_->offset = lines_.offset;
+  next_->offset = line_.offset;
   next_->count = 0;
   bool damaged = false;
   for (int k = 0; k <= kPageHeaderLines; ++k) {  // 8 header lines, then hex
-    if (!lines_.next()) return skip("truncated_page", "input ends inside a page", true);
-    if (is_line(lines_.data, lines_.size, kPageStart)) {
+    if (!lines_.next(line_)) return skip("truncated_page", "input ends inside a page", true);
+    if (is_line(line_.p, line_.n, kPageStart)) {
       lines_.unread();
       return skip("bad_page_header", "page with a missing line skipped", false);
     }
     if (k == kPageHeaderLines) break;
-    if (!lines_.complete) return skip("truncated_page", "input ends inside a page", true);
-    if (!damaged && !page_field(k, lines_.data, lines_.size)) damaged = true;
+    if (!line_.has_end) return skip("truncated_page", "input ends inside a page", true);
+    if (!damaged && !page_field(k, line_.p, line_.n)) damaged = true;
   }
   if (damaged) return skip("bad_page_header", "page with a damaged header line skipped", false);
-  const bool whole_line = lines_.complete;
-  if (lines_.cut || !decode_hex(lines_.data, lines_.size, whole_line)) {
+  const bool whole_line = line_.has_end;
+  if (line_.too_long || !decode_hex(line_.p, line_.n, whole_line)) {
     if (!whole_line) return skip("truncated_page", "input ends inside a malformed hex line", true);
     return skip("bad_hex", "page with a malformed hex line skipped", false);
   }
-  if (!whole_line && lines_.size < kDigitsPerPage) {
+  if (!whole_line && line_.n < kDigitsPerPage) {
     report_.truncated = true;
     report_.count("truncated_page");
     note_at(("input ends inside the hex line: " + std::to_string(next_->count) + " of 300 samples kept").c_str(),
@@ -851,7 +754,7 @@ inline void GeneactivDecoder::check_time() {
 inline void GeneactivDecoder::accept(Unit u) {
   if (u == Unit::skipped) {
     ++report_.skipped;
-    if (compat_) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
+    if (rules_.compat) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
     ++pages_seen_;
     return;
   }
@@ -871,7 +774,7 @@ inline void GeneactivDecoder::accept(Unit u) {
   last_good_rate_ = p.freq;
   block_rate_ = p.freq;
   p.base_ms = chain_ms_;
-  if (compat_) advance_chain(p.freq, p.count);
+  if (rules_.compat) advance_chain(p.freq, p.count);
   ++report_.units;
   ++pages_seen_;
   std::swap(next_, cur_);
@@ -899,7 +802,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   if (out.time != nullptr) {
     for (std::size_t j = 0; j < k; ++j) {
       const double i = static_cast<double>(emitted_ + j);
-      if (compat_) {
+      if (rules_.compat) {
         // Unix ms as the reference: truncated to an integer, then / 1000
         const double t = ms_after(static_cast<double>(p.base_ms), i * inv);
         out.time[n + j] = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
@@ -953,7 +856,7 @@ inline void GeneactivDecoder::light_table() {
 // compat 1: the reference adds the first page's time and ((s - 1) * 300) /
 // rate (rate of the call's last page) to its ms count / 1000.
 inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
-  if (!compat_ || out.time == nullptr || out.n == n0) return;
+  if (!rules_.compat || out.time == nullptr || out.n == n0) return;
   double start = anchor_;
   if (block_first_ > 0) {
     start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
@@ -965,9 +868,9 @@ inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
 inline void GeneactivDecoder::finish_input() {
   if (done_) return;
   done_ = true;
-  if (lines_.read_error()) {
+  if (lines_.read_failed()) {
     report_.read_error = true;
-    report_.note("read error after byte " + std::to_string(lines_.offset) + ": data end there");
+    report_.note("read error after byte " + std::to_string(line_.offset) + ": data end there");
   }
   if (header_pages_ >= 0 && header_pages_ != pages_seen_) {
     report_.note("header says " + std::to_string(header_pages_) + " pages, the file has " +
@@ -979,7 +882,7 @@ inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_u
   const std::size_t n0 = out.n;
   keep_hex_ = out.light != nullptr;
   std::int64_t units = 0;
-  if (compat_ && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
+  if (rules_.compat && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
     // a new reference call from page pages_seen_ + 1
     block_open_ = true;
     chain_ms_ = 0;

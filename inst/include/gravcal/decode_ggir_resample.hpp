@@ -59,9 +59,9 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
-#include "decode_geneactiv.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/decode_geneactiv.hpp"
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 

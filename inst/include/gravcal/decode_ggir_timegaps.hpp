@@ -45,7 +45,7 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
+#include "gravcal/decode.hpp"
 
 namespace gravcal {
 

@@ -62,7 +62,7 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
+#include "gravcal/decode.hpp"
 
 namespace gravcal {
 
@@ -568,8 +568,7 @@ class Gt3xDecoder : public Decoder {
   // `zip` is the .gt3x file; `inflater` reads deflated entries (null: only
   // stored entries can be read). Options: compat (1), impute_zeroes (0).
   Gt3xDecoder(ByteSource& zip, const Options& opts, EntryInflater* inflater = nullptr)
-      : zip_(zip), inflater_(inflater) {
-    compat_ = ReadRules::of(opts).compat;
+      : zip_(zip), inflater_(inflater), rules_(ReadRules::of(opts)) {
     impute_ = opts.num("impute_zeroes", 0) != 0;
   }
 
@@ -746,7 +745,7 @@ class Gt3xDecoder : public Decoder {
       max_samples_ = static_cast<std::int64_t>(std::min(n, 2147483647.0));
     }
     bound_secs_ = max_samples_ / rate_ + 1;
-    cap_ = compat_ && impute_ ? max_samples_ : -1;
+    cap_ = rules_.compat && impute_ ? max_samples_ : -1;
     expected_ = start_u32_;
   }
 
@@ -762,7 +761,7 @@ class Gt3xDecoder : public Decoder {
   }
 
   double time_of(std::uint32_t ts, std::int64_t i) const {
-    if (compat_) {
+    if (rules_.compat) {
       const double idx = (static_cast<double>(static_cast<std::uint32_t>(ts - start_u32_)) +
                           static_cast<double>(i) * inv_rate_) * gt3x::kTimeUnit;
       return start_d_ + idx / gt3x::kTimeUnit;
@@ -770,7 +769,7 @@ class Gt3xDecoder : public Decoder {
     return static_cast<double>(ts) + static_cast<double>(i) / rate_;
   }
   double time_of_old(std::int64_t i) const {
-    if (compat_) return start_d_ + (static_cast<double>(i) * inv_rate_ * gt3x::kTimeUnit) / gt3x::kTimeUnit;
+    if (rules_.compat) return start_d_ + (static_cast<double>(i) * inv_rate_ * gt3x::kTimeUnit) / gt3x::kTimeUnit;
     return start_d_ + static_cast<double>(i) / rate_;
   }
 
@@ -961,7 +960,7 @@ class Gt3xDecoder : public Decoder {
       const std::uint16_t addr = le16(q + i), key = le16(q + i + 2);
       const std::uint32_t v = le32(q + i + 4);
       if (addr == gt3x::kAddrConfig && key == gt3x::kKeyStartTime) expected_ = v;
-      if (addr == gt3x::kAddrDevice && key == gt3x::kKeyAccelScale && !compat_) {
+      if (addr == gt3x::kAddrDevice && key == gt3x::kKeyAccelScale && !rules_.compat) {
         const double s = gt3x::decode_param_float(v);
         if (plausible_scale(s) && s != scale_) {
           scale_ = s;
@@ -1120,7 +1119,9 @@ class Gt3xDecoder : public Decoder {
   std::vector<std::unique_ptr<ByteSource>> inflated_;
   ByteSource* data_ = nullptr;
   gt3x::WindowSource* window_ = nullptr;  // the data entry's stored bytes
-  bool compat_ = true, impute_ = false, old_ = false;
+  // the reading rules (compat, interpolation, resample_fused), read once
+  const ReadRules rules_;
+  bool impute_ = false, old_ = false;
   // from info.txt
   int rate_ = 1;
   double inv_rate_ = 1.0, scale_ = 256.0, start_d_ = 0.0;

@@ -44,8 +44,8 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 
@@ -361,9 +361,7 @@ class MovisensDecoder : public Decoder {
       : acc_src_(acc),
         temp_src_(std::move(temp)),
         xml_(std::move(xml)),
-        compat_(ReadRules::of(opts).compat),
-        nearest_(ReadRules::of(opts).nearest()),
-        fused_(ReadRules::of(opts).fused),
+        rules_(ReadRules::of(opts)),
         block_opt_(opts.num("block_samples", 0)),
         opts_(opts) {}
 
@@ -412,7 +410,7 @@ class MovisensDecoder : public Decoder {
     }
     // GGIR fails on a recording whose first block has a temperature and a
     // later one none: in its mode, so does the decoder (at once)
-    if (compat_ && info_.has_temperature) {
+    if (rules_.compat && info_.has_temperature) {
       for (std::int64_t from = block_; from < n_; from += block_) {
         const std::int64_t to = n_ - from < block_ ? n_ : from + block_;
         if (!block_temperature_ok(from + 1, to)) {
@@ -591,8 +589,8 @@ class MovisensDecoder : public Decoder {
       for (std::int64_t i = 0; i < m; ++i) out[i] = temp_.value(tfrom_ - 1, temp_chan_);
       return;
     }
-    if (nearest_) temperatures_as<true, false>(p, m, out);
-    else if (fused_) temperatures_as<false, true>(p, m, out);
+    if (rules_.nearest()) temperatures_as<true, false>(p, m, out);
+    else if (rules_.fused) temperatures_as<false, true>(p, m, out);
     else temperatures_as<false, false>(p, m, out);
   }
 
@@ -654,7 +652,8 @@ class MovisensDecoder : public Decoder {
   ByteSource& acc_src_;
   std::unique_ptr<ByteSource> temp_src_;
   std::string xml_;
-  bool compat_ = true, nearest_ = false, fused_ = false;
+  // the reading rules (compat, interpolation, resample_fused), read once
+  const ReadRules rules_;
   double block_opt_ = 0;
   Options opts_;
   double sf_ = 0;

@@ -64,8 +64,8 @@
 #include <string>
 #include <vector>
 
-#include "decode.hpp"
-#include "kernels.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/kernels.hpp"
 
 namespace gravcal {
 
@@ -113,9 +113,7 @@ class ParmayDecoder : public Decoder {
 
   ParmayDecoder(ByteSource& src, const Options& opts)
       : src_(src),
-        compat_(ReadRules::of(opts).compat),
-        nearest_(ReadRules::of(opts).nearest()),
-        fused_(ReadRules::of(opts).fused),
+        rules_(ReadRules::of(opts)),
         run_loop_(opts.num("run_loop", 1) != 0) {}
 
   bool open() override {
@@ -161,7 +159,7 @@ class ParmayDecoder : public Decoder {
     info_.range_g = static_cast<double>(range_);
     if (!packets_.empty()) info_.start_time = packets_[0].t0;
     // GGIRread gives nothing when the header declares no packet
-    if (compat_ && declared_ < 1) {
+    if (rules_.compat && declared_ < 1) {
       report_.note("the header declares " + std::to_string(declared_) +
                    " packets: no samples (as GGIRread)");
       finished_ = true;
@@ -176,7 +174,7 @@ class ParmayDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
     while (!out.full()) {
-      if (compat_ && ((run_loop_ && run(out)) || next_points(out))) continue;
+      if (rules_.compat && ((run_loop_ && run(out)) || next_points(out))) continue;
       if (finished_) break;
       if (chunk_.i >= chunk_.n) {
         // the next raw samples: the rest of a packet at most, so that a
@@ -192,7 +190,7 @@ class ParmayDecoder : public Decoder {
       }
       const int i = chunk_.i++;
       const double v[3] = {chunk_.x[i], chunk_.y[i], chunk_.z[i]};
-      if (!compat_) {
+      if (!rules_.compat) {
         // gravcal's own reading: the samples at their times, no grid
         put(out, v, chunk_.t[i]);
         continue;
@@ -304,11 +302,11 @@ class ParmayDecoder : public Decoder {
       if (!p.ok) {
         report_.count("bad_checksum");
         ++report_.skipped;
-        note(compat_ ? "a packet with a bad checksum (kept as GGIRread keeps it: acceleration "
+        note(rules_.compat ? "a packet with a bad checksum (kept as GGIRread keeps it: acceleration "
                        "(0, 0, 1), temperature of its neighbours)"
                      : "a packet with a bad checksum (skipped)",
              p.at);
-        if (!compat_) continue;
+        if (!rules_.compat) continue;
       }
       packets_.push_back(p);
     }
@@ -349,7 +347,7 @@ class ParmayDecoder : public Decoder {
   // packet when it starts a second or more after it.
   double packet_start(std::size_t i) const {
     const double t0 = packets_[i].t0;
-    if (i == 0 || !compat_) return t0;
+    if (i == 0 || !rules_.compat) return t0;
     const double gap = t0 - packets_[i - 1].t1;
     return gap >= 1 ? t0 - gap : t0;
   }
@@ -405,7 +403,7 @@ class ParmayDecoder : public Decoder {
       const int per = width() / 2;
       const std::int64_t want = static_cast<std::int64_t>(c) * per;
       const std::int64_t r = (want < words ? want : words) / per;
-      return r > 0 || !d->compat_ ? r : 1;
+      return r > 0 || !d->rules_.compat ? r : 1;
     }
     bool fetch(std::int64_t at, unsigned char* out, std::size_t k) {
       const std::int64_t end = at + static_cast<std::int64_t>(k);
@@ -704,9 +702,9 @@ class ParmayDecoder : public Decoder {
       }
       double u = (g - prev_t_) / (cur_t_ - prev_t_);
       if (u < 0 || u > 1) u = 0;
-      if (nearest_) u = ggir_nearest_weight(u);
+      if (rules_.nearest()) u = ggir_nearest_weight(u);
       double v[3];
-      for (int c = 0; c < 3; ++c) v[c] = kernels::ggir_lerp(u, prev_v_[c], cur_v_[c], fused_);
+      for (int c = 0; c < 3; ++c) v[c] = kernels::ggir_lerp(u, prev_v_[c], cur_v_[c], rules_.fused);
       const std::int64_t k = k_++;
       any = true;
       if (held_n_ == 0 && static_cast<double>(k) < confirmed_) {
@@ -771,9 +769,10 @@ class ParmayDecoder : public Decoder {
       if (!temp_started_) return false;
       temp_mode = temp_ended_ ? 1 : 2;
     }
-    const TempSpan ts{temp_mode, temp_first_, tp_t_, tc_t_, tp_v_, tc_v_, nearest_, fused_, na};
+    const TempSpan ts{temp_mode, temp_first_, tp_t_, tc_t_, tp_v_, tc_v_,
+                      rules_.nearest(), rules_.fused, na};
     const double start = start_, by = by_, sf = sf_;
-    const bool nearest = nearest_, fused = fused_;
+    const bool nearest = rules_.nearest(), fused = rules_.fused;
     double prev_t = prev_t_, cur_t = cur_t_;
     double p0 = prev_v_[0], p1 = prev_v_[1], p2 = prev_v_[2];
     double c0 = cur_v_[0], c1 = cur_v_[1], c2 = cur_v_[2];
@@ -945,14 +944,13 @@ class ParmayDecoder : public Decoder {
     }
     double u = (g - tp_t_) / (tc_t_ - tp_t_);
     if (u < 0 || u > 1) u = 0;
-    if (nearest_) u = ggir_nearest_weight(u);
-    return kernels::ggir_lerp(u, tp_v_, tc_v_, fused_);
+    if (rules_.nearest()) u = ggir_nearest_weight(u);
+    return kernels::ggir_lerp(u, tp_v_, tc_v_, rules_.fused);
   }
 
   ByteSource& src_;
-  bool compat_ = true;
-  bool nearest_ = false;
-  bool fused_ = false;  // GGIRread's resample() fused (option resample_fused)
+  // the reading rules (compat, interpolation, resample_fused), read once
+  const ReadRules rules_;
   // run()'s loop (option run_loop; 0: next_points() and take() alone, the
   // point-by-point path the fuzzer compares it with)
   bool run_loop_ = true;

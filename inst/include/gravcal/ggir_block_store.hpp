@@ -34,7 +34,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "decode.hpp"
+#include "gravcal/decode.hpp"
 
 namespace gravcal {
 namespace ggir_part1 {

@@ -55,8 +55,8 @@
 #include <limits>
 #include <vector>
 
-#include "r_arith.hpp"
-#include "segmenter.hpp"
+#include "gravcal/r_arith.hpp"
+#include "gravcal/segmenter.hpp"
 
 namespace gravcal {
 

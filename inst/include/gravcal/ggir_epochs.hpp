@@ -29,7 +29,7 @@
 #ifndef GRAVCAL_GGIR_EPOCHS_HPP
 #define GRAVCAL_GGIR_EPOCHS_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -42,8 +42,8 @@
 #include <string>
 #include <vector>
 
-#include "ggir_filters.hpp"
-#include "r_arith.hpp"
+#include "gravcal/ggir_filters.hpp"
+#include "gravcal/r_arith.hpp"
 
 namespace gravcal {
 namespace ggir_part1 {

@@ -61,14 +61,14 @@
 #ifndef GRAVCAL_GGIR_FILTERS_HPP
 #define GRAVCAL_GGIR_FILTERS_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <vector>
 
-#include "decode.hpp"          // r_na_real()
-#include "kernels/decode.hpp"  // kernels::replay_fma()
+#include "gravcal/decode.hpp"          // r_na_real()
+#include "gravcal/kernels/decode.hpp"  // kernels::replay_fma()
 
 namespace gravcal {
 

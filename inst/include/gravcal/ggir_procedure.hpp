@@ -33,12 +33,12 @@
 #include <string>
 #include <vector>
 
-#include "ggir_blocks.hpp"
-#include "icp.hpp"
-#include "model.hpp"
-#include "pipeline.hpp"
-#include "r_arith.hpp"
-#include "segmenter.hpp"
+#include "gravcal/ggir_blocks.hpp"
+#include "gravcal/icp.hpp"
+#include "gravcal/model.hpp"
+#include "gravcal/pipeline.hpp"
+#include "gravcal/r_arith.hpp"
+#include "gravcal/segmenter.hpp"
 
 namespace gravcal {
 

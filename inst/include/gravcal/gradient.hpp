@@ -25,8 +25,8 @@
 
 #include <cmath>
 
-#include "gradient_analytic.hpp"
-#include "model.hpp"
+#include "gravcal/gradient_analytic.hpp"
+#include "gravcal/model.hpp"
 
 namespace gravcal {
 

@@ -60,8 +60,8 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "fixed_point.hpp"
-#include "model.hpp"
+#include "gravcal/fixed_point.hpp"
+#include "gravcal/model.hpp"
 
 namespace gravcal {
 

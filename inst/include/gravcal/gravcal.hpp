@@ -8,7 +8,7 @@
 #ifndef GRAVCAL_GRAVCAL_HPP
 #define GRAVCAL_GRAVCAL_HPP
 
-#include "mcu.hpp"
-#include "segmenter.hpp"
+#include "gravcal/mcu.hpp"
+#include "gravcal/segmenter.hpp"
 
 #endif  // GRAVCAL_GRAVCAL_HPP

@@ -39,8 +39,8 @@
 #include <limits>
 #include <vector>
 
-#include "model.hpp"
-#include "r_arith.hpp"
+#include "gravcal/model.hpp"
+#include "gravcal/r_arith.hpp"
 
 namespace gravcal {
 

@@ -25,12 +25,12 @@
 #ifndef GRAVCAL_KERNELS_HPP
 #define GRAVCAL_KERNELS_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
-#include "simd.hpp"
-#include "kernels/decode.hpp"
-#include "kernels/r_mean.hpp"
-#include "kernels/window.hpp"
+#include "gravcal/simd.hpp"
+#include "gravcal/kernels/decode.hpp"
+#include "gravcal/kernels/r_mean.hpp"
+#include "gravcal/kernels/window.hpp"
 
 #if defined(GRAVCAL_SSE2)
 #include <cstdlib>

@@ -9,13 +9,13 @@
 #ifndef GRAVCAL_MCU_HPP
 #define GRAVCAL_MCU_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
-#include "model.hpp"
-#include "stats_streaming.hpp"
-#include "window_cutter.hpp"
-#include "bins.hpp"
-#include "gradient.hpp"
-#include "fixed_point.hpp"
+#include "gravcal/model.hpp"
+#include "gravcal/stats_streaming.hpp"
+#include "gravcal/window_cutter.hpp"
+#include "gravcal/bins.hpp"
+#include "gravcal/gradient.hpp"
+#include "gravcal/fixed_point.hpp"
 
 #endif  // GRAVCAL_MCU_HPP

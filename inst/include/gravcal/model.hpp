@@ -14,7 +14,7 @@
 #ifndef GRAVCAL_MODEL_HPP
 #define GRAVCAL_MODEL_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 namespace gravcal {
 

@@ -26,9 +26,9 @@
 #include <limits>
 #include <vector>
 
-#include "decode.hpp"
-#include "ggir_blocks.hpp"
-#include "segmenter.hpp"
+#include "gravcal/decode.hpp"
+#include "gravcal/ggir_blocks.hpp"
+#include "gravcal/segmenter.hpp"
 
 namespace gravcal {
 

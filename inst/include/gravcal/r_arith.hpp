@@ -26,7 +26,7 @@
 #ifndef GRAVCAL_R_ARITH_HPP
 #define GRAVCAL_R_ARITH_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>

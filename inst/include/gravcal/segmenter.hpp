@@ -28,10 +28,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "stats_r.hpp"
-#include "stats_streaming.hpp"
-#include "window_cutter.hpp"
-#include "window_stats.hpp"
+#include "gravcal/stats_r.hpp"
+#include "gravcal/stats_streaming.hpp"
+#include "gravcal/window_cutter.hpp"
+#include "gravcal/window_stats.hpp"
 
 namespace gravcal {
 

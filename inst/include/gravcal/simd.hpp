@@ -16,7 +16,7 @@
 #ifndef GRAVCAL_SIMD_HPP
 #define GRAVCAL_SIMD_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cstdlib>
 

@@ -32,7 +32,7 @@
 #ifndef GRAVCAL_STATS_R_HPP
 #define GRAVCAL_STATS_R_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -40,10 +40,10 @@
 #include <cstring>
 #include <type_traits>
 
-#include "kernels.hpp"
-#include "r_arith.hpp"
-#include "window_cutter.hpp"
-#include "window_stats.hpp"
+#include "gravcal/kernels.hpp"
+#include "gravcal/r_arith.hpp"
+#include "gravcal/window_cutter.hpp"
+#include "gravcal/window_stats.hpp"
 
 namespace gravcal {
 

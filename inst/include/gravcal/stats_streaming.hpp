@@ -15,14 +15,14 @@
 #ifndef GRAVCAL_STATS_STREAMING_HPP
 #define GRAVCAL_STATS_STREAMING_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
-#include "window_cutter.hpp"
-#include "window_stats.hpp"
+#include "gravcal/window_cutter.hpp"
+#include "gravcal/window_stats.hpp"
 
 namespace gravcal {
 

@@ -35,13 +35,13 @@
 #ifndef GRAVCAL_WINDOW_CUTTER_HPP
 #define GRAVCAL_WINDOW_CUTTER_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
-#include "window_stats.hpp"
+#include "gravcal/window_stats.hpp"
 
 namespace gravcal {
 

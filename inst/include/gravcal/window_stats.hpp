@@ -8,7 +8,7 @@
 #ifndef GRAVCAL_WINDOW_STATS_HPP
 #define GRAVCAL_WINDOW_STATS_HPP
 
-#include "fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>

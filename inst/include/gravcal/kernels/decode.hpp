@@ -9,13 +9,13 @@
 #ifndef GRAVCAL_KERNELS_DECODE_HPP
 #define GRAVCAL_KERNELS_DECODE_HPP
 
-#include "../fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
-#include "../simd.hpp"
+#include "gravcal/simd.hpp"
 
 namespace gravcal {
 

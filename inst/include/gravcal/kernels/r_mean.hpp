@@ -10,13 +10,13 @@
 #ifndef GRAVCAL_KERNELS_R_MEAN_HPP
 #define GRAVCAL_KERNELS_R_MEAN_HPP
 
-#include "../fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <limits>
 
-#include "../simd.hpp"
+#include "gravcal/simd.hpp"
 
 namespace gravcal {
 namespace kernels {

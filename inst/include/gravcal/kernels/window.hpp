@@ -16,16 +16,16 @@
 #ifndef GRAVCAL_KERNELS_WINDOW_HPP
 #define GRAVCAL_KERNELS_WINDOW_HPP
 
-#include "../fp_contract.hpp"
+#include "gravcal/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 
-#include "../simd.hpp"
-#include "../stats_streaming.hpp"
-#include "../window_cutter.hpp"
+#include "gravcal/simd.hpp"
+#include "gravcal/stats_streaming.hpp"
+#include "gravcal/window_cutter.hpp"
 
 namespace gravcal {
 namespace kernels {
