@@ -390,7 +390,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
     src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
                        reader = a$reader, compat = compat,
                        rmc = if (is.character(x)) rmc_values(a$rmc))
-    if (!a$use_temp) src$temperature <- FALSE
+    if (!a$use_temp) src <- source_with(src, temperature = FALSE)
     src
   }
   src <- open()

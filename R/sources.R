@@ -1,4 +1,5 @@
-# Sources. A source is a list with `format`, `sf`, `filename`, `temperature`
+# Sources. A source (class gravcal_source, made and checked by new_source()
+# only) is a list with `format`, `sf`, `filename`, `temperature`
 # (does it carry a temperature column), `units` (the source's units in one
 # of GGIR's blocks), `short_rows` (GENEActiv in compatible mode: a block
 # with fewer rows is the last) and `pump()`, which makes the core's source
@@ -49,31 +50,81 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
       sf <- layout$sf
     }
   }
-  src <- NULL
+  # the source's fields: from the native decoder (source_native()), else
+  # from the format's own reader (its `source`: the fields of a source, or a
+  # reader's format, sf, temperature and read(i))
+  got <- NULL
   if (reader == "native" && format_has_decoder(format)) {
-    src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
+    got <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
                          extra = layout$opts, part = part)
   }
-  if (is.null(src)) {
+  if (is.null(got)) {
     check_reference_opts(read_opts, format)
-    src <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg, format) else
+    got <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg, format) else
       format_entry(format)$source(datafile, sf, chunksize, arg, format, layout = layout)
   }
-  if (!is.null(layout$serial)) src$info$serial <- layout$serial
-  check_sf_agrees(sf, src$sf, format, datafile, sf_arg)
-  src$filename <- ggir_file_name(datafile)
-  src$path <- datafile
-  if (is.null(src$pump)) src <- reference_source(src)
-  if (!is.null(shown)) src$format <- shown
-  src
+  fields <- unclass(got)
+  if (!is.null(layout$serial)) fields$info$serial <- layout$serial
+  check_sf_agrees(sf, fields$sf, format, datafile, sf_arg)
+  fields$filename <- ggir_file_name(datafile)
+  fields$path <- datafile
+  if (is.null(fields$pump)) {
+    fields$units <- 1
+    fields$pump <- reference_pump(fields$read)
+  }
+  if (!is.null(shown)) fields$format <- shown
+  do.call(new_source, fields)
 }
 
-# A source whose blocks GGIR's own readers give (`read(i)`): one block a
-# unit. The previous block is garbage once the next is asked for: it is
-# collected before the next is read, so that memory stays at about one
-# block.
-reference_source <- function(src) {
-  read <- src$read
+# A source (see the top of this file), its fields checked: `format`,
+# `sf`, `temperature`, `units` and `pump()` are required; a decoder's
+# source has `info`, `native` and `report()`, a reference reader's
+# `read(i)`, samples in memory `n` and `time`; meta_source() adds what the
+# decoder was opened with for g.getmeta() (`getmeta_timegaps`,
+# `epoch_gaps`, `clock_shifted`). A field of the wrong type is an error
+# (the package's, not the caller's).
+new_source <- function(format, sf, temperature, units, pump, filename = NA_character_,
+                       path = NULL, short_rows = 0, info = NULL, native = NULL,
+                       report = NULL, read = NULL, n = NULL, time = NULL,
+                       getmeta_timegaps = NULL, epoch_gaps = NULL, clock_shifted = NULL) {
+  bad <- function(what) abort("Internal error: a source's `", what, "`.")
+  one <- function(x, test) length(x) == 1 && test(x)
+  if (!one(format, is.character) || is.na(format)) bad("format")
+  if (!one(sf, is.numeric)) bad("sf")
+  if (!one(temperature, is.logical) || is.na(temperature)) bad("temperature")
+  if (!one(units, is.numeric)) bad("units")
+  if (!is.function(pump)) bad("pump")
+  if (!one(filename, is.character)) bad("filename")
+  if (!is.null(path) && !one(path, is.character)) bad("path")
+  if (!one(short_rows, is.numeric)) bad("short_rows")
+  if (!is.null(info) && !is.list(info)) bad("info")
+  if (!is.null(native) && !is.list(native)) bad("native")
+  for (f in c("report", "read")) {
+    if (!is.null(get(f)) && !is.function(get(f))) bad(f)
+  }
+  if (!is.null(n) && !one(n, is.numeric)) bad("n")
+  if (!is.null(time) && !is.atomic(time)) bad("time")
+  for (f in c("getmeta_timegaps", "epoch_gaps", "clock_shifted")) {
+    if (!is.null(get(f)) && !one(get(f), is.logical)) bad(f)
+  }
+  src <- list(format = format, sf = sf, filename = filename, path = path,
+              temperature = temperature, units = units, short_rows = short_rows,
+              info = info, native = native, report = report, read = read, n = n,
+              time = time, getmeta_timegaps = getmeta_timegaps, epoch_gaps = epoch_gaps,
+              clock_shifted = clock_shifted, pump = pump)
+  structure(src[!vapply(src, is.null, TRUE)], class = "gravcal_source")
+}
+
+# `src` with some fields given anew, checked again.
+source_with <- function(src, ...) {
+  do.call(new_source, utils::modifyList(unclass(src), list(...)))
+}
+
+# The pump of a source whose blocks GGIR's own readers give (`read(i)`):
+# one block a unit. The previous block is garbage once the next is asked
+# for: it is collected before the next is read, so that memory stays at
+# about one block.
+reference_pump <- function(read) {
   columns <- function(blk) {
     if (is.null(blk)) return(NULL)
     d <- blk$data
@@ -85,8 +136,7 @@ reference_source <- function(src) {
          temperature = if ("temperature" %in% names(d)) col(d$temperature),
          last = isTRUE(blk$last))
   }
-  src$units <- 1
-  src$pump <- function() {
+  function() {
     i <- 1
     first <- columns(read(1))
     if (is.null(first)) {
@@ -99,7 +149,6 @@ reference_source <- function(src) {
       columns(read(i))
     })
   }
-  src
 }
 
 # What a fit was computed from: the source, the samples read and, from a
@@ -186,6 +235,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   B <- format_block_units(format, sf, chunksize, part)
   # GGIR's last block (GENEActiv: fewer rows than its pages hold)
   short <- if (isTRUE(compat) && !is.null(entry$ggir_short_rows)) entry$ggir_short_rows(B) else 0
+  # a source's fields (open_source() makes the source)
   list(format = format, sf = sf, temperature = isTRUE(h$info$temperature),
        info = h$info, native = h, units = B, short_rows = short,
        report = function() native_report(h),
@@ -212,16 +262,18 @@ check_reference_opts <- function(read_opts, format) {
   invisible()
 }
 
-source_frame <- function(x, sf, chunksize, arg) {
+# Samples in memory; `format` is "data.frame" but for a csv file of
+# samples read whole (source_csv()).
+source_frame <- function(x, sf, chunksize, arg, format = "data.frame") {
   s <- as_samples(x, arg)
   if (is.null(sf)) sf <- attr(x, "sf")
   if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
   if (is.null(sf)) abort("The sampling frequency of `", arg, "` is unknown: give `sf`.")
   check_sf(sf)
-  list(format = "data.frame", sf = sf, filename = NA_character_,
-       temperature = !is.null(s$temperature), n = s$n, time = s$time,
-       units = frame_block_units(sf, chunksize), short_rows = 0,
-       pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
+  new_source(format = format, sf = sf, filename = NA_character_,
+             temperature = !is.null(s$temperature), n = s$n, time = s$time,
+             units = frame_block_units(sf, chunksize), short_rows = 0,
+             pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
 }
 
 # ActiGraph csv export (10 header lines, optional column-name line, then
@@ -232,9 +284,7 @@ source_csv <- function(file, sf, chunksize, format) {
   actigraph <- is_actigraph_csv(file)
   if (!actigraph) {
     rec <- read_file(file, sf, "native", "datafile")
-    src <- source_frame(rec$data, rec$sf, chunksize, "datafile")
-    src$format <- format
-    return(src)
+    return(source_frame(rec$data, rec$sf, chunksize, "datafile", format))
   }
   hz <- regmatches(head[1], regexpr("[0-9.]+ *Hz", head[1]))
   if (is.null(sf)) {
