@@ -390,7 +390,7 @@ rmc_sf <- function(p, header, file) {
 # An ad hoc csv file block by block through data.table::fread() (reader =
 # "reference"): the same blocks, columns and units as the native decoder,
 # in R.
-source_adhoc <- function(file, sf, chunksize, arg, layout) {
+source_adhoc <- function(file, sf, chunksize, arg, layout, format) {
   if (!requireNamespace("data.table", quietly = TRUE)) {
     abort("Reading ad hoc csv files with reader = \"reference\" needs the data.table package.")
   }
@@ -404,7 +404,7 @@ source_adhoc <- function(file, sf, chunksize, arg, layout) {
     abort("`rmc.check4timegaps` = TRUE is taken by gravcal's own csv decoder only ",
           "(reader = \"native\"), not with reader = \"reference\".")
   }
-  B <- format_block_units("adhoc_csv", sf, chunksize)
+  B <- format_block_units(format, sf, chunksize)
   acc <- function(a) {
     if (!is.null(o$acc_div)) a <- a / o$acc_div
     if (!is.null(o$acc_scale)) a <- a * o$acc_scale
@@ -416,7 +416,7 @@ source_adhoc <- function(file, sf, chunksize, arg, layout) {
     switch(o$temp_unit + 1, t, t + 272.15, (t - 32) * (5 / 9))
   }
   cols <- c(o$col_x, o$col_y, o$col_z, o$col_temp)
-  list(format = "adhoc_csv", sf = sf, temperature = !is.null(o$col_temp),
+  list(format = format, sf = sf, temperature = !is.null(o$col_temp),
        read = function(i) {
          d <- tryCatch(data.table::fread(file, skip = layout$skip + (i - 1) * B, nrows = B,
                                          header = FALSE, dec = if (is.null(o$dec)) "." else o$dec,

@@ -257,14 +257,14 @@ axivity_csv_layout <- function(file, sf = NULL, compat = FALSE, zone = "",
 # The file block by block through data.table::fread() and GGIRread's
 # resampling (reader = "reference"), the time column as GGIR's reader takes
 # it in the session's zone (desiredtz and configtz "").
-source_axivity_csv <- function(file, sf, chunksize) {
+source_axivity_csv <- function(file, sf, chunksize, format) {
   if (!requireNamespace("data.table", quietly = TRUE)) {
     abort("Reading Axivity csv files with reader = \"reference\" needs the data.table package.")
   }
   need_ggirread("Axivity csv")
   sf <- axivity_csv_layout(file, sf, compat = TRUE)$sf
-  B <- format_block_units("axivity_csv", sf, chunksize)
-  list(format = "axivity_csv", sf = sf, temperature = FALSE,
+  B <- format_block_units(format, sf, chunksize)
+  list(format = format, sf = sf, temperature = FALSE,
        read = function(i) {
          d <- tryCatch(data.table::fread(file, skip = (i - 1) * B, nrows = B, header = FALSE,
                                          showProgress = FALSE, data.table = FALSE),

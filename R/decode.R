@@ -7,23 +7,11 @@
 # them; a .cwa calendar's offsets in GGIR's zone), as gc_decoder_open() answers (ptr NULL, with error or unsupported,
 # when it cannot).
 decoder_open <- function(file, format, options = list()) {
-  # "zone": GGIR's zone for a GGIR-compatible .cwa read (R/zone.R)
-  if (!is.null(tz <- options$zone)) {
-    options$zone <- NULL
-    if (format == "cwa" && !identical(as.numeric(options$compat %||% 1), 0)) {
-      zo <- zone_options(tz)
-      options[names(zo)] <- zo
-    }
-  }
-  if (format == "movisens") {
-    nums <- unisens_r_numbers(file)
-    options[names(nums)] <- nums
-  }
-  if (format == "geneactiv") {
-    lo <- geneactiv_light_header(file)
-    lo <- lo[setdiff(names(lo), names(options))]
-    options[names(lo)] <- lo
-  }
+  # "zone": GGIR's zone, for the format's r_options() (R/formats.R)
+  zone <- options$zone
+  options$zone <- NULL
+  add <- format_entry(format)$r_options
+  if (!is.null(add)) options <- add(file, options, zone)
   gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
 }
 

@@ -172,7 +172,7 @@ epochs_frame_source <- function(x, sf, start, chunksize) {
   }
   light <- if (is.data.frame(x) && "light" %in% names(x)) as.double(x$light)
   list(format = "data.frame", sf = sf, filename = NA_character_,
-       units = format_block_units("csv", sf, 2 * chunksize),
+       units = frame_block_units(sf, 2 * chunksize),
        samples = list(time = time, x = s$x, y = s$y, z = s$z,
                       temperature = s$temperature, light = light))
 }

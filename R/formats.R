@@ -50,15 +50,61 @@
 #   the format cannot hold the samples as given, write(x, file, sf, start):
 #   the file; `x` a data frame x, y, z (g), maybe temperature and light,
 #   `start` POSIXct; folder = TRUE where `file` is a folder).
+#
+# What the readers, GGIR's drop-ins and messages decide by format (a field
+# left out is FALSE / NULL / nothing to do):
+# * block_units(sf, chunksize, part): as above; `part` is "calibrate" or
+#   "getmeta" (Movisens: GGIR's block is a fixed number of samples by part,
+#   whatever chunksize);
+# * source(file, sf, chunksize, arg, format): `format` is the entry's name
+#   (the source's `format`);
+# * rmc: TRUE for the format the rmc.* parameters choose (rmc_format());
+# * adhoc_layout(file, arg, compat): read as that format, with this layout
+#   (rmc_layout()); an error where GGIR's result is asked for (compat) and
+#   GGIR does not read the file;
+# * decoder_options(file, opts, sf, read): the native decoder's options
+#   (and the rate) for this format, as list(opts, sf); `read` is list(whole
+#   = TRUE for read_recording()'s whole read, else a source's stream,
+#   compat, format, chunksize, part, zone, zone_arg);
+# * r_options(file, options, zone): options this R itself decides, added
+#   on every opening of the decoder (decoder_open()); `zone` is GGIR's zone
+#   where the caller gave one;
+# * resample_fused, fread_rule: TRUE where a GGIR-compatible read replays
+#   GGIRread::resample / data.table::fread's numbers (with_resample_fused());
+# * ggir_read_opts: the decoder options GGIR's reading parameters set for
+#   this format (reader = "reference" takes GGIR's defaults only:
+#   check_reference_opts());
+# * ggir_check_sf(file, sf): an error where GGIR's reading of the file at
+#   that rate would be wrong (compatible reads);
+# * ggir_short_rows(units): GGIR takes a block with fewer rows than this
+#   for the last (compatible reads; 0 where not given);
+# * empty_why: why a file that gave no sample holds none, where nothing
+#   was skipped ("it holds no samples" where not given); long_lines_hint:
+#   what to add when the decoder counted lines too long to read;
+# * ggir_noise: "default" where GGIR's g.calibrate takes rmc.noise (its
+#   default where not given) for the sd criterion, "given" where gravcal
+#   takes it only when given (GGIR reads no such file);
+# * ggir_codes: GGIR's g.inspectfile() monitor and data format codes, as
+#   "monc dformc" (ggir_inspect_format());
+# * ggir_decimal: a csv export whose decimal mark GGIR takes from
+#   g.inspectfile()'s `decn` (gravcal reads decimal points);
+# * ggir_zone_ambiguous: a GGIR-compatible native read counts blocks that
+#   start at a time that is ambiguous in the zone (ggir_check_zone_read());
+# * ggir_calendar: GGIR's own reader converts each block's calendar time in
+#   configtz / desiredtz (ggir_check_tz());
+# * ggir_clip: g.getmeta()'s clipping threshold where no dynamic range is
+#   known (7.5 where not given).
 recording_formats <- list(
   actigraph_csv = list(
     ggir_getmeta = TRUE,
     ggir_monitor = "actigraph", ggir_timegaps = TRUE, ggir_time = FALSE,
+    ggir_codes = "3 2", ggir_decimal = TRUE, fread_rule = TRUE,
+    empty_why = "it has a header but no data lines",
     ggir_start = function(file, p) actigraph_csv_start(file, p),
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
     detect = function(file) is_actigraph_csv(file),
     label = "an ActiGraph csv export", unit = "line",
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize) * 300,
     decoder = "actigraph_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
@@ -67,22 +113,26 @@ recording_formats <- list(
         write_actigraph_csv_file(x, file, sf, start = format(start, "%Y-%m-%d %H:%M:%OS3", tz = "UTC"),
                                  stamps = "actilife")
       }),
-    source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_csv(file, sf, chunksize, format)),
   # GENEActiv's csv export: refused where GGIR's result is asked for (GGIR
   # reads it no more), else read as the ad hoc csv file its header
   # describes (R/geneactiv-csv.R)
   geneactiv_csv = list(
-    ggir_monitor = "geneactiv",
+    ggir_monitor = "geneactiv", ggir_codes = "2 2",
     ext = c(csv = NA, csv.gz = NA), detect = function(file) is_geneactiv_csv(file),
+    adhoc_layout = function(file, arg, compat) {
+      if (isTRUE(compat)) geneactiv_csv_refuse(file, arg)
+      rmc_layout(rmc_values(geneactiv_csv_rmc(file, arg)), file, ggir = FALSE)
+    },
     label = "a GENEActiv csv export", unit = "line", own_rate = TRUE,
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize) * 300,
     decoder = NULL,
     read = function(file, sf, reader, arg) {
       d <- read_adhoc(file, reader, rmc_values(geneactiv_csv_rmc(file, arg)))$data
       if (is.list(attr(d, "input"))) attr(d, "input")$format <- "geneactiv_csv"
       d
     },
-    source = function(file, sf, chunksize, arg) {
+    source = function(file, sf, chunksize, arg, format) {
       open_source(file, sf, chunksize, arg, compat = FALSE)
     }),
   # Axivity's csv export (OMGUI): no header, lines of UNIX time stamp, x,
@@ -91,51 +141,85 @@ recording_formats <- list(
   axivity_csv = list(
     ggir_getmeta = TRUE,
     ggir_monitor = "axivity", ggir_timegaps = TRUE, local_clock = "sample",
+    ggir_codes = "4 2", ggir_decimal = TRUE, ggir_zone_ambiguous = TRUE,
+    ggir_read_opts = "interpolation", resample_fused = TRUE, fread_rule = TRUE,
+    # the time stamps' layout and GGIR's rate (R/axivity-csv.R); in GGIR's
+    # blocks of lines when streamed
+    decoder_options = function(file, opts, sf, read) {
+      lay <- if (read$whole) axivity_csv_layout(file, sf) else {
+        axivity_csv_layout(file, sf, compat = isTRUE(read$compat), zone = read$zone %||% "",
+                           zone_arg = read$zone_arg %||% "desiredtz")
+      }
+      sf <- lay$sf
+      opts[names(lay$opts)] <- lay$opts
+      if (!read$whole) opts$block_lines <- format_block_units(read$format, sf, read$chunksize)
+      list(opts = opts, sf = sf)
+    },
     ext = c(csv = NA, csv.gz = NA), detect = function(file) is_axivity_csv(file),
     label = "an Axivity csv export", unit = "line",
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize) * 300,
     decoder = "axivity_csv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
-    source = function(file, sf, chunksize, arg) source_axivity_csv(file, sf, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_axivity_csv(file, sf, chunksize, format)),
   csv = list(
     ext = c(csv = NA, csv.gz = NA), detect = NULL,
+    fread_rule = TRUE, ggir_noise = "given",
+    empty_why = "it has a header but no data lines",
+    long_lines_hint = "Fields with comma decimals must be separated by semicolons",
     label = "a csv file of samples", unit = "line",
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize) * 300,
     decoder = "csv",
     read = function(file, sf, reader, arg) read_plain_csv(file, arg),
-    source = function(file, sf, chunksize, arg) source_csv(file, sf, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_csv(file, sf, chunksize, format)),
   # GGIR's ad hoc csv: never found from the file itself, but chosen by the
   # rmc.* parameters (rmc.firstrow.acc; R/adhoc-csv.R), which give its
   # layout to the csv decoder (and to `source`, as `layout`)
   adhoc_csv = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "ad_hoc", ggir_timegaps = TRUE,
+    ggir_monitor = "ad_hoc", ggir_timegaps = TRUE, ggir_codes = "0 5", rmc = TRUE,
+    ggir_noise = "default", ggir_zone_ambiguous = TRUE, resample_fused = TRUE, fread_rule = TRUE,
+    # GGIR's block of lines: where its first line's text time is ambiguous
+    # in a zone with daylight saving (rmc_time_opts())
+    decoder_options = function(file, opts, sf, read) {
+      if (!read$whole && !is.null(sf)) {
+        opts$block_lines <- format_block_units(read$format, sf, read$chunksize)
+      }
+      list(opts = opts, sf = sf)
+    },
     ext = c(csv = NA, csv.gz = NA), detect = function(file) FALSE,
     label = "an ad hoc csv file (GGIR's rmc.* parameters)", unit = "line",
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize) * 300,
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize) * 300,
     decoder = "adhoc_csv",
     read = function(file, sf, reader, arg) {
       abort("Reading \"", file, "\" as an ad hoc csv file needs its rmc.* parameters.")
     },
-    source = function(file, sf, chunksize, arg, layout = NULL) {
-      source_adhoc(file, sf, chunksize, arg, layout)
+    source = function(file, sf, chunksize, arg, format, layout = NULL) {
+      source_adhoc(file, sf, chunksize, arg, layout, format)
     }),
   rds = list(
     ext = c(rds = ".rds"), detect = NULL,
     label = "an .rds file", unit = "unit", block_units = NULL, decoder = NULL,
     read = function(file, sf, reader, arg) read_rds(file, arg),
-    source = function(file, sf, chunksize, arg) {
+    source = function(file, sf, chunksize, arg, format) {
       rec <- read_file(file, sf, "native", arg)
       source_frame(rec$data, rec$sf, chunksize, arg)
     }),
   gt3x = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "actigraph",
+    ggir_monitor = "actigraph", ggir_codes = "3 6",
     ext = c(gt3x = ".gt3x"), detect = NULL,
+    # idle sleep: GGIR's batches leave it out; gravcal's own streams put it
+    # back as zeros where it was, as a whole read does (as read.gt3x's
+    # imputeZeroes = TRUE, to its last sample time; calibration skips them)
+    decoder_options = function(file, opts, sf, read) {
+      if (read$whole) opts$compat <- 1
+      if (read$whole || !isTRUE(read$compat)) opts$impute_zeroes <- 1
+      list(opts = opts, sf = sf)
+    },
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     local_clock = "sample", ggir_timegaps = TRUE,
-    ggir_inspect = function(file, tz) ggir_inspect_gt3x(file, tz),
-    block_units = function(sf, chunksize) (12 * 3600) * chunksize,  # seconds
+    ggir_inspect = function(file, tz) ggir_inspect_gt3x(file, tz, decoder = "gt3x"),
+    block_units = function(sf, chunksize, part) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",
     read = function(file, sf, reader, arg) read_gt3x_file(file),
     write = list(
@@ -149,14 +233,24 @@ recording_formats <- list(
       write = function(x, file, sf, start) {
         write_gt3x(x[c("x", "y", "z")], file, sf = sf, start = start)
       }),
-    source = function(file, sf, chunksize, arg) source_gt3x(file, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_gt3x(file, chunksize, format)),
   cwa = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "axivity",
+    ggir_monitor = "axivity", ggir_codes = "4 4", ggir_zone_ambiguous = TRUE,
+    ggir_calendar = TRUE, resample_fused = TRUE,
+    ggir_read_opts = c("interpolation", "frequency_tol"),
     ext = c(cwa = ".cwa"), detect = NULL,
+    # GGIR's zone for a GGIR-compatible read (R/zone.R)
+    r_options = function(file, options, zone) {
+      if (!is.null(zone) && !identical(as.numeric(options$compat %||% 1), 0)) {
+        zo <- zone_options(zone)
+        options[names(zo)] <- zo
+      }
+      options
+    },
     label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
-    block_units = function(sf, chunksize) round(12 * 3600 * sf / 80 * chunksize),
+    block_units = function(sf, chunksize, part) round(12 * 3600 * sf / 80 * chunksize),
     decoder = "cwa",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
@@ -175,18 +269,36 @@ recording_formats <- list(
                   temperature = if (is.null(x$temperature)) 25 else x$temperature,
                   light = if (is.null(x$light)) 0 else x$light)
       }),
-    source = function(file, sf, chunksize, arg) source_cwa(file, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_cwa(file, chunksize, format)),
   # Movisens: a unisens folder (unisens.xml, acc.bin, temp.bin), named by
   # the folder or its acc.bin (GGIR's filename); GGIR reads it in blocks of
   # sf * 60 * 1440 / 2 samples whatever chunksize, and assumes 64 Hz
   movisens = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "movisens",
+    ggir_monitor = "movisens", ggir_codes = "5 1", ggir_clip = 15.5,
+    ggir_read_opts = "interpolation", resample_fused = TRUE,
+    decoder_options = function(file, opts, sf, read) {
+      if (!read$whole) opts$block_samples <- movisens_block(file, read$part)
+      list(opts = opts, sf = sf)
+    },
+    r_options = function(file, options, zone) {
+      nums <- unisens_r_numbers(file)
+      options[names(nums)] <- nums
+      options
+    },
+    # GGIR takes every Movisens recording for 64 Hz (g.inspectfile)
+    ggir_check_sf = function(file, sf) {
+      if (!identical(sf, 64)) {
+        abort("\"", file, "\" is a Movisens recording at ", format(sf), " Hz; GGIR ",
+              "reads every Movisens recording as 64 Hz, so its results for this one ",
+              "would be wrong: use calibrate() (gravcal's own methods) instead.")
+      }
+    },
     ggir_start = function(file, p) movisens_start(file, p),
     ext = c(bin = "Movisens (a unisens folder or its acc.bin)"),
     detect = function(file) is_movisens_bin(file),
     label = "a Movisens recording", unit = "sample", own_rate = TRUE,
-    block_units = function(sf, chunksize) movisens_block(),
+    block_units = function(sf, chunksize, part) movisens_block(NULL, part),
     decoder = "movisens",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
@@ -195,13 +307,24 @@ recording_formats <- list(
       write = function(x, file, sf, start) {
         write_movisens(x, file, sf = sf, start = start, temp = !is.null(x$temperature))
       }),
-    source = function(file, sf, chunksize, arg) source_movisens(file)),
+    source = function(file, sf, chunksize, arg, format) source_movisens(file, format)),
   geneactiv = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "geneactiv",
+    ggir_monitor = "geneactiv", ggir_codes = "2 1",
+    ggir_read_opts = "interpolation", resample_fused = TRUE,
+    # GGIR's g.readaccfile takes a block with fewer rows than its pages hold
+    # for the last one; after its resampling of a rate that rounds down
+    # (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
+    ggir_short_rows = function(units) units * 300,
+    r_options = function(file, options, zone) {
+      lo <- geneactiv_light_header(file)
+      lo <- lo[setdiff(names(lo), names(options))]
+      options[names(lo)] <- lo
+      options
+    },
     ext = c(bin = "GENEActiv .bin"), detect = function(file) !is_parmay_bin(file),
     label = "a GENEActiv .bin file", unit = "page", own_rate = TRUE, local_clock = "block",
-    block_units = function(sf, chunksize) ggir_pages(sf, chunksize),
+    block_units = function(sf, chunksize, part) ggir_pages(sf, chunksize),
     decoder = "geneactiv",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
@@ -211,7 +334,7 @@ recording_formats <- list(
       write = function(x, file, sf, start) {
         write_geneactiv_bin(x, file, sf = sf, start = format(start, "%Y-%m-%d %H:%M:%OS3", tz = "UTC"))
       }),
-    source = function(file, sf, chunksize, arg) source_geneactiv(file, chunksize)),
+    source = function(file, sf, chunksize, arg, format) source_geneactiv(file, chunksize, format)),
   # Parmay Matrix: "MDTC" at byte 512. GGIRread's reader reads from the
   # block's first packet to the end of the file whatever end it is given, so
   # GGIR's first block is the whole file (and its last). Its times are the
@@ -221,12 +344,13 @@ recording_formats <- list(
   # (parmay_qclog())
   parmay = list(
     ggir_getmeta = TRUE,
-    ggir_monitor = "parmay_mtx",
+    ggir_monitor = "parmay_mtx", ggir_codes = "7 1",
+    ggir_read_opts = "interpolation", resample_fused = TRUE,
     ggir_qclog = function(src) parmay_qclog(src),
     ggir_stops = function(src) parmay_ggir_stops(src),
     ext = c(bin = "Parmay Matrix .bin"), detect = function(file) is_parmay_bin(file),
     label = "a Parmay Matrix .bin file", unit = "packet", own_rate = TRUE,
-    block_units = function(sf, chunksize) 2^52,
+    block_units = function(sf, chunksize, part) 2^52,
     decoder = "parmay",
     read = function(file, sf, reader, arg) read_blocks(file, sf, reader),
     write = list(
@@ -242,7 +366,7 @@ recording_formats <- list(
       write = function(x, file, sf, start) {
         write_parmay_bin(x, file, sf = sf, start = as.numeric(start))
       }),
-    source = function(file, sf, chunksize, arg) source_parmay(file))
+    source = function(file, sf, chunksize, arg, format) source_parmay(file, format))
 )
 
 # Whether `file` is the acc.bin of a unisens folder (a Movisens recording).
@@ -340,6 +464,25 @@ ggir_pages <- function(sf, chunksize) {
   round((14512 * (sf / 50)) * (chunksize * 0.5))
 }
 
-format_block_units <- function(format, sf, chunksize) {
-  format_entry(format)$block_units(sf, chunksize)
+format_block_units <- function(format, sf, chunksize, part = "calibrate") {
+  format_entry(format)$block_units(sf, chunksize, part)
+}
+
+# Samples in memory (a data frame) are cut as a csv file of samples.
+frame_block_units <- function(sf, chunksize) {
+  format_block_units("csv", sf, chunksize)
+}
+
+# The format the rmc.* parameters choose (GGIR's ad hoc csv).
+rmc_format <- function() {
+  names(Filter(function(f) isTRUE(f$rmc), recording_formats))
+}
+
+# The native decoder's options and rate for `format` (its
+# decoder_options(), where it has one): list(opts, sf).
+format_decoder_options <- function(format, file, opts, sf, read) {
+  f <- format_entry(format)$decoder_options
+  if (is.null(f)) return(list(opts = opts, sf = sf))
+  read$format <- format
+  f(file, opts, sf, read)
 }

@@ -121,17 +121,18 @@ ggir_resample_fused <- function() {
 }
 
 # The decoder options with "resample_fused" added for the reads that replay
-# GGIRread::resample (GGIR-compatible .cwa, GENEActiv, Parmay Matrix, Axivity
-# csv and ad hoc csv with rmc.doresample), and "fread_rule" for the csv
-# reads that replay data.table::fread's numbers, unless the caller gave them.
+# GGIRread::resample (GGIR-compatible reads of the formats whose registry
+# entry says resample_fused: .cwa, GENEActiv, Parmay Matrix, Axivity csv,
+# ad hoc csv with rmc.doresample, ...), and "fread_rule" for the csv reads
+# that replay data.table::fread's numbers (fread_rule), unless the caller
+# gave them.
 with_resample_fused <- function(opts, format) {
   compat <- !identical(as.numeric(opts$compat %||% 1), 0)
-  if (format %in% c("cwa", "geneactiv", "axivity_csv", "adhoc_csv", "parmay", "movisens") &&
-      is.null(opts$resample_fused) && compat) {
+  entry <- format_entry(format)
+  if (isTRUE(entry$resample_fused) && is.null(opts$resample_fused) && compat) {
     opts$resample_fused <- as.numeric(ggir_resample_fused())
   }
-  if (format %in% c("csv", "actigraph_csv", "axivity_csv", "adhoc_csv") &&
-      is.null(opts$fread_rule) && compat) {
+  if (isTRUE(entry$fread_rule) && is.null(opts$fread_rule) && compat) {
     opts$fread_rule <- as.numeric(fread_number_rule())
   }
   opts

@@ -181,9 +181,10 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   # GGIR uses rmc.noise only for ad hoc csv files (its "AD_HOC" monitor),
   # with GGIR's default (load_params(): 13) where the list has none;
   # samples in a data frame, which GGIR does not take, are treated alike
-  sdcriter <- if (src$format == "adhoc_csv") {
+  noise <- if (identical(src$format, "data.frame")) "given" else format_entry(src$format)$ggir_noise
+  sdcriter <- if (identical(noise, "default")) {
     (pr$rmc.noise %||% ggir_constants$rmc_noise) * 1.2
-  } else if (src$format %in% c("csv", "data.frame") && !is.null(pr$rmc.noise)) {
+  } else if (identical(noise, "given") && !is.null(pr$rmc.noise)) {
     pr$rmc.noise * 1.2
   } else {
     ggir_constants$max_sd
@@ -192,7 +193,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                         minloadcrit = pr$minloadcrit,
                         sdcriter = sdcriter, verbose = verbose,
                         printsummary = pr$printsummary)
-  if (identical(src$format, "adhoc_csv") && !is.null(rmc)) {
+  if (identical(src$format, rmc_format()) && !is.null(rmc)) {
     ggir_check_zone_read(src, attr(rmc, "tz") %||% "", attr(rmc, "tz_arg"))
   } else {
     ggir_check_zone_read(src, tz %||% "", tz_arg)
@@ -212,10 +213,9 @@ ggir_inspect_format <- function(I) {
     return(NULL)
   }
   if (isTRUE(mon == 6)) mon <- 3  # Verisense: read as ActiGraph
-  switch(paste(mon, dform),
-         "3 2" = "actigraph_csv", "4 2" = "axivity_csv", "2 2" = "geneactiv_csv",
-         "3 6" = "gt3x", "4 4" = "cwa", "2 1" = "geneactiv", "5 1" = "movisens",
-         "7 1" = "parmay", "0 5" = "adhoc_csv", NA_character_)
+  code <- paste(mon, dform)
+  hit <- names(Filter(function(f) code %in% f$ggir_codes, recording_formats))
+  if (length(hit)) hit[1] else NA_character_
 }
 
 # g.calibrate() follows an `inspectfileobject` (GGIR's g.inspectfile()
@@ -231,7 +231,7 @@ ggir_check_inspect <- function(I, datafile, adhoc) {
   if (!is.null(claimed)) {
     file <- unisens_acc(datafile)
     check_file(file, "datafile")
-    actual <- if (adhoc) "adhoc_csv" else tryCatch(file_format(file, "datafile"),
+    actual <- if (adhoc) rmc_format() else tryCatch(file_format(file, "datafile"),
                                                    error = function(e) NA_character_)
     if (!identical(claimed, actual)) {
       what <- if (is.na(claimed)) "a format gravcal does not read" else format_entry(claimed)$label
@@ -243,7 +243,7 @@ ggir_check_inspect <- function(I, datafile, adhoc) {
             "GGIR::g.inspectfile()'s result for this file with the same parameters, or ",
             "leave `inspectfileobject` out.")
     }
-    if (claimed %in% c("actigraph_csv", "axivity_csv") && identical(I$decn, ",")) {
+    if (isTRUE(format_entry(claimed)$ggir_decimal) && identical(I$decn, ",")) {
       abort("`inspectfileobject$decn` = \",\": GGIR would read the values of \"",
             basename(datafile), "\" with decimal commas; gravcal reads this csv export ",
             "with decimal points.")
@@ -297,7 +297,7 @@ ggir_params <- function(params_rawdata, params_general, dots) {
 # that depends on R's conversions before it, which gravcal does not know:
 # an error naming the parameter.
 ggir_check_zone_read <- function(src, tz, arg) {
-  if (!isTRUE(src$format %in% c("cwa", "adhoc_csv", "axivity_csv")) || is.null(src$report)) {
+  if (!isTRUE(format_entry(src$format)$ggir_zone_ambiguous) || is.null(src$report)) {
     return(invisible())
   }
   n <- src$report()$counters["zone_ambiguous"]
@@ -324,7 +324,7 @@ ggir_check_zone_read <- function(src, tz, arg) {
 # at is the first block's time to the last block's (calendar times read as
 # UTC), 15 hours either side (more than any zone's offset).
 ggir_check_tz <- function(src, datafile, desiredtz, configtz) {
-  if (!identical(src$format, "cwa") || !is.character(datafile)) return(invisible())
+  if (!isTRUE(format_entry(src$format)$ggir_calendar) || !is.character(datafile)) return(invisible())
   tz <- if (length(configtz)) configtz else desiredtz
   arg <- if (length(configtz)) "configtz" else "desiredtz"
   span <- cwa_time_span(datafile)
@@ -390,7 +390,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
     src <- open_source(x, sf = sf, chunksize = a$chunksize, arg = "x",
                        reader = a$reader, compat = compat,
                        rmc = if (is.character(x)) rmc_values(a$rmc))
-    if (!a$use_temp) src$temperature <- FALSE
+    if (!a$use_temp) src <- source_with(src, temperature = FALSE)
     src
   }
   src <- open()

@@ -38,14 +38,14 @@ ggir_inspect_filename <- function(datafile) {
 # extension GGIR does not take as .gt3x, a Movisens folder beside the file
 # (GGIR then reads it as Movisens), an info.txt gravcal cannot read (GGIR
 # warns and leaves `sf` NULL, or stops).
-ggir_inspect_gt3x <- function(datafile, desiredtz) {
+ggir_inspect_gt3x <- function(datafile, desiredtz, decoder) {
   ext <- utils::tail(strsplit(basename(datafile), ".", fixed = TRUE)[[1]], 1)
   if (!ext %in% c("gt3x", "GT3X") || dir.exists(datafile) ||
       file.exists(file.path(dirname(datafile), "unisens.xml")) ||
       !requireNamespace("read.gt3x", quietly = TRUE)) {
     return(NULL)
   }
-  opened <- gc_decoder_open(path.expand(datafile), "gt3x", list())
+  opened <- gc_decoder_open(path.expand(datafile), decoder, list())
   if (is.null(opened$ptr)) return(NULL)
   gc_decoder_close(opened$ptr)
   text <- opened$info$header_text

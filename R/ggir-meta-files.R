@@ -224,7 +224,7 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
                                           "meta file exists (overwrite = FALSE)", meta)
       next
     }
-    fmt <- if (!is.null(mp$.rmc)) "adhoc_csv" else {
+    fmt <- if (!is.null(mp$.rmc)) rmc_format() else {
       tryCatch(file_format(fnamesfull[i]), error = function(e) NA_character_)
     }
     if (is.na(fmt) || !fmt %in% meta_formats()) {

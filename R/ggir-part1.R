@@ -361,7 +361,7 @@ meta_nonwear <- function(src, p) {
   mon <- format_entry(src$format)$ggir_monitor
   # a Parmay Matrix's range from its header, whatever dynrange says
   if (identical(mon, "parmay_mtx")) dynrange <- src$info$range_g
-  clipthres <- if (length(dynrange)) dynrange - 0.5 else if (identical(mon, "movisens")) 15.5 else 7.5
+  clipthres <- if (length(dynrange)) dynrange - 0.5 else format_entry(src$format)$ggir_clip %||% 7.5
   sdcriter <- 0.013
   if (identical(mon, "ad_hoc")) {
     # GGIR's AD_HOC monitor: clipping beyond rmc.dynamic_range itself (none

@@ -41,11 +41,8 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
     ro$clock_until <- tab$until
   }
   gc_decoder_close(src$native$ptr)
-  src <- open(ro)
-  src$getmeta_timegaps <- TRUE
-  src$epoch_gaps <- TRUE
-  src$clock_shifted <- !is.null(tab)
-  src
+  source_with(open(ro), getmeta_timegaps = TRUE, epoch_gaps = TRUE,
+              clock_shifted = !is.null(tab))
 }
 
 # The zone in which GGIR 3.3-9's g.imputeTimegaps() reads the time of day

@@ -78,7 +78,7 @@ read_adhoc <- function(file, reader, p) {
   }
   if (reader == "native") {
     layout <- rmc_layout(p, file, ggir = FALSE)
-    d <- read_native(file, "adhoc_csv", layout$sf, "file",
+    d <- read_native(file, rmc_format(), layout$sf, "file",
                      extra = c(layout$opts, compat = 1))
     if (is.null(d)) reader <- "reference"
   }
@@ -87,7 +87,7 @@ read_adhoc <- function(file, reader, p) {
                        rmc = p)
     d <- as.data.frame(gc_pump(src$pump(), "samples", list(time = 0)))
     attr(d, "sf") <- src$sf
-    attr(d, "input") <- list(source = basename(file), format = "adhoc_csv",
+    attr(d, "input") <- list(source = basename(file), format = rmc_format(),
                              reader = "reference", samples = nrow(d))
   }
   if (!nrow(d)) abort("`file` holds no samples: \"", file, "\".")
@@ -193,14 +193,12 @@ no_samples_error <- function(data, file, format, arg) {
     paste0("every ", unit_name(format, 1), " read was skipped (",
            format(r$skipped), " skipped",
            if (length(r$notes)) paste0("; first: ", r$notes[1]), ")")
-  } else if (format %in% c("csv", "actigraph_csv")) {
-    "it has a header but no data lines"
   } else {
-    "it holds no samples"
+    format_entry(format)$empty_why %||% "it holds no samples"
   }
-  if (!is.null(r) && format == "csv" && isTRUE(unname(r$counters["long_lines"]) > 0)) {
-    why <- paste0(why, ". Fields with comma decimals must be separated by ",
-                  "semicolons")
+  hint <- format_entry(format)$long_lines_hint
+  if (!is.null(r) && !is.null(hint) && isTRUE(unname(r$counters["long_lines"]) > 0)) {
+    why <- paste0(why, ". ", hint)
   }
   abort("`", arg, "` \"", file, "\" holds no samples: ", why, ".")
 }
@@ -209,17 +207,13 @@ no_samples_error <- function(data, file, format, arg) {
 # as POSIXct; NULL when this build has no decoder for the format.
 read_native <- function(file, format, sf, arg = "file", extra = NULL) {
   opts <- list(compat = 0)
-  # a whole .gt3x read gives idle-sleep periods as zeros at their times, as
-  # read.gt3x(imputeZeroes = TRUE) does, to its last sample time; calibration
-  # skips them
-  if (format == "gt3x") opts <- list(compat = 1, impute_zeroes = 1)
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
-  if (format == "axivity_csv") {
-    lay <- axivity_csv_layout(file, sf)
-    sf <- lay$sf
-    opts[names(lay$opts)] <- lay$opts
-  }
+  # the format's own options for a whole read (R/formats.R: a .gt3x's
+  # idle sleep as zeros, an Axivity csv export's layout)
+  set <- format_decoder_options(format, file, opts, sf, list(whole = TRUE))
+  opts <- set$opts
+  sf <- set$sf
   h <- decoder_open(file, format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)

@@ -1,4 +1,5 @@
-# Sources. A source is a list with `format`, `sf`, `filename`, `temperature`
+# Sources. A source (class gravcal_source, made and checked by new_source()
+# only) is a list with `format`, `sf`, `filename`, `temperature`
 # (does it carry a temperature column), `units` (the source's units in one
 # of GGIR's blocks), `short_rows` (GENEActiv in compatible mode: a block
 # with fewer rows is the last) and `pump()`, which makes the core's source
@@ -37,44 +38,93 @@ open_source <- function(datafile, sf = NULL, chunksize = 1, arg = "datafile",
   layout <- NULL
   shown <- NULL  # the format fits and tables name, where it is read as another
   if (!is.null(rmc$rmc.firstrow.acc)) {
-    format <- "adhoc_csv"
+    format <- rmc_format()
     layout <- rmc_layout(rmc, datafile, ggir = compat, stamps = identical(part, "getmeta"))
     sf <- layout$sf
   } else {
     format <- file_format(datafile, arg)
-    if (format == "geneactiv_csv") {
-      if (isTRUE(compat)) geneactiv_csv_refuse(datafile, arg)
+    if (!is.null(as_adhoc <- format_entry(format)$adhoc_layout)) {
+      layout <- as_adhoc(datafile, arg, compat)
       shown <- format
-      format <- "adhoc_csv"
-      layout <- rmc_layout(rmc_values(geneactiv_csv_rmc(datafile, arg)), datafile, ggir = FALSE)
+      format <- rmc_format()
       sf <- layout$sf
     }
   }
-  src <- NULL
+  # the source's fields: from the native decoder (source_native()), else
+  # from the format's own reader (its `source`: the fields of a source, or a
+  # reader's format, sf, temperature and read(i))
+  got <- NULL
   if (reader == "native" && format_has_decoder(format)) {
-    src <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
+    got <- source_native(datafile, format, sf, chunksize, compat, arg, read_opts,
                          extra = layout$opts, part = part)
   }
-  if (is.null(src)) {
+  if (is.null(got)) {
     check_reference_opts(read_opts, format)
-    src <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg) else
-      format_entry(format)$source(datafile, sf, chunksize, arg, layout = layout)
+    got <- if (is.null(layout)) format_entry(format)$source(datafile, sf, chunksize, arg, format) else
+      format_entry(format)$source(datafile, sf, chunksize, arg, format, layout = layout)
   }
-  if (!is.null(layout$serial)) src$info$serial <- layout$serial
-  check_sf_agrees(sf, src$sf, format, datafile, sf_arg)
-  src$filename <- ggir_file_name(datafile)
-  src$path <- datafile
-  if (is.null(src$pump)) src <- reference_source(src)
-  if (!is.null(shown)) src$format <- shown
-  src
+  fields <- unclass(got)
+  if (!is.null(layout$serial)) fields$info$serial <- layout$serial
+  check_sf_agrees(sf, fields$sf, format, datafile, sf_arg)
+  fields$filename <- ggir_file_name(datafile)
+  fields$path <- datafile
+  if (is.null(fields$pump)) {
+    fields$units <- 1
+    fields$pump <- reference_pump(fields$read)
+  }
+  if (!is.null(shown)) fields$format <- shown
+  do.call(new_source, fields)
 }
 
-# A source whose blocks GGIR's own readers give (`read(i)`): one block a
-# unit. The previous block is garbage once the next is asked for: it is
-# collected before the next is read, so that memory stays at about one
-# block.
-reference_source <- function(src) {
-  read <- src$read
+# A source (see the top of this file), its fields checked: `format`,
+# `sf`, `temperature`, `units` and `pump()` are required; a decoder's
+# source has `info`, `native` and `report()`, a reference reader's
+# `read(i)`, samples in memory `n` and `time`; meta_source() adds what the
+# decoder was opened with for g.getmeta() (`getmeta_timegaps`,
+# `epoch_gaps`, `clock_shifted`). A field of the wrong type is an error
+# (the package's, not the caller's).
+new_source <- function(format, sf, temperature, units, pump, filename = NA_character_,
+                       path = NULL, short_rows = 0, info = NULL, native = NULL,
+                       report = NULL, read = NULL, n = NULL, time = NULL,
+                       getmeta_timegaps = NULL, epoch_gaps = NULL, clock_shifted = NULL) {
+  bad <- function(what) abort("Internal error: a source's `", what, "`.")
+  one <- function(x, test) length(x) == 1 && test(x)
+  if (!one(format, is.character) || is.na(format)) bad("format")
+  if (!one(sf, is.numeric)) bad("sf")
+  if (!one(temperature, is.logical) || is.na(temperature)) bad("temperature")
+  if (!one(units, is.numeric)) bad("units")
+  if (!is.function(pump)) bad("pump")
+  if (!one(filename, is.character)) bad("filename")
+  if (!is.null(path) && !one(path, is.character)) bad("path")
+  if (!one(short_rows, is.numeric)) bad("short_rows")
+  if (!is.null(info) && !is.list(info)) bad("info")
+  if (!is.null(native) && !is.list(native)) bad("native")
+  for (f in c("report", "read")) {
+    if (!is.null(get(f)) && !is.function(get(f))) bad(f)
+  }
+  if (!is.null(n) && !one(n, is.numeric)) bad("n")
+  if (!is.null(time) && !is.atomic(time)) bad("time")
+  for (f in c("getmeta_timegaps", "epoch_gaps", "clock_shifted")) {
+    if (!is.null(get(f)) && !one(get(f), is.logical)) bad(f)
+  }
+  src <- list(format = format, sf = sf, filename = filename, path = path,
+              temperature = temperature, units = units, short_rows = short_rows,
+              info = info, native = native, report = report, read = read, n = n,
+              time = time, getmeta_timegaps = getmeta_timegaps, epoch_gaps = epoch_gaps,
+              clock_shifted = clock_shifted, pump = pump)
+  structure(src[!vapply(src, is.null, TRUE)], class = "gravcal_source")
+}
+
+# `src` with some fields given anew, checked again.
+source_with <- function(src, ...) {
+  do.call(new_source, utils::modifyList(unclass(src), list(...)))
+}
+
+# The pump of a source whose blocks GGIR's own readers give (`read(i)`):
+# one block a unit. The previous block is garbage once the next is asked
+# for: it is collected before the next is read, so that memory stays at
+# about one block.
+reference_pump <- function(read) {
   columns <- function(blk) {
     if (is.null(blk)) return(NULL)
     d <- blk$data
@@ -86,8 +136,7 @@ reference_source <- function(src) {
          temperature = if ("temperature" %in% names(d)) col(d$temperature),
          last = isTRUE(blk$last))
   }
-  src$units <- 1
-  src$pump <- function() {
+  function() {
     i <- 1
     first <- columns(read(1))
     if (is.null(first)) {
@@ -100,7 +149,6 @@ reference_source <- function(src) {
       columns(read(i))
     })
   }
-  src
 }
 
 # What a fit was computed from: the source, the samples read and, from a
@@ -166,41 +214,28 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
   opts$zone_arg <- NULL
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
-  if (format == "movisens") opts$block_samples <- movisens_block(file, part)
-  # GGIR's block of lines: where its first line's text time is ambiguous in
-  # a zone with daylight saving (rmc_time_opts())
-  if (format == "adhoc_csv" && !is.null(sf)) opts$block_lines <- format_block_units(format, sf, chunksize)
-  if (format == "axivity_csv") {
-    lay <- axivity_csv_layout(file, sf, compat = isTRUE(compat), zone = read_opts$zone %||% "",
-                              zone_arg = read_opts$zone_arg %||% "desiredtz")
-    sf <- lay$sf
-    opts[names(lay$opts)] <- lay$opts
-    opts$block_lines <- format_block_units(format, sf, chunksize)
-  }
-  # .gt3x idle sleep: GGIR's batches leave it out; gravcal's own streams put
-  # it back as zeros where it was, as a whole read does
-  if (format == "gt3x" && !isTRUE(compat)) opts$impute_zeroes <- 1
+  set <- format_decoder_options(format, file, opts, sf,
+                                list(whole = FALSE, compat = compat, chunksize = chunksize,
+                                     part = part, zone = read_opts$zone,
+                                     zone_arg = read_opts$zone_arg))
+  opts <- set$opts
+  sf <- set$sf
   h <- decoder_open(file, format, opts)
   if (is.null(h$ptr)) {
     if (isTRUE(h$unsupported)) return(NULL)
     native_open_error(file, format, h$error, arg)
   }
-  if (is.null(sf) || isTRUE(format_entry(format)$own_rate)) sf <- h$info$sf
-  # GGIR takes every Movisens recording for 64 Hz (g.inspectfile)
-  if (format == "movisens" && isTRUE(compat) && !identical(sf, 64)) {
-    abort("\"", file, "\" is a Movisens recording at ", format(sf), " Hz; GGIR ",
-          "reads every Movisens recording as 64 Hz, so its results for this one ",
-          "would be wrong: use calibrate() (gravcal's own methods) instead.")
-  }
+  entry <- format_entry(format)
+  if (is.null(sf) || isTRUE(entry$own_rate)) sf <- h$info$sf
+  if (isTRUE(compat) && !is.null(entry$ggir_check_sf)) entry$ggir_check_sf(file, sf)
   if (!isTRUE(is.finite(sf) && sf > 0)) {
     abort("The sampling frequency of \"", file, "\" is unknown: give `sf`.")
   }
   check_sf(sf)
-  B <- if (format == "movisens") movisens_block(file, part) else format_block_units(format, sf, chunksize)
-  # GGIR's g.readaccfile takes a GENEActiv block with fewer rows than its
-  # pages hold for the last one; after its resampling of a rate that rounds
-  # down (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
-  short <- if (format == "geneactiv" && isTRUE(compat)) B * 300 else 0
+  B <- format_block_units(format, sf, chunksize, part)
+  # GGIR's last block (GENEActiv: fewer rows than its pages hold)
+  short <- if (isTRUE(compat) && !is.null(entry$ggir_short_rows)) entry$ggir_short_rows(B) else 0
+  # a source's fields (open_source() makes the source)
   list(format = format, sf = sf, temperature = isTRUE(h$info$temperature),
        info = h$info, native = h, units = B, short_rows = short,
        report = function() native_report(h),
@@ -215,9 +250,7 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
 check_reference_opts <- function(read_opts, format) {
   defaults <- list(interpolation = c(interpolationType = 1),
                    frequency_tol = c(frequency_tol = 0.1))
-  used <- switch(format, cwa = c("interpolation", "frequency_tol"),
-                 geneactiv = , axivity_csv = , parmay = , movisens = "interpolation",
-                 character(0))
+  used <- format_entry(format)$ggir_read_opts
   for (nm in intersect(intersect(names(read_opts), names(defaults)), used)) {
     d <- defaults[[nm]]
     if (!identical(as.numeric(read_opts[[nm]]), unname(d))) {
@@ -229,29 +262,29 @@ check_reference_opts <- function(read_opts, format) {
   invisible()
 }
 
-source_frame <- function(x, sf, chunksize, arg) {
+# Samples in memory; `format` is "data.frame" but for a csv file of
+# samples read whole (source_csv()).
+source_frame <- function(x, sf, chunksize, arg, format = "data.frame") {
   s <- as_samples(x, arg)
   if (is.null(sf)) sf <- attr(x, "sf")
   if (is.null(sf) && !is.null(s$time)) sf <- sf_from_time(s$time)
   if (is.null(sf)) abort("The sampling frequency of `", arg, "` is unknown: give `sf`.")
   check_sf(sf)
-  list(format = "data.frame", sf = sf, filename = NA_character_,
-       temperature = !is.null(s$temperature), n = s$n, time = s$time,
-       units = format_block_units("csv", sf, chunksize), short_rows = 0,
-       pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
+  new_source(format = format, sf = sf, filename = NA_character_,
+             temperature = !is.null(s$temperature), n = s$n, time = s$time,
+             units = frame_block_units(sf, chunksize), short_rows = 0,
+             pump = function() gc_source_columns(s$x, s$y, s$z, s$temperature))
 }
 
 # ActiGraph csv export (10 header lines, optional column-name line, then
 # [timestamp,] x, y, z) or a plain csv with a header line naming x, y, z.
-source_csv <- function(file, sf, chunksize) {
+source_csv <- function(file, sf, chunksize, format) {
   head <- suppressWarnings(readLines(file, n = 12, warn = FALSE))
   if (!length(head)) abort("`datafile` is empty: \"", file, "\".")
   actigraph <- is_actigraph_csv(file)
   if (!actigraph) {
     rec <- read_file(file, sf, "native", "datafile")
-    src <- source_frame(rec$data, rec$sf, chunksize, "datafile")
-    src$format <- "csv"
-    return(src)
+    return(source_frame(rec$data, rec$sf, chunksize, "datafile", format))
   }
   hz <- regmatches(head[1], regexpr("[0-9.]+ *Hz", head[1]))
   if (is.null(sf)) {
@@ -264,7 +297,7 @@ source_csv <- function(file, sf, chunksize) {
     first <- strsplit(head[11], ",")[[1]][1]
     if (is.na(suppressWarnings(as.numeric(first)))) skip0 <- 11L
   }
-  B <- format_block_units("actigraph_csv", sf, chunksize)
+  B <- format_block_units(format, sf, chunksize)
   # with a time stamp column first, x, y, z are columns 2 to 4; the time
   # stamps are not read at all (as strings they would take more memory than
   # the samples)
@@ -291,7 +324,7 @@ source_csv <- function(file, sf, chunksize) {
     }
     d
   }
-  list(format = "actigraph_csv", sf = sf, temperature = FALSE,
+  list(format = format, sf = sf, temperature = FALSE,
        read = function(i) {
          d <- read_rows(skip0 + (i - 1) * B, B)
          if (is.null(d)) return(NULL)
@@ -305,7 +338,7 @@ need_ggirread <- function(what) {
   }
 }
 
-source_cwa <- function(file, chunksize) {
+source_cwa <- function(file, chunksize, format) {
   need_ggirread("Axivity .cwa")
   first <- tryCatch(GGIRread::readAxivity(file, start = 0, end = 1, progressBar = FALSE),
                     error = function(e) NULL)
@@ -313,8 +346,8 @@ source_cwa <- function(file, chunksize) {
     abort("Corrupt or unreadable .cwa file \"", file, "\".")
   }
   sf <- first$header$frequency
-  B <- format_block_units("cwa", sf, chunksize)
-  list(format = "cwa", sf = sf, temperature = TRUE,
+  B <- format_block_units(format, sf, chunksize)
+  list(format = format, sf = sf, temperature = TRUE,
        read = function(i) {
          start <- B * (i - 1)
          P <- tryCatch(GGIRread::readAxivity(file, start = start, end = start + B,
@@ -328,7 +361,7 @@ source_cwa <- function(file, chunksize) {
        })
 }
 
-source_geneactiv <- function(file, chunksize) {
+source_geneactiv <- function(file, chunksize, format) {
   need_ggirread("GENEActiv .bin")
   first <- tryCatch(GGIRread::readGENEActiv(file, start = 1, end = 2),
                     error = function(e) NULL)
@@ -336,8 +369,8 @@ source_geneactiv <- function(file, chunksize) {
     abort("Corrupt or unreadable GENEActiv .bin file \"", file, "\".")
   }
   sf <- round(first$header$SampleRate)
-  B <- format_block_units("geneactiv", sf, chunksize)
-  list(format = "geneactiv", sf = sf, temperature = TRUE,
+  B <- format_block_units(format, sf, chunksize)
+  list(format = format, sf = sf, temperature = TRUE,
        read = function(i) {
          start <- B * (i - 1) + 1
          P <- tryCatch(GGIRread::readGENEActiv(file, start = start, end = start + B - 1),
@@ -349,13 +382,13 @@ source_geneactiv <- function(file, chunksize) {
 }
 
 # GGIRread's reader gives the whole file in one call (see R/formats.R).
-source_parmay <- function(file) {
+source_parmay <- function(file, format) {
   need_ggirread("Parmay Matrix .bin")
   sf <- tryCatch(GGIRread::readParmayMatrix(file, output = "sf"), error = function(e) NULL)
   if (!isTRUE(is.numeric(sf) && length(sf) == 1 && is.finite(sf))) {
     abort("Corrupt or unreadable Parmay Matrix .bin file \"", file, "\".")
   }
-  list(format = "parmay", sf = sf, temperature = TRUE,
+  list(format = format, sf = sf, temperature = TRUE,
        read = function(i) {
          if (i > 1) return(NULL)
          P <- tryCatch(GGIRread::readParmayMatrix(file, start = 1, end = 2^31 - 1),
@@ -401,7 +434,7 @@ unisens_r_numbers <- function(file) {
 
 # GGIR's own reading of a Movisens recording, block by block: unisensR for
 # the acceleration, movisens_temperature() for the temperature.
-source_movisens <- function(file) {
+source_movisens <- function(file, format) {
   if (!requireNamespace("unisensR", quietly = TRUE) ||
       !requireNamespace("GGIRread", quietly = TRUE)) {
     abort("Reading Movisens recordings by GGIR's reader needs the unisensR and GGIRread packages.")
@@ -413,7 +446,7 @@ source_movisens <- function(file) {
     abort("Corrupt or unreadable Movisens recording \"", file, "\".")
   }
   B <- movisens_block(file)
-  list(format = "movisens", sf = 64, temperature = TRUE,
+  list(format = format, sf = 64, temperature = TRUE,
        read = function(i) {
          from <- (i - 1) * B + 1
          if (from > n) return(NULL)
@@ -448,7 +481,7 @@ movisens_temperature <- function(dir, from, to, acc_sf, n) {
   GGIRread::resample(v, at, seq(from = 1, to = at[k], length.out = n), k, type = 1)
 }
 
-source_gt3x <- function(file, chunksize) {
+source_gt3x <- function(file, chunksize, format) {
   if (!requireNamespace("read.gt3x", quietly = TRUE)) {
     abort("Reading .gt3x files needs the read.gt3x package: install.packages(\"read.gt3x\").")
   }
@@ -460,10 +493,10 @@ source_gt3x <- function(file, chunksize) {
   # the zeros that a whole read (imputeZeroes = TRUE) puts there. Put them
   # back from the time stamps, so that a streamed file has the same samples
   # at the same positions as the file read whole.
-  B <- format_block_units("gt3x", sf, chunksize)
+  B <- format_block_units(format, sf, chunksize)
   t0 <- NULL
   next_i <- 0
-  list(format = "gt3x", sf = sf, temperature = FALSE,
+  list(format = format, sf = sf, temperature = FALSE,
        read = function(i) {
          from <- B * (i - 1) + 1
          d <- tryCatch(read.gt3x::read.gt3x(file, batch_begin = from,

@@ -87,3 +87,81 @@ test_that("R's registry and the C++ table of decoders name the same decoders", {
   expect_true(h$unsupported)
   expect_match(h$error, "no native decoder for format rds")
 })
+
+# Every decision that depends on a recording format is a field of the
+# format's registry entry (R/formats.R): no other R file compares a format
+# with a name or lists format names. The scan reads the package's R sources
+# (parsed, so comments and documentation do not count): a string equal to
+# a registry name, a name of switch() equal to one, or `format` / `fmt`
+# compared (==, !=, %in% c(...)) with a literal.
+registry_name_uses <- function(dir, names) {
+  out <- NULL
+  for (f in list.files(dir, pattern = "\\.[Rr]$", full.names = TRUE)) {
+    if (basename(f) == "formats.R") next
+    pd <- utils::getParseData(parse(f, keep.source = TRUE))
+    callee <- function(id) {  # the function a call (expression `id`) calls
+      kids <- pd[pd$parent == id, ]
+      first <- kids[order(kids$line1, kids$col1), ][1, ]
+      fn <- pd$text[pd$parent == first$id & pd$token == "SYMBOL_FUNCTION_CALL"]
+      if (length(fn)) fn[1] else ""
+    }
+    tk <- pd[pd$terminal, ]
+    tk <- tk[order(tk$line1, tk$col1), ]
+    n <- nrow(tk)
+    str <- ifelse(tk$token == "STR_CONST", substr(tk$text, 2, nchar(tk$text) - 1), NA)
+    hit <- tk$token == "STR_CONST" & str %in% names
+    sub <- which(tk$token == "SYMBOL_SUB" & tk$text %in% names)
+    hit[sub] <- vapply(tk$parent[sub], callee, "") == "switch"
+    cmp <- tk$token %in% c("EQ", "NE") | (tk$token == "SPECIAL" & tk$text == "%in%")
+    left <- c("", tk$text[-n])
+    right <- c(tk$text[-1], "")
+    right_tok <- c(tk$token[-1], "")
+    hit <- hit | (cmp & left %in% c("format", "fmt") &
+                    (right_tok == "STR_CONST" | right == "c"))
+    code <- readLines(f, warn = FALSE)
+    for (i in which(hit)) {
+      out <- rbind(out, data.frame(file = basename(f), line = tk$line1[i],
+                                   code = trimws(code[tk$line1[i]])))
+    }
+  }
+  out
+}
+
+test_that("no R file but R/formats.R branches on a recording format's name", {
+  # the source tree's R/, or under R CMD check the sources it unpacked
+  # beside the tests (gravcal.Rcheck/00_pkg_src/gravcal/R)
+  dirs <- c(test_path("..", "..", "R"),
+            test_path("..", "..", "00_pkg_src", "gravcal", "R"))
+  dir <- dirs[dir.exists(dirs)][1]
+  if (is.na(dir)) skip("the package's R sources are not here (an installed package's tests)")
+  expect_true(file.exists(file.path(dir, "formats.R")))
+  # uses of such names that are not recording formats: file and line text
+  allowed <- list(
+    # coefficient file formats (write_coefs()/read_coefs()), not recordings
+    list(file = "coef-formats.R", code = 'format == "auto"'),
+    list(file = "coef-formats.R", code = 'fmt != "skdh"'),
+    list(file = "coef-formats.R", code = 'format == "ggir"'),
+    # write_gt3x()'s kind of data (activity samples), not a recording format
+    list(file = "write-gt3x.R", code = 'format == "activity"'),
+    # GGIR's own names: g.inspectfile()'s test of a .gt3x file's extension
+    # and its data format name (dformn), which ggir_inspect_gt3x() rebuilds
+    list(file = "ggir-inspect.R", code = 'c("gt3x", "GT3X")'),
+    list(file = "ggir-inspect.R", code = 'dformn = "gt3x"')
+  )
+  uses <- registry_name_uses(dir, names(gravcal:::recording_formats))
+  expect_false(is.null(uses))  # the allowed ones are found: the scan works
+  ok <- vapply(seq_len(nrow(uses)), function(i) {
+    any(vapply(allowed, function(a) a$file == uses$file[i] &&
+                 grepl(a$code, uses$code[i], fixed = TRUE), TRUE))
+  }, TRUE)
+  bad <- uses[!ok, ]
+  expect(nrow(bad) == 0, paste0(
+    "recording formats named outside R/formats.R (make it a field of the registry):\n",
+    paste0(bad$file, ":", bad$line, ": ", bad$code, collapse = "\n")))
+  # every allow-list entry is still needed
+  used <- vapply(allowed, function(a) {
+    any(uses$file == a$file & grepl(a$code, uses$code, fixed = TRUE))
+  }, TRUE)
+  expect(all(used), paste("allow-list entries no longer used:",
+                          paste(vapply(allowed[!used], `[[`, "", "code"), collapse = ", ")))
+})

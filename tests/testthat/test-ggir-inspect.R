@@ -47,7 +47,7 @@ test_that("a .gt3x file's I is GGIR's g.inspectfile()'s, without reading the log
   expect_identical(neo[c("monc", "monn", "dformc", "dformn", "decn", "filename")],
                    list(monc = 3L, monn = "actigraph", dformc = 6L, dformn = "gt3x",
                         decn = ".", filename = "neo.gt3x"))
-  expect_identical(rownames(ggir_inspect_gt3x(files[1], "")$header)[1], "Serial Number")
+  expect_identical(rownames(ggir_inspect_gt3x(files[1], "", "gt3x")$header)[1], "Serial Number")
 })
 
 test_that("what gravcal's I does not cover goes to GGIR's g.inspectfile()", {
@@ -61,7 +61,7 @@ test_that("what gravcal's I does not cover goes to GGIR's g.inspectfile()", {
   at <- grepRaw("info.txt", bytes, all = TRUE)
   for (a in at) bytes[a:(a + 7)] <- charToRaw("xnfo.txt")
   writeBin(bytes, broken)
-  expect_null(ggir_inspect_gt3x(broken, ""))
+  expect_null(ggir_inspect_gt3x(broken, "", "gt3x"))
   expect_identical(keep_warn(suppressWarnings(part1_inspect(broken, "", list(), NULL))),
                    inspect_ggir(broken, ""))
   # beside a Movisens recording's unisens.xml GGIR reads the file as Movisens
@@ -69,7 +69,7 @@ test_that("what gravcal's I does not cover goes to GGIR's g.inspectfile()", {
   dir.create(mv)
   file.copy(src, file.path(mv, "a.gt3x"))
   writeLines("<unisens/>", file.path(mv, "unisens.xml"))
-  expect_null(ggir_inspect_gt3x(file.path(mv, "a.gt3x"), ""))
+  expect_null(ggir_inspect_gt3x(file.path(mv, "a.gt3x"), "", "gt3x"))
   # ad hoc csv parameters: GGIR reads the file as ad hoc csv whatever its name
   expect_null(format_entry("csv")$ggir_inspect)
 })
