@@ -222,7 +222,7 @@
 #'   corrected procedure (`FALSE`, default).
 #' @param ... For the lightweight method, arguments passed on to
 #'   [rest_windows()] (`window`, `max_range`, `axes`, `skip_zero`,
-#'   `chunk_size`, `progress`, `reader`, `rmc`), the guards (`max_norm_error`, in g,
+#'   `block_samples`, `progress`, `reader`, `rmc`), the guards (`max_norm_error`, in g,
 #'   default 0.3; `range_g`, the sensor's full scale in g, default from the
 #'   file or unknown; `max_identical`, default 0.8; `off_sphere`, the cut-off
 #'   of the rule on rest that is not on the sphere in robust spreads, default
@@ -399,8 +399,8 @@ calibrate <- function(x, sf, method = c("lightweight", "ggir"),
     rargs$stop <- budget_rule(args$fit_gradient, choice, max_norm_error,
                               range_g, max_identical)
     rargs$stop_every <- choice$check_hours
-    if (is.null(rargs$chunk_size) && !is.character(x)) {
-      rargs$chunk_size <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
+    if (is.null(rargs$block_samples) && is.null(rargs$chunk_size) && !is.character(x)) {
+      rargs$block_samples <- min(1e6, ceiling(choice$check_hours * 3600 * sf))
     }
   }
   w <- do.call(rest_windows, c(list(x = x, sf = sf, method = method), rargs))

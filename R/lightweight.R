@@ -7,7 +7,7 @@
 lightweight_args <- function(dots) {
   args <- split_dots(dots, list(
     rest_windows = c("window", "max_range", "axes", "skip_zero",
-                     "chunk_size", "progress", "reader", "rmc"),
+                     "block_samples", "chunk_size", "progress", "reader", "rmc"),
     guards = c("max_norm_error", "range_g", "max_identical", "off_sphere"),
     choice = c("selection", "cell", "max_se", "model", "use_temp",
                "segments", "change_alpha", "budget", "target_se",

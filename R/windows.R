@@ -15,7 +15,7 @@
 #'   standard deviation is below `max_sd` (13 mg) and the absolute mean below
 #'   `max_abs_mean` (2 g) on all three axes.
 #'
-#' Samples are fed to the core in chunks of `chunk_size`; the result does not
+#' Samples are fed to the core in blocks of `block_samples`; the result does not
 #' depend on the chunk size (the segmenter carries the open window across
 #' chunks). A trailing incomplete window is dropped. Samples with x, y and z
 #' all exactly 0 (ActiGraph idle sleep) are skipped when `skip_zero` is TRUE.
@@ -41,7 +41,9 @@
 #' @param max_abs_mean GGIR clipping guard on each axis' absolute mean, in g
 #'   (2 g).
 #' @param skip_zero Skip samples that are exactly zero on all three axes.
-#' @param chunk_size Number of samples passed to the core at a time.
+#' @param block_samples Number of samples passed to the core at a time (a
+#'   memory bound for samples held in R; not GGIR's `chunksize`, the
+#'   fraction of 12 hours GGIR reads per block).
 #' @param progress Show a progress bar (default: in interactive sessions, for
 #'   recordings of more than 20 chunks).
 #' @param reader For a file: `"native"` (default), gravcal's own decoders
@@ -61,6 +63,7 @@
 #'   returns `TRUE` (attribute `stopped` then TRUE). [calibrate()] uses it
 #'   for its adaptive data budget.
 #' @param stop_every Hours of samples between calls of `stop`.
+#' @param chunk_size Deprecated: the old name of `block_samples` (a warning).
 #' @return A data frame, one row per complete window: `start` (time of the
 #'   first sample, from `time` when given, else seconds from the start), `n`
 #'   (samples), `mean_x`, `mean_y`, `mean_z`, `sd_x`, `sd_y`, `sd_z`,
@@ -89,9 +92,17 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
                          window = NULL, max_range = 0.12,
                          axes = c("x", "y", "z"), max_sd = 0.013,
                          max_abs_mean = 2, skip_zero = TRUE,
-                         chunk_size = 1e6, progress = NULL,
+                         block_samples = 1e6, progress = NULL,
                          reader = c("native", "reference"), rmc = NULL,
-                         stop = NULL, stop_every = 6) {
+                         stop = NULL, stop_every = 6, chunk_size = NULL) {
+  if (!is.null(chunk_size)) {
+    if (!missing(block_samples)) {
+      abort("Give `block_samples`, or the deprecated `chunk_size`, not both.")
+    }
+    warning("rest_windows(): `chunk_size` is deprecated: use `block_samples` (the ",
+            "samples passed to the core at a time).", call. = FALSE)
+    block_samples <- chunk_size
+  }
   method <- match_choice(method, "method")
   if (!is.null(stop) && !is.function(stop)) {
     abort("`stop` must be NULL or a function, not ", describe(stop), ".")
@@ -124,7 +135,7 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
           src$filename, "\""), ").")
   }
   check_flag(skip_zero, "skip_zero")
-  check_number(chunk_size, "chunk_size", min = 1)
+  check_number(block_samples, "block_samples", min = 1)
   if (!is.null(progress)) check_flag(progress, "progress")
   if (method == "lightweight") {
     check_number(max_range, "max_range", min = 0, min_inclusive = FALSE)
@@ -146,8 +157,8 @@ rest_windows <- function(x, sf, method = c("lightweight", "ggir"),
   }
   if (is.null(src)) {
     pump_src <- gc_source_columns(s$x, s$y, s$z, s$temperature)
-    units <- chunk_size
-    blocks <- ceiling(s$n / chunk_size)
+    units <- block_samples
+    blocks <- ceiling(s$n / block_samples)
   } else {
     pump_src <- src$pump()
     units <- src$units

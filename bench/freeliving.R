@@ -148,7 +148,7 @@ windowings <- list(
   "5 s, chunks of 10,000 samples" = list(x = ag, window = 5, chunk = 1e4))
 wfits <- lapply(windowings, function(a) {
   calibrate(a$x, sf = sf, window = a$window,
-            chunk_size = if (is.null(a$chunk)) 1e6 else a$chunk)
+            block_samples = if (is.null(a$chunk)) 1e6 else a$chunk)
 })
 coefs <- sapply(wfits, function(f) stats::coef(f)[param_names()])
 ses <- sapply(wfits, function(f) f$se[param_names()])

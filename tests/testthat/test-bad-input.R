@@ -330,7 +330,7 @@ test_that("exported functions: numbers out of range or given as text are named",
   expect_snapshot(error = TRUE, calibrate(base, sf = 10, method = "ggir", max_iter = 1e10))
   expect_snapshot(error = TRUE, calibrate(base, sf = 10, method = "ggir", max_iter = 2.5))
   expect_snapshot(error = TRUE, rest_windows(base, sf = 10, progress = "a"))
-  expect_snapshot(error = TRUE, rest_windows(base, sf = 10, chunk_size = "a"))
+  expect_snapshot(error = TRUE, rest_windows(base, sf = 10, block_samples = "a"))
   expect_snapshot(error = TRUE, g.calibrate(base, sf = 10, verbose = FALSE,
                                             params_rawdata = list(chunksize = "a")))
   expect_snapshot(error = TRUE, select_points(w, min_distance = "a"))

@@ -3,7 +3,7 @@
 test_that("rest_windows() stops reading when `stop` says so", {
   rec <- simulate_recording(hours = 12, sf = 10, seed = 9)
   seen <- integer(0)
-  w <- rest_windows(rec, sf = 10, chunk_size = 36000, stop_every = 2,
+  w <- rest_windows(rec, sf = 10, block_samples = 36000, stop_every = 2,
                     stop = function(w) {
                       seen <<- c(seen, nrow(w))
                       nrow(w) >= 2000

@@ -27,7 +27,7 @@ test_that("the window table counts samples equal to the one before", {
   w3 <- rest_windows(rec, sf = 1, window = 5, method = "ggir")
   expect_equal(w3$n_repeat, c(2L, 4L))
   # chunking does not change the counts
-  w4 <- rest_windows(rec, sf = 1, window = 5, max_range = 10, chunk_size = 3)
+  w4 <- rest_windows(rec, sf = 1, window = 5, max_range = 10, block_samples = 3)
   expect_equal(w4$n_repeat, w$n_repeat)
 })
 

@@ -178,7 +178,7 @@ test_that("the same recording windowed differently agrees within its standard er
   expect_lt(sqrt(mean(z^2)), 1.5)
   expect_lt(max(abs(z)), 4)
   # chunks change nothing at all
-  expect_identical(calibrate(rec, sf = 10, chunk_size = 5000)$params,
+  expect_identical(calibrate(rec, sf = 10, block_samples = 5000)$params,
                    fits[[1]]$params)
   # the real recording: within 2 standard errors (issue 17; measured in
   # bench/results/freeliving.md: at most 1.0)

@@ -28,15 +28,27 @@ test_that("window statistics match an independent R computation", {
   expect_identical(w1$rest, ref$range_x < 0.12)
 })
 
+test_that("chunk_size, the old name of block_samples, still works, with a warning", {
+  rec <- simulate_recording(hours = 0.2, sf = 30, seed = 23)
+  new <- rest_windows(rec, sf = 30, block_samples = 1000)
+  expect_warning(old <- rest_windows(rec, sf = 30, chunk_size = 1000), "`chunk_size` is deprecated")
+  expect_identical(old, new)
+  expect_error(rest_windows(rec, sf = 30, block_samples = 1000, chunk_size = 1000),
+               "not both")
+  # through calibrate()'s `...` too
+  expect_warning(f <- calibrate(rec, sf = 30, chunk_size = 1000), "`chunk_size` is deprecated")
+  expect_identical(f$params, calibrate(rec, sf = 30, block_samples = 1000)$params)
+})
+
 test_that("the segmenter gives identical windows however the signal is split", {
   rec <- simulate_recording(hours = 0.5, sf = 30, seed = 22)
   rec$x[c(100, 20000)] <- 0
   rec$y[c(100, 20000)] <- 0
   rec$z[c(100, 20000)] <- 0
-  whole <- rest_windows(rec, sf = 30, chunk_size = nrow(rec))
+  whole <- rest_windows(rec, sf = 30, block_samples = nrow(rec))
   set.seed(7)
   for (cs in c(1, 7, 149, 150, 151, sample(2:5000, 5))) {
-    expect_identical(rest_windows(rec, sf = 30, chunk_size = cs), whole)
+    expect_identical(rest_windows(rec, sf = 30, block_samples = cs), whole)
   }
   # also through the core directly with random, uneven chunk boundaries
   s <- gravcal:::as_samples(rec)
