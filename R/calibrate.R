@@ -358,7 +358,10 @@
 #'     windows' temperature does not vary: sd below 0.01 degrees C), `sd`,
 #'     `value`, `hours` and `stuck` (flat over 12 h or more: a stuck sensor,
 #'     flagged `"temperature_stuck"` by `print()` and [calibrate_files()];
-#'     see [plausible_bounds()]) and `note`. For the GGIR method the rest
+#'     see [plausible_bounds()]), `note`, and `implausible` with
+#'     `range_note` (a temperature outside -20 to 70 degrees C: a faulty
+#'     sensor or a misread temperature, flagged `"temperature_implausible"`).
+#'     For the GGIR method the rest
 #'     windows are read again only when the procedure left the temperature
 #'     out because it does not vary.
 #' @seealso [apply_calibration()], [plot.gravcal_fit()], [rest_windows()]

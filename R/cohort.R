@@ -81,7 +81,10 @@
 #' 0.02 from the device's reference or 0.03 from 1, beyond their uncertainty:
 #' what a firmware fault that attenuates the raw signal does, as in
 #' ActiGraph's notice 16CPAN03), `"out_of_bounds"` (beyond omconvert's
-#' bounds, or not applied because beyond gravcal's), `"temperature_stuck"`
+#' bounds, or not applied because beyond gravcal's),
+#' `"temperature_implausible"` (a mean temperature outside -20 to 70 degrees
+#' C, `plausible_bounds()`'s `temperature_range`: a faulty sensor or a
+#' misread temperature), `"temperature_stuck"`
 #' (the recording's temperature does not vary, column `temperature_flat`,
 #' over 12 h or more, or while another recording of the device has a
 #' temperature that varies: a stuck sensor, whose recording is calibrated

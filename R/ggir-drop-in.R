@@ -457,13 +457,14 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
                             hours_total = if (!is.character(x)) {
                               NROW(x) / src$sf / 3600
                             })
-  # a stuck temperature sensor (gravcal's own mode, see ?plausible_bounds):
-  # where the procedure left the temperature out because a block's does not
-  # vary, the rest windows of the whole recording say whether it ever does
-  # (a second pass of the segmenter, only then)
+  # a stuck or implausible temperature sensor (gravcal's own mode, see
+  # ?plausible_bounds): where the procedure left the temperature out because
+  # a block's does not vary, or its first values exceed GGIR's 120, the rest
+  # windows of the whole recording say whether it ever varies and what it
+  # reads (a second pass of the segmenter, only then)
   if (!compat) {
     temps <- NULL
-    if (isTRUE(src$temperature) && any(grepl("does not vary", temp_warn, fixed = TRUE))) {
+    if (isTRUE(src$temperature) && any(grepl("does not vary|exceed", temp_warn))) {
       temps <- tryCatch({
         w <- rest_windows(x, sf = src$sf, method = "ggir", reader = a$reader,
                           rmc = if (is.character(x)) a$rmc)
@@ -472,7 +473,7 @@ calibrate_ggir <- function(x, sf, compat, dots, call, over = NULL) {
     }
     fit$temperature_check <- temperature_check(
       fit_hours(fit), isTRUE(src$temperature), temps = temps,
-      flat = if (is.null(temps)) FALSE)
+      flat = if (is.null(temps)) FALSE, mean_temp = fit$meantemp)
   }
   fit
 }

@@ -48,7 +48,26 @@
 #' `temperature_stuck_hours` (such a temperature over a recording of at
 #' least this many hours is a stuck sensor by itself; a shorter one is,
 #' when another recording of the same device has a temperature that
-#' varies).
+#' varies), and `temperature_range` (degrees C: a rest window's temperature
+#' outside it, or a mean temperature outside it where the windows' are not
+#' kept, flags `"temperature_implausible"`: no worn device nor one left in
+#' a room, a car or on a radiator reads it, so the sensor is faulty or the
+#' file's temperature misread, a Kelvin or raw reading say; the fit's
+#' temperature term rests on it).
+#'
+#' **What a device's history shows that one recording does not.** Flagged:
+#' a change of the coefficients beyond their uncertainty and practical size
+#' (`"device_outlier"`: a knock, a repair, a swapped sensor), a common
+#' change of the three scales (`"attenuated"`: firmware that scales the raw
+#' signal) and a temperature that stays flat while the device's other
+#' recordings vary (`"temperature_stuck"`, in recordings too short to tell
+#' alone). Not flagged, because three or four recordings per device do not
+#' show them reliably: a slow drift of the coefficients over a device's
+#' life (it needs dated recordings over years, and a drift smaller than a
+#' recording's uncertainty is what the practical minimum leaves alone),
+#' recordings of two devices under one serial number (a bimodal history),
+#' and a sensor whose noise grows (the rest windows' spread is not compared
+#' across recordings).
 #'
 #' **Practical minimum.** `practical_min` is the smallest difference from
 #' the device's reference that makes a `"device_outlier"`, whatever its
@@ -112,7 +131,8 @@ plausible_bounds <- function() {
 history_rules <- list(min_recordings = 3L, z = 4, attenuation = 0.02,
                       attenuation_absolute = 0.03, agreement = 0.5,
                       min_reference = 2L, temperature_flat_sd = 0.01,
-                      temperature_stuck_hours = 12)
+                      temperature_stuck_hours = 12,
+                      temperature_range = c(-20, 70))
 
 # The refusal bounds as guard_fit() and the GGIR method's own mode read them.
 plausible <- local({
@@ -173,6 +193,9 @@ fit_plausibility <- function(fit) {
     return(list(flag = "attenuated", note = a))
   }
   tc <- fit$temperature_check
+  if (isTRUE(tc$implausible)) {
+    return(list(flag = "temperature_implausible", note = tc$range_note))
+  }
   if (isTRUE(tc$stuck)) {
     return(list(flag = "temperature_stuck", note = tc$note))
   }
@@ -187,11 +210,17 @@ fit_plausibility <- function(fit) {
 # history_rules$temperature_stuck_hours (see ?plausible_bounds). For the
 # lightweight method `temps` are the rest windows' temperatures; for the
 # GGIR method `flat` is the procedure's own verdict (its block's samples'
-# sd below 0.01) and `temps` NULL.
-temperature_check <- function(hours, available, temps = NULL, flat = NULL) {
+# sd below 0.01) and `temps` NULL. `implausible`: the rest windows'
+# temperatures (else `mean_temp`, the fit's mean temperature) leave
+# history_rules$temperature_range, with its note `range_note`.
+temperature_check <- function(hours, available, temps = NULL, flat = NULL,
+                              mean_temp = NULL) {
   rules <- history_rules
   sdv <- NA_real_
   value <- NA_real_
+  seen <- if (!is.null(temps)) temps[is.finite(temps)] else
+    if (length(mean_temp) == 1 && is.finite(mean_temp)) mean_temp else numeric(0)
+  range_note <- if (available && length(seen)) temperature_range_note(range(seen)) else ""
   if (!is.null(temps)) {
     temps <- temps[is.finite(temps)]
     available <- available && length(temps) > 0
@@ -207,7 +236,20 @@ temperature_check <- function(hours, available, temps = NULL, flat = NULL) {
   stuck <- isTRUE(flat) && isTRUE(hours >= rules$temperature_stuck_hours)
   list(available = available, flat = flat, sd = sdv, value = value,
        hours = hours, stuck = stuck,
-       note = if (stuck) temperature_stuck_note(hours, value) else "")
+       note = if (stuck) temperature_stuck_note(hours, value) else "",
+       implausible = nzchar(range_note), range_note = range_note)
+}
+
+# The note of a temperature outside history_rules$temperature_range (`r`:
+# the lowest and highest temperature seen, degrees C), or "" when inside.
+temperature_range_note <- function(r) {
+  lim <- history_rules$temperature_range
+  if (!any(is.finite(r)) || (min(r) >= lim[1] && max(r) <= lim[2])) return("")
+  paste0("temperature implausible: the sensor reads ",
+         if (r[1] == r[2]) sprintf("%.1f", r[1]) else sprintf("%.1f to %.1f", r[1], r[2]),
+         sprintf(" degrees C, outside the %g to %g degrees C any worn or resting device has", lim[1], lim[2]),
+         ": a faulty sensor or a misread temperature (Kelvin, raw counts); the ",
+         "calibration's temperature term rests on it")
 }
 
 # The temperature at which a device's recordings (rows `rows` of a cohort
@@ -304,6 +346,11 @@ cohort_plausibility <- function(tab) {
   key <- ifelse(is.na(serial), paste0("\r", seq_len(n)), serial)
   files <- if (is.null(tab$file)) as.character(seq_len(n)) else tab$file
   stuck <- temperature_stuck_notes(tab, applied, pooled, key)
+  # a mean temperature outside any a worn or resting device has
+  hot <- vapply(seq_len(n), function(i) {
+    m <- if ("meantempcal" %in% names(tab)) tab$meantempcal[i] else NA_real_
+    if (applied[i] && isTRUE(is.finite(m))) temperature_range_note(c(m, m)) else ""
+  }, "")
   # each device's history (its recordings, offsets restated at one
   # temperature, the attenuation signature relative to 1)
   hists <- list()
@@ -412,7 +459,7 @@ cohort_plausibility <- function(tab) {
     h <- hists[[d]]
     vapply(seq_along(h$hist), function(j) {
       i <- h$hist[j]
-      !is.na(pass1[[d]][[j]]$kind) || length(bounds[[i]]) > 0 || nzchar(stuck[i])
+      !is.na(pass1[[d]][[j]]$kind) || length(bounds[[i]]) > 0 || nzchar(stuck[i]) || nzchar(hot[i])
     }, NA)
   }
   refs2 <- lapply(seq_along(hists), function(d) {
@@ -471,9 +518,11 @@ cohort_plausibility <- function(tab) {
                     paste(bounds[[i]], collapse = ", ")))
     }
     if (nzchar(stuck[i])) add(i, stuck[i])
+    if (nzchar(hot[i])) add(i, hot[i])
   }
   flag[outlier] <- "device_outlier"
   flag[applied & nzchar(stuck)] <- "temperature_stuck"
+  flag[applied & nzchar(hot)] <- "temperature_implausible"
   flag[applied & lengths(bounds) > 0] <- "out_of_bounds"
   flag[att] <- "attenuated"
   tab$plausibility <- flag

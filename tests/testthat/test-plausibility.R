@@ -465,3 +465,39 @@ test_that("calibrate_files() flags a stuck temperature sensor, both methods", {
     expect_identical(attr(res, "fits")[[3]]$plausibility$flag, "temperature_stuck")
   }
 })
+
+test_that("a temperature no worn or resting device has is flagged: the fit, print() and the cohort", {
+  lim <- attr(plausible_bounds(), "history")$temperature_range
+  expect_identical(lim, c(-20, 70))
+  tc <- gravcal:::temperature_check(26, TRUE, temps = c(301.2, 302.5, 300.9))
+  expect_true(tc$implausible)
+  expect_match(tc$range_note, "the sensor reads 300.9 to 302.5 degrees C, outside the -20 to 70", fixed = TRUE)
+  # at the edges: inside; just beyond: flagged; a mean where no windows are kept
+  expect_false(gravcal:::temperature_check(26, TRUE, temps = c(-20, 70))$implausible)
+  expect_true(gravcal:::temperature_check(26, TRUE, temps = c(25, 70.1))$implausible)
+  expect_true(gravcal:::temperature_check(26, TRUE, flat = FALSE, mean_temp = -40)$implausible)
+  expect_false(gravcal:::temperature_check(26, TRUE, flat = FALSE, mean_temp = 31)$implausible)
+  # no temperature: nothing judged
+  expect_false(gravcal:::temperature_check(26, FALSE, temps = numeric(0))$implausible)
+  # a recording whose temperature was read in Kelvin: both own modes flag it
+  rec <- simulate_recording(hours = 13, sf = 10, seed = 48, tempoffset = c(0.001, -0.0005, 0.0008))
+  kelvin <- rec
+  kelvin$temperature <- kelvin$temperature + 273.15
+  for (m in c("lightweight", "ggir")) {
+    f <- suppressWarnings(calibrate(kelvin, sf = 10, method = m))
+    expect_true(f$temperature_check$implausible, label = m)
+    expect_identical(gravcal:::fit_plausibility(f)$flag, "temperature_implausible", label = m)
+    expect_output(print(f), "plausibility: temperature_implausible - temperature implausible: the sensor reads 29")
+    g <- calibrate(rec, sf = 10, method = m)
+    expect_false(g$temperature_check$implausible, label = m)
+  }
+  # in a cohort table: by its mean temperature, and left out of the device's reference
+  set.seed(49)
+  co <- device_rows(c(1.01, 0.99, 1.005, 0.02, -0.01, 0.015), 4, 0.0005)
+  tab <- cohort_tab(co, 0.0005, "T2")
+  tab$meantempcal <- c(30.1, 303.4, 29.5, 31.0)
+  j <- gravcal:::cohort_plausibility(tab)
+  expect_identical(j$tab$plausibility, c("ok", "temperature_implausible", "ok", "ok"))
+  expect_match(j$tab$plausibility_note[2], "temperature implausible: the sensor reads 303.4 degrees C", fixed = TRUE)
+  expect_false(grepl("r02.cwa", j$devices$reference_files, fixed = TRUE))
+})
