@@ -152,7 +152,7 @@ cross-check: setup-test
 # gravcal built as a user with aggressive flags in ~/.R/Makevars builds it
 # (R_MAKEVARS_USER; a C++17 package is compiled with CXX17FLAGS, not
 # CXXFLAGS, so both are set). g++ with -O3 -march=native (and GCC's default
-# -ffp-contract=fast, said explicitly): the pin in gravcal/fp_contract.hpp
+# -ffp-contract=fast, said explicitly): the pin in gravcal/mcu/fp_contract.hpp
 # wins, so no fused multiply-add outside Eigen's own kernels
 # (tools/fma-count.sh), g.calibrate() identical to GGIR's on real files
 # (tools/flags-check.R) and the core's digests those of the default build.

@@ -1,4 +1,4 @@
-# Native decoders for device files (inst/include/gravcal/decode*.hpp), as
+# Native decoders for device files (inst/include/gravcal/decoders/decode*.hpp), as
 # seen from R: open a file, pull blocks of samples, read what was skipped.
 
 # The one call that opens a native decoder: the options with what this R

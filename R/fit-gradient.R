@@ -51,7 +51,7 @@ param_names <- function() {
 #'   64-bit intermediates) or `"fixed16"` (Q1.14 in 16-bit integers, 32-bit
 #'   intermediates), saturating on overflow. The points are rounded to the
 #'   arithmetic first. The result is bit for bit what the same header-only
-#'   core computes on a device (`inst/include/gravcal/fixed_point.hpp`; see
+#'   core computes on a device (`inst/include/gravcal/mcu/fixed_point.hpp`; see
 #'   `vignette("firmware")`).
 #' @param max_iter Number of iterations M (paper: 50).
 #' @param rates Learning rates for the scale, misalignment and offset groups
@@ -81,7 +81,7 @@ param_names <- function() {
 #'   `"fixed16"` then comes within 1 % of double's mean absolute error on
 #'   the paper's simulation, against 11 times (forward) and 3.8 times
 #'   (central) at 1 mg of noise (`bench/results/fixed.md`;
-#'   `inst/include/gravcal/gradient_analytic.hpp`).
+#'   `inst/include/gravcal/mcu/gradient_analytic.hpp`).
 #' @param model Which parameters to fit: `"full"` (all nine, the paper's
 #'   model), `"scale_offset"` (scales and offsets; the cross-axis terms stay
 #'   0) or `"offset"` (offsets only; scales 1, cross-axis terms 0). A

@@ -1,6 +1,6 @@
 # The floating-point build of the compiled code. GGIR's numbers are promised
 # to the bit, which holds only if the compiler rounded every product and sum
-# as R does: no fused multiply-add (gravcal/fp_contract.hpp pins that where
+# as R does: no fused multiply-add (gravcal/mcu/fp_contract.hpp pins that where
 # the compiler lets it) and no -ffast-math. The package probes its own build
 # when it loads and refuses the GGIR-compatible procedure from a build that
 # breaks the rule, rather than return numbers that only look like GGIR's.

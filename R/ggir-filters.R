@@ -1,6 +1,6 @@
 # GGIR's filtered metrics (g.applymetrics(): BFEN, LFENMO, HFEN, HFENplus,
 # ZC*, ...): their Butterworth coefficients, built as GGIR builds them, and
-# the per-sample signals from the core (gravcal/ggir_filters.hpp). Internal:
+# the per-sample signals from the core (gravcal/ggir/ggir_filters.hpp). Internal:
 # GGIR's part 1 is being reproduced around them.
 
 # The coefficient sets of one block's sample rate, from signal::butter()

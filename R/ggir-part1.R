@@ -1,6 +1,6 @@
 # GGIR part 1 after calibration: g.getmeta()'s calibrated epoch signals,
 # read by gravcal's decoders and computed by its core
-# (inst/include/gravcal/ggir_epochs.hpp), block by block as GGIR does.
+# (inst/include/gravcal/ggir/ggir_epochs.hpp), block by block as GGIR does.
 
 #' Calibrated epoch signals as GGIR's g.getmeta, on gravcal's core
 #'

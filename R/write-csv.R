@@ -1,6 +1,6 @@
 # Writers of synthetic csv files for the csv decoder's tests and benchmark
 # (not exported). ActiLife's layout as the format description in
-# inst/include/gravcal/decode_csv.hpp gives it: 10 header lines, an optional
+# inst/include/gravcal/decoders/decode_csv.hpp gives it: 10 header lines, an optional
 # column-name line, then [time stamp,] x, y, z.
 
 # ActiLife's 10 header lines for a recording of n samples at sf Hz from

@@ -1,5 +1,5 @@
 # Test-only writer of Movisens recordings, from the unisens 2.0 format as
-# unisensR reads it (see inst/include/gravcal/decode_movisens.hpp): a folder
+# unisensR reads it (see inst/include/gravcal/decoders/decode_movisens.hpp): a folder
 # with unisens.xml, whose root element <unisens> (namespace
 # http://www.unisens.org/unisens2.0) gives timestampStart and whose
 # <signalEntry> elements each describe one binary file (id: its name;

@@ -1,5 +1,5 @@
 # Test-only writer of Parmay Matrix .bin files, from the format as GGIRread
-# 1.2.0 documents and reads it (see inst/include/gravcal/decode_parmay.hpp):
+# 1.2.0 documents and reads it (see inst/include/gravcal/decoders/decode_parmay.hpp):
 # 512 bytes of remarks, "MDTC", the packet count (int32), the accelerometer
 # range (int16, g) and the gyroscope range (int16); then packets of
 # "MDTCPACK", a CRC-32 of the packet from its byte 12, the packet's start

@@ -65,10 +65,10 @@ md <- c("# The lightweight method in fixed point", "",
                 format(Sys.Date()), R.version.string, cases, elapsed), "",
         "fixed32 is Q3.29 in 32-bit integers with 64-bit intermediates, fixed16 Q1.14 in",
         "16-bit integers with 32-bit intermediates, both saturating",
-        "(`inst/include/gravcal/fixed_point.hpp`). \"analytic\": the gradient's closed form,",
+        "(`inst/include/gravcal/mcu/fixed_point.hpp`). \"analytic\": the gradient's closed form,",
         "no step; in fixed point in block floating point (16 x 16 -> 32-bit products for",
         "fixed16, the scale of every sum a power of two chosen from the data) with the",
-        "parameters kept in 32 bits between steps (`inst/include/gravcal/gradient_analytic.hpp`).",
+        "parameters kept in 32 bits between steps (`inst/include/gravcal/mcu/gradient_analytic.hpp`).",
         "Mean absolute error of each parameter; in brackets, the ratio to double's (forward",
         "differences, the paper's method).", "")
 for (nz in unique(tab$noise_mg)) {

@@ -3,14 +3,14 @@
 // contraction pin first, then the same flags), fuses a * b + c, and whether
 // -ffast-math was on. The operands come from R, so the compiler cannot fold
 // the expression.
-#include "gravcal/fp_contract.hpp"  // first, as in every translation unit
+#include "gravcal/mcu/fp_contract.hpp"  // first, as in every translation unit
 
 #include <Rcpp.h>
 
 #include <cstring>
 
-#include "gravcal/decode_csv_text.hpp"
-#include "gravcal/r_arith.hpp"
+#include "gravcal/decoders/decode_csv_text.hpp"
+#include "gravcal/host/r_arith.hpp"
 #include "r_services.h"
 
 // [[Rcpp::export(rng = false)]]

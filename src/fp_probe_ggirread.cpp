@@ -2,7 +2,7 @@
 // GGIRread's resampling step u * (v1 - v0) + v0 (GGIRread::resample, C++
 // compiled when GGIRread was installed): one fused multiply-add or two
 // roundings. Unlike every other translation unit of gravcal this one does
-// NOT include gravcal/fp_contract.hpp: it stands for another package's code,
+// NOT include gravcal/mcu/fp_contract.hpp: it stands for another package's code,
 // compiled as that package's is. GCC contracts by default (-ffp-contract=fast
 // outside strict ISO mode), which fuses on processors whose base instruction
 // set has a multiply-add (aarch64, ppc64le, s390x) and not on x86-64 without

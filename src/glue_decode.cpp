@@ -1,7 +1,7 @@
 // Rcpp glue for the device-file decoders (decode*.hpp): opens a file with
 // the format's decoder, hands blocks of samples to R, and reports what was
 // skipped. Converts and calls, nothing more.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/decode.hpp"
+#include "gravcal/decoders/decode.hpp"
 #include "decoders.h"
 #include "r_services.h"
 #include "sources_glue.h"

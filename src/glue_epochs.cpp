@@ -1,6 +1,6 @@
 // Rcpp glue for GGIR part 1's blocks (ggir_block_store.hpp) and their
 // epoch signals (ggir_epochs.hpp). Converts and checks shapes only.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/ggir_block_store.hpp"
-#include "gravcal/ggir_epochs.hpp"
+#include "gravcal/ggir/ggir_block_store.hpp"
+#include "gravcal/ggir/ggir_epochs.hpp"
 #include "r_services.h"
 #include "sources_glue.h"
 

@@ -1,14 +1,14 @@
-// Rcpp glue for GGIR's filtered signals (gravcal/ggir_filters.hpp), internal
+// Rcpp glue for GGIR's filtered signals (gravcal/ggir/ggir_filters.hpp), internal
 // (for tests and for R/ggir-filters.R): converts, calls, and turns the
 // core's statuses into R's own errors. Converts and calls, nothing more.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
 #include <string>
 #include <vector>
 
-#include "gravcal/ggir_filters.hpp"
+#include "gravcal/ggir/ggir_filters.hpp"
 
 namespace {
 

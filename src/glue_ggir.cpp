@@ -1,5 +1,5 @@
 // Rcpp glue for the GGIR fit (icp.hpp). Converts and checks shapes only.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <RcppEigen.h>
 
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/ggir_blocks.hpp"
-#include "gravcal/icp.hpp"
+#include "gravcal/ggir/ggir_blocks.hpp"
+#include "gravcal/ggir/icp.hpp"
 #include "r_services.h"
 #include "windows_glue.h"
 

@@ -1,8 +1,8 @@
-// Rcpp glue for the kernel table (inst/include/gravcal/kernels.hpp): the
+// Rcpp glue for the kernel table (inst/include/gravcal/kernels/kernels.hpp): the
 // switch the tests and benchmarks use, and every variant of a kernel run on
 // the same input, for tests/testthat/test-simd.R to compare with the scalar
 // reference. Converts and calls, nothing more.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/kernels.hpp"
+#include "gravcal/kernels/kernels.hpp"
 
 namespace {
 

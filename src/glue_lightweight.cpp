@@ -1,7 +1,7 @@
 // Rcpp glue for the segmenter, the bin selector and the gradient fit.
 // Converts, checks shapes, calls the core in inst/include/gravcal. No
 // algorithm lives here, and R's memory is only read.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 

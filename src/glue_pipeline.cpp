@@ -1,7 +1,7 @@
 // Rcpp glue for the one pump (pipeline.hpp): makes a source, runs one stage
 // over it (the segmenter, GGIR's procedure, or a collector of samples) and
 // converts the result. Nothing here decides anything about the samples.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <Rcpp.h>
 
@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/ggir_procedure.hpp"
-#include "gravcal/pipeline.hpp"
+#include "gravcal/ggir/ggir_procedure.hpp"
+#include "gravcal/ggir/pipeline.hpp"
 #include "r_services.h"
 #include "sources_glue.h"
 #include "windows_glue.h"

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "gravcal/decode.hpp"
+#include "gravcal/decoders/decode.hpp"
 
 namespace gravcal_glue {
 

@@ -8,8 +8,8 @@
 
 #include <memory>
 
-#include "gravcal/decode.hpp"
-#include "gravcal/pipeline.hpp"
+#include "gravcal/decoders/decode.hpp"
+#include "gravcal/ggir/pipeline.hpp"
 
 namespace gravcal_glue {
 

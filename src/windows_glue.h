@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "gravcal/gravcal.hpp"
-#include "gravcal/segmenter.hpp"
-#include "gravcal/ggir_blocks.hpp"
+#include "gravcal/host/segmenter.hpp"
+#include "gravcal/ggir/ggir_blocks.hpp"
 #include "r_services.h"
 
 namespace gravcal_glue {

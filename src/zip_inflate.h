@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "gravcal/decode_gt3x.hpp"
+#include "gravcal/decoders/decode_gt3x.hpp"
 
 namespace gravcal_glue {
 

@@ -2,7 +2,7 @@
 # flags (the Makefile's R_MAKEVARS_USER), against GGIR. Run from the
 # repository's root with R_LIBS pointing at that installation.
 #   Rscript tools/flags-check.R bits    the build does not fuse multiply-adds
-#     (the pin in gravcal/fp_contract.hpp won over the flags), and
+#     (the pin in gravcal/mcu/fp_contract.hpp won over the flags), and
 #     g.calibrate() gives GGIR's result, to the bit, on real files
 #   Rscript tools/flags-check.R refuse  the flags beat the pin (clang's
 #     -ffp-contract=fast): the load-time probe says so, and both

@@ -13,7 +13,7 @@
 # ms_after), an instruction wherever the target has one, always through
 # kernels::replay_fma, which is kept out of line: that function is counted
 # apart. Every other one is a
-# contraction that gravcal/fp_contract.hpp should have stopped: the script
+# contraction that gravcal/mcu/fp_contract.hpp should have stopped: the script
 # fails and lists the functions that hold them.
 #   sh tools/fma-count.sh path/to/gravcal.so [objdump]
 so=$1

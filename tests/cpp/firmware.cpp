@@ -12,12 +12,12 @@
 // streaming statistics, the bins, the gradient fit, fixed point.
 #include <cstdint>
 
-#include "gravcal/bins.hpp"
-#include "gravcal/fixed_point.hpp"
-#include "gravcal/gradient.hpp"
-#include "gravcal/model.hpp"
-#include "gravcal/stats_streaming.hpp"
-#include "gravcal/window_cutter.hpp"
+#include "gravcal/mcu/bins.hpp"
+#include "gravcal/mcu/fixed_point.hpp"
+#include "gravcal/mcu/gradient.hpp"
+#include "gravcal/mcu/model.hpp"
+#include "gravcal/mcu/stats_streaming.hpp"
+#include "gravcal/mcu/window_cutter.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <cstring>
 #include <string>
 
-#include "gravcal/decode.hpp"
+#include "gravcal/decoders/decode.hpp"
 
 // Windows' long is 32 bits (LLP64): the build for Windows proves it here,
 // so its run (under wine, make cross-check) is a run with a 32-bit long

@@ -6,7 +6,7 @@
 // window arithmetic is also chunk invariant.
 // First, as in the package: no contraction anywhere in this translation
 // unit (the test data's generators included), whatever the flags.
-#include "gravcal/fp_contract.hpp"
+#include "gravcal/mcu/fp_contract.hpp"
 
 #include <cctype>
 #include <cmath>
@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/decode_cwa.hpp"
-#include "gravcal/decode_geneactiv.hpp"
-#include "gravcal/ggir_blocks.hpp"
+#include "gravcal/decoders/decode_cwa.hpp"
+#include "gravcal/decoders/decode_geneactiv.hpp"
+#include "gravcal/ggir/ggir_blocks.hpp"
 #include "gravcal/gravcal.hpp"
-#include "gravcal/segmenter.hpp"
-#include "gravcal/icp.hpp"
+#include "gravcal/host/segmenter.hpp"
+#include "gravcal/ggir/icp.hpp"
 
 static int failures = 0;
 #define CHECK(cond)                                                   \

@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/decode_csv.hpp"
+#include "gravcal/decoders/decode_csv.hpp"
 
 namespace csv = gravcal::csv_text;
 

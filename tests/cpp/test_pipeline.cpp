@@ -4,7 +4,7 @@
 // a known miscalibration, and stops when its host says so. The Movisens
 // decoder's samples and temperatures against a sample-by-sample replay of
 // unisensR and GGIR's g.readtemp_movisens, in runs of any length.
-#include "gravcal/fp_contract.hpp"  // first: see there
+#include "gravcal/mcu/fp_contract.hpp"  // first: see there
 
 #include <cmath>
 #include <cstdio>
@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/decode.hpp"
-#include "gravcal/decode_movisens.hpp"
-#include "gravcal/ggir_procedure.hpp"
-#include "gravcal/pipeline.hpp"
+#include "gravcal/decoders/decode.hpp"
+#include "gravcal/decoders/decode_movisens.hpp"
+#include "gravcal/ggir/ggir_procedure.hpp"
+#include "gravcal/ggir/pipeline.hpp"
 
 static int failures = 0;
 #define CHECK(cond)                                                   \

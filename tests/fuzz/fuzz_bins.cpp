@@ -6,8 +6,8 @@
 #include <type_traits>
 
 #include "fuzz_input.hpp"
-#include "gravcal/bins.hpp"
-#include "gravcal/fixed_point.hpp"
+#include "gravcal/mcu/bins.hpp"
+#include "gravcal/mcu/fixed_point.hpp"
 
 // The resolution of T: the selector squares and sums differences in T, so
 // each of the three squares and the squared threshold can be off by about

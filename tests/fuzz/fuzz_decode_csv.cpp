@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "gravcal/decode_csv.hpp"
+#include "gravcal/decoders/decode_csv.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/decode_cwa.hpp"
+#include "gravcal/decoders/decode_cwa.hpp"
 
 namespace {
 
@@ -122,7 +122,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t cap = 4096;
   const bool ok = run(file, compat, window, cap, big, interpolation, zone);
   if (run(file, compat, window, 7, small, interpolation, zone) != ok) __builtin_trap();
-  // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
+  // the baseline paths (no AVX2: gravcal/kernels/simd.hpp) give the same bits
   if (gravcal::use_avx2()) {
     Run base;
     gravcal::set_avx2(false);

@@ -12,7 +12,7 @@
 #include <cstdio>
 
 #include "fuzz_input.hpp"
-#include "gravcal/decode_geneactiv.hpp"
+#include "gravcal/decoders/decode_geneactiv.hpp"
 
 // Stops with the line of the broken invariant.
 #define CHECK(cond)                                             \
@@ -99,7 +99,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint64_t h = decode_all(bytes, mode);
   // light asked or not (mode bit 64): the other columns are the same
   CHECK(decode_all(bytes, mode ^ 64) == h);
-  // the baseline paths (no AVX2: gravcal/simd.hpp) give the same bits
+  // the baseline paths (no AVX2: gravcal/kernels/simd.hpp) give the same bits
   if (gravcal::use_avx2()) {
     gravcal::set_avx2(false);
     const std::uint64_t b = decode_all(bytes, mode);

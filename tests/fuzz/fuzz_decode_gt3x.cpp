@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/decode_gt3x.hpp"
+#include "gravcal/decoders/decode_gt3x.hpp"
 #include "../../src/zip_inflate.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/decode_movisens.hpp"
+#include "gravcal/decoders/decode_movisens.hpp"
 
 #define CHECK(cond)                                                              \
   do {                                                                           \

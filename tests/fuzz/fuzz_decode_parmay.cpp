@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/decode_parmay.hpp"
+#include "gravcal/decoders/decode_parmay.hpp"
 
 #define CHECK(cond)                                                              \
   do {                                                                           \

@@ -10,13 +10,13 @@
 // then, against R's sds everywhere, every other statistic is the same, and
 // so are the rest windows (with their sds, to the bit) and the ties GGIR's
 // duplicate filter counts between a window and the last one with means.
-// And all of it is the same bits without the AVX2 paths (gravcal/simd.hpp).
+// And all of it is the same bits without the AVX2 paths (gravcal/kernels/simd.hpp).
 #include <cmath>
 #include <cstring>
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/ggir_blocks.hpp"
+#include "gravcal/ggir/ggir_blocks.hpp"
 
 namespace {
 
@@ -71,7 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Out out[5];
   for (int way = 0; way < 5; ++way) {
     if (way == 3 && !lazy) continue;
-    // way 4: as way 0 without the AVX2 paths (gravcal/simd.hpp)
+    // way 4: as way 0 without the AVX2 paths (gravcal/kernels/simd.hpp)
     if (way == 4 && !gravcal::use_avx2()) break;
     struct Avx2Off {
       bool on;

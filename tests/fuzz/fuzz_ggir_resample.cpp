@@ -13,8 +13,8 @@
 #include <memory>
 #include <vector>
 
-#include "gravcal/decode_csv.hpp"
-#include "gravcal/decode_ggir_resample.hpp"
+#include "gravcal/decoders/decode_csv.hpp"
+#include "gravcal/decoders/decode_ggir_resample.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;

@@ -20,9 +20,9 @@
 #include <memory>
 #include <vector>
 
-#include "gravcal/decode_csv.hpp"
-#include "gravcal/decode_ggir_resample.hpp"
-#include "gravcal/decode_ggir_timegaps.hpp"
+#include "gravcal/decoders/decode_csv.hpp"
+#include "gravcal/decoders/decode_ggir_resample.hpp"
+#include "gravcal/decoders/decode_ggir_timegaps.hpp"
 
 using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, long double>;
 

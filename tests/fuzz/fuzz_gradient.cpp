@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/fixed_point.hpp"
-#include "gravcal/gradient.hpp"
+#include "gravcal/mcu/fixed_point.hpp"
+#include "gravcal/mcu/gradient.hpp"
 
 template <typename T>
 static void run(const std::vector<double>& xs, const std::vector<double>& ys,

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/icp.hpp"
+#include "gravcal/ggir/icp.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzInput in{data, size};

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "fuzz_input.hpp"
-#include "gravcal/segmenter.hpp"
+#include "gravcal/host/segmenter.hpp"
 
 static bool same(const gravcal::WindowStats& a, const gravcal::WindowStats& b) {
   return std::memcmp(&a, &b, sizeof a) == 0;

@@ -1,4 +1,4 @@
-# The native csv decoder (inst/include/gravcal/decode_csv.hpp) against the
+# The native csv decoder (inst/include/gravcal/decoders/decode_csv.hpp) against the
 # reference readers: data.table::fread as GGIR 3.3.9's g.readaccfile calls it
 # for ActiGraph csv (fread(skip = s, nrows = B, header = FALSE), columns 2:4
 # when there are more than 3), and g.readaccfile itself where it can read

@@ -1,4 +1,4 @@
-# The native Axivity .cwa decoder (inst/include/gravcal/decode_cwa.hpp).
+# The native Axivity .cwa decoder (inst/include/gravcal/decoders/decode_cwa.hpp).
 # References: GGIRread 1.2.0's readAxivity() on the same bytes, called as
 # GGIR's g.readaccfile calls it (windows of B blocks, start = previous end),
 # and the samples given to write_cwa() (R/write-cwa.R, from openmovement's

@@ -1,4 +1,4 @@
-# Native .gt3x decoder (inst/include/gravcal/decode_gt3x.hpp) against
+# Native .gt3x decoder (inst/include/gravcal/decoders/decode_gt3x.hpp) against
 # read.gt3x 1.2.0, the reader GGIR and read_recording() use, on the real
 # files and on files written from the format documents by write_gt3x().
 

@@ -1,4 +1,4 @@
-# GGIR's filtered metrics (gravcal/ggir_filters.hpp, R/ggir-filters.R):
+# GGIR's filtered metrics (gravcal/ggir/ggir_filters.hpp, R/ggir-filters.R):
 # signal::filter() of a Butterworth Arma, and g.applymetrics()'s per-sample
 # signals before averaging, to the bit. References: signal 1.8.1's
 # filter() and GGIR 3.3-9's g.applymetrics() themselves, and R restatements

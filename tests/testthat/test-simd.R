@@ -1,4 +1,4 @@
-# The core's AVX2 paths (inst/include/gravcal/simd.hpp) against its baseline
+# The core's AVX2 paths (inst/include/gravcal/kernels/simd.hpp) against its baseline
 # ones: where the processor has AVX2 they run by default, and they must give
 # the same bits. gc_set_avx2(FALSE) turns them off for one side of each
 # comparison. On a processor without AVX2 there is nothing to compare.

@@ -9,6 +9,6 @@
 #define GRAVCAL_GRAVCAL_HPP
 
 #include "gravcal/mcu.hpp"
-#include "gravcal/segmenter.hpp"
+#include "gravcal/host/segmenter.hpp"
 
 #endif  // GRAVCAL_GRAVCAL_HPP

@@ -9,13 +9,13 @@
 #ifndef GRAVCAL_MCU_HPP
 #define GRAVCAL_MCU_HPP
 
-#include "gravcal/fp_contract.hpp"
+#include "gravcal/mcu/fp_contract.hpp"
 
-#include "gravcal/model.hpp"
-#include "gravcal/stats_streaming.hpp"
-#include "gravcal/window_cutter.hpp"
-#include "gravcal/bins.hpp"
-#include "gravcal/gradient.hpp"
-#include "gravcal/fixed_point.hpp"
+#include "gravcal/mcu/model.hpp"
+#include "gravcal/mcu/stats_streaming.hpp"
+#include "gravcal/mcu/window_cutter.hpp"
+#include "gravcal/mcu/bins.hpp"
+#include "gravcal/mcu/gradient.hpp"
+#include "gravcal/mcu/fixed_point.hpp"
 
 #endif  // GRAVCAL_MCU_HPP

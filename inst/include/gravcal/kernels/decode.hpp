@@ -9,13 +9,13 @@
 #ifndef GRAVCAL_KERNELS_DECODE_HPP
 #define GRAVCAL_KERNELS_DECODE_HPP
 
-#include "gravcal/fp_contract.hpp"
+#include "gravcal/mcu/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
-#include "gravcal/simd.hpp"
+#include "gravcal/kernels/simd.hpp"
 
 namespace gravcal {
 

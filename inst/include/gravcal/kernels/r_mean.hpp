@@ -10,13 +10,13 @@
 #ifndef GRAVCAL_KERNELS_R_MEAN_HPP
 #define GRAVCAL_KERNELS_R_MEAN_HPP
 
-#include "gravcal/fp_contract.hpp"
+#include "gravcal/mcu/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <limits>
 
-#include "gravcal/simd.hpp"
+#include "gravcal/kernels/simd.hpp"
 
 namespace gravcal {
 namespace kernels {

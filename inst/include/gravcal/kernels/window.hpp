@@ -16,16 +16,16 @@
 #ifndef GRAVCAL_KERNELS_WINDOW_HPP
 #define GRAVCAL_KERNELS_WINDOW_HPP
 
-#include "gravcal/fp_contract.hpp"
+#include "gravcal/mcu/fp_contract.hpp"
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 
-#include "gravcal/simd.hpp"
-#include "gravcal/stats_streaming.hpp"
-#include "gravcal/window_cutter.hpp"
+#include "gravcal/kernels/simd.hpp"
+#include "gravcal/mcu/stats_streaming.hpp"
+#include "gravcal/mcu/window_cutter.hpp"
 
 namespace gravcal {
 namespace kernels {

@@ -1,0 +1,736 @@
+// gravcal: GGIR part 1's epoch signals for one block, as g.getmeta()
+// computes them (GGIR 3.3-9: g.getmeta, g.applymetrics,
+// detect_nonwear_clipping), to the bit.
+//
+// g.getmeta() reads a recording in blocks of about 24 hours, keeps the
+// whole long epochs (15 min) of each, applies the calibration, and computes
+// per block: short-epoch metrics (5 s: ENMO, anglez, ...), and per long
+// epoch non-wear and clipping scores and the means of the norm, the
+// temperature and the light. Its arithmetic decides bits in ways that this
+// header repeats (the reasons are GGIR's R code; the order of operations
+// is R's):
+// - calibration: scale(data, center = -offset, scale = 1 / scale), that is
+//   (v + offset) / (1 / scale), then + (T - meantempcal) / (1 / tempoffset);
+// - epoch means: a cumulative sum over the whole block (R's cumsum(), in
+//   R's long double accumulator rounded to double after each addition),
+//   read at round(seq(1, n + 1, by = sf * epoch)), differenced, divided by
+//   the index difference. So a mean depends on where its block starts;
+// - angles: every floor(sf / 10)-th sample, a running median of about 5 s
+//   (zoo::rollmedian with zero fill), zeros near the head and tail of the
+//   block replaced, values repeated back to the full rate (the raw signal
+//   when the repeated length exceeds the block's), then atan(z / sqrt(x^2
+//   + y^2)) / (pi / 180);
+// - non-wear and clipping per long epoch, with R's sd() and the index
+//   arithmetic of R's `:` and seq() on fractional bounds;
+// - R's sequences (`:`, seq()) index with truncation, 0 dropped, beyond the
+//   end NA (left out by the max/min/sd with na.rm).
+// Rounding (round(x, 4)) and the text round trip of metashort are R's own,
+// applied by the caller in R. Header-only, standard headers only.
+#ifndef GRAVCAL_GGIR_EPOCHS_HPP
+#define GRAVCAL_GGIR_EPOCHS_HPP
+
+#include "gravcal/mcu/fp_contract.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "gravcal/ggir/ggir_filters.hpp"
+#include "gravcal/host/r_arith.hpp"
+
+namespace gravcal {
+namespace ggir_part1 {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// R's `from:to` on doubles (seq_colon): n = floor(|to - from| + 1 +
+// FLT_EPSILON) values from, from +- 1, ... (integers when from is one).
+struct RColon {
+  double from = 0;
+  std::int64_t n = 0;
+  bool down = false;
+  double at(std::int64_t k) const {
+    return down ? from - static_cast<double>(k) : from + static_cast<double>(k);
+  }
+};
+
+inline RColon r_colon(double from, double to) {
+  RColon c;
+  c.from = from;
+  c.down = from > to;
+  const double r = std::fabs(to - from);
+  c.n = static_cast<std::int64_t>(r + 1 + FLT_EPSILON);
+  return c;
+}
+
+// R's seq(from, to, by = by) for finite doubles with from <= to, by > 0,
+// from and to not both integer-typed (the double branch of seq.default):
+// n = as.integer((to - from) / by + 1e-10); from + k by, capped at to. A
+// single `from` when (to - from) / max(|to|, |from|) < 100 eps.
+inline std::vector<double> r_seq_by(double from, double to, double by) {
+  const double del = to - from;
+  std::vector<double> out;
+  if (del == 0 && to == 0) {
+    out.push_back(to);
+    return out;
+  }
+  const double n = del / by;
+  if (!std::isfinite(n) || n < 0) throw std::runtime_error("seq(): invalid (to - from) / by");
+  if (n > 2147483647.0) throw std::runtime_error("seq(): 'by' is much too small");
+  if (std::fabs(del) / std::max(std::fabs(to), std::fabs(from)) < 100 * DBL_EPSILON) {
+    out.push_back(from);
+    return out;
+  }
+  const std::int64_t k = static_cast<std::int64_t>(n + 1e-10);
+  out.resize(static_cast<std::size_t>(k) + 1);
+  for (std::int64_t i = 0; i <= k; ++i) {
+    const double v = from + static_cast<double>(i) * by;
+    out[static_cast<std::size_t>(i)] = std::min(v, to);
+  }
+  return out;
+}
+
+// R's round(x) (digits 0): to the nearest integer, ties to even.
+inline double r_round0(double x) { return std::nearbyint(x); }
+
+// GGIR's averagePerEpoch() (mean = true) and sumPerEpoch() (mean = false)
+// of the values f(0), ..., f(n - 1) for epochs of `by` samples (sf * epoch
+// length, maybe not whole): the differences of R's cumsum(c(0, x)) (R's
+// accumulator Acc, each sum rounded to double) at round(seq(1, n + 1, by)),
+// divided by the epoch's length. The sums are taken as the values stream
+// (the rounded bounds never decrease), so that neither the values nor their
+// cumulative sums are held.
+template <class Acc, class F>
+std::vector<double> per_epoch_of(std::size_t n, double by, bool mean, F&& f) {
+  const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
+  std::vector<double> out;
+  if (sel.size() < 2) return out;
+  out.resize(sel.size() - 1);
+  Acc s = 0;
+  std::size_t at = 0;  // values summed so far: the sum is cumsum's [at]
+  // cumsum(c(0, x))[j] (1-based j within 1..n + 1)
+  auto cum = [&](double j) {
+    const std::size_t to = static_cast<std::size_t>(j) - 1;
+    for (; at < to; ++at) s += f(at);
+    return static_cast<double>(s);
+  };
+  double prev = r_round0(sel[0]);
+  double cprev = cum(prev);
+  for (std::size_t i = 1; i < sel.size(); ++i) {
+    const double cur = r_round0(sel[i]);
+    const double ccur = cum(cur);
+    const double d = ccur - cprev;
+    out[i - 1] = mean ? d / std::fabs(cur - prev) : d;
+    prev = cur;
+    cprev = ccur;
+  }
+  return out;
+}
+
+template <class Acc>
+std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
+  return per_epoch_of<Acc>(n, by, mean, [x](std::size_t i) { return x[i]; });
+}
+
+// The calibration as g.getmeta applies it, in place: v = (v + offset) /
+// inv_scale (inv_scale = 1 / scale, computed by R), then, with a
+// temperature, + (t - meantemp) / inv_tempoffset.
+struct Calibration {
+  double offset[3] = {0, 0, 0};
+  double inv_scale[3] = {1, 1, 1};
+  bool temp = false;  // apply the temperature term
+  double meantemp = 0;
+  double inv_tempoffset[3] = {1, 1, 1};
+};
+
+// `t(i)`: the temperature of row i (asked in increasing i, axis by axis),
+// `have_t` whether there is one.
+template <class T>
+void apply_calibration(const Calibration& c, double* x, double* y, double* z, T&& t,
+                       bool have_t, std::size_t n) {
+  double* v[3] = {x, y, z};
+  for (int a = 0; a < 3; ++a) {
+    double* p = v[a];
+    const double o = c.offset[a], s = c.inv_scale[a];
+    for (std::size_t i = 0; i < n; ++i) p[i] = (p[i] + o) / s;
+    if (c.temp && have_t) {
+      const double m = c.meantemp, to = c.inv_tempoffset[a];
+      // a temperature holds for a page: its term is computed once per value
+      // (the same operands, the same bits)
+      std::uint64_t last = 0;
+      bool have = false;
+      double term = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double ti = t(i);
+        std::uint64_t bits;
+        std::memcpy(&bits, &ti, sizeof bits);
+        if (!have || bits != last) {
+          term = (ti - m) / to;
+          last = bits;
+          have = true;
+        }
+        p[i] = p[i] + term;
+      }
+    }
+  }
+}
+
+// sqrt(x^2 + y^2 + z^2) in R's order.
+inline double r_norm(double x, double y, double z) {
+  return std::sqrt(x * x + y * y + z * z);
+}
+
+// A running median of odd width k over v (zoo::rollmedian(v, k, fill = 0),
+// centred): out[i] = the median of v[i - m .. i + m] for m <= i < N - m, 0
+// elsewhere; a window holding NaN gives NaN (zoo then uses median(),
+// whose result is NA). Sorted window, insert and erase by binary search.
+inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vector<double>& out) {
+  const std::size_t N = v.size();
+  out.assign(N, 0.0);
+  if (k == 0 || k > N) {
+    // zoo: rollapply of median over windows that never fit: all fill
+    return;
+  }
+  const std::size_t m = k / 2;
+  std::vector<double> win;
+  win.reserve(k);
+  std::size_t nans = 0;
+  auto add = [&](double a) {
+    if (std::isnan(a)) {
+      ++nans;
+      return;
+    }
+    win.insert(std::upper_bound(win.begin(), win.end(), a), a);
+  };
+  auto drop = [&](double a) {
+    if (std::isnan(a)) {
+      --nans;
+      return;
+    }
+    auto it = std::lower_bound(win.begin(), win.end(), a);
+    win.erase(it);
+  };
+  // the window slides: the value leaving is found (the first equal, as
+  // drop() finds it) and the one entering takes its place, moved to where
+  // add() would put it (after its equals): the same window, one shift
+  auto slide = [&](double o, double a) {
+    if (std::isnan(o) || std::isnan(a)) {
+      drop(o);
+      add(a);
+      return;
+    }
+    std::size_t pos = static_cast<std::size_t>(std::lower_bound(win.begin(), win.end(), o) - win.begin());
+    while (pos > 0 && win[pos - 1] > a) {
+      win[pos] = win[pos - 1];
+      --pos;
+    }
+    while (pos + 1 < win.size() && win[pos + 1] <= a) {
+      win[pos] = win[pos + 1];
+      ++pos;
+    }
+    win[pos] = a;
+  };
+  for (std::size_t i = 0; i < k; ++i) add(v[i]);
+  for (std::size_t c = m;; ++c) {
+    out[c] = nans ? kNaN : win[m];
+    if (c + m + 1 >= N) break;
+    slide(v[c - m], v[c + m + 1]);
+  }
+}
+
+// GGIR's rollmed() of one axis of a block, as a view: the value at sample
+// i is the running median of the 10 Hz subsample (xm[i / step]) up to LN
+// = xm.size() * step, the last median after it; or, in GGIR's fallback
+// (when LN exceeds the block), the raw axis itself. Held at the
+// subsample's rate: a tenth of the block, or none.
+struct RollMed {
+  std::vector<double> xm;
+  const double* raw = nullptr;  // the fallback: the raw axis
+  std::size_t step = 1, LN = 0;
+  double tail = kNaN;
+  double operator[](std::size_t i) const {
+    if (raw != nullptr) return raw[i];
+    return i < LN ? xm[i / step] : tail;
+  }
+};
+
+// GGIR's rollmed(): the smoothed axis used for the angles and the
+// roll_med_acc metrics, for one axis of a block.
+inline RollMed ggir_rollmed(const double* x, std::size_t LX, double sf) {
+  const double fl = std::floor(sf / 10);
+  const std::size_t step = static_cast<std::size_t>(std::max(fl, 1.0));
+  const double newsf = step > 1 ? 10.0 : sf;
+  double winsi = r_round0(newsf * 5);
+  if (r_round0(winsi / 2) == winsi / 2) winsi = winsi + 1;
+  if (std::fmod(winsi, 2.0) == 0) winsi = winsi + 1;
+  RollMed r;
+  std::vector<double> sub;
+  sub.reserve(LX / step + 1);
+  for (std::size_t i = 0; i < LX; i += step) sub.push_back(x[i]);
+  std::vector<double>& xm = r.xm;
+  rolling_median(sub, static_cast<std::size_t>(winsi), xm);
+  std::vector<double>().swap(sub);
+  const std::size_t LN0 = xm.size();
+  // the head: zeros among the first S2check values take the first value
+  // there that is not zero (NA when there is none)
+  double S2check = std::max(sf * 60, 1000.0);
+  {
+    const RColon c = r_colon(1, S2check);
+    const std::size_t lim = static_cast<std::size_t>(std::min<double>(static_cast<double>(c.n), static_cast<double>(LN0)));
+    double first = kNaN;
+    for (std::size_t i = 0; i < lim; ++i) {
+      if (!std::isnan(xm[i]) && xm[i] != 0) {
+        first = xm[i];
+        break;
+      }
+    }
+    for (std::size_t i = 0; i < lim; ++i) {
+      if (xm[i] == 0) xm[i] = first;
+    }
+  }
+  // the tail: xm[(LN - S2check):LN], zeros there take the first value of
+  // the tail that is not zero (NA when there is none)
+  if (LN0 >= 1) {
+    S2check = std::min(static_cast<double>(LN0) - 1, S2check);
+    const RColon c = r_colon(static_cast<double>(LN0) - S2check, static_cast<double>(LN0));
+    std::vector<std::size_t> idx;
+    idx.reserve(static_cast<std::size_t>(c.n));
+    for (std::int64_t k = 0; k < c.n; ++k) {
+      const double d = c.at(k);
+      const std::int64_t j = static_cast<std::int64_t>(d);  // R truncates
+      if (j >= 1 && j <= static_cast<std::int64_t>(LN0)) idx.push_back(static_cast<std::size_t>(j - 1));
+    }
+    double lastvalue = kNaN;
+    for (std::size_t j : idx) {
+      if (!std::isnan(xm[j]) && xm[j] != 0) {
+        lastvalue = xm[j];
+        break;
+      }
+    }
+    for (std::size_t j : idx) {
+      if (xm[j] == 0) xm[j] = lastvalue;
+    }
+  }
+  const std::size_t LN = LN0 * step;
+  if (LN > LX) {
+    std::vector<double>().swap(xm);
+    r.raw = x;  // GGIR's fallback: the raw axis
+    return r;
+  }
+  r.step = step;
+  r.LN = LN;
+  r.tail = LN ? xm[LN0 - 1] : kNaN;
+  return r;
+}
+
+// After rollmed() of the three axes (n samples each): when any value of
+// any axis is NA, each axis's NA values take that axis's last value that is
+// not NA.
+inline void fill_na_last(RollMed* ax[3], std::size_t n) {
+  auto has_nan = [n](const RollMed& r) {
+    if (r.raw != nullptr) {
+      for (std::size_t i = 0; i < n; ++i) {
+        if (std::isnan(r.raw[i])) return true;
+      }
+      return false;
+    }
+    const std::size_t used = r.LN / r.step;
+    for (std::size_t j = 0; j < used; ++j) {
+      if (std::isnan(r.xm[j])) return true;
+    }
+    return r.LN < n && std::isnan(r.tail);
+  };
+  bool any = false;
+  for (int a = 0; a < 3 && !any; ++a) any = has_nan(*ax[a]);
+  if (!any) return;
+  for (int a = 0; a < 3; ++a) {
+    RollMed& r = *ax[a];
+    if (r.raw != nullptr) {
+      if (!has_nan(r)) continue;
+      // the raw axis copied, to be filled
+      r.xm.assign(r.raw, r.raw + n);
+      r.raw = nullptr;
+      r.step = 1;
+      r.LN = n;
+      r.tail = kNaN;
+    }
+    double last = kNaN;
+    for (std::size_t i = n; i-- > 0;) {
+      const double v = r[i];
+      if (!std::isnan(v)) {
+        last = v;
+        break;
+      }
+    }
+    const std::size_t used = r.LN / r.step;
+    for (std::size_t j = 0; j < used; ++j) {
+      if (std::isnan(r.xm[j])) r.xm[j] = last;
+    }
+    if (std::isnan(r.tail)) r.tail = last;
+  }
+}
+
+// Non-wear and clipping per long epoch (GGIR's medium epoch, ws2),
+// detect_nonwear_clipping() for approaches "2013" and "2023" without a
+// wear column.
+struct NonwearConfig {
+  double sf = 0;
+  double ws2 = 900;   // seconds
+  double ws = 3600;   // seconds
+  double clipthres = 7.5;
+  double sdcriter = 0.013;
+  double racriter = 0.15;
+  bool approach_2023 = true;
+  bool r_long_double = true;
+};
+
+struct NonwearResult {
+  std::vector<double> nonwear;   // NWav
+  std::vector<double> clipping;  // CWav
+  std::int64_t epochs = 0;       // nmin
+};
+
+// Values of one axis at R's indices (1-based, truncated), keeping those
+// within 1..n (R's NA beyond the end, left out by na.rm); 0 dropped.
+// A negative index would be R's exclusion: GGIR's sequences give none for
+// blocks of at least one window `ws`.
+template <class F>
+inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
+  if (!c.down && c.from >= 1 && c.from == std::floor(c.from) && c.from < 9007199254740992.0) {
+    // a whole start counting up: the indices are from, from + 1, ... (the
+    // sums are exact), those within 1..n
+    const std::int64_t first = static_cast<std::int64_t>(c.from);
+    const std::int64_t last = std::min<std::int64_t>(first + c.n - 1, static_cast<std::int64_t>(n));
+    for (std::int64_t j = first; j <= last; ++j) f(static_cast<std::size_t>(j - 1));
+    return;
+  }
+  for (std::int64_t k = 0; k < c.n; ++k) {
+    const double d = c.at(k);
+    if (d < 0) throw std::runtime_error("negative index in GGIR's non-wear window");
+    const std::int64_t j = static_cast<std::int64_t>(d);
+    if (j >= 1 && j <= static_cast<std::int64_t>(n)) f(static_cast<std::size_t>(j - 1));
+  }
+}
+
+template <class Acc>
+NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, const NonwearConfig& cf) {
+  NonwearResult r;
+  const double M = cf.ws2 * cf.sf;  // MediumEpochSize
+  const double L = cf.ws * cf.sf;   // LongEpochSize
+  const std::int64_t N = static_cast<std::int64_t>(std::floor(static_cast<double>(nrow) / M));
+  r.epochs = N;
+  if (N <= 0) return r;
+  std::vector<double> nwlog(static_cast<std::size_t>(N) * 3, 0.0);
+  r.nonwear.assign(static_cast<std::size_t>(N), 0.0);
+  r.clipping.assign(static_cast<std::size_t>(N), 0.0);
+  const double minimumEpochCount = ((L / M) / 2) + 1;
+  const double stride = std::ceil(cf.sf / 5);
+  std::vector<double> vals;
+  for (std::int64_t h = 1; h <= N; ++h) {
+    const double hd = static_cast<double>(h);
+    const double clipstart = (((hd - 1) * M) + M * 0.5) - M * 0.5;
+    const double clipend = (((hd - 1) * M) + M * 0.5) + M * 0.5;
+    double nwstart = 0, nwend = 0;
+    std::int64_t flag_from = h, flag_to = h;
+    if (!cf.approach_2023) {
+      if (hd <= minimumEpochCount) {
+        nwstart = 1;
+        nwend = L;
+      } else if (hd >= (static_cast<double>(N) - minimumEpochCount)) {
+        nwstart = (static_cast<double>(N) - minimumEpochCount) * M;
+        nwend = static_cast<double>(N) * M;
+      } else {
+        nwstart = (((hd - 1) * M) + M * 0.5) - L * 0.5;
+        nwend = (((hd - 1) * M) + M * 0.5) + L * 0.5;
+      }
+    } else {
+      // h:(h + L / M - 1), those beyond N left out
+      const RColon fc = r_colon(hd, hd + L / M - 1);
+      flag_from = h;
+      flag_to = h;
+      if (fc.n > 0) {
+        const double lastv = fc.at(fc.n - 1);
+        flag_to = static_cast<std::int64_t>(std::min(lastv, static_cast<double>(N)));
+      }
+      nwstart = hd * M - M;
+      nwend = nwstart + L;
+      if (nwend > static_cast<double>(nrow)) nwend = static_cast<double>(nrow);
+    }
+    double cmax = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double* v = xyz[a];
+      // clipping: values beyond clipthres in (1 + clipstart):clipend
+      const RColon cc = r_colon(1 + clipstart, clipend);
+      double count = 0;
+      bool extreme = false;
+      at_r_indices(cc, nrow, [&](std::size_t j) {
+        const double av = std::fabs(v[j]);
+        if (av > cf.clipthres) {
+          count += 1;
+          if (av > cf.clipthres * 1.5) extreme = true;
+        }
+      });
+      if (count > 0 && extreme) count = M;
+      cmax = a == 0 ? count / M : std::max(cmax, count / M);
+      // non-wear: range, then sd, of the window's values
+      vals.clear();
+      if (!cf.approach_2023) {
+        at_r_indices(r_colon(1 + nwstart, nwend), nrow, [&](std::size_t j) { vals.push_back(v[j]); });
+      } else {
+        const std::vector<double> s = r_seq_by(1 + nwstart, nwend, stride);
+        for (double d : s) {
+          const std::int64_t j = static_cast<std::int64_t>(d);
+          if (j >= 1 && j <= static_cast<std::int64_t>(nrow)) vals.push_back(v[static_cast<std::size_t>(j - 1)]);
+        }
+      }
+      double mx = -std::numeric_limits<double>::infinity();
+      double mn = std::numeric_limits<double>::infinity();
+      for (double e : vals) {
+        if (std::isnan(e)) continue;
+        if (e > mx) mx = e;
+        if (e < mn) mn = e;
+      }
+      const double absrange = std::fabs(mx - mn);
+      if (absrange < cf.racriter) {
+        const RMeanSd ms = r_mean_sd<Acc>([&](auto&& f) {
+          for (double e : vals) f(e);
+        });
+        if (ms.sd < cf.sdcriter) {
+          for (std::int64_t g = flag_from; g <= flag_to; ++g) {
+            nwlog[static_cast<std::size_t>(g - 1) * 3 + static_cast<std::size_t>(a)] = 1;
+          }
+        }
+      }
+    }
+    // R's max(c(...)) of the three clipping fractions
+    r.clipping[static_cast<std::size_t>(h - 1)] = cmax;
+    const std::size_t b = static_cast<std::size_t>(h - 1) * 3;
+    r.nonwear[static_cast<std::size_t>(h - 1)] = nwlog[b] + nwlog[b + 1] + nwlog[b + 2];
+  }
+  // an isolated 1 between two scores above 1 becomes 2
+  for (std::size_t i = 1; i + 1 < r.nonwear.size(); ++i) {
+    if (r.nonwear[i] == 1 && r.nonwear[i - 1] > 1 && r.nonwear[i + 1] > 1) r.nonwear[i] = 2;
+  }
+  return r;
+}
+
+// GGIR's lightpeak: for li in 1:(n / M), max(light[((li - 1) M):(li M)])
+// (index 0 dropped, so the first epoch has M values and the others M + 1).
+template <class L>
+std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
+  std::vector<double> out;
+  const RColon loop = r_colon(1, static_cast<double>(n) / M);
+  if (static_cast<double>(n) / M < 1) return out;
+  out.resize(static_cast<std::size_t>(loop.n), 0.0);
+  for (std::int64_t k = 0; k < loop.n; ++k) {
+    const double li = loop.at(k);
+    double mx = -std::numeric_limits<double>::infinity();
+    bool na = false;
+    at_r_indices(r_colon((li - 1) * M, li * M), n, [&](std::size_t j) {
+      const double v = light(j);
+      if (std::isnan(v)) na = true;
+      else if (v > mx) mx = v;
+    });
+    // indices beyond the end are NA in R, and max() without na.rm is NA
+    const RColon c = r_colon((li - 1) * M, li * M);
+    if (static_cast<std::int64_t>(c.at(c.n - 1)) > static_cast<std::int64_t>(n)) na = true;
+    out[static_cast<std::size_t>(k)] = na ? kNaN : mx;
+  }
+  return out;
+}
+
+
+// The short-epoch metrics of g.applymetrics() that need no filter, for a
+// block of calibrated samples: "roll_med_acc_x" (and y, z),
+// "dev_roll_med_acc_x" (y, z), "angle_x" (y, z), "ENMO", "MAD", "EN",
+// "ENMOa"; with filter coefficients `fc`, also the filtered metrics of
+// ggir_filters.hpp ("BFEN", "LFENMO", "ZCX", ...: zero crossings summed
+// per epoch, the others averaged). Each asked name gets its epoch values
+// (unrounded), in the order asked. Unknown names are an error.
+template <class Acc>
+std::vector<std::vector<double>> short_metrics(const double* x, const double* y, const double* z,
+                                               std::size_t n, double sf, double ws3,
+                                               const std::vector<std::string>& names,
+                                               const GgirFilterCoefs* fc = nullptr,
+                                               RFilterArith arith = {}) {
+  const double by = sf * ws3;
+  std::vector<std::vector<double>> out(names.size());
+  RollMed rm[3];
+  bool have_rm = false;
+  auto need_rm = [&]() {
+    if (have_rm) return;
+    const double* v[3] = {x, y, z};
+    for (int a = 0; a < 3; ++a) rm[a] = ggir_rollmed(v[a], n, sf);
+    RollMed* p[3] = {&rm[0], &rm[1], &rm[2]};
+    fill_na_last(p, n);
+    have_rm = true;
+  };
+  auto en = [x, y, z](std::size_t i) { return r_norm(x[i], y[i], z[i]); };
+  const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
+  std::vector<double> sig, work;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string& nm = names[k];
+    FilteredMetric fm;
+    if (filtered_metric_from_name(nm.c_str(), &fm)) {
+      if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
+      sig.resize(n);
+      work.resize(3 * n);
+      const SignalStatus st = ggir_filtered_signal(fm, x, y, z, n, *fc, sig.data(), work.data(), arith);
+      if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
+      if (st == SignalStatus::replacement_length)
+        throw std::runtime_error("number of items to replace is not a multiple of replacement length");
+      if (st == SignalStatus::too_short) throw std::runtime_error("GGIR's zero crossings need at least 2 samples");
+      const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY || fm == FilteredMetric::ZCZ;
+      out[k] = per_epoch<Acc>(sig.data(), n, by, !zc);
+      continue;
+    }
+    int axis = -1;
+    if (nm.size() > 2 && nm[nm.size() - 2] == '_') {
+      const char c = nm.back();
+      axis = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
+    }
+    const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
+    if (base == "roll_med_acc" && axis >= 0) {
+      need_rm();
+      const RollMed& r = rm[axis];
+      out[k] = per_epoch_of<Acc>(n, by, true, [&r](std::size_t i) { return r[i]; });
+    } else if (base == "dev_roll_med_acc" && axis >= 0) {
+      need_rm();
+      const double* v = axis == 0 ? x : axis == 1 ? y : z;
+      const RollMed& r = rm[axis];
+      out[k] = per_epoch_of<Acc>(n, by, true, [v, &r](std::size_t i) { return std::fabs(v[i] - r[i]); });
+    } else if (base == "angle" && axis >= 0) {
+      need_rm();
+      const RollMed& a = rm[axis];
+      const RollMed& b = rm[(axis + 1) % 3];
+      const RollMed& c = rm[(axis + 2) % 3];
+      // GGIR's order: angle_x: atan(x / sqrt(y^2 + z^2)); angle_y: y over
+      // x, z; angle_z: z over x, y
+      const RollMed& p = axis == 1 ? c : b;  // first in the sum
+      const RollMed& q = axis == 1 ? b : c;
+      auto angle = [&a, &p, &q, deg](std::size_t i) {
+        const double pi = p[i], qi = q[i];
+        return std::atan(a[i] / (std::sqrt(pi * pi + qi * qi))) / deg;
+      };
+      // the medians hold for `step` samples (10 Hz): their angle is taken
+      // once per subsample value (the same inputs, the same result)
+      const bool held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr &&
+                        a.step == p.step && a.step == q.step && a.LN == p.LN && a.LN == q.LN;
+      std::size_t last = static_cast<std::size_t>(-1);
+      double value = 0;
+      out[k] = per_epoch_of<Acc>(n, by, true, [&](std::size_t i) {
+        if (!held || i >= a.LN) return angle(i);
+        const std::size_t j = i / a.step;
+        if (j != last) {
+          last = j;
+          value = angle(i);
+        }
+        return value;
+      });
+    } else if (nm == "ENMO") {
+      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) {
+        const double e = en(i) - 1;
+        return e < 0 ? 0 : e;
+      });
+    } else if (nm == "EN") {
+      out[k] = per_epoch_of<Acc>(n, by, true, en);
+    } else if (nm == "ENMOa") {
+      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) { return std::fabs(en(i) - 1); });
+    } else if (nm == "MAD") {
+      // rep(epoch means, each = sf * ws3) (each truncated to an integer),
+      // recycled against EN as R's `-` recycles
+      const std::vector<double> means = per_epoch_of<Acc>(n, by, true, en);
+      const std::size_t each = static_cast<std::size_t>(by);
+      const std::size_t m = means.size() * each;
+      const std::size_t len = (n == 0 || m == 0) ? 0 : std::max(n, m);
+      out[k] = per_epoch_of<Acc>(len, by, true, [&en, &means, n, m, each](std::size_t i) {
+        return std::fabs(en(i % n) - means[(i % m) / each]);
+      });
+    } else {
+      throw std::runtime_error("unknown GGIR metric: " + nm);
+    }
+  }
+  return out;
+}
+
+// The gradient of each short epoch's ENMO with respect to the coefficients
+// of a linear calibration, for the standard error that the coefficients'
+// uncertainty puts on summaries of ENMO (the delta method; R/outcome-se.R).
+// Model: a = K (v + o) + (t - meantemp) tempoffset, K lower triangular (the
+// fit's; GGIR's diagonal scale is K = diag(scale)). ENMO of a sample is
+// max(|a| - 1, 0), so its gradient is [|a| > 1] (a / |a|)' da/dtheta with
+// da/dk_ij = (v_j + o_j) e_i (i >= j), da/do_j = K[, j] and
+// da/dt_j = (t - meantemp) e_j. An epoch's gradient is the mean of its
+// samples' over the epochs per_epoch() cuts (R's round(seq(1, n + 1, by))
+// bounds), in plain double sums: a derivative, not a promised bit.
+// Columns in coef()'s order: k_xx, k_yy, k_zz, k_xy, k_xz, k_yz, o_x, o_y,
+// o_z, t_x, t_y, t_z; row-major, out[e * kGradientColumns + c].
+constexpr std::size_t kGradientColumns = 12;
+
+struct LinearCalibration {
+  double K[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // K[row][column]
+  double offset[3] = {0, 0, 0};
+  bool temp = false;  // the temperature term applies
+  double meantemp = 0;
+  double tempoffset[3] = {0, 0, 0};
+};
+
+template <class T>
+std::vector<double> enmo_gradient(const double* x, const double* y, const double* z,
+                                         T&& t, bool have_t, std::size_t n, double by,
+                                         const LinearCalibration& m) {
+  constexpr std::size_t C = kGradientColumns;
+  const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
+  std::vector<double> out;
+  if (sel.size() < 2) return out;
+  const std::size_t ne = sel.size() - 1;
+  out.assign(ne * C, 0.0);
+  const bool temp = m.temp && have_t;
+  std::size_t from = static_cast<std::size_t>(r_round0(sel[0])) - 1;
+  for (std::size_t e = 0; e < ne; ++e) {
+    const std::size_t to = static_cast<std::size_t>(r_round0(sel[e + 1])) - 1;
+    double* g = &out[e * C];
+    for (std::size_t i = from; i < to; ++i) {
+      const double u[3] = {x[i] + m.offset[0], y[i] + m.offset[1], z[i] + m.offset[2]};
+      const double dt = temp ? t(i) - m.meantemp : 0;
+      double a[3];
+      for (int r = 0; r < 3; ++r) {
+        a[r] = m.K[r][0] * u[0] + m.K[r][1] * u[1] + m.K[r][2] * u[2];
+        if (temp) a[r] = a[r] + dt * m.tempoffset[r];
+      }
+      const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+      if (!(na > 1)) continue;  // ENMO is 0 here, and so is its gradient
+      const double q[3] = {a[0] / na, a[1] / na, a[2] / na};
+      g[0] += q[0] * u[0];
+      g[1] += q[1] * u[1];
+      g[2] += q[2] * u[2];
+      g[3] += q[1] * u[0];
+      g[4] += q[2] * u[0];
+      g[5] += q[2] * u[1];
+      for (int j = 0; j < 3; ++j) {
+        g[6 + j] += q[0] * m.K[0][j] + q[1] * m.K[1][j] + q[2] * m.K[2][j];
+      }
+      if (temp) {
+        g[9] += q[0] * dt;
+        g[10] += q[1] * dt;
+        g[11] += q[2] * dt;
+      }
+    }
+    const double len = static_cast<double>(to > from ? to - from : 1);
+    for (std::size_t c = 0; c < C; ++c) g[c] = g[c] / len;
+    from = to;
+  }
+  return out;
+}
+
+}  // namespace ggir_part1
+}  // namespace gravcal
+
+#endif  // GRAVCAL_GGIR_EPOCHS_HPP
