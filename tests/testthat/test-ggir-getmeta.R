@@ -102,6 +102,14 @@ test_that("g.getmeta() is GGIR's on a GENEActiv .bin recording, in a zone with a
                                      params_rawdata = list(nonwear_range_threshold = 100))))
   expect_same_meta(b)
   expect_match(b$gravcal$metashort$timestamp[1], "\\+0200$")
+  # GGIR's half-size blocks (chunksize 0.5: about 12 h, three blocks over
+  # the 28 hours and the carry between them)
+  b2 <- meta_both(f, c(cal_args, list(params_general = list(desiredtz = "Europe/Amsterdam"),
+                                      params_rawdata = list(nonwear_range_threshold = 100,
+                                                            chunksize = 0.5))))
+  expect_same_meta(b2)
+  # the blocks' edges show (the angles' running median restarts per block)
+  expect_false(identical(b2$gravcal$metashort, b$gravcal$metashort))
 })
 
 test_that("g.getmeta() is GGIR's without calibration, for a daylimit, and on a file too short", {
