@@ -48,11 +48,13 @@ ggir_filter <- function(coef, x) {
   gc_ggir_filter(as.double(coef$b), as.double(coef$a), as.double(x), fu$conv, fu$rec)
 }
 
-# One metric's per-sample signal before g.applymetrics() averages it per
-# epoch; xyz: a block's calibrated samples (3 columns), coefs:
-# ggir_filter_coefs().
-ggir_filtered_signal <- function(xyz, metric, coefs) {
-  fu <- stats_filter_fused()
-  gc_ggir_filtered_signal(as.double(xyz[, 1]), as.double(xyz[, 2]), as.double(xyz[, 3]),
-                          metric, coefs, fu$conv, fu$rec)
+# The per-sample signals of filtered metrics before g.applymetrics()
+# averages them per epoch; xyz: a block's calibrated samples (3 columns),
+# coefs: ggir_filter_coefs(). One metric: its signal; several: a list
+# named by them (each filter run once for all). `fused`: whether R's
+# stats::filter() fuses its multiply-adds (this R's, or as given).
+ggir_filtered_signal <- function(xyz, metric, coefs, fused = stats_filter_fused()) {
+  out <- gc_ggir_filtered_signal(as.double(xyz[, 1]), as.double(xyz[, 2]), as.double(xyz[, 3]),
+                                 metric, coefs, fused$conv, fused$rec)
+  if (length(metric) == 1) out[[1]] else out
 }

@@ -67,6 +67,18 @@ run <- switch(contender,
     saveRDS(list(M$metashort, M$metalong), f, compress = FALSE)
     list(coef = nrow(M$metashort), status = unname(tools::md5sum(f)))
   },
+  # the same with every metric GGIR computes itself (every do.* but the
+  # counts of other packages), as bench/part1.R's "every metric"
+  "gravcal::g.getmeta, every metric" = function() {
+    pm <- GGIR::load_params()$params_metrics
+    for (k in grep("^do[.]", names(pm), value = TRUE)) {
+      pm[[k]] <- !k %in% c("do.brondcounts", "do.neishabouricounts")
+    }
+    M <- quiet(gravcal::g.getmeta(file, params_metrics = pm, verbose = FALSE))
+    f <- tempfile()
+    saveRDS(list(M$metashort, M$metalong), f, compress = FALSE)
+    list(coef = nrow(M$metashort), status = unname(tools::md5sum(f)))
+  },
   "calibrate(method = \"ggir\")" = function() {
     f <- if (length(rmc)) {
       quiet(gravcal::calibrate(file, method = "ggir", rmc = rmc))

@@ -308,18 +308,18 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_ggir_filtered_signal
-Rcpp::NumericVector gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const std::string& metric, const Rcpp::List& coefs, bool conv_fused, bool rec_fused);
-RcppExport SEXP _gravcal_gc_ggir_filtered_signal(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP metricSEXP, SEXP coefsSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
+Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::CharacterVector& metrics, const Rcpp::List& coefs, bool conv_fused, bool rec_fused);
+RcppExport SEXP _gravcal_gc_ggir_filtered_signal(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP metricsSEXP, SEXP coefsSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< const std::string& >::type metric(metricSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::CharacterVector& >::type metrics(metricsSEXP);
     Rcpp::traits::input_parameter< const Rcpp::List& >::type coefs(coefsSEXP);
     Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
     Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_ggir_filtered_signal(x, y, z, metric, coefs, conv_fused, rec_fused));
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_filtered_signal(x, y, z, metrics, coefs, conv_fused, rec_fused));
     return rcpp_result_gen;
 END_RCPP
 }

@@ -56,37 +56,50 @@ Rcpp::NumericVector gc_ggir_filter(const Rcpp::NumericVector& b, const Rcpp::Num
   return Rcpp::NumericVector(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(r.length));
 }
 
-// One of g.applymetrics()'s filtered per-sample signals (metric: GGIR's
-// name, "BFEN", ..., "ZCZ") of a block's calibrated axes. coefs: list(band,
-// low, high, zc = list(b, a) each, zc_sb), as ggir_filter_coefs() gives.
+// g.applymetrics()'s filtered per-sample signals (metrics: GGIR's names,
+// "BFEN", ..., "ZCZ") of a block's calibrated axes, each filter run once for
+// all of them (ggir_filtered_signals()): a list, one signal per metric.
+// coefs: list(band, low, high, zc = list(b, a) each, zc_sb), as
+// ggir_filter_coefs() gives. R's error for the first metric, in the order
+// given, that R could not compute.
 // [[Rcpp::export(rng = false)]]
-Rcpp::NumericVector gc_ggir_filtered_signal(const Rcpp::NumericVector& x,
-                                            const Rcpp::NumericVector& y,
-                                            const Rcpp::NumericVector& z,
-                                            const std::string& metric, const Rcpp::List& coefs,
-                                            bool conv_fused, bool rec_fused) {
+Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
+                                   const Rcpp::NumericVector& z,
+                                   const Rcpp::CharacterVector& metrics, const Rcpp::List& coefs,
+                                   bool conv_fused, bool rec_fused) {
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
-  gravcal::FilteredMetric m;
-  if (!gravcal::filtered_metric_from_name(metric.c_str(), &m))
-    Rcpp::stop("`metric` must be one of GGIR's filtered metrics, not \"%s\"", metric);
+  std::vector<gravcal::FilteredMetric> ms(static_cast<std::size_t>(metrics.size()));
+  for (R_xlen_t k = 0; k < metrics.size(); ++k) {
+    const std::string nm = Rcpp::as<std::string>(metrics[k]);
+    if (!gravcal::filtered_metric_from_name(nm.c_str(), &ms[static_cast<std::size_t>(k)]))
+      Rcpp::stop("`metric` must be one of GGIR's filtered metrics, not \"%s\"", nm);
+  }
   gravcal::GgirFilterCoefs c;
   c.band = arma(coefs["band"], "coefs$band");
   c.low = arma(coefs["low"], "coefs$low");
   c.high = arma(coefs["high"], "coefs$high");
   c.zc = arma(coefs["zc"], "coefs$zc");
   c.zc_sb = Rcpp::as<double>(coefs["zc_sb"]);
-  Rcpp::NumericVector out(n);
-  const gravcal::SignalStatus s = gravcal::ggir_filtered_signal(
-      m, x.begin(), y.begin(), z.begin(), static_cast<std::size_t>(n), c, out.begin(),
-      arith_of(conv_fused, rec_fused));
-  switch (s) {
-    case gravcal::SignalStatus::ok: break;
-    case gravcal::SignalStatus::internal_na: Rcpp::stop("time series contains internal NAs");
-    case gravcal::SignalStatus::replacement_length:
-      Rcpp::stop("number of items to replace is not a multiple of replacement length");
-    case gravcal::SignalStatus::too_short:
-      Rcpp::stop("GGIR's zero crossings need at least 2 samples");
+  Rcpp::List out(metrics.size());
+  std::vector<gravcal::SignalStatus> status(ms.size(), gravcal::SignalStatus::ok);
+  gravcal::ggir_filtered_signals(
+      ms.data(), ms.size(), x.begin(), y.begin(), z.begin(), static_cast<std::size_t>(n), c,
+      arith_of(conv_fused, rec_fused),
+      [&](std::size_t i, gravcal::SignalStatus st, const double* sig) {
+        status[i] = st;
+        if (sig != nullptr) out[static_cast<R_xlen_t>(i)] = Rcpp::NumericVector(sig, sig + n);
+      });
+  for (gravcal::SignalStatus s : status) {
+    switch (s) {
+      case gravcal::SignalStatus::ok: break;
+      case gravcal::SignalStatus::internal_na: Rcpp::stop("time series contains internal NAs");
+      case gravcal::SignalStatus::replacement_length:
+        Rcpp::stop("number of items to replace is not a multiple of replacement length");
+      case gravcal::SignalStatus::too_short:
+        Rcpp::stop("GGIR's zero crossings need at least 2 samples");
+    }
   }
+  out.names() = metrics;
   return out;
 }

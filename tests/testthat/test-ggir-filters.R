@@ -190,6 +190,57 @@ test_that("the per-sample signals: g.applymetrics()'s expressions, bit for bit",
   expect_error(gravcal:::ggir_filtered_signal(xyz, "ENMO", co), "filtered metrics")
 })
 
+test_that("every filtered metric at once (each filter run once, the three axes side by side) gives each one's own bits", {
+  # g.getmeta() asks for all its filtered metrics in one call: the filters
+  # run once per coefficient set and axis, and the three axes' recursions
+  # side by side where no axis has NA. The result must be each metric's
+  # signal computed alone (one axis at a time), under both of R's possible
+  # multiply-add arithmetics, with NA, NaN and Inf in the block, and R's
+  # error for the first metric (in the order asked) that R cannot compute.
+  skip_if_no_filter_refs()
+  xyz <- ax3_xyz()[1:3000, ]
+  co <- gravcal:::ggir_filter_coefs(100)
+  nan_x <- xyz
+  nan_x[1:7, 1] <- NaN                              # x shorter, not recycled: R stops
+  inf_y <- xyz
+  inf_y[1500, 2] <- Inf                             # y: NaN from Inf - Inf mid-block
+  tail_z <- xyz
+  tail_z[1501:3000, 3] <- NA                        # z: half the block, recycled
+  blocks <- list(clean = xyz, nan_x = nan_x, inf_y = inf_y, tail_z = tail_z)
+  one_by_one <- function(b, ms, fused) {
+    lapply(stats::setNames(ms, ms), function(m) {
+      tryCatch(gravcal:::ggir_filtered_signal(b, m, co, fused), error = conditionMessage)
+    })
+  }
+  arithmetics <- list(plain = list(conv = FALSE, rec = FALSE), fused = list(conv = TRUE, rec = TRUE),
+                      mixed = list(conv = FALSE, rec = TRUE))
+  orders <- list(ggir = filtered_metrics, reversed = rev(filtered_metrics),
+                 some = c("HFENplus", "LFX", "BFEN", "ZCY"))
+  for (fu in names(arithmetics)) for (bn in names(blocks)) for (ms in orders) {
+    b <- blocks[[bn]]
+    alone <- one_by_one(b, ms, arithmetics[[fu]])
+    together <- tryCatch(gravcal:::ggir_filtered_signal(b, ms, co, arithmetics[[fu]]),
+                         error = conditionMessage)
+    failed <- vapply(alone, is.character, TRUE)
+    if (any(failed)) {
+      # R stops at the first metric it cannot compute
+      expect_identical(together, alone[[which(failed)[1]]], info = paste(fu, bn))
+    } else {
+      expect_identical(names(together), ms)
+      expect_same_bits(unlist(together), unlist(alone))
+    }
+  }
+  # the cases reach each path: a clean block is computed, a NaN at the
+  # start stops R, an Inf gives NaN values, a half-NA axis is recycled
+  expect_false(anyNA(unlist(gravcal:::ggir_filtered_signal(xyz, filtered_metrics, co))))
+  expect_error(gravcal:::ggir_filtered_signal(nan_x, "BFX", co), "replacement length")
+  expect_true(anyNA(gravcal:::ggir_filtered_signal(inf_y, "LFY", co)))
+  expect_same_bits(gravcal:::ggir_filtered_signal(tail_z, "BFZ", co), ref_signal(tail_z, "BFZ", co))
+  # R's own signal for each, with this R's arithmetic
+  together <- gravcal:::ggir_filtered_signal(xyz, filtered_metrics, co)
+  for (m in filtered_metrics) expect_same_bits(together[[m]], ref_signal(xyz, m, co))
+})
+
 test_that("the per-sample signals, on a calibrated day block at 30 Hz (shared data)", {
   skip_if_no_filter_refs()
   skip_if_quick()

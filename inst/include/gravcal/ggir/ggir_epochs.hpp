@@ -574,21 +574,41 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
   };
   auto en = [x, y, z](std::size_t i) { return r_norm(x[i], y[i], z[i]); };
   const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
-  std::vector<double> sig, work;
+  // the filtered metrics first, each filter run once for all of them
+  // (ggir_filtered_signals()); their errors are raised below, in the
+  // order asked
+  std::vector<FilteredMetric> fms;
+  std::vector<std::size_t> fk;  // their places among names
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    FilteredMetric fm;
+    if (filtered_metric_from_name(names[k].c_str(), &fm)) {
+      fms.push_back(fm);
+      fk.push_back(k);
+    }
+  }
+  std::vector<SignalStatus> fstatus(names.size(), SignalStatus::ok);
+  if (fc != nullptr && !fms.empty()) {
+    ggir_filtered_signals(fms.data(), fms.size(), x, y, z, n, *fc, arith,
+                          [&](std::size_t i, SignalStatus st, const double* sig) {
+                            const std::size_t k = fk[i];
+                            fstatus[k] = st;
+                            if (sig == nullptr) return;
+                            const FilteredMetric fm = fms[i];
+                            const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY ||
+                                            fm == FilteredMetric::ZCZ;
+                            out[k] = per_epoch<Acc>(sig, n, by, !zc);
+                          });
+  }
   for (std::size_t k = 0; k < names.size(); ++k) {
     const std::string& nm = names[k];
     FilteredMetric fm;
     if (filtered_metric_from_name(nm.c_str(), &fm)) {
       if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
-      sig.resize(n);
-      work.resize(3 * n);
-      const SignalStatus st = ggir_filtered_signal(fm, x, y, z, n, *fc, sig.data(), work.data(), arith);
+      const SignalStatus st = fstatus[k];
       if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
       if (st == SignalStatus::replacement_length)
         throw std::runtime_error("number of items to replace is not a multiple of replacement length");
       if (st == SignalStatus::too_short) throw std::runtime_error("GGIR's zero crossings need at least 2 samples");
-      const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY || fm == FilteredMetric::ZCZ;
-      out[k] = per_epoch<Acc>(sig.data(), n, by, !zc);
       continue;
     }
     int axis = -1;
@@ -623,13 +643,14 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       // once per subsample value (the same inputs, the same result)
       const bool held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr &&
                         a.step == p.step && a.step == q.step && a.LN == p.LN && a.LN == q.LN;
-      std::size_t last = static_cast<std::size_t>(-1);
+      // (per_epoch_of() asks for i = 0, 1, ... in turn: the value is new
+      // where i reaches the next multiple of the step)
+      std::size_t next = 0;
       double value = 0;
       out[k] = per_epoch_of<Acc>(n, by, true, [&](std::size_t i) {
         if (!held || i >= a.LN) return angle(i);
-        const std::size_t j = i / a.step;
-        if (j != last) {
-          last = j;
+        if (i >= next) {
+          next = (i / a.step + 1) * a.step;
           value = angle(i);
         }
         return value;

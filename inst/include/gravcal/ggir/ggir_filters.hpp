@@ -28,8 +28,10 @@
 //        NA, so both give the same bits.)
 //    The coefficients are divided here as R divides them (b[j] / a[1],
 //    (-a[j]) / a[1]): pass signal::butter()'s b and a untouched.
-// 2. ggir_filtered_signal(): what g.applymetrics computes per sample before
-//    averaging, for one metric (FilteredMetric), from the three axes:
+// 2. ggir_filtered_signals(): what g.applymetrics computes per sample before
+//    averaging, for metrics (FilteredMetric), from the three axes, each
+//    filter run once per axis for all the metrics that read it
+//    (ggir_filtered_signal(): one metric):
 //      BFX/BFY/BFZ |band(lb, hb)| per axis; BFEN their norm;
 //      LFX/LFY/LFZ |low(hb)|; LFEN their norm; LFENMO that norm - 1, values
 //        below 0 set to 0;
@@ -63,6 +65,7 @@
 
 #include "gravcal/mcu/fp_contract.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -105,8 +108,174 @@ namespace ggir_filters_detail {
 
 inline bool r_ok(double v) { return !std::isnan(v); }  // filter.c's my_isok
 
-inline double madd(double acc, double p, double q, bool fused) {
-  return fused ? kernels::replay_fma(p, q, acc) : acc + p * q;  // not contracted
+template <bool Fused>
+inline double madd(double acc, double p, double q) {
+  return Fused ? kernels::replay_fma(p, q, acc) : acc + p * q;  // not contracted
+}
+
+// cfilter over c(rep(0, nb - 1), x), sides = 1, into y[0, n): output i
+// is z = 0, then z += f[j] * v[i - j] for j = 0, 1, ..., v[i - j] = x[i - j]
+// or a leading zero where i - j < 0; NA_real_ where an operand is NA. Past
+// the leading zeros the sum is taken without the tests, and taken again
+// with them only where it comes out NaN (a NA operand makes it NaN; an
+// overflow too, and the tests then give the same NaN).
+template <bool Fused>
+inline void convolve(const double* f, std::size_t nb, const double* x, std::size_t n, double* y) {
+  const double na_real = r_na_real();
+  auto tested = [&](std::size_t i) {
+    double z = 0;
+    for (std::size_t j = 0; j < nb; ++j) {
+      const double tmp = j <= i ? x[i - j] : 0.0;
+      if (!r_ok(tmp)) return na_real;
+      z = madd<Fused>(z, f[j], tmp);
+    }
+    return z;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + 1 < nb) {
+      y[i] = tested(i);
+      continue;
+    }
+    double z = 0;
+    for (std::size_t j = 0; j < nb; ++j) z = madd<Fused>(z, f[j], x[i - j]);
+    y[i] = std::isnan(z) ? tested(i) : z;
+  }
+}
+
+// rfilter's output i taken with R's tests (recurse()): sum = v[first + i],
+// then sum += r[i - 1 - j] * g[j] for j = 0, ..., ng - 1 over the outputs r
+// (written over y from y[0]), zero before the start; NA_real_ where an
+// operand is NA.
+template <bool Fused>
+inline double recurse_tested(const double* g, std::size_t ng, const double* y, std::size_t first,
+                             std::size_t i) {
+  double sum = y[first + i];
+  if (!r_ok(sum)) return r_na_real();
+  for (std::size_t j = 0; j < ng; ++j) {
+    const double tmp = i >= j + 1 ? y[i - 1 - j] : 0.0;
+    if (!r_ok(tmp)) return r_na_real();
+    sum = madd<Fused>(sum, tmp, g[j]);
+  }
+  return sum;
+}
+
+// rfilter in place: output i is written to y[i] over its input y[first +
+// i] (not yet overwritten: first + i >= i). Past the start, untested, as
+// convolve().
+template <bool Fused>
+inline void recurse(const double* g, std::size_t ng, double* y, std::size_t first,
+                    std::size_t len) {
+  for (std::size_t i = 0; i < len; ++i) {
+    if (i < ng) {
+      y[i] = recurse_tested<Fused>(g, ng, y, first, i);
+      continue;
+    }
+    double sum = y[first + i];
+    for (std::size_t j = 0; j < ng; ++j) sum = madd<Fused>(sum, y[i - 1 - j], g[j]);
+    y[i] = std::isnan(sum) ? recurse_tested<Fused>(g, ng, y, first, i) : sum;
+  }
+}
+
+// recurse() of three columns of len values, each from its start (first
+// = 0), side by side: the same operations on each column in the same
+// order, so the same bits, but three independent chains of sums where one
+// would wait on its last sum (rfilter's time is that chain's).
+template <bool Fused>
+inline void recurse3(const double* g, std::size_t ng, double* const y[3], std::size_t len) {
+  double* const a = y[0];
+  double* const b = y[1];
+  double* const c = y[2];
+  for (std::size_t i = 0; i < len; ++i) {
+    if (i < ng) {
+      for (int k = 0; k < 3; ++k) y[k][i] = recurse_tested<Fused>(g, ng, y[k], 0, i);
+      continue;
+    }
+    double sa = a[i], sb = b[i], sc = c[i];
+    for (std::size_t j = 0; j < ng; ++j) {
+      sa = madd<Fused>(sa, a[i - 1 - j], g[j]);
+      sb = madd<Fused>(sb, b[i - 1 - j], g[j]);
+      sc = madd<Fused>(sc, c[i - 1 - j], g[j]);
+    }
+    a[i] = std::isnan(sa) ? recurse_tested<Fused>(g, ng, a, 0, i) : sa;
+    b[i] = std::isnan(sb) ? recurse_tested<Fused>(g, ng, b, 0, i) : sb;
+    c[i] = std::isnan(sc) ? recurse_tested<Fused>(g, ng, c, 0, i) : sc;
+  }
+}
+
+// b / a[1] and -a[-1] / a[1], as R divides them.
+struct DividedArma {
+  std::vector<double> f, g;
+  DividedArma(const double* b, std::size_t nb, const double* a, std::size_t na)
+      : f(nb), g(na > 1 ? na - 1 : 0) {
+    for (std::size_t j = 0; j < nb; ++j) f[j] = b[j] / a[0];
+    for (std::size_t j = 0; j + 1 < na; ++j) g[j] = (-a[j + 1]) / a[0];
+  }
+};
+
+// filter_arma() up to the recursion: x's NA cases, the convolution into y
+// and na.omit()'s span. A result whose status is not ok (all_na,
+// internal_na, no_output) is final; else res.length is the span's length
+// and `first` its start, and the recursion (recurse_from()) remains.
+inline FilterResult filter_front(const DividedArma& d, const double* x, std::size_t n, double* y,
+                                 RFilterArith arith, std::size_t* first) {
+  FilterResult res;
+  *first = 0;
+  if (n == 0) {
+    res.status = FilterStatus::no_output;
+    return res;
+  }
+  bool any_ok = false;
+  for (std::size_t i = 0; i < n && !any_ok; ++i) any_ok = r_ok(x[i]);
+  if (!any_ok) {  // all(is.na(x)): x
+    for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
+    res.status = FilterStatus::all_na;
+    res.length = n;
+    return res;
+  }
+  const std::size_t nb = d.f.size();
+  std::size_t last = n;  // the convolution's non-NA span [first, last)
+  if (nb > 0) {
+    // cfilter over the nb - 1 zeros and x: its nb - 1 outputs before x's
+    // first are NA (cut by na.omit); output i of the rest reads x[i - j],
+    // or a leading zero
+    if (arith.conv_fused) convolve<true>(d.f.data(), nb, x, n, y);
+    else convolve<false>(d.f.data(), nb, x, n, y);
+    // na.omit(): the leading and trailing NAs dropped
+    while (*first < n && !r_ok(y[*first])) ++*first;
+    if (*first == n) {  // all(is.na(x1)): x
+      for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
+      res.status = FilterStatus::all_na;
+      res.length = n;
+      return res;
+    }
+    while (!r_ok(y[last - 1])) --last;
+    for (std::size_t i = *first; i < last; ++i) {
+      if (!r_ok(y[i])) {
+        res.status = FilterStatus::internal_na;
+        return res;
+      }
+    }
+  } else {
+    for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
+  }
+  res.length = last - *first;
+  return res;
+}
+
+// The rest of filter_arma() after filter_front(): the recursion over the
+// span (or the span moved to y[0]); the status ok or shortened.
+inline FilterResult recurse_from(const DividedArma& d, double* y, std::size_t n, std::size_t first,
+                                 std::size_t len, RFilterArith arith) {
+  if (!d.g.empty()) {
+    if (arith.rec_fused) recurse<true>(d.g.data(), d.g.size(), y, first, len);
+    else recurse<false>(d.g.data(), d.g.size(), y, first, len);
+  } else if (first > 0) {
+    for (std::size_t i = 0; i < len; ++i) y[i] = y[first + i];
+  }
+  FilterResult res;
+  res.length = len;
+  res.status = len == n ? FilterStatus::ok : FilterStatus::shortened;
+  return res;
 }
 
 }  // namespace ggir_filters_detail
@@ -118,85 +287,35 @@ inline FilterResult filter_arma(const double* b, std::size_t nb, const double* a
                                 const double* x, std::size_t n, double* y,
                                 RFilterArith arith = RFilterArith()) {
   namespace d = ggir_filters_detail;
-  FilterResult res;
-  if (n == 0) {
-    res.status = FilterStatus::no_output;
-    return res;
+  const d::DividedArma da(b, nb, a, na);
+  std::size_t first = 0;
+  const FilterResult res = d::filter_front(da, x, n, y, arith, &first);
+  if (res.status != FilterStatus::ok) return res;
+  return d::recurse_from(da, y, n, first, res.length, arith);
+}
+
+// filter_arma() of three columns x[k] into y[k] (each distinct from the
+// x's), res[k] each one's result: the same bits as three calls. Where
+// each column's span is whole (no NA: the usual case), the three
+// recursions run side by side (recurse3()).
+inline void filter_arma3(const ArmaCoefs& c, const double* const x[3], std::size_t n,
+                         double* const y[3], RFilterArith arith, FilterResult res[3]) {
+  namespace d = ggir_filters_detail;
+  const d::DividedArma da(c.b, c.nb, c.a, c.na);
+  std::size_t first[3];
+  bool whole = true;
+  for (int k = 0; k < 3; ++k) {
+    res[k] = d::filter_front(da, x[k], n, y[k], arith, &first[k]);
+    whole = whole && res[k].status == FilterStatus::ok && first[k] == 0 && res[k].length == n;
   }
-  bool any_ok = false;
-  for (std::size_t i = 0; i < n && !any_ok; ++i) any_ok = d::r_ok(x[i]);
-  if (!any_ok) {  // all(is.na(x)): x
-    for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
-    res.status = FilterStatus::all_na;
-    res.length = n;
-    return res;
+  if (whole && !da.g.empty()) {
+    if (arith.rec_fused) d::recurse3<true>(da.g.data(), da.g.size(), y, n);
+    else d::recurse3<false>(da.g.data(), da.g.size(), y, n);
+    return;
   }
-  // b / a[1] and -a[-1] / a[1], as R divides them
-  std::vector<double> fb(nb), ga(na > 1 ? na - 1 : 0);
-  for (std::size_t j = 0; j < nb; ++j) fb[j] = b[j] / a[0];
-  for (std::size_t j = 0; j + 1 < na; ++j) ga[j] = (-a[j + 1]) / a[0];
-  const double na_real = r_na_real();
-  std::size_t first = 0, last = n;  // the convolution's non-NA span [first, last)
-  if (nb > 0) {
-    // cfilter over c(rep(0, nb - 1), x), sides = 1: its first nb - 1
-    // outputs are NA (cut by na.omit); output i of the rest reads
-    // v[i - j] = x[i - j], or a leading zero where i - j < 0.
-    for (std::size_t i = 0; i < n; ++i) {
-      double z = 0;
-      bool bad = false;
-      for (std::size_t j = 0; j < nb; ++j) {
-        const double tmp = j <= i ? x[i - j] : 0.0;
-        if (!d::r_ok(tmp)) {
-          bad = true;
-          break;
-        }
-        z = d::madd(z, fb[j], tmp, arith.conv_fused);
-      }
-      y[i] = bad ? na_real : z;
-    }
-    // na.omit(): the leading and trailing NAs dropped
-    while (first < n && !d::r_ok(y[first])) ++first;
-    if (first == n) {  // all(is.na(x1)): x
-      for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
-      res.status = FilterStatus::all_na;
-      res.length = n;
-      return res;
-    }
-    while (!d::r_ok(y[last - 1])) --last;
-    for (std::size_t i = first; i < last; ++i) {
-      if (!d::r_ok(y[i])) {
-        res.status = FilterStatus::internal_na;
-        return res;
-      }
-    }
-  } else {
-    for (std::size_t i = 0; i < n; ++i) y[i] = x[i];
+  for (int k = 0; k < 3; ++k) {
+    if (res[k].status == FilterStatus::ok) res[k] = d::recurse_from(da, y[k], n, first[k], res[k].length, arith);
   }
-  const std::size_t len = last - first;
-  if (na >= 2) {
-    // rfilter in place: output i (written to y[i]) reads input y[first + i]
-    // (not yet overwritten: first + i >= i) and the outputs y[i - 1 - j],
-    // zero before the start.
-    const std::size_t nf = na - 1;
-    for (std::size_t i = 0; i < len; ++i) {
-      double sum = y[first + i];
-      bool bad = !d::r_ok(sum);
-      for (std::size_t j = 0; j < nf && !bad; ++j) {
-        const double tmp = i >= j + 1 ? y[i - 1 - j] : 0.0;
-        if (!d::r_ok(tmp)) {
-          bad = true;
-          break;
-        }
-        sum = d::madd(sum, tmp, ga[j], arith.rec_fused);
-      }
-      y[i] = bad ? na_real : sum;
-    }
-  } else if (first > 0) {
-    for (std::size_t i = 0; i < len; ++i) y[i] = y[first + i];
-  }
-  res.length = len;
-  res.status = len == n ? FilterStatus::ok : FilterStatus::shortened;
-  return res;
 }
 
 inline FilterResult filter_arma(const ArmaCoefs& c, const double* x, std::size_t n, double* y,
@@ -255,16 +374,21 @@ enum class SignalStatus {
 
 namespace ggir_filters_detail {
 
-// data_processed[, i] = signal::filter(coef, data[, i]) into a column of n.
-inline SignalStatus filter_column(const ArmaCoefs& c, const double* x, std::size_t n, double* y,
-                                  RFilterArith arith) {
-  const FilterResult r = filter_arma(c, x, n, y, arith);
+// data_processed[, i] <- a column's filter_arma() result r (in y, n long):
+// its status, the shortened result recycled as R's matrix assignment does.
+inline SignalStatus assign_column(const FilterResult& r, double* y, std::size_t n) {
   if (r.status == FilterStatus::internal_na) return SignalStatus::internal_na;
   if (r.status == FilterStatus::shortened) {  // R's matrix assignment recycles
     if (n % r.length != 0) return SignalStatus::replacement_length;
     for (std::size_t i = r.length; i < n; ++i) y[i] = y[i - r.length];
   }
   return SignalStatus::ok;
+}
+
+// data_processed[, i] = signal::filter(coef, data[, i]) into a column of n.
+inline SignalStatus filter_column(const ArmaCoefs& c, const double* x, std::size_t n, double* y,
+                                  RFilterArith arith) {
+  return assign_column(filter_arma(c, x, n, y, arith), y, n);
 }
 
 // R's sign() of a double
@@ -286,97 +410,178 @@ inline double norm3(double p, double q, double r, bool absolute) {
 
 }  // namespace ggir_filters_detail
 
-// One metric's per-sample signal over a block of n samples (x, y, z:
-// calibrated axes) into out[0, n). work: room for 3 n doubles (the filtered
-// axes), none of it aliasing x, y, z or out. On a status other than ok, out
-// holds nothing defined (R stops there).
-inline SignalStatus ggir_filtered_signal(FilteredMetric m, const double* x, const double* y,
-                                         const double* z, std::size_t n,
-                                         const GgirFilterCoefs& c, double* out, double* work,
-                                         RFilterArith arith = RFilterArith()) {
-  namespace d = ggir_filters_detail;
-  const double* axes[3] = {x, y, z};
-  double* f[3] = {work, work + n, work + 2 * n};
-  SignalStatus s = SignalStatus::ok;
-  auto filter3 = [&](const ArmaCoefs& co) {
-    for (int k = 0; k < 3 && s == SignalStatus::ok; ++k)
-      s = d::filter_column(co, axes[k], n, f[k], arith);
-    return s == SignalStatus::ok;
-  };
-  auto one_axis = [&](const ArmaCoefs& co, int k) {
-    s = d::filter_column(co, axes[k], n, out, arith);
-    if (s == SignalStatus::ok)
-      for (std::size_t i = 0; i < n; ++i) out[i] = std::fabs(out[i]);
-    return s;
-  };
+// The filter a metric's signal reads: the coefficient set, in the order
+// GGIR runs them (HFENplus reads "low", then "high").
+enum class FilterGroup { band, low, high, zc };
+constexpr int kFilterGroups = 4;
+
+namespace ggir_filters_detail {
+
+// What metric m reads: its last filter group, its axis (0, 1, 2; -1 for all
+// three), and whether it also reads "low" first (HFENplus).
+struct MetricUse {
+  FilterGroup group;
+  int axis;
+  bool low_first;
+};
+
+inline MetricUse metric_use(FilteredMetric m) {
   switch (m) {
-    case FilteredMetric::BFX: return one_axis(c.band, 0);
-    case FilteredMetric::BFY: return one_axis(c.band, 1);
-    case FilteredMetric::BFZ: return one_axis(c.band, 2);
-    case FilteredMetric::LFX: return one_axis(c.low, 0);
-    case FilteredMetric::LFY: return one_axis(c.low, 1);
-    case FilteredMetric::LFZ: return one_axis(c.low, 2);
-    case FilteredMetric::HFX: return one_axis(c.high, 0);
-    case FilteredMetric::HFY: return one_axis(c.high, 1);
-    case FilteredMetric::HFZ: return one_axis(c.high, 2);
-    case FilteredMetric::BFEN:
-    case FilteredMetric::LFEN:
-    case FilteredMetric::HFEN: {
-      const ArmaCoefs& co = m == FilteredMetric::BFEN ? c.band
-                            : m == FilteredMetric::LFEN ? c.low : c.high;
-      if (!filter3(co)) return s;
-      for (std::size_t i = 0; i < n; ++i) out[i] = d::norm3(f[0][i], f[1][i], f[2][i], true);
-      return s;
-    }
-    case FilteredMetric::LFENMO: {
-      if (!filter3(c.low)) return s;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double v = d::norm3(f[0][i], f[1][i], f[2][i], true) - 1;
-        out[i] = v < 0 ? 0.0 : v;  // NA stays NA (which() skips it)
-      }
-      return s;
-    }
-    case FilteredMetric::HFENplus: {
-      if (!filter3(c.low)) return s;  // GCP = EN(low) - gravity, not |.|
-      for (std::size_t i = 0; i < n; ++i) out[i] = d::norm3(f[0][i], f[1][i], f[2][i], false) - 1;
-      if (!filter3(c.high)) return s;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double v = d::norm3(f[0][i], f[1][i], f[2][i], false) + out[i];
-        out[i] = v < 0 ? 0.0 : v;
-      }
-      return s;
-    }
-    case FilteredMetric::ZCX:
-    case FilteredMetric::ZCY:
-    case FilteredMetric::ZCZ: {
-      if (n < 2) return SignalStatus::too_short;
-      const int k = m == FilteredMetric::ZCX ? 0 : m == FilteredMetric::ZCY ? 1 : 2;
-      double* v = f[0];
-      s = d::filter_column(c.zc, axes[k], n, v, arith);
-      if (s != SignalStatus::ok) return s;
-      const double na_real = r_na_real();
-      for (std::size_t i = 0; i < n; ++i) {
-        double w = v[i];
-        if (std::fabs(w) < c.zc_sb) w = 0;  // false for NA
-        // ifelse(w >= 0, 1, -1): a NA test gives NA_real_
-        v[i] = std::isnan(w) ? na_real : (w >= 0 ? 1.0 : -1.0);
-      }
-      for (std::size_t i = 1; i < n; ++i)
-        out[i] = std::fabs(d::r_sign(v[i]) - d::r_sign(v[i - 1])) * 0.5;
-      out[0] = out[1];
-      return s;
-    }
+    case FilteredMetric::BFEN: return {FilterGroup::band, -1, false};
+    case FilteredMetric::BFX: return {FilterGroup::band, 0, false};
+    case FilteredMetric::BFY: return {FilterGroup::band, 1, false};
+    case FilteredMetric::BFZ: return {FilterGroup::band, 2, false};
+    case FilteredMetric::LFENMO:
+    case FilteredMetric::LFEN: return {FilterGroup::low, -1, false};
+    case FilteredMetric::LFX: return {FilterGroup::low, 0, false};
+    case FilteredMetric::LFY: return {FilterGroup::low, 1, false};
+    case FilteredMetric::LFZ: return {FilterGroup::low, 2, false};
+    case FilteredMetric::HFEN: return {FilterGroup::high, -1, false};
+    case FilteredMetric::HFX: return {FilterGroup::high, 0, false};
+    case FilteredMetric::HFY: return {FilterGroup::high, 1, false};
+    case FilteredMetric::HFZ: return {FilterGroup::high, 2, false};
+    case FilteredMetric::HFENplus: return {FilterGroup::high, -1, true};
+    case FilteredMetric::ZCX: return {FilterGroup::zc, 0, false};
+    case FilteredMetric::ZCY: return {FilterGroup::zc, 1, false};
+    case FilteredMetric::ZCZ: return {FilterGroup::zc, 2, false};
   }
-  return s;
+  return {FilterGroup::band, -1, false};
 }
 
-// The same with its own work space.
+inline const ArmaCoefs& group_coefs(const GgirFilterCoefs& c, FilterGroup g) {
+  return g == FilterGroup::band ? c.band : g == FilterGroup::low ? c.low
+                                      : g == FilterGroup::high ? c.high : c.zc;
+}
+
+// The first status that is not ok among a metric's axes (x, y, z order), as
+// R stops at the first column it cannot assign.
+inline SignalStatus first_failed(const SignalStatus* st, int axis) {
+  if (axis >= 0) return st[axis];
+  for (int k = 0; k < 3; ++k)
+    if (st[k] != SignalStatus::ok) return st[k];
+  return SignalStatus::ok;
+}
+
+// GGIR's zerocross() of a filtered axis v (overwritten) into out: |v| <
+// zc_sb set to 0; +1 where v >= 0, -1 below (NA stays NA: ifelse); then
+// |sign(s[k]) - sign(s[k - 1])| * 0.5, its first value repeated in front.
+inline void zero_crossings(double* v, std::size_t n, double zc_sb, double* out) {
+  const double na_real = r_na_real();
+  for (std::size_t i = 0; i < n; ++i) {
+    double w = v[i];
+    if (std::fabs(w) < zc_sb) w = 0;  // false for NA
+    // ifelse(w >= 0, 1, -1): a NA test gives NA_real_
+    v[i] = std::isnan(w) ? na_real : (w >= 0 ? 1.0 : -1.0);
+  }
+  for (std::size_t i = 1; i < n; ++i) out[i] = std::fabs(r_sign(v[i]) - r_sign(v[i - 1])) * 0.5;
+  out[0] = out[1];
+}
+
+}  // namespace ggir_filters_detail
+
+// The per-sample signals of `count` metrics ms[] over a block of n samples
+// (x, y, z: calibrated axes), each filter run once per coefficient set and
+// axis however many metrics read it (a filtered axis is the same bits for
+// every metric that reads it). For each metric i, emit(i, status, signal):
+// signal, n values, valid during the call, when status is ok; null
+// otherwise (R stops there). Work space: the three filtered axes of one
+// coefficient set, one signal, and for HFENplus the low filter's part.
+template <class Emit>
+void ggir_filtered_signals(const FilteredMetric* ms, std::size_t count, const double* x,
+                           const double* y, const double* z, std::size_t n,
+                           const GgirFilterCoefs& c, RFilterArith arith, Emit&& emit) {
+  namespace d = ggir_filters_detail;
+  const double* axes[3] = {x, y, z};
+  std::vector<double> work, sig, gcp;
+  double* f[3] = {nullptr, nullptr, nullptr};
+  SignalStatus low_status[3] = {SignalStatus::ok, SignalStatus::ok, SignalStatus::ok};
+  for (int gi = 0; gi < kFilterGroups; ++gi) {
+    const FilterGroup g = static_cast<FilterGroup>(gi);
+    // the axes this group's filter must give, and whether HFENplus is asked
+    bool need[3] = {false, false, false}, plus = false;
+    for (std::size_t i = 0; i < count; ++i) {
+      const d::MetricUse u = d::metric_use(ms[i]);
+      if (ms[i] == FilteredMetric::ZCX || ms[i] == FilteredMetric::ZCY || ms[i] == FilteredMetric::ZCZ) {
+        if (n < 2) continue;  // zerocross() needs 2 samples: nothing is filtered
+      }
+      plus = plus || u.low_first;
+      if (u.group != g && !(u.low_first && g == FilterGroup::low)) continue;
+      for (int k = 0; k < 3; ++k) need[k] = need[k] || u.axis < 0 || u.axis == k;
+    }
+    if (!need[0] && !need[1] && !need[2]) continue;
+    if (work.empty()) {
+      work.resize(3 * n);
+      sig.resize(n);
+      for (int k = 0; k < 3; ++k) f[k] = work.data() + k * n;
+    }
+    SignalStatus st[3] = {SignalStatus::ok, SignalStatus::ok, SignalStatus::ok};
+    const ArmaCoefs& co = d::group_coefs(c, g);
+    if (need[0] && need[1] && need[2]) {
+      FilterResult r[3];
+      filter_arma3(co, axes, n, f, arith, r);
+      for (int k = 0; k < 3; ++k) st[k] = d::assign_column(r[k], f[k], n);
+    } else {
+      for (int k = 0; k < 3; ++k)
+        if (need[k]) st[k] = d::filter_column(co, axes[k], n, f[k], arith);
+    }
+    if (g == FilterGroup::low && plus) {
+      // HFENplus's GCP = EN(low) - gravity, not |.|, kept for the high filter
+      for (int k = 0; k < 3; ++k) low_status[k] = st[k];
+      if (d::first_failed(st, -1) == SignalStatus::ok) {
+        gcp.resize(n);
+        for (std::size_t i = 0; i < n; ++i) gcp[i] = d::norm3(f[0][i], f[1][i], f[2][i], false) - 1;
+      }
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const FilteredMetric m = ms[i];
+      const d::MetricUse u = d::metric_use(m);
+      if (u.group != g) continue;
+      if (g == FilterGroup::zc && n < 2) {
+        emit(i, SignalStatus::too_short, static_cast<const double*>(nullptr));
+        continue;
+      }
+      SignalStatus s = u.low_first ? d::first_failed(low_status, -1) : SignalStatus::ok;
+      if (s == SignalStatus::ok) s = d::first_failed(st, u.axis);
+      if (s != SignalStatus::ok) {
+        emit(i, s, static_cast<const double*>(nullptr));
+        continue;
+      }
+      double* out = sig.data();
+      if (g == FilterGroup::zc) {
+        d::zero_crossings(f[u.axis], n, c.zc_sb, out);
+      } else if (u.axis >= 0) {
+        for (std::size_t j = 0; j < n; ++j) out[j] = std::fabs(f[u.axis][j]);
+      } else if (u.low_first) {  // HFENplus: EN(high) + GCP, below 0 set to 0
+        for (std::size_t j = 0; j < n; ++j) {
+          const double v = d::norm3(f[0][j], f[1][j], f[2][j], false) + gcp[j];
+          out[j] = v < 0 ? 0.0 : v;
+        }
+      } else if (m == FilteredMetric::LFENMO) {
+        for (std::size_t j = 0; j < n; ++j) {
+          const double v = d::norm3(f[0][j], f[1][j], f[2][j], true) - 1;
+          out[j] = v < 0 ? 0.0 : v;  // NA stays NA (which() skips it)
+        }
+      } else {  // BFEN, LFEN, HFEN
+        for (std::size_t j = 0; j < n; ++j) out[j] = d::norm3(f[0][j], f[1][j], f[2][j], true);
+      }
+      emit(i, SignalStatus::ok, static_cast<const double*>(out));
+    }
+  }
+}
+
+// One metric's per-sample signal over a block of n samples into out[0, n).
+// On a status other than ok, out holds nothing defined (R stops there).
 inline SignalStatus ggir_filtered_signal(FilteredMetric m, const double* x, const double* y,
                                          const double* z, std::size_t n,
                                          const GgirFilterCoefs& c, double* out,
                                          RFilterArith arith = RFilterArith()) {
-  std::vector<double> work(3 * n);
-  return ggir_filtered_signal(m, x, y, z, n, c, out, work.data(), arith);
+  SignalStatus status = SignalStatus::ok;
+  ggir_filtered_signals(&m, 1, x, y, z, n, c, arith,
+                        [&](std::size_t, SignalStatus s, const double* sig) {
+                          status = s;
+                          if (sig != nullptr) std::copy(sig, sig + n, out);
+                        });
+  return status;
 }
 
 }  // namespace gravcal
