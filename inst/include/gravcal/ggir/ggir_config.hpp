@@ -1,8 +1,8 @@
 // gravcal: the settings of GGIR's auto-calibration procedure
 // (ggir_procedure.hpp) and of its window table (ggir_window_table.hpp), in
-// one typed struct. The R glue builds it from R's option list
-// (src/glue_pipeline.cpp's ggir_config()); the stages take the struct and
-// read no option by name.
+// one typed struct. The R glue builds it once from R's option list
+// (src/glue_pipeline.cpp's parse_ggir_options(): each key read there and only
+// there); the stages take the struct and read no option by name.
 #ifndef GRAVCAL_GGIR_CONFIG_HPP
 #define GRAVCAL_GGIR_CONFIG_HPP
 
