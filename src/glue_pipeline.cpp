@@ -5,6 +5,7 @@
 
 #include <Rcpp.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -26,10 +27,55 @@ SourceBox* source(SEXP ptr) {
   return p.get();
 }
 
-double num(const Rcpp::List& o, const char* name) {
-  if (!o.containsElementNamed(name)) Rcpp::stop("option '%s' is missing", name);
-  return Rcpp::as<double>(o[name]);
-}
+// A stage's options (gc_pump()'s `opts`, an R list), read once where the
+// stage starts: each key through one of the readers below, and done()
+// rejects any key none of them read (a misspelt option would otherwise be
+// ignored without a word).
+class OptionReader {
+ public:
+  explicit OptionReader(const Rcpp::List& o) : o_(o) {}
+  // a required number
+  double num(const char* name) {
+    if (!has(name)) Rcpp::stop("option '%s' is missing", name);
+    return Rcpp::as<double>(o_[name]);
+  }
+  // a required switch (a number, 0: off)
+  bool flag(const char* name) { return num(name) != 0; }
+  // an optional number
+  double num_or(const char* name, double fallback) {
+    return has(name) ? Rcpp::as<double>(o_[name]) : fallback;
+  }
+  // a required numeric vector
+  Rcpp::NumericVector vec(const char* name) {
+    if (!has(name)) Rcpp::stop("option '%s' is missing", name);
+    return o_[name];
+  }
+  // an optional R function (absent or NULL: none)
+  Rcpp::Nullable<Rcpp::Function> function(const char* name) {
+    if (!has(name)) return R_NilValue;
+    SEXP f = o_[name];
+    if (Rf_isNull(f)) return R_NilValue;
+    return Rcpp::Function(f);
+  }
+  // every key of the list was read
+  void done() const {
+    if (o_.size() == 0) return;
+    const SEXP names = o_.names();
+    for (R_xlen_t i = 0; i < o_.size(); ++i) {
+      const std::string key = Rf_isNull(names) ? "" : CHAR(STRING_ELT(names, i));
+      if (std::find(read_.begin(), read_.end(), key) == read_.end())
+        Rcpp::stop("unknown option '%s'", key.c_str());
+    }
+  }
+
+ private:
+  bool has(const char* name) {
+    read_.push_back(name);
+    return o_.containsElementNamed(name);
+  }
+  const Rcpp::List& o_;
+  std::vector<std::string> read_;
+};
 
 bool interrupt_tick() {
   Rcpp::checkUserInterrupt();  // throws on Ctrl-C
@@ -42,17 +88,22 @@ bool interrupt_tick() {
 // stop.
 Rcpp::List run_windows(gravcal::Source& src, const Rcpp::List& o,
                        Rcpp::Nullable<Rcpp::Function> on_block) {
-  const double L = num(o, "window_samples");
+  OptionReader opt(o);
+  const double L = opt.num("window_samples");
   if (!(L >= 1.0 && L < 1e7)) Rcpp::stop("window_samples must be in [1, 1e7)");
-  gravcal_glue::SegmenterBox box(L, num(o, "skip_zero") != 0, num(o, "r_arithmetic") != 0);
-  Rcpp::NumericVector par = o["par"];
-  const gravcal_glue::RestRule is_rest(static_cast<int>(num(o, "rule")), par);
-  gravcal::SegmenterStage stage(box.seg, num(o, "temperature") != 0);
+  const bool skip_zero = opt.flag("skip_zero"), r_arithmetic = opt.flag("r_arithmetic");
+  Rcpp::NumericVector par = opt.vec("par");
+  const int rule = static_cast<int>(opt.num("rule"));
+  const bool temperature = opt.flag("temperature");
+  const double bu = opt.num("block_units");
+  const bool want_table = opt.flag("want_table");
+  opt.done();
+  gravcal_glue::SegmenterBox box(L, skip_zero, r_arithmetic);
+  const gravcal_glue::RestRule is_rest(rule, par);
+  gravcal::SegmenterStage stage(box.seg, temperature);
   gravcal_glue::WindowTable table;
   auto sink = [&](const gravcal::WindowStats& w) { table.add(w, is_rest(w)); };
-  const double bu = num(o, "block_units");
   const std::int64_t units = bu < 0 ? -1 : static_cast<std::int64_t>(bu);
-  const bool want_table = num(o, "want_table") != 0;
   double samples = 0;
   bool stopped = false;
   std::vector<double> per_block;  // units and samples of each block
@@ -79,21 +130,33 @@ Rcpp::List run_windows(gravcal::Source& src, const Rcpp::List& o,
       Rcpp::Named("pending") = static_cast<double>(s.pending()));
 }
 
+// The keys of GGIR's block rules, in the "ggir" and "blocks" stages alike.
+void parse_block_rules(OptionReader& opt, gravcal::GgirConfig& c) {
+  c.sf = opt.num("sf");
+  if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
+  c.compat = opt.flag("compat");
+  c.temperature = opt.flag("temperature");
+  c.temp_min_sd = opt.num("temp_min_sd");
+  c.block_units = opt.num("block_units");
+}
+
 // GGIR's block rules alone over the source, one block of block_units units
 // at a time, with the segmenter behind them: per block, its windows and what
 // the rules saw (for the tests of the rules; the procedure is run_ggir()).
 Rcpp::List run_blocks(gravcal::Source& src, const Rcpp::List& o) {
-  const double sf = num(o, "sf");
-  if (!(10 * sf >= 1 && 10 * sf < 1e7)) Rcpp::stop("sf out of range");
-  const bool compat = num(o, "compat") != 0;
-  gravcal_glue::SegmenterBox box(10 * sf, false, compat);
-  const bool temp = num(o, "temperature") != 0 && src.has_temperature();
-  gravcal::GgirBlocks blocks(box.seg, num(o, "per_hour"), compat, temp, num(o, "temp_min_sd"),
+  OptionReader opt(o);
+  gravcal::GgirConfig c;
+  parse_block_rules(opt, c);
+  const double per_hour = opt.num("per_hour");
+  Rcpp::NumericVector par = opt.vec("par");
+  opt.done();
+  gravcal_glue::SegmenterBox box(10 * c.sf, false, c.compat);
+  const bool temp = c.temperature && src.has_temperature();
+  gravcal::GgirBlocks blocks(box.seg, per_hour, c.compat, temp, c.temp_min_sd,
                              gravcal_glue::r_long_double());
   gravcal::BlocksStage stage(blocks, temp);
-  Rcpp::NumericVector par = o["par"];
   const gravcal_glue::RestRule is_rest(1, par);
-  const std::int64_t units = static_cast<std::int64_t>(num(o, "block_units"));
+  const std::int64_t units = static_cast<std::int64_t>(c.block_units);
   Rcpp::List out;
   for (;;) {
     gravcal_glue::WindowTable table;
@@ -114,15 +177,18 @@ Rcpp::List run_blocks(gravcal::Source& src, const Rcpp::List& o) {
 // source has it), time (option time), light (option light, default 1, when
 // the source has it).
 Rcpp::List run_samples(gravcal::Source& src, const Rcpp::List& o) {
-  const double chunk = o.containsElementNamed("chunk") ? num(o, "chunk") : 65536.0;
+  OptionReader opt(o);
+  const double chunk = opt.num_or("chunk", 65536.0);
   if (!(chunk >= 1 && chunk <= 1e8)) Rcpp::stop("chunk must be in [1, 1e8]");
-  const bool light = (!o.containsElementNamed("light") || num(o, "light") != 0) && src.has_light();
-  gravcal::CollectStage stage(src.has_temperature(), num(o, "time") != 0,
-                              static_cast<std::size_t>(chunk), light);
+  const bool light = opt.num_or("light", 1) != 0 && src.has_light();
+  const bool time = opt.flag("time");
+  opt.done();
+  gravcal::CollectStage stage(src.has_temperature(), time, static_cast<std::size_t>(chunk),
+                              light);
   gravcal::pump(src, stage, -1, [](const gravcal::WindowStats&) {}, interrupt_tick);
   using C = gravcal::CollectStage;
   const char* names[C::kColumns] = {"x", "y", "z", "temperature", "time", "light"};
-  const bool on[C::kColumns] = {true, true, true, stage.temperature(), num(o, "time") != 0, light};
+  const bool on[C::kColumns] = {true, true, true, stage.temperature(), time, light};
   Rcpp::List out;
   for (int c = 0; c < C::kColumns; ++c) {
     if (!on[c]) continue;
@@ -192,37 +258,48 @@ Rcpp::RObject scalar(double v, bool present) {
   return Rcpp::NumericVector::create(v);
 }
 
-// GGIR's procedure's settings from R (ggir_run()'s list).
-gravcal::GgirConfig ggir_config(const Rcpp::List& o) {
-  gravcal::GgirConfig c;
-  c.compat = num(o, "compat") != 0;
-  c.temperature = num(o, "temperature") != 0;
-  c.lazy = num(o, "lazy") != 0;
-  c.nonfinite_in_sums = o.containsElementNamed("nonfinite_in_sums") &&
-                        num(o, "nonfinite_in_sums") != 0;
+// GGIR's procedure's options from R (ggir_options()'s list, R/ggir.R),
+// parsed once: the core's settings and the host's (printing, the adaptive
+// budget's rule). Every key of the list is read here (those of GGIR's block
+// rules through parse_block_rules()) and nowhere else; a key not read here
+// is an error.
+struct GgirOptions {
+  gravcal::GgirConfig cfg;
+  bool verbose = false;
+  Rcpp::Nullable<Rcpp::Function> on_fit = R_NilValue;  // RHost::enough()
+};
+
+GgirOptions parse_ggir_options(const Rcpp::List& o) {
+  OptionReader opt(o);
+  GgirOptions g;
+  g.verbose = opt.flag("verbose");
+  g.on_fit = opt.function("on_fit");
+  gravcal::GgirConfig& c = g.cfg;
+  parse_block_rules(opt, c);
+  c.lazy = opt.flag("lazy");
+  c.nonfinite_in_sums = opt.num_or("nonfinite_in_sums", 0) != 0;
   c.r_long_double = gravcal_glue::r_long_double();
-  c.min_rest = static_cast<int>(num(o, "min_rest"));
-  c.error_digits = static_cast<int>(num(o, "error_digits"));
-  c.max_iter = static_cast<int>(num(o, "max_iter"));
-  c.reading = static_cast<int>(num(o, "reading"));
+  c.min_rest = static_cast<int>(opt.num("min_rest"));
+  c.error_digits = static_cast<int>(opt.num("error_digits"));
+  c.max_iter = static_cast<int>(opt.num("max_iter"));
+  c.reading = static_cast<int>(opt.num("reading"));
   if (c.reading < 0 || c.reading > 2) Rcpp::stop("reading must be 0, 1 or 2");
   const struct {
     const char* name;
     double* field;
   } numbers[] = {
-      {"sf", &c.sf}, {"block_units", &c.block_units},
       {"short_block_rows", &c.short_block_rows}, {"spherecrit", &c.spherecrit},
       {"minloadcrit", &c.minloadcrit}, {"max_sd", &c.max_sd},
       {"max_abs_mean", &c.max_abs_mean}, {"enough_offset", &c.enough_offset},
       {"min_hours", &c.min_hours}, {"max_error", &c.max_error},
-      {"temp_max_first", &c.temp_max_first}, {"temp_min_sd", &c.temp_min_sd},
-      {"temp_missing", &c.temp_missing}, {"fill", &c.fill}, {"tol", &c.tol},
-      {"max_weight", &c.max_weight}, {"refit_growth", &c.refit_growth},
+      {"temp_max_first", &c.temp_max_first}, {"temp_missing", &c.temp_missing},
+      {"fill", &c.fill}, {"tol", &c.tol}, {"max_weight", &c.max_weight},
+      {"refit_growth", &c.refit_growth},
       {"guard_norm", &c.guard_norm}, {"guard_clip", &c.guard_clip},
       {"guard_repeat", &c.guard_repeat}, {"check_hours", &c.check_hours}};
-  for (const auto& f : numbers) *f.field = num(o, f.name);
-  if (!(10 * c.sf >= 1 && 10 * c.sf < 1e7)) Rcpp::stop("sf out of range");
-  return c;
+  for (const auto& f : numbers) *f.field = opt.num(f.name);
+  opt.done();
+  return g;
 }
 
 // The procedure's outcome for R (ggir_run() shapes GGIR's list from it).
@@ -283,19 +360,12 @@ bool RHost::enough(const gravcal::GgirOutcome& o) {
   return v.size() == 1 && v[0] == TRUE;
 }
 
-// the R function in opts$on_fit, if any
-Rcpp::Nullable<Rcpp::Function> on_fit(const Rcpp::List& o) {
-  if (!o.containsElementNamed("on_fit")) return R_NilValue;
-  SEXP f = o["on_fit"];
-  if (Rf_isNull(f)) return R_NilValue;
-  return Rcpp::Function(f);
-}
-
 // GGIR's procedure over the source (ggir_procedure.hpp).
 Rcpp::List run_ggir(gravcal::Source& src, const Rcpp::List& o,
                     Rcpp::Nullable<Rcpp::Function> on_block) {
-  RHost host(num(o, "verbose") != 0, on_block, on_fit(o));
-  gravcal::GgirProcedure proc(ggir_config(o), host);
+  const GgirOptions g = parse_ggir_options(o);
+  RHost host(g.verbose, on_block, g.on_fit);
+  gravcal::GgirProcedure proc(g.cfg, host);
   return outcome_list(proc.run(src), host);
 }
 
@@ -356,8 +426,9 @@ Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts,
 Rcpp::List gc_ggir_fit_table(const Rcpp::NumericMatrix& table, bool temp_available,
                              double hours, const Rcpp::List& opts) {
   if (table.ncol() != 7 && table.ncol() != 8) Rcpp::stop("the table needs 7 or 8 columns");
-  RHost host(num(opts, "verbose") != 0, R_NilValue);
-  gravcal::GgirProcedure proc(ggir_config(opts), host);
+  const GgirOptions g = parse_ggir_options(opts);
+  RHost host(g.verbose, R_NilValue, g.on_fit);
+  gravcal::GgirProcedure proc(g.cfg, host);
   return outcome_list(proc.fit_table(table.begin(), static_cast<std::size_t>(table.nrow()),
                                      table.ncol() == 8, temp_available, hours),
                       host);

@@ -6,11 +6,11 @@
 //       one pump into GGIR's block rules and the segmenter (pipeline.hpp);
 //   [2] check the block's temperature (first values, variation);
 //   [3] add its windows to the window table (means, sds, norm, temperature,
-//       the rest rule's flag);
+//       the rest rule's flag; ggir_window_table.hpp);
 //   [4] after a block that may end the reading, filter the table (missing
-//       values, GGIR's fill value, duplicate windows, the first window),
-//       decide whether there is enough data, keep the rest windows, check
-//       that they cover the sphere;
+//       values, GGIR's fill value, duplicate windows, the first window: the
+//       window table again), decide whether there is enough data, keep the
+//       rest windows, check that they cover the sphere;
 //   [5] fit scale, offset and temperature offset by weighted iterative
 //       closest point (icp.hpp) and compute GGIR's error;
 //   [6] stop once the error is small enough after minloadcrit hours, else
@@ -34,6 +34,8 @@
 #include <vector>
 
 #include "gravcal/ggir/ggir_blocks.hpp"
+#include "gravcal/ggir/ggir_config.hpp"
+#include "gravcal/ggir/ggir_window_table.hpp"
 #include "gravcal/ggir/icp.hpp"
 #include "gravcal/mcu/model.hpp"
 #include "gravcal/ggir/pipeline.hpp"
@@ -41,62 +43,6 @@
 #include "gravcal/host/segmenter.hpp"
 
 namespace gravcal {
-
-// GGIR's constants used by the procedure (the R side lists them all, with
-// their sources, in ggir_constants).
-struct GgirConfig {
-  bool compat = true;          // GGIR's rules, accidents included
-  double sf = 0.0;             // samples per second
-  double block_units = 0.0;    // source units per GGIR block
-  double short_block_rows = 0.0;  // a block with fewer rows is the last (0: none)
-  bool temperature = true;     // use the source's temperature if it has one
-  bool lazy = true;            // compatible mode: R's sds only where seen
-  bool nonfinite_in_sums = false;  // compatible mode: a non-finite sample
-                                   // enters R's cumulative sums (GGIR's
-                                   // readers' samples: its NaN empties the
-                                   // rest of its block); else left out of
-                                   // its window (samples in memory)
-  bool r_long_double = true;   // R's accumulator (its LDOUBLE) is long
-                               // double; false: double (an R without long
-                               // double, capabilities("long.double") FALSE)
-  double spherecrit = 0.3;     // g
-  double minloadcrit = 168.0;  // h
-  double max_sd = 0.013;       // g, rest: sd of every axis below
-  double max_abs_mean = 2.0;   // g, rest: |mean| of every axis below
-  int min_rest = 10;           // rest windows needed to try a fit
-  double enough_offset = 21.0; // GGIR: windows > minloadcrit - 21
-  double min_hours = 1.0;      // own mode: hours of distinct windows needed
-  double max_error = 0.01;     // g
-  int error_digits = 5;
-  double temp_max_first = 120.0;
-  double temp_min_sd = 0.01;
-  double temp_missing = 99999.0;
-  double fill = 99999.0;
-  int max_iter = 1000;
-  double tol = 1e-10;
-  double max_weight = 100.0;
-  double refit_growth = 1.25;  // own mode: refit once the table grew by this
-  std::size_t decide_windows = 10000;  // own mode: most windows (evenly
-                                       // spaced) a decision to read on fits,
-  double decide_tol = 1e-6;            // and to what tolerance
-  // own mode's guards on rest windows (compatible mode has none; R's
-  // calibrate() documents them): a window whose mean vector's norm is
-  // farther than guard_norm g from 1 g; one that reaches guard_clip g on
-  // some axis (|mean| + max - min; not positive or NaN: not checked); one
-  // with more than guard_repeat of its samples after the first equal to the
-  // one before (WindowStats::n_repeat). Inf: the guard is off.
-  double guard_norm = INFINITY;
-  double guard_clip = 0.0;
-  double guard_repeat = INFINITY;
-  // own mode only: when to stop reading. 0: GGIR's rule (the error target
-  // met after minloadcrit hours); 1: read the whole recording (coefficients
-  // per segment of time need every part of it); 2: the adaptive budget: a
-  // converged fit every check_hours of windows (or once the table grew by
-  // refit_growth, whichever is later), and stop once GGIR's error target
-  // is met and the host's enough() says the coefficients are determined
-  int reading = 0;
-  double check_hours = 6.0;
-};
 
 // The QC outcome (R maps each to GGIR's message).
 enum class GgirQc { none, done, done_no_temp, attempted, no_decrease, no_sphere,
@@ -155,13 +101,10 @@ struct GgirOutcome {
   bool early = false;         // the reading stopped before the recording's end
 };
 
-// Why own mode's guards leave a rest window out (none: kept).
-enum GgirWhy : unsigned char { why_none = 0, why_norm = 1, why_clipped = 2, why_identical = 3 };
-
 class GgirProcedure {
  public:
   GgirProcedure(const GgirConfig& cfg, GgirHost& host)
-      : cfg_(cfg), host_(host), L_(10.0 * cfg.sf), seg_(L_, false) {
+      : cfg_(cfg), host_(host), L_(10.0 * cfg.sf), seg_(L_, false), table_(cfg) {
     // compatible mode: the window statistics in R's arithmetic, and R's sds
     // only where GGIR's rules can see them (the rest rule, the duplicate
     // filter): see Segmenter::lazy_r_sd()
@@ -174,8 +117,6 @@ class GgirProcedure {
       held_.assign(buffer_.size(), 0.0);
       seg_.lazy_r_sd(cfg_.max_sd, &lazy_, held_.data(), held_.size());
     }
-    rule_.max_sd = cfg_.max_sd;
-    rule_.max_abs_mean = cfg_.max_abs_mean;
   }
 
   // The procedure on `src`. An interrupt (the host's interrupted()) ends it
@@ -229,8 +170,8 @@ class GgirProcedure {
     for (int i = 1;; ++i) {
       host_.print(i == 1 ? "\nLoading chunk: 1" : " " + std::to_string(i));
       // [1] a block through the pump
-      block_.clear();
-      auto sink = [&](const WindowStats& w) { block_.push_back(Row{w, is_rest(w, rule_)}); };
+      table_.start_block();
+      auto sink = [&](const WindowStats& w) { table_.hold(w); };
       const GgirBlockRead rd = read_ggir_block(src, blocks, stage, units, sink,
                                                [&] { return host_.interrupted(); });
       const PumpResult& p = rd.pump;
@@ -259,7 +200,7 @@ class GgirProcedure {
       bool added = false;
       if (present && b.used > 0) {
         if (o.use_temp) o.use_temp = temperature_usable(b);  // [2]
-        add_windows(o);                                      // [3]
+        table_.add_block(o.temp_available, o.use_temp);      // [3]
         added = true;
         ++o.blocks;
         host_.block_added(i);
@@ -289,12 +230,7 @@ class GgirProcedure {
     finish(o);  // [7]
   }
 
-  struct Row {
-    WindowStats w;
-    bool rest;
-  };
-
-  std::int64_t n_feat() const { return static_cast<std::int64_t>(col_[0].size()); }
+  std::int64_t n_feat() const { return static_cast<std::int64_t>(table_.size()); }
 
   int reading() const { return cfg_.compat ? 0 : cfg_.reading; }
 
@@ -325,39 +261,6 @@ class GgirProcedure {
     if (why == nullptr) return true;
     host_.warn(std::string("temperature not used for calibration: ") + why);
     return false;
-  }
-
-  // [3] the block's windows into the table: mean norm, means, sds and, when
-  // the recording has a temperature, the temperature (or GGIR's fill when
-  // it is not used)
-  void add_windows(const GgirOutcome& o) {
-    for (const Row& r : block_) {
-      const WindowStats& w = r.w;
-      col_[0].push_back(w.mean_norm);
-      for (int a = 0; a < 3; ++a) col_[1 + a].push_back(w.mean[a]);
-      for (int a = 0; a < 3; ++a) col_[4 + a].push_back(w.sd[a]);
-      if (o.temp_available) col_[7].push_back(o.use_temp ? w.temperature : cfg_.temp_missing);
-      rest_.push_back(r.rest);
-      why_.push_back(static_cast<unsigned char>(cfg_.compat || !r.rest ? why_none : guard(w)));
-    }
-  }
-
-  // own mode's guards on a rest window (GgirConfig): identical samples
-  // first, then clipping, then the norm (one reason per window)
-  GgirWhy guard(const WindowStats& w) const {
-    const double valid = static_cast<double>(w.n) - static_cast<double>(w.n_invalid);
-    if (valid > 1 && static_cast<double>(w.n_repeat) > cfg_.guard_repeat * (valid - 1)) {
-      return why_identical;
-    }
-    if (cfg_.guard_clip > 0) {
-      for (int a = 0; a < 3; ++a) {
-        if (std::fabs(w.mean[a]) + (w.max[a] - w.min[a]) >= cfg_.guard_clip) return why_clipped;
-      }
-    }
-    const double nm = std::sqrt(w.mean[0] * w.mean[0] + w.mean[1] * w.mean[1] +
-                                w.mean[2] * w.mean[2]);
-    if (std::fabs(nm - 1.0) > cfg_.guard_norm) return why_norm;
-    return why_none;
   }
 
   // GGIR's calibration error: mean | |a| - 1 | over the rows' means after
@@ -392,38 +295,11 @@ class GgirProcedure {
     decided_ = false;
     next_fit_ = static_cast<double>(n_feat()) * cfg_.refit_growth;
     next_check_ = static_cast<double>(n_feat()) + cfg_.check_hours * 3600 / 10;
-    const std::size_t N = col_[0].size();
-    std::vector<std::size_t> idx;
-    idx.reserve(N);
-    for (std::size_t r = 0; r < N; ++r) {
-      if (std::isnan(col_[3][r]) || std::isnan(col_[0][r])) continue;
-      // GGIR also drops a window whose mean norm equals its table's fill
-      if (cfg_.compat && col_[0][r] == cfg_.fill) continue;
-      idx.push_back(r);
-    }
-    // own mode: the rest windows its guards leave out, by reason, counted
-    // before the duplicate filter (which also drops all but the last window
-    // of a run of equal windows, as a stuck sensor's)
-    for (int k = 0; k < 3; ++k) o.excluded[k] = 0;
-    for (const std::size_t r : idx) {
-      if (rest_[r] && why_[r] != why_none) ++o.excluded[why_[r] - 1];
-    }
-    if (idx.size() > 1) {
-      // consecutive windows equal in 3 (GGIR) or all 6 of means and sds
-      const double* cols[7];
-      for (int c = 0; c < 7; ++c) cols[c] = col_[c].data();
-      const std::vector<std::size_t> cut =
-          duplicate_cuts(cols, idx.data(), idx.size(), cfg_.compat ? 3 : 6);
-      remove_positions(idx, cut);
-    }
+    // the filters, then the rest windows to fit (ggir_window_table.hpp)
+    const std::vector<std::size_t> idx = table_.usable(o.excluded);
+    const std::vector<std::size_t> keep = table_.rest(idx);
     o.has_table = false;
     o.nhoursused = 0;
-    // the first window is left out, then the windows at rest, then (own
-    // mode) those its guards leave out
-    std::vector<std::size_t> keep;
-    for (std::size_t j = 1; j < idx.size(); ++j) {
-      if (rest_[idx[j]] && why_[idx[j]] == why_none) keep.push_back(idx[j]);
-    }
     const double n = static_cast<double>(idx.size());
     const bool enough = cfg_.compat ? n > (cfg_.minloadcrit - cfg_.enough_offset)
                                     : !too_short_ && n * 10 >= cfg_.min_hours * 3600;
@@ -604,26 +480,11 @@ class GgirProcedure {
   void take_table(GgirOutcome& o, const std::vector<std::size_t>& rows) const {
     const int nc = o.temp_available ? 8 : 7;
     const std::size_t n = rows.size();
-    o.table.assign(static_cast<std::size_t>(nc) * n, 0.0);
-    for (int c = 0; c < nc; ++c) {
-      for (std::size_t i = 0; i < n; ++i) o.table[static_cast<std::size_t>(c) * n + i] = col_[c][rows[i]];
-    }
+    table_.copy(rows, nc, o.table);
     o.table_rows.resize(n);
     for (std::size_t i = 0; i < n; ++i) o.table_rows[i] = rows[i] + 1;
     o.table_columns = nc;
     o.has_table = true;
-  }
-
-  static void remove_positions(std::vector<std::size_t>& v, const std::vector<std::size_t>& pos) {
-    std::size_t w = 0, p = 0;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      if (p < pos.size() && pos[p] == i) {
-        ++p;
-        continue;
-      }
-      v[w++] = v[i];
-    }
-    v.resize(w);
   }
 
   // a number as R's paste0() prints it (15 significant digits)
@@ -650,11 +511,7 @@ class GgirProcedure {
   std::vector<double> buffer_, held_;
   LazySd lazy_;
   Segmenter seg_;
-  SdRestRule rule_;
-  std::vector<Row> block_;
-  std::vector<double> col_[8];
-  std::vector<bool> rest_;
-  std::vector<unsigned char> why_;  // own mode's guard on each rest row (GgirWhy)
+  GgirWindowTable table_;
   bool pending_ = false;
   bool decided_ = false;    // own mode: the last fit was a decision's
   bool too_short_ = false;  // own mode: the recording holds under two hours
