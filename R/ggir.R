@@ -131,7 +131,7 @@ ggir_run <- function(src, compat = TRUE,
               source_input(src, r$samples), verbose, printsummary)
 }
 
-# The procedure's settings for the core (GgirConfig in ggir_procedure.hpp):
+# The procedure's settings for the core (GgirConfig in ggir_config.hpp):
 # the user's, then GGIR's constants.
 # `reading` (own mode only): when to stop reading: "ggir" (GGIR's rule,
 # minloadcrit), "all" (the whole recording, for coefficients per segment of
