@@ -14,8 +14,9 @@
 // it (time_iso). The sequence of times is checked line by line: a stamp
 // coarser than a sample period is spread over its lines (k / sf for the
 // k-th line of the same stamp), a jump forward of more than 1.5 sample
-// periods is a gap, a step back of more than half a period is counted, and
-// an unreadable stamp takes the time one step after the last. The top of
+// periods (plus the stamps' resolution) is a gap, a step back of more than
+// half a period (plus the resolution) is counted, and an unreadable stamp
+// takes the time one step after the last. The top of
 // decode_csv.hpp describes these rules for each format.
 #ifndef GRAVCAL_DECODE_CSV_TIME_HPP
 #define GRAVCAL_DECODE_CSV_TIME_HPP

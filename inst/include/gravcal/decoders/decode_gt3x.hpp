@@ -49,6 +49,14 @@
 // in one batch) is not applied; on damaged files it fails (index out of
 // bounds) when a gap passes max_samples in a whole read, and keeps records
 // whose checksum fails.
+//
+// The code: the zip structures and info.txt are read by the functions of
+// namespace gt3x; gt3x::ZipReader finds the entries and opens them as byte
+// sources (inflated through the EntryInflater when deflated);
+// gt3x::RecordStream reads the data entry through one buffer and frames
+// log.bin's records, resynchronising after damage; Gt3xDecoder applies
+// read.gt3x's rules to the records: the time of each sample, the cap at
+// info.txt's end, idle-sleep and gap zeros, and the checks of the stamps.
 #ifndef GRAVCAL_DECODE_GT3X_HPP
 #define GRAVCAL_DECODE_GT3X_HPP
 
