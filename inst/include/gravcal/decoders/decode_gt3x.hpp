@@ -49,6 +49,14 @@
 // in one batch) is not applied; on damaged files it fails (index out of
 // bounds) when a gap passes max_samples in a whole read, and keeps records
 // whose checksum fails.
+//
+// The code: the zip structures and info.txt are read by the functions of
+// namespace gt3x; gt3x::ZipReader finds the entries and opens them as byte
+// sources (inflated through the EntryInflater when deflated);
+// gt3x::RecordStream reads the data entry through one buffer and frames
+// log.bin's records, resynchronising after damage; Gt3xDecoder applies
+// read.gt3x's rules to the records: the time of each sample, the cap at
+// info.txt's end, idle-sleep and gap zeros, and the checks of the stamps.
 #ifndef GRAVCAL_DECODE_GT3X_HPP
 #define GRAVCAL_DECODE_GT3X_HPP
 
@@ -561,6 +569,258 @@ inline int unpack12(const unsigned char* p, std::size_t nib) {
   return (v & 0x800) ? v - 4096 : v;
 }
 
+// The entries of a .gt3x's zip as byte sources: found from the central
+// directory (else from the local headers), and each opened as a window on
+// its stored bytes, inflated when deflated. Owns the sources it opens; the
+// zip and the inflater must outlive it. Where it fails, `error` says why,
+// in the words of the decoder's error().
+class ZipReader {
+ public:
+  // `inflater` reads deflated entries (null: only stored entries can be read).
+  ZipReader(ByteSource& zip, EntryInflater* inflater) : zip_(zip), inflater_(inflater) {}
+
+  // info.txt, log.bin and activity.bin, from the central directory; when
+  // it is unreadable, from the local headers, which is counted and noted in
+  // `report` ("zip_directory_damaged").
+  bool find_entries(ZipEntries& z, Report& report, std::string& error) {
+    if (!read_central_directory(zip_, z)) {
+      const std::string cd_why = z.error;
+      z = ZipEntries();
+      if (!read_local_headers(zip_, z)) {
+        if (!z.error.empty()) {
+          return fail(error, z.error + (cd_why.empty() ? "" : "; and " + cd_why));
+        }
+        if (!cd_why.empty()) return fail(error, cd_why + ", and no readable local file header at byte 0");
+        return fail(error, "not a zip file (no readable central directory, no local file header at byte 0)");
+      }
+      report.count("zip_directory_damaged");
+      report.note("zip central directory unreadable" + (cd_why.empty() ? "" : " (" + cd_why + ")") +
+                  ": entries found from their local headers");
+    }
+    return true;
+  }
+
+  // A byte source for an entry's (inflated) bytes.
+  bool open_entry(const ZipEntry& e, ByteSource*& src, std::string& error) {
+    std::string why;
+    const std::int64_t at = entry_data_offset(zip_, e, why);
+    if (at < 0) return fail(error, why);
+    const std::int64_t len = e.comp_size >= 0 ? e.comp_size : std::max<std::int64_t>(0, zip_.size() - at);
+    windows_.emplace_back(new WindowSource(zip_, at, len));
+    WindowSource* w = windows_.back().get();
+    if (e.method == kStored) {
+      src = w;
+      return true;
+    }
+    if (e.method != kDeflated) {
+      return fail(error, "zip entry compressed with method " + std::to_string(e.method) +
+                         " (only stored and deflated are read)");
+    }
+    if (inflater_ == nullptr) return fail(error, "zip entry is deflated and no inflater was given");
+    inflated_.push_back(inflater_->open(*w));
+    src = inflated_.back().get();
+    if (src == nullptr) return fail(error, "cannot inflate zip entry");
+    return true;
+  }
+
+  // info.txt's text (at most kMaxInfo bytes).
+  bool read_small_entry(const ZipEntry& e, std::string& text, std::string& error) {
+    ByteSource* src = nullptr;
+    if (!open_entry(e, src, error)) return false;
+    std::vector<unsigned char> b(kMaxInfo);
+    const std::size_t k = read_full(*src, b.data(), b.size());
+    text.assign(reinterpret_cast<const char*>(b.data()), k);
+    if (windows_.back()->short_read()) {
+      return fail(error, "info.txt cut short at byte " + std::to_string(windows_.back()->position()) +
+                         " of " + std::to_string(windows_.back()->size()) + " (the file ends there)");
+    }
+    if (k == 0) return fail(error, "info.txt is empty or unreadable");
+    return true;
+  }
+
+  // The window on the stored bytes of the entry opened last.
+  WindowSource* last_window() const { return windows_.back().get(); }
+
+ private:
+  static bool fail(std::string& error, const std::string& why) {
+    error = why;
+    return false;
+  }
+
+  ByteSource& zip_;
+  EntryInflater* inflater_;
+  std::vector<std::unique_ptr<WindowSource>> windows_;
+  std::vector<std::unique_ptr<ByteSource>> inflated_;
+};
+
+// The data entry (log.bin, or activity.bin) read through one buffer, and
+// log.bin's records in it: each record's separator, size and checksum
+// checked, and after damage the stream resynchronised on the next record
+// that checks (each damaged stretch counted and noted in the decoder's
+// report, which must outlive this).
+class RecordStream {
+ public:
+  explicit RecordStream(Report& report) : report_(report) {}
+
+  // Starts reading `data`, the entry's bytes (`window`: its stored bytes in
+  // the zip, which tell a file cut short). After damage a record is taken
+  // only when stamped from a day before info.txt's start (`start_u32`) to a
+  // day after `bound_secs` seconds past it.
+  void start(ByteSource* data, WindowSource* window, std::uint32_t start_u32, std::int64_t bound_secs) {
+    data_ = data;
+    window_ = window;
+    start_u32_ = start_u32;
+    bound_secs_ = bound_secs;
+    buf_.assign(kBufLen, 0);
+  }
+  bool started() const { return data_ != nullptr; }
+
+  // The buffered bytes from the read position, buffered() of them (at
+  // least n after ensure(n) is true; valid until the next ensure()).
+  const unsigned char* here() const { return buf_.data() + beg_; }
+  std::size_t buffered() const { return end_ - beg_; }
+  void advance(std::size_t n) { beg_ += n; }
+  // The read position, and the end of the buffered bytes, as byte offsets
+  // in the entry.
+  std::int64_t offset() const { return buf_off_ + static_cast<std::int64_t>(beg_); }
+  std::int64_t buffered_end() const { return buf_off_ + static_cast<std::int64_t>(end_); }
+
+  // At least n bytes from beg_ in the buffer, unless the input ends first.
+  bool ensure(std::size_t n) {
+    if (end_ - beg_ >= n) return true;
+    if (beg_ + n > buf_.size()) {
+      std::memmove(buf_.data(), buf_.data() + beg_, end_ - beg_);
+      buf_off_ += static_cast<std::int64_t>(beg_);
+      end_ -= beg_;
+      beg_ = 0;
+    }
+    while (end_ - beg_ < n && !eof_) {
+      const std::size_t k = data_->read(buf_.data() + end_, buf_.size() - end_);
+      if (k == 0) {
+        eof_ = true;
+        const std::int64_t at = buf_off_ + static_cast<std::int64_t>(end_);
+        if (window_ != nullptr && window_->short_read()) {  // the file is cut short
+          report_.truncated = true;
+          report_.note("zip entry cut short: " + std::to_string(window_->position()) + " of " +
+                       std::to_string(window_->size()) + " stored bytes (" + std::to_string(at) +
+                       " bytes of data)");
+        } else if (data_->failed()) {
+          report_.read_error = true;
+          report_.note("read error (or corrupt deflate data) in the data entry at byte " + std::to_string(at));
+        }
+      }
+      end_ += k;
+    }
+    return end_ - beg_ >= n;
+  }
+
+  // The next record that checks, at beg_; false at the end of the input.
+  bool next_record() {
+    for (;;) {
+      if (!ensure(1)) {
+        end_resync(true);
+        return false;
+      }
+      const unsigned char b = buf_[beg_];
+      if (b != kSeparator) {
+        if (!resync_) {
+          if (b == 0) {  // zero bytes between records happen (README): ignored
+            ++beg_;
+            continue;
+          }
+          start_resync("bad_separator");
+        }
+        const void* q = std::memchr(buf_.data() + beg_, kSeparator, end_ - beg_);
+        beg_ = q ? static_cast<std::size_t>(static_cast<const unsigned char*>(q) - buf_.data()) : end_;
+        continue;
+      }
+      if (!ensure(kHeaderLen + 1) ||
+          !ensure(kHeaderLen + 1 + le16(buf_.data() + beg_ + 6))) {
+        start_resync("record_past_end");
+        ++beg_;
+        continue;
+      }
+      const unsigned char* p = buf_.data() + beg_;
+      const std::size_t size = le16(p + 6);
+      unsigned char x = 0;
+      for (std::size_t i = 0; i < kHeaderLen + size; ++i) x ^= p[i];
+      if (static_cast<unsigned char>(~x) != p[kHeaderLen + size]) {
+        start_resync("bad_checksum");
+        ++beg_;
+        continue;
+      }
+      if (resync_ && (!known_type(p[1]) || !plausible_time(le32(p + 2)))) {
+        ++beg_;  // a chance match inside damaged bytes
+        continue;
+      }
+      end_resync(false);
+      return true;
+    }
+  }
+
+  // The time stamp of the next ACTIVITY / ACTIVITY2 record after beg_, if
+  // the records up to it check; looks a few records ahead in the buffer.
+  bool peek_activity_time(std::uint32_t& ts) {
+    std::size_t at = 0;
+    for (int i = 0; i < kPeekRecords; ++i) {
+      if (at + kMaxRecord > kBufLen || !ensure(at + kHeaderLen + 1)) return false;
+      const unsigned char* p = buf_.data() + beg_ + at;
+      const std::size_t size = le16(p + 6);
+      if (p[0] != kSeparator || !ensure(at + kHeaderLen + size + 1)) return false;
+      p = buf_.data() + beg_ + at;
+      unsigned char x = 0;
+      for (std::size_t j = 0; j < kHeaderLen + size; ++j) x ^= p[j];
+      if (static_cast<unsigned char>(~x) != p[kHeaderLen + size]) return false;
+      if (p[1] == kActivity || p[1] == kActivity2) {
+        ts = le32(p + 2);
+        return true;
+      }
+      at += kHeaderLen + size + 1;
+    }
+    return false;
+  }
+
+ private:
+  void start_resync(const char* why) {
+    if (resync_) return;
+    resync_ = true;
+    resync_why_ = why;
+    resync_from_ = offset();
+  }
+
+  void end_resync(bool at_end) {
+    if (!resync_) return;
+    resync_ = false;
+    if (at_end && std::strcmp(resync_why_, "record_past_end") == 0) {
+      report_.truncated = true;
+      report_.note("log.bin ends inside a record at byte " + std::to_string(resync_from_));
+      return;
+    }
+    report_.count(resync_why_);
+    ++report_.skipped;
+    report_.note(std::string(resync_why_) + ": log.bin bytes " + std::to_string(resync_from_) + " to " +
+                 std::to_string(offset()) + " skipped");
+  }
+
+  // After damage: a record stamped within a day of the recording.
+  bool plausible_time(std::uint32_t ts) const {
+    const std::int64_t rel = static_cast<std::int64_t>(ts) - start_u32_;
+    return rel >= -86400 && rel <= bound_secs_ + 86400;
+  }
+
+  Report& report_;
+  ByteSource* data_ = nullptr;
+  WindowSource* window_ = nullptr;  // the data entry's stored bytes
+  std::uint32_t start_u32_ = 0;
+  std::int64_t bound_secs_ = 0;
+  std::vector<unsigned char> buf_;
+  std::size_t beg_ = 0, end_ = 0;
+  std::int64_t buf_off_ = 0;
+  bool eof_ = false, resync_ = false;
+  const char* resync_why_ = "";
+  std::int64_t resync_from_ = 0;
+};
+
 }  // namespace gt3x
 
 class Gt3xDecoder : public Decoder {
@@ -568,7 +828,7 @@ class Gt3xDecoder : public Decoder {
   // `zip` is the .gt3x file; `inflater` reads deflated entries (null: only
   // stored entries can be read). Options: compat (1), impute_zeroes (0).
   Gt3xDecoder(ByteSource& zip, const Options& opts, EntryInflater* inflater = nullptr)
-      : zip_(zip), inflater_(inflater), rules_(ReadRules::of(opts)) {
+      : zip_(zip, inflater), records_(report_), rules_(ReadRules::of(opts)) {
     impute_ = opts.num("impute_zeroes", 0) != 0;
   }
 
@@ -576,23 +836,10 @@ class Gt3xDecoder : public Decoder {
     info_.format = "gt3x";
     info_.has_time = true;
     gt3x::ZipEntries z;
-    if (!gt3x::read_central_directory(zip_, z)) {
-      const std::string cd_why = z.error;
-      z = gt3x::ZipEntries();
-      if (!gt3x::read_local_headers(zip_, z)) {
-        if (!z.error.empty()) {
-          return fail(z.error + (cd_why.empty() ? "" : "; and " + cd_why));
-        }
-        if (!cd_why.empty()) return fail(cd_why + ", and no readable local file header at byte 0");
-        return fail("not a zip file (no readable central directory, no local file header at byte 0)");
-      }
-      report_.count("zip_directory_damaged");
-      report_.note("zip central directory unreadable" + (cd_why.empty() ? "" : " (" + cd_why + ")") +
-                   ": entries found from their local headers");
-    }
+    if (!zip_.find_entries(z, report_, error_)) return false;
     if (!z.info.found) return fail(z.error.empty() ? "no info.txt in the zip" : z.error);
     std::string text;
-    if (!read_small_entry(z.info, text)) return false;
+    if (!zip_.read_small_entry(z.info, text, error_)) return false;
     gt3x::Info info;
     info.parse(text);
     if (!take_info(info)) return false;
@@ -603,20 +850,21 @@ class Gt3xDecoder : public Decoder {
       return fail(z.error.empty() ? "no log.bin or activity.bin in the zip" : z.error);
     }
     old_ = use_activity;
-    if (!open_entry(use_activity ? z.activity : z.log, data_)) return false;
-    window_ = windows_.back().get();
+    ByteSource* data = nullptr;
+    if (!zip_.open_entry(use_activity ? z.activity : z.log, data, error_)) return false;
+    gt3x::WindowSource* const window = zip_.last_window();
     if (old_) {
       act_total_ = z.activity.size * 2 / 9;  // 36 bits a sample
       cap_ = -1;  // read.gt3x neither caps nor pads activity.bin
     }
     build_table();
-    buf_.assign(gt3x::kBufLen, 0);
+    records_.start(data, window, start_u32_, bound_secs_);
     return true;
   }
 
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override {
     std::int64_t units = 0;
-    if (data_ == nullptr) {
+    if (!records_.started()) {
       done_ = true;
       return 0;
     }
@@ -647,43 +895,6 @@ class Gt3xDecoder : public Decoder {
   bool fail(const std::string& why) {
     error_ = why;
     return false;
-  }
-
-  // A byte source for an entry's (inflated) bytes.
-  bool open_entry(const gt3x::ZipEntry& e, ByteSource*& src) {
-    std::string why;
-    const std::int64_t at = gt3x::entry_data_offset(zip_, e, why);
-    if (at < 0) return fail(why);
-    const std::int64_t len = e.comp_size >= 0 ? e.comp_size : std::max<std::int64_t>(0, zip_.size() - at);
-    windows_.emplace_back(new gt3x::WindowSource(zip_, at, len));
-    gt3x::WindowSource* w = windows_.back().get();
-    if (e.method == gt3x::kStored) {
-      src = w;
-      return true;
-    }
-    if (e.method != gt3x::kDeflated) {
-      return fail("zip entry compressed with method " + std::to_string(e.method) +
-                  " (only stored and deflated are read)");
-    }
-    if (inflater_ == nullptr) return fail("zip entry is deflated and no inflater was given");
-    inflated_.push_back(inflater_->open(*w));
-    src = inflated_.back().get();
-    if (src == nullptr) return fail("cannot inflate zip entry");
-    return true;
-  }
-
-  bool read_small_entry(const gt3x::ZipEntry& e, std::string& text) {
-    ByteSource* src = nullptr;
-    if (!open_entry(e, src)) return false;
-    std::vector<unsigned char> b(gt3x::kMaxInfo);
-    const std::size_t k = read_full(*src, b.data(), b.size());
-    text.assign(reinterpret_cast<const char*>(b.data()), k);
-    if (windows_.back()->short_read()) {
-      return fail("info.txt cut short at byte " + std::to_string(windows_.back()->position()) +
-                  " of " + std::to_string(windows_.back()->size()) + " (the file ends there)");
-    }
-    if (k == 0) return fail("info.txt is empty or unreadable");
-    return true;
   }
 
   bool take_info(const gt3x::Info& info) {
@@ -830,123 +1041,20 @@ class Gt3xDecoder : public Decoder {
     compat_pad_done_ = true;
   }
 
-  // ---- input buffer over the data entry
-
-  std::int64_t offset() const { return buf_off_ + static_cast<std::int64_t>(beg_); }
-
-  // At least n bytes from beg_ in the buffer, unless the input ends first.
-  bool ensure(std::size_t n) {
-    if (end_ - beg_ >= n) return true;
-    if (beg_ + n > buf_.size()) {
-      std::memmove(buf_.data(), buf_.data() + beg_, end_ - beg_);
-      buf_off_ += static_cast<std::int64_t>(beg_);
-      end_ -= beg_;
-      beg_ = 0;
-    }
-    while (end_ - beg_ < n && !eof_) {
-      const std::size_t k = data_->read(buf_.data() + end_, buf_.size() - end_);
-      if (k == 0) {
-        eof_ = true;
-        const std::int64_t at = buf_off_ + static_cast<std::int64_t>(end_);
-        if (window_ != nullptr && window_->short_read()) {  // the file is cut short
-          report_.truncated = true;
-          report_.note("zip entry cut short: " + std::to_string(window_->position()) + " of " +
-                       std::to_string(window_->size()) + " stored bytes (" + std::to_string(at) +
-                       " bytes of data)");
-        } else if (data_->failed()) {
-          report_.read_error = true;
-          report_.note("read error (or corrupt deflate data) in the data entry at byte " + std::to_string(at));
-        }
-      }
-      end_ += k;
-    }
-    return end_ - beg_ >= n;
-  }
-
   // ---- log.bin
-
-  void start_resync(const char* why) {
-    if (resync_) return;
-    resync_ = true;
-    resync_why_ = why;
-    resync_from_ = offset();
-  }
-
-  void end_resync(bool at_end) {
-    if (!resync_) return;
-    resync_ = false;
-    if (at_end && std::strcmp(resync_why_, "record_past_end") == 0) {
-      report_.truncated = true;
-      report_.note("log.bin ends inside a record at byte " + std::to_string(resync_from_));
-      return;
-    }
-    report_.count(resync_why_);
-    ++report_.skipped;
-    report_.note(std::string(resync_why_) + ": log.bin bytes " + std::to_string(resync_from_) + " to " +
-                 std::to_string(offset()) + " skipped");
-  }
-
-  bool plausible_time(std::uint32_t ts) const {
-    const std::int64_t rel = static_cast<std::int64_t>(ts) - start_u32_;
-    return rel >= -86400 && rel <= bound_secs_ + 86400;
-  }
-
-  // The next record that checks, at beg_; false at the end of the input.
-  bool next_record() {
-    for (;;) {
-      if (!ensure(1)) {
-        end_resync(true);
-        return false;
-      }
-      const unsigned char b = buf_[beg_];
-      if (b != gt3x::kSeparator) {
-        if (!resync_) {
-          if (b == 0) {  // zero bytes between records happen (README): ignored
-            ++beg_;
-            continue;
-          }
-          start_resync("bad_separator");
-        }
-        const void* q = std::memchr(buf_.data() + beg_, gt3x::kSeparator, end_ - beg_);
-        beg_ = q ? static_cast<std::size_t>(static_cast<const unsigned char*>(q) - buf_.data()) : end_;
-        continue;
-      }
-      if (!ensure(gt3x::kHeaderLen + 1) ||
-          !ensure(gt3x::kHeaderLen + 1 + le16(buf_.data() + beg_ + 6))) {
-        start_resync("record_past_end");
-        ++beg_;
-        continue;
-      }
-      const unsigned char* p = buf_.data() + beg_;
-      const std::size_t size = le16(p + 6);
-      unsigned char x = 0;
-      for (std::size_t i = 0; i < gt3x::kHeaderLen + size; ++i) x ^= p[i];
-      if (static_cast<unsigned char>(~x) != p[gt3x::kHeaderLen + size]) {
-        start_resync("bad_checksum");
-        ++beg_;
-        continue;
-      }
-      if (resync_ && (!gt3x::known_type(p[1]) || !plausible_time(le32(p + 2)))) {
-        ++beg_;  // a chance match inside damaged bytes
-        continue;
-      }
-      end_resync(false);
-      return true;
-    }
-  }
 
   // Reads records until one gives a second of samples (returns 1) or zeros
   // are pending or the input ends (returns 0).
   std::int64_t next_log_record() {
     while (!pending() && !input_done_) {
-      if (!next_record()) {
+      if (!records_.next_record()) {
         finish();
         return 0;
       }
-      const unsigned char* p = buf_.data() + beg_;
+      const unsigned char* p = records_.here();
       const std::size_t size = le16(p + 6);
-      const std::int64_t at = offset();
-      beg_ += gt3x::kHeaderLen + size + 1;
+      const std::int64_t at = records_.offset();
+      records_.advance(gt3x::kHeaderLen + size + 1);
       if (p[1] == gt3x::kParameters) take_parameters(p + gt3x::kHeaderLen, size);
       if (p[1] == gt3x::kActivity || p[1] == gt3x::kActivity2) {
         if (activity(p[1], le32(p + 2), p + gt3x::kHeaderLen, size, at)) return 1;
@@ -970,28 +1078,6 @@ class Gt3xDecoder : public Decoder {
     }
   }
 
-  // The time stamp of the next ACTIVITY / ACTIVITY2 record after beg_, if
-  // the records up to it check; looks a few records ahead in the buffer.
-  bool peek_activity_time(std::uint32_t& ts) {
-    std::size_t at = 0;
-    for (int i = 0; i < gt3x::kPeekRecords; ++i) {
-      if (at + gt3x::kMaxRecord > gt3x::kBufLen || !ensure(at + gt3x::kHeaderLen + 1)) return false;
-      const unsigned char* p = buf_.data() + beg_ + at;
-      const std::size_t size = le16(p + 6);
-      if (p[0] != gt3x::kSeparator || !ensure(at + gt3x::kHeaderLen + size + 1)) return false;
-      p = buf_.data() + beg_ + at;
-      unsigned char x = 0;
-      for (std::size_t j = 0; j < gt3x::kHeaderLen + size; ++j) x ^= p[j];
-      if (static_cast<unsigned char>(~x) != p[gt3x::kHeaderLen + size]) return false;
-      if (p[1] == gt3x::kActivity || p[1] == gt3x::kActivity2) {
-        ts = le32(p + 2);
-        return true;
-      }
-      at += gt3x::kHeaderLen + size + 1;
-    }
-    return false;
-  }
-
   // A stamp outside the recording is skipped (false); a jump forward that
   // the next record does not follow (it goes back between the expected time
   // and this stamp) is a damaged stamp, taken as the expected time.
@@ -1008,7 +1094,7 @@ class Gt3xDecoder : public Decoder {
       return false;
     }
     std::uint32_t next = 0;
-    if (ts > expected_ && seen_activity_ && peek_activity_time(next) && next >= expected_ && next < ts) {
+    if (ts > expected_ && seen_activity_ && records_.peek_activity_time(next) && next >= expected_ && next < ts) {
       report_.count("bad_timestamp");
       report_.note("record at log.bin byte " + std::to_string(at) + " stamped " + std::to_string(ts) +
                    ", the next " + std::to_string(next) + ": taken as " + std::to_string(expected_));
@@ -1088,24 +1174,24 @@ class Gt3xDecoder : public Decoder {
     }
     const std::size_t nib = static_cast<std::size_t>(act_i_ & 1);  // odd samples start mid-byte
     const std::size_t nibs = nib + 9 * static_cast<std::size_t>(n);
-    if (!ensure((nibs + 1) / 2)) {
-      const std::size_t have = (end_ - beg_) * 2;  // nibbles left
+    if (!records_.ensure((nibs + 1) / 2)) {
+      const std::size_t have = records_.buffered() * 2;  // nibbles left
       const std::int64_t whole = static_cast<std::int64_t>(have > nib ? (have - nib) / 9 : 0);
       report_.truncated = true;
-      report_.note("activity.bin ends at byte " + std::to_string(buf_off_ + static_cast<std::int64_t>(end_)) +
+      report_.note("activity.bin ends at byte " + std::to_string(records_.buffered_end()) +
                    ", " + std::to_string(act_total_ - act_i_ - whole) + " samples short of its size");
       act_total_ = act_i_ + whole;
       return next_activity_bin_second();
     }
     const double* t = table_.data();
-    const unsigned char* q = buf_.data() + beg_;
+    const unsigned char* q = records_.here();
     for (std::int64_t i = 0; i < n; ++i) {
       const std::size_t k = nib + 9 * static_cast<std::size_t>(i);
       cy_[i] = t[static_cast<std::uint16_t>(gt3x::unpack12(q, k))];
       cx_[i] = t[static_cast<std::uint16_t>(gt3x::unpack12(q, k + 3))];
       cz_[i] = t[static_cast<std::uint16_t>(gt3x::unpack12(q, k + 6))];
     }
-    beg_ += nibs / 2;
+    records_.advance(nibs / 2);
     cur_first_ = act_i_;
     cur_n_ = static_cast<int>(n);
     cur_i_ = 0;
@@ -1113,12 +1199,8 @@ class Gt3xDecoder : public Decoder {
     return 1;
   }
 
-  ByteSource& zip_;
-  EntryInflater* inflater_;
-  std::vector<std::unique_ptr<gt3x::WindowSource>> windows_;
-  std::vector<std::unique_ptr<ByteSource>> inflated_;
-  ByteSource* data_ = nullptr;
-  gt3x::WindowSource* window_ = nullptr;  // the data entry's stored bytes
+  gt3x::ZipReader zip_;
+  gt3x::RecordStream records_;  // the data entry's bytes and records
   // the reading rules (compat, interpolation, resample_fused), read once
   const ReadRules rules_;
   bool impute_ = false, old_ = false;
@@ -1128,13 +1210,6 @@ class Gt3xDecoder : public Decoder {
   std::uint32_t start_u32_ = 0;
   std::int64_t max_samples_ = 0, bound_secs_ = 0, cap_ = -1, act_total_ = 0, act_i_ = 0;
   std::vector<double> table_;
-  // input
-  std::vector<unsigned char> buf_;
-  std::size_t beg_ = 0, end_ = 0;
-  std::int64_t buf_off_ = 0;
-  bool eof_ = false, resync_ = false;
-  const char* resync_why_ = "";
-  std::int64_t resync_from_ = 0;
   // stream state
   std::uint32_t expected_ = 0;
   bool seen_activity_ = false, input_done_ = false, done_ = false, compat_pad_done_ = false;
