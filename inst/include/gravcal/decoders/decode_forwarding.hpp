@@ -20,7 +20,10 @@
 
 namespace gravcal {
 
-template <class Inner>
+// Self: the decorator (its add_own(Report&) const adds its own counts to
+// the report; called without a virtual call, as it was when each decorator
+// wrote this itself).
+template <class Inner, class Self>
 class ForwardingDecoder : public Decoder {
  public:
   std::size_t max_samples_per_unit() const override {
@@ -40,14 +43,11 @@ class ForwardingDecoder : public Decoder {
     return ok;
   }
 
-  // The decorator's own counts, added to the inner decoder's report.
-  virtual void add_own(Report&) const {}
-
   // The report after a read: the inner decoder's, the decorator's own
   // counts, and the samples the decorator gave.
   void forward_report() {
     report_ = inner_->report();
-    add_own(report_);
+    static_cast<const Self&>(*this).add_own(report_);
     report_.samples = given_;
   }
 

@@ -67,13 +67,11 @@
 namespace gravcal {
 
 template <class Inner>
-class GgirResamplerOf : public ForwardingDecoder<Inner> {
-  using Base = ForwardingDecoder<Inner>;
+class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> {
+  using Base = ForwardingDecoder<Inner, GgirResamplerOf<Inner>>;
+  friend Base;  // add_own()
   using Base::inner_;
-  using Base::left_;
-  using Base::given_;
   using Base::info_;
-  using Base::report_;
 
  public:
   // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
@@ -105,7 +103,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner> {
     if (out.light != nullptr && info_.has_light) want_light_ = true;
     if (!active_) {
       const std::int64_t u = inner_->read(out, max_units);
-      report_ = inner_->report();
+      this->report_ = inner_->report();
       return u;
     }
     if (!in_call_ && head_ == ready_.size()) start_call(max_units);
@@ -150,7 +148,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner> {
 
   void start_call(std::int64_t max_units) {
     in_call_ = true;
-    left_ = max_units;
+    this->left_ = max_units;
     first_read_ = true;
     have_prev_ = false;
     have_interval_ = false;
@@ -216,7 +214,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner> {
     std::size_t made = 0;
     const bool ended = walk_.through(
         k_, cur_[4], [&](std::int64_t) { return made < kGenBatch; },
-        [&](std::int64_t k, double g) {
+        [&](std::int64_t k, double g) GRAVCAL_GRID_POINT {
           pending_.push_back(point_at(k, g, prev_, cur_));
           ++made;
           return true;
@@ -262,7 +260,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner> {
     confirm(m);
   }
 
-  void add_own(Report& r) const override {
+  void add_own(Report& r) const {
     if (bad_time_ > 0) r.count("resample_bad_time", bad_time_);
     if (gaps_not_filled_ > 0) r.count("resample_gaps_not_filled", gaps_not_filled_);
     for (const auto& n : gap_notes_) r.note(n);
@@ -301,7 +299,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner> {
       const Point& p = ready_[head_++];
       if (out.light != nullptr) out.light[out.n] = p.v[kLight];
       out.put(p.v[0], p.v[1], p.v[2], p.v[3], p.v[4]);
-      ++given_;
+      ++this->given_;
     }
   }
 

@@ -98,13 +98,11 @@ struct GgirTimegapsMode {
 };
 
 template <class Inner, class Acc = long double>
-class GgirTimegapsOf : public ForwardingDecoder<Inner> {
-  using Base = ForwardingDecoder<Inner>;
+class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc>> {
+  using Base = ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc>>;
+  friend Base;  // add_own()
   using Base::inner_;
-  using Base::left_;
-  using Base::given_;
   using Base::info_;
-  using Base::report_;
   using EpochGap = Decoder::EpochGap;
 
  public:
@@ -138,7 +136,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner> {
         take(raw_at_++);
         continue;
       }
-      if (left_ == 0 || inner_->done() || !refill()) end_call();
+      if (this->left_ == 0 || inner_->done() || !refill()) end_call();
     }
     this->forward_report();
     return this->call_units(in_call_ || pending());
@@ -173,7 +171,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner> {
 
   void start_call(std::int64_t max_units) {
     in_call_ = true;
-    left_ = max_units;
+    this->left_ = max_units;
     first_ = true;
     have_held_ = false;
     have_zero_ = false;
@@ -422,7 +420,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner> {
         }
         out.put(r.v[0], r.v[1], r.v[2], r.v[3], t);
         last_given_ = t;
-        ++given_;
+        ++this->given_;
       }
       if (r.j == r.n) ++head_;
     }
@@ -432,7 +430,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner> {
     }
   }
 
-  void add_own(Report& r) const override {
+  void add_own(Report& r) const {
     const std::string& p = mode_.counter_prefix;
     auto count = [&](const char* name, std::int64_t k) { r.count((p + name).c_str(), k); };
     if (gaps_ > 0) count("timegaps_imputed", gaps_);

@@ -628,7 +628,7 @@ class MovisensDecoder : public Decoder {
       std::int64_t q = p + i;
       walk.through(
           q, r1, [&](std::int64_t k) { return k < p + m; },
-          [&](std::int64_t k, double g) {
+          [&](std::int64_t k, double g) GRAVCAL_GRID_POINT {
             out[k - p] = walk.value(walk.weight(g, r0, r1), v0, v1);
             return true;
           });

@@ -223,8 +223,10 @@ inline std::int64_t cwa_interp_scalar(const InterpSpan& s, std::int64_t pos, std
   // the grid, weight and interpolation rules of the one grid walk
   // (ggir_grid.hpp); its stepping, GridWalk::through(), is not used: this
   // loop searches the interval afresh for every point, the reference its
-  // AVX2 twin follows lane by lane and calls one point at a time
-  const GridWalk<CappedGrid, UnclampedWeight> walk{{s.start, s.step, s.end}, {s.nearest, s.fused}};
+  // AVX2 twin follows lane by lane and calls one point at a time. Its
+  // interpolation rule is the span itself (s.nearest, s.fused, read where
+  // they are, as this loop always read them: the same machine code)
+  const GridWalk<CappedGrid, UnclampedWeight, const InterpSpan&> walk{{s.start, s.step, s.end}, s};
   double* const ox = o.x;
   double* const oy = o.y;
   double* const oz = o.z;

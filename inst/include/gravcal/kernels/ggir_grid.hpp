@@ -26,10 +26,15 @@
 // positions), and what it does with a point (hold it until the grid is
 // known to reach beyond it, keep the grid's last or drop it).
 //
-// The cwa kernel (kernels/decode.hpp, cwa_interp_scalar) uses the grid,
-// weight and interpolation rules here but not GridWalk::through(): its
-// scalar loop is the reference its AVX2 twin stands in for point by point
-// (see the comment there).
+// Who uses what: the resampler (decode_ggir_resample.hpp), Movisens's
+// temperature (decode_movisens.hpp) and Parmay's point-by-point path
+// (ParmayDecoder::next_points()) step the grid with GridWalk::through().
+// Two hot loops take the walk's grid, weight and interpolation but step
+// the grid themselves, each for a measured reason given where it is:
+// Parmay's run() (through() and its lambdas cost it about 10% more
+// instructions) and the cwa kernel's scalar reference (kernels/decode.hpp,
+// cwa_interp_scalar: it searches the interval afresh for every point, the
+// loop its AVX2 twin follows lane by lane and calls one point at a time).
 //
 // Header-only, standard headers only.
 #ifndef GRAVCAL_KERNELS_GGIR_GRID_HPP
@@ -39,6 +44,15 @@
 
 #include <cmath>
 #include <cstdint>
+
+// Marks the functions a walk calls for each grid point (the callers'
+// lambdas): inlined into the walk's loop, so that the caller's state stays
+// in registers (GCC's heuristics leave a large lambda out of line).
+#if defined(__GNUC__) || defined(__clang__)
+#define GRAVCAL_GRID_POINT __attribute__((always_inline))
+#else
+#define GRAVCAL_GRID_POINT
+#endif
 
 namespace gravcal {
 
