@@ -16,6 +16,10 @@
 // + v[j-1] into one multiply-add (GCC's default on aarch64), `fused` does
 // so too (kernels::ggir_lerp; R/fp-build.R finds out which).
 //
+// The stepping over the grid is GGIR's one grid walk (kernels/ggir_grid.hpp:
+// a regular grid, the weight not clamped); the keep-last rule below is the
+// resampler's own.
+//
 // GgirResampler does this while the samples stream: a grid point is computed
 // once its interval has arrived and given on once the grid is known to go
 // beyond it (the block's last point is dropped), so it holds a few samples,
@@ -48,6 +52,10 @@
 // noted ("resample_gaps_not_filled"), and a time stamp that is not a finite
 // number, or lies more than 2^51 grid steps from 1970, is left out with its
 // sample ("resample_bad_time").
+//
+// What it forwards to the decoder it wraps (opening it, its report, its
+// units) is ForwardingDecoder's (decode_forwarding.hpp), shared with the
+// other decorator.
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 

@@ -34,6 +34,10 @@
 // block's last zero sample, never a block. A gap of more than kMaxGapRows
 // samples (about 11.6 days at 100 Hz, where GGIR would need gigabytes) is not
 // filled but counted and noted ("timegaps_not_filled").
+//
+// What it forwards to the decoder it wraps (opening it, its report, its
+// units) is ForwardingDecoder's (decode_forwarding.hpp), shared with the
+// other decorator.
 #ifndef GRAVCAL_DECODE_GGIR_TIMEGAPS_HPP
 #define GRAVCAL_DECODE_GGIR_TIMEGAPS_HPP
 

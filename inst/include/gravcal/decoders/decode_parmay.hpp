@@ -48,6 +48,11 @@
 // actually found (at least 36 bytes each), and samples are read through
 // small fixed buffers.
 //
+// The file's packets and the cursors over their samples are
+// decode_parmay_packets.hpp's (ParmayFile, ParmayStream); the resampling
+// here is GGIR's grid walk (kernels/ggir_grid.hpp) with the weight clamped
+// to [0, 1], as GGIRread resamples for readParmayMatrix().
+//
 // Not reproduced (GGIRread's behaviour in cases that real files do not
 // show, each counted where seen): temperature times out of order
 // (GGIRread sorts them: temperature_time_backwards), equal temperature
