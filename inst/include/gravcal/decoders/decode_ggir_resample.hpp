@@ -11,10 +11,14 @@
 // with t[j] >= g (j >= 1), and takes u (v[j] - v[j-1]) + v[j-1] with u = (g
 // - t[j-1]) / (t[j] - t[j-1]), as GGIRread::resample computes it; with
 // GGIR's interpolationType = 2 (nearest neighbour) u is replaced by
-// ggir_nearest_weight(u) (kernels/decode.hpp). GGIRread::resample is C++
+// ggir_nearest_weight(u) (kernels/ggir_grid.hpp). GGIRread::resample is C++
 // compiled by the R it runs in; where that compiler fused u (v[j] - v[j-1])
 // + v[j-1] into one multiply-add (GCC's default on aarch64), `fused` does
 // so too (kernels::ggir_lerp; R/fp-build.R finds out which).
+//
+// The stepping over the grid is GGIR's one grid walk (kernels/ggir_grid.hpp:
+// a regular grid, the weight not clamped); the keep-last rule below is the
+// resampler's own.
 //
 // GgirResampler does this while the samples stream: a grid point is computed
 // once its interval has arrived and given on once the grid is known to go
@@ -48,6 +52,10 @@
 // noted ("resample_gaps_not_filled"), and a time stamp that is not a finite
 // number, or lies more than 2^51 grid steps from 1970, is left out with its
 // sample ("resample_bad_time").
+//
+// What it forwards to the decoder it wraps (opening it, its report, its
+// units) is ForwardingDecoder's (decode_forwarding.hpp), shared with the
+// other decorator.
 #ifndef GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 #define GRAVCAL_DECODE_GGIR_RESAMPLE_HPP
 
@@ -60,13 +68,19 @@
 #include <vector>
 
 #include "gravcal/decoders/decode.hpp"
+#include "gravcal/decoders/decode_forwarding.hpp"
 #include "gravcal/decoders/decode_geneactiv.hpp"
 #include "gravcal/kernels/kernels.hpp"
 
 namespace gravcal {
 
 template <class Inner>
-class GgirResamplerOf : public Decoder {
+class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> {
+  using Base = ForwardingDecoder<Inner, GgirResamplerOf<Inner>>;
+  friend Base;  // add_own()
+  using Base::inner_;
+  using Base::info_;
+
  public:
   // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
   // linear, 2 nearest neighbour (GGIR's interpolationType); fused: GGIRread's
@@ -74,25 +88,20 @@ class GgirResamplerOf : public Decoder {
   explicit GgirResamplerOf(std::unique_ptr<Inner> inner, double grid_rate = 0,
                            int interpolation = 1, bool keep_last = false,
                            bool fused = false)
-      : inner_(std::move(inner)),
-        grid_rate_(grid_rate),
-        nearest_(interpolation == 2),
-        keep_last_(keep_last),
-        fused_(fused) {}
+      : Base(std::move(inner)), grid_rate_(grid_rate), keep_last_(keep_last) {
+    walk_.interp.nearest = interpolation == 2;
+    walk_.interp.fused = fused;
+  }
 
   bool open() override {
-    const bool ok = inner_->open();
-    info_ = inner_->info();
-    error_ = inner_->error();
-    report_ = inner_->report();
-    if (!ok) return false;
+    if (!this->open_inner()) return false;
     const double rate = info_.sf;
     // R's round(): halves to even (12.5 Hz becomes 12), as nearbyint in
     // the default rounding mode
     active_ = grid_rate_ > 0 || (rate > 0 && rate != std::nearbyint(rate));
     if (active_) {
       info_.sf = grid_rate_ > 0 ? grid_rate_ : std::nearbyint(rate);
-      by_ = 1.0 / info_.sf;
+      walk_.grid.by = 1.0 / info_.sf;
       raw_.assign(kRawCols * kRawChunk, 0.0);
     }
     return true;
@@ -102,7 +111,7 @@ class GgirResamplerOf : public Decoder {
     if (out.light != nullptr && info_.has_light) want_light_ = true;
     if (!active_) {
       const std::int64_t u = inner_->read(out, max_units);
-      report_ = inner_->report();
+      this->report_ = inner_->report();
       return u;
     }
     if (!in_call_ && head_ == ready_.size()) start_call(max_units);
@@ -124,24 +133,13 @@ class GgirResamplerOf : public Decoder {
       // page that did not fit; the call ends when nothing more comes
       if (inner_->done() || !refill()) end_call();
     }
-    report_ = inner_->report();
-    add_own(report_);
-    report_.samples = given_;
-    // the call's units count once all its samples are given, so that a
-    // caller reading a block of units gets the whole block
-    if (in_call_ || head_ < ready_.size()) return 0;
-    const std::int64_t u = call_units_;
-    call_units_ = 0;
-    return u;
+    this->forward_report();
+    return this->call_units(in_call_ || head_ < ready_.size());
   }
 
   bool done() const override {
     return inner_->done() && !in_call_ && !gen_active_ && head_ == ready_.size() &&
            raw_at_ >= raw_n_;
-  }
-
-  std::size_t max_samples_per_unit() const override {
-    return 2 * inner_->max_samples_per_unit();
   }
 
  private:
@@ -158,7 +156,7 @@ class GgirResamplerOf : public Decoder {
 
   void start_call(std::int64_t max_units) {
     in_call_ = true;
-    left_ = max_units;
+    this->left_ = max_units;
     first_read_ = true;
     have_prev_ = false;
     have_interval_ = false;
@@ -174,10 +172,8 @@ class GgirResamplerOf : public Decoder {
     SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true, raw_light_);
     inner_->continue_call(!first_read_);
     first_read_ = false;
-    const std::int64_t u = inner_->read(b, left_);
+    const std::int64_t u = this->read_inner(b);
     inner_->continue_call(false);
-    call_units_ += u;
-    if (left_ > 0) left_ -= u;
     raw_n_ = b.n;
     raw_at_ = 0;
     return b.n > 0 || u > 0;
@@ -192,26 +188,26 @@ class GgirResamplerOf : public Decoder {
     // resolution (beyond 2^51 steps: more than 700,000 years at 100 Hz)
     // has no grid around it: left out as a non-finite one is (the grid's
     // k and its points would stop moving, and the loops with them)
-    if (!(std::fabs(cur_[4]) < kMaxTimeSteps * by_)) {
+    if (!(std::fabs(cur_[4]) < kMaxTimeSteps * walk_.grid.by)) {
       ++bad_time_;
       return;
     }
     if (!have_prev_) {
       for (std::size_t c = 0; c < kRawCols; ++c) prev_[c] = cur_[c];
-      from_ = cur_[4];
+      walk_.grid.origin = cur_[4];
       have_prev_ = true;
       return;
     }
-    if ((cur_[4] - prev_[4]) / by_ > kMaxGapPoints) {
+    if ((cur_[4] - prev_[4]) / walk_.grid.by > kMaxGapPoints) {
       // not filled: the grid goes on after the gap
       ++gaps_not_filled_;
       if (gap_notes_.size() < 5) {
         gap_notes_.push_back("time stamps jump by " + std::to_string(cur_[4] - prev_[4]) +
                              " s within a block; the gap is not filled by resampling");
       }
-      double k = std::floor((cur_[4] - from_) / by_);
-      while (k > 0 && from_ + k * by_ > cur_[4]) k -= 1;
-      while (from_ + k * by_ <= cur_[4]) k += 1;
+      double k = std::floor((cur_[4] - walk_.grid.origin) / walk_.grid.by);
+      while (k > 0 && walk_.grid.at(k) > cur_[4]) k -= 1;
+      while (walk_.grid.at(k) <= cur_[4]) k += 1;
       k_ = static_cast<std::int64_t>(k);
       end_interval();
       return;
@@ -223,23 +219,32 @@ class GgirResamplerOf : public Decoder {
   // Grid points up to cur_'s time, interpolated from the interval (prev_,
   // cur_], at most kGenBatch of them per call.
   void generate() {
-    for (std::size_t made = 0; made < kGenBatch; ++made) {
-      const double g = from_ + static_cast<double>(k_) * by_;
-      if (!(g <= cur_[4])) {
-        gen_active_ = false;
-        end_interval();
-        return;
-      }
-      Point p;
-      p.k = k_++;
-      double u = (g - prev_[4]) / (cur_[4] - prev_[4]);
-      if (nearest_) u = ggir_nearest_weight(u);
-      for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev_[c], cur_[c], fused_);
-      p.v[4] = g;
-      p.v[kLight] = want_light_ ? kernels::ggir_lerp(u, prev_[kLight], cur_[kLight], fused_) : 0.0;
-      pending_.push_back(p);
+    std::size_t made = 0;
+    const bool ended = walk_.through(
+        k_, cur_[4], [&](std::int64_t) { return made < kGenBatch; },
+        [&](std::int64_t k, double g) GRAVCAL_GRID_POINT {
+          pending_.push_back(point_at(k, g, prev_, cur_));
+          ++made;
+          return true;
+        });
+    if (ended) {
+      gen_active_ = false;
+      end_interval();
+      return;
     }
     confirm_upto(cur_[4]);
+  }
+
+  // Grid point k at time g, interpolated between the raw samples lo and hi
+  // (the interval (lo's time, hi's time]).
+  Point point_at(std::int64_t k, double g, const double* lo, const double* hi) const {
+    Point p;
+    p.k = k;
+    const double u = walk_.weight(g, lo[4], hi[4]);
+    for (int c = 0; c < 4; ++c) p.v[c] = walk_.value(u, lo[c], hi[c]);
+    p.v[4] = g;
+    p.v[kLight] = want_light_ ? walk_.value(u, lo[kLight], hi[kLight]) : 0.0;
+    return p;
   }
 
   void end_interval() {
@@ -256,7 +261,7 @@ class GgirResamplerOf : public Decoder {
   // (with keep_last: a point the grid reaches is in it), the grid reaching
   // as far as time stamp t.
   void confirm_upto(double t) {
-    const double reach = (t - from_) / by_ + 1e-10;
+    const double reach = (t - walk_.grid.origin) / walk_.grid.by + 1e-10;
     const std::int64_t ahead = keep_last_ ? 0 : 1;
     std::size_t m = 0;
     while (m < pending_.size() && static_cast<double>(pending_[m].k + ahead) <= reach) ++m;
@@ -277,7 +282,7 @@ class GgirResamplerOf : public Decoder {
   void end_call() {
     in_call_ = false;
     if (have_prev_) {
-      const double n = std::floor((last_ - from_) / by_ + 1e-10);
+      const double n = std::floor((last_ - walk_.grid.origin) / walk_.grid.by + 1e-10);
       std::size_t m = 0;
       if (keep_last_) {
         while (m < pending_.size() && static_cast<double>(pending_[m].k) <= n) ++m;
@@ -286,14 +291,7 @@ class GgirResamplerOf : public Decoder {
       }
       confirm(m);
       if (keep_last_ && have_interval_ && static_cast<double>(k_) == n) {
-        Point p;
-        p.k = k_++;
-        double u = (last_ - prev2_[4]) / (prev_[4] - prev2_[4]);
-        if (nearest_) u = ggir_nearest_weight(u);
-        for (int c = 0; c < 4; ++c) p.v[c] = kernels::ggir_lerp(u, prev2_[c], prev_[c], fused_);
-        p.v[4] = last_;
-        p.v[kLight] = want_light_ ? kernels::ggir_lerp(u, prev2_[kLight], prev_[kLight], fused_) : 0.0;
-        ready_.push_back(p);
+        ready_.push_back(point_at(k_++, last_, prev2_, prev_));
       }
     }
     pending_.clear();
@@ -309,19 +307,18 @@ class GgirResamplerOf : public Decoder {
       const Point& p = ready_[head_++];
       if (out.light != nullptr) out.light[out.n] = p.v[kLight];
       out.put(p.v[0], p.v[1], p.v[2], p.v[3], p.v[4]);
-      ++given_;
+      ++this->given_;
     }
   }
 
-  std::unique_ptr<Inner> inner_;
   double grid_rate_ = 0.0;
-  bool nearest_ = false;
   bool keep_last_ = false;
-  bool fused_ = false;
   bool active_ = false;
   bool want_light_ = false;  // light asked for (and the inner decoder has it)
   bool raw_light_ = false;   // the raw samples in raw_ have light
-  double by_ = 0.0;
+  // the grid, origin + k by (the origin the call's first time stamp), its
+  // weights unclamped (GGIRread::resample's)
+  kernels::GridWalk<kernels::RegularGrid, kernels::UnclampedWeight> walk_;
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
   bool in_call_ = false, first_read_ = true, have_prev_ = false, have_interval_ = false;
@@ -329,16 +326,13 @@ class GgirResamplerOf : public Decoder {
   double cur_[kRawCols] = {0, 0, 0, 0, 0, 0};
   std::int64_t bad_time_ = 0, gaps_not_filled_ = 0;
   std::vector<std::string> gap_notes_;
-  std::int64_t left_ = -1;
-  std::int64_t call_units_ = 0;
   std::int64_t k_ = 0;
-  double from_ = 0.0, last_ = 0.0;
+  double last_ = 0.0;
   double prev_[kRawCols] = {0, 0, 0, 0, 0, 0};
   double prev2_[kRawCols] = {0, 0, 0, 0, 0, 0};  // the sample before prev_
   std::vector<Point> pending_;  // computed, maybe the grid's last
   std::vector<Point> ready_;    // confirmed, not yet given
   std::size_t head_ = 0;
-  std::int64_t given_ = 0;
 };
 
 using GgirResampler = GgirResamplerOf<GeneactivDecoder>;

@@ -34,6 +34,10 @@
 // block's last zero sample, never a block. A gap of more than kMaxGapRows
 // samples (about 11.6 days at 100 Hz, where GGIR would need gigabytes) is not
 // filled but counted and noted ("timegaps_not_filled").
+//
+// What it forwards to the decoder it wraps (opening it, its report, its
+// units) is ForwardingDecoder's (decode_forwarding.hpp), shared with the
+// other decorator.
 #ifndef GRAVCAL_DECODE_GGIR_TIMEGAPS_HPP
 #define GRAVCAL_DECODE_GGIR_TIMEGAPS_HPP
 
@@ -46,6 +50,7 @@
 #include <vector>
 
 #include "gravcal/decoders/decode.hpp"
+#include "gravcal/decoders/decode_forwarding.hpp"
 
 namespace gravcal {
 
@@ -97,19 +102,21 @@ struct GgirTimegapsMode {
 };
 
 template <class Inner, class Acc = long double>
-class GgirTimegapsOf : public Decoder {
+class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc>> {
+  using Base = ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc>>;
+  friend Base;  // add_own()
+  using Base::inner_;
+  using Base::info_;
+  using EpochGap = Decoder::EpochGap;
+
  public:
   // sf: the rate GGIR imputes at (the layout's: rmc.sf or the header's; 0:
   // the inner decoder's)
   GgirTimegapsOf(std::unique_ptr<Inner> inner, double sf, GgirTimegapsMode mode = {})
-      : inner_(std::move(inner)), sf_(sf), mode_(std::move(mode)) {}
+      : Base(std::move(inner)), sf_(sf), mode_(std::move(mode)) {}
 
   bool open() override {
-    const bool ok = inner_->open();
-    info_ = inner_->info();
-    error_ = inner_->error();
-    report_ = inner_->report();
-    if (!ok) return false;
+    if (!this->open_inner()) return false;
     if (!(sf_ > 0)) sf_ = info_.sf;
     by_ = 1.0 / sf_;
     k_ = 0.25;
@@ -133,21 +140,15 @@ class GgirTimegapsOf : public Decoder {
         take(raw_at_++);
         continue;
       }
-      if (left_ == 0 || inner_->done() || !refill()) end_call();
+      if (this->left_ == 0 || inner_->done() || !refill()) end_call();
     }
-    report_ = inner_->report();
-    add_own(report_);
-    report_.samples = given_;
-    if (in_call_ || pending()) return 0;
-    const std::int64_t u = call_units_;
-    call_units_ = 0;
-    return u;
+    this->forward_report();
+    return this->call_units(in_call_ || pending());
   }
 
   bool done() const override {
     return inner_->done() && !in_call_ && !pending() && raw_at_ >= raw_n_;
   }
-  std::size_t max_samples_per_unit() const override { return 2 * inner_->max_samples_per_unit(); }
   std::vector<EpochGap> take_epoch_gaps() override {
     std::vector<EpochGap> out;
     out.swap(epoch_gaps_);
@@ -174,7 +175,7 @@ class GgirTimegapsOf : public Decoder {
 
   void start_call(std::int64_t max_units) {
     in_call_ = true;
-    left_ = max_units;
+    this->left_ = max_units;
     first_ = true;
     have_held_ = false;
     have_zero_ = false;
@@ -191,9 +192,7 @@ class GgirTimegapsOf : public Decoder {
 
   bool refill() {
     SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true);
-    const std::int64_t u = inner_->read(b, left_);
-    call_units_ += u;
-    if (left_ > 0) left_ -= u;
+    const std::int64_t u = this->read_inner(b);
     raw_n_ = b.n;
     raw_at_ = 0;
     rows_read_ += static_cast<std::int64_t>(b.n);
@@ -425,7 +424,7 @@ class GgirTimegapsOf : public Decoder {
         }
         out.put(r.v[0], r.v[1], r.v[2], r.v[3], t);
         last_given_ = t;
-        ++given_;
+        ++this->given_;
       }
       if (r.j == r.n) ++head_;
     }
@@ -453,7 +452,6 @@ class GgirTimegapsOf : public Decoder {
     for (const auto& n : gap_notes_) r.note(n);
   }
 
-  std::unique_ptr<Inner> inner_;
   double sf_ = 0.0, by_ = 0.0, k_ = 0.25;
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
@@ -462,7 +460,6 @@ class GgirTimegapsOf : public Decoder {
   double zero_[kCols] = {0, 0, 0, 0, 0};
   std::vector<Run> runs_;
   std::size_t head_ = 0;
-  std::int64_t left_ = -1, call_units_ = 0, given_ = 0;
   std::int64_t gaps_ = 0, rows_added_ = 0, zeros_dropped_ = 0;
   std::int64_t gaps_not_filled_ = 0;
   std::vector<std::string> gap_notes_;

@@ -598,22 +598,23 @@ class MovisensDecoder : public Decoder {
   void temperatures_as(std::int64_t p, std::int64_t m, double* out) {
     const std::int64_t t0 = tfrom_ - 1;  // 0-based first temperature sample
     const double tm = static_cast<double>(tm_);
-    const double by = (tm - 1) / static_cast<double>(bn_ - 1);
-    const std::int64_t last = bn_ - 1;
-    auto position = [&](std::int64_t q) {
-      return q == 0 ? 1.0 : q == last ? tm : 1 + static_cast<double>(q) * by;
-    };
-    // whether position g lies beyond the interval (pos, pos + 1] (never
-    // beyond the last one): one test, for the search and for the run
-    auto beyond = [&](std::int64_t pos, double g) {
-      return pos < tm_ - 1 && static_cast<double>(pos + 1) < g;
+    // the grid walk (kernels/ggir_grid.hpp) over positions: R's seq(1, tm,
+    // length.out = n), weights g - r0
+    const kernels::GridWalk<kernels::PositionGrid, kernels::UnitWeight,
+                            kernels::InterpAs<Nearest, Fused>>
+        walk{{tm, (tm - 1) / static_cast<double>(bn_ - 1), bn_ - 1}, {}};
+    // the end of the interval (pos, pos + 1]; the last one has none (a
+    // position beyond tm, never given, would take it)
+    const double inf = std::numeric_limits<double>::infinity();
+    auto end_of = [&](std::int64_t pos) {
+      return pos < tm_ - 1 ? static_cast<double>(pos + 1) : inf;
     };
     std::int64_t pos = pos_;
     std::int64_t i = 0;
     while (i < m) {
       // the interval that holds sample i's position
-      const double gi = position(p + i);
-      while (beyond(pos, gi)) ++pos;
+      const double gi = walk.grid.at(p + i);
+      while (!(gi <= end_of(pos))) ++pos;
       // the temperature samples at its ends, read once for the samples in
       // it (after a read error, every time: value() then gives NaN past it)
       if (t0 + pos != tv_at_ || temp_.failed()) {
@@ -622,15 +623,16 @@ class MovisensDecoder : public Decoder {
         tv_[1] = temp_.value(tv_at_, temp_chan_);
       }
       const double v0 = tv_[0], v1 = tv_[1];
-      const double r0 = static_cast<double>(pos);
+      const double r0 = static_cast<double>(pos), r1 = end_of(pos);
       // sample i and those after it in the same interval
-      for (; i < m; ++i) {
-        const double g = position(p + i);
-        if (beyond(pos, g)) break;
-        double u = g - r0;
-        if (Nearest) u = ggir_nearest_weight(u);
-        out[i] = kernels::ggir_lerp(u, v0, v1, Fused);
-      }
+      std::int64_t q = p + i;
+      walk.through(
+          q, r1, [&](std::int64_t k) { return k < p + m; },
+          [&](std::int64_t k, double g) GRAVCAL_GRID_POINT {
+            out[k - p] = walk.value(walk.weight(g, r0, r1), v0, v1);
+            return true;
+          });
+      i = q - p;
     }
     pos_ = pos;
   }

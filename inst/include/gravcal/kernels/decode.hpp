@@ -15,19 +15,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "gravcal/kernels/ggir_grid.hpp"
 #include "gravcal/kernels/simd.hpp"
 
 namespace gravcal {
-
-// GGIR's nearest-neighbour resampling (interpolationType = 2, as
-// GGIRread::resample computes it): the weight u of a grid point between two
-// samples becomes 0 up to u = 0.5 and 1 beyond (0 outside [0, 1]); the value
-// is then computed as the linear one, w * (right - left) + left.
-inline double ggir_nearest_weight(double u) {
-  if (u < 0 || u > 1) u = 0;
-  return std::ceil(u - 0.5);
-}
-
 namespace kernels {
 
 // ---------------------------------------------------------------------------
@@ -212,25 +203,6 @@ struct InterpSpan {
   bool fused = false;    // std::fma for the value (the scalar reference only)
 };
 
-// The replay's one deliberate fused multiply-add, a * b + c rounded once
-// (std::fma), kept out of line: wherever it is called, the instruction the
-// target has for it sits in this function alone, which tools/fma-count.sh
-// counts apart from contractions (a build with -march=native would
-// otherwise inline it into every caller).
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-inline double replay_fma(double a, double b, double c) {
-  return std::fma(a, b, c);
-}
-
-// GGIRread's w (v1 - v0) + v0, rounded twice (R's compiler did not contract
-// it) or once (it did).
-inline double ggir_lerp(double w, double v0, double v1, bool fused) {
-  const double d = v1 - v0;
-  return fused ? replay_fma(w, d, v0) : w * d + v0;  // not contracted: fp_contract.hpp
-}
-
 struct InterpOut {
   double* x = nullptr;
   double* y = nullptr;
@@ -247,7 +219,14 @@ inline std::int64_t cwa_interp_scalar(const InterpSpan& s, std::int64_t pos, std
   const double* X = s.v[0];
   const double* Y = s.v[1];
   const double* Z = s.v[2];
-  const double start = s.start, step = s.step, end = s.end, lim = s.lim, temp = s.temp;
+  const double lim = s.lim, temp = s.temp;
+  // the grid, weight and interpolation rules of the one grid walk
+  // (ggir_grid.hpp); its stepping, GridWalk::through(), is not used: this
+  // loop searches the interval afresh for every point, the reference its
+  // AVX2 twin follows lane by lane and calls one point at a time. Its
+  // interpolation rule is the span itself (s.nearest, s.fused, read where
+  // they are, as this loop always read them: the same machine code)
+  const GridWalk<CappedGrid, UnclampedWeight, const InterpSpan&> walk{{s.start, s.step, s.end}, s};
   double* const ox = o.x;
   double* const oy = o.y;
   double* const oz = o.z;
@@ -257,16 +236,13 @@ inline std::int64_t cwa_interp_scalar(const InterpSpan& s, std::int64_t pos, std
   int src = source;
   std::int64_t k = 0;
   for (; pos + k < end_pos; ++k) {
-    volatile double e = static_cast<double>(pos + k) * step;  // no fused multiply-add
-    double t = start + e;
-    t = t < end ? t : end;
+    const double t = walk.grid.at(pos + k);
     if (!(t <= lim)) break;
     while (src < s.len && T[src] < t) ++src;
-    double w = (t - T[src - 1]) / (T[src] - T[src - 1]);
-    if (s.nearest) w = ggir_nearest_weight(w);
-    a0 = ggir_lerp(w, X[src - 1], X[src], s.fused);
-    a1 = ggir_lerp(w, Y[src - 1], Y[src], s.fused);
-    a2 = ggir_lerp(w, Z[src - 1], Z[src], s.fused);
+    const double w = walk.weight(t, T[src - 1], T[src]);
+    a0 = walk.value(w, X[src - 1], X[src]);
+    a1 = walk.value(w, Y[src - 1], Y[src]);
+    a2 = walk.value(w, Z[src - 1], Z[src]);
     ox[k] = a0;
     oy[k] = a1;
     oz[k] = a2;
