@@ -137,7 +137,9 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
       if (pending()) break;  // out is full
       if (!in_call_) break;
       if (raw_at_ < raw_n_) {
-        take(raw_at_++);
+        take_plain(out);
+        if (out.full()) break;
+        if (raw_at_ < raw_n_) take(raw_at_++);
         continue;
       }
       if (this->left_ == 0 || inner_->done() || !refill()) end_call();
@@ -265,6 +267,42 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
     have_zero_ = false;
     release(s[4]);
     hold(s);
+  }
+
+  // take(), drain() and what they do for a sample that needs none of
+  // take()'s cases (most of them), straight to out: the held sample is
+  // given as release() queues it and drain() gives it (a run of one copy,
+  // at its own time), and the sample is held in its place. Stops at a
+  // sample that is zero or follows a zero, at a step of k_ or more from the
+  // held sample (a gap), where times slip or runs are queued, and where out
+  // is full; take() and drain() go on from there, so the samples, times
+  // and counts are the same.
+  void take_plain(SampleBuffer& out) {
+    if (first_ || have_zero_ || !have_held_ || pending() || !slip_.empty()) return;
+    const double* x = raw_.data();
+    const double* y = x + kRawChunk;
+    const double* z = y + kRawChunk;
+    const double* tc = z + kRawChunk;
+    const double* time = tc + kRawChunk;
+    while (raw_at_ < raw_n_ && !out.full()) {
+      const std::size_t i = raw_at_;
+      if (x[i] == 0 && y[i] == 0 && z[i] == 0) return;
+      if (time[i] - held_[4] >= k_) return;  // release()'s gap (a NaN step is none)
+      // push() of the held sample's run of one, then drain()'s copy j = 0
+      last_gap_ = false;
+      last_time_ = held_[4];
+      ++queued_;
+      const double t = held_[4] + 0.0 * by_;
+      out.put(held_[0], held_[1], held_[2], held_[3], t);
+      last_given_ = t;
+      ++this->given_;
+      held_[0] = x[i];
+      held_[1] = y[i];
+      held_[2] = z[i];
+      held_[3] = tc[i];
+      held_[4] = time[i];
+      ++raw_at_;
+    }
   }
 
   void hold(const double* s) {
