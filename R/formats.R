@@ -41,7 +41,7 @@
 # * block_units: the size of one of GGIR's blocks in those units, from the
 #   sampling rate and chunksize (g.calibrate's blocksize; chunksize = 1 is
 #   about 12 hours; NULL: not read natively);
-# * decoder: the name of its native decoder (src/decoders.h), or NULL;
+# * decoder: the name of its native decoder (find_decoder() in inst/include/gravcal/decoders/decoder_table.hpp), or NULL;
 # * read(file, sf, reader, arg): the whole file by the reference reader (or
 #   the native one where the reference reads blocks: read_blocks());
 # * source(file, sf, chunksize, arg): the file block by block, without a

@@ -1,169 +1,21 @@
-// The formats gravcal decodes natively, and what each needs from outside the
-// header-only core (gzip for csv, a zip entry's inflated bytes for .gt3x):
-// one table, decoder_kinds(), whose names are the decoder names of R's
-// format registry (R/formats.R). A new format adds its row there.
+// The decoders' host in the glue (gravcal/decoders/decoder_table.hpp has
+// the formats' table and puts the decoders together): the bytes a decoder
+// reads, a file or gzip-compressed csv; zlib's inflater for .gt3x; and R's
+// answer to whether it sums in long double.
 #ifndef GRAVCAL_GLUE_DECODERS_H
 #define GRAVCAL_GLUE_DECODERS_H
 
-#include <limits>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
-#include "gravcal/decoders/decode.hpp"
-#include "gravcal/decoders/decode_csv.hpp"
-#include "gravcal/decoders/decode_cwa.hpp"
-#include "gravcal/decoders/decode_geneactiv.hpp"
-#include "gravcal/decoders/decode_ggir_resample.hpp"
-#include "gravcal/decoders/decode_ggir_timegaps.hpp"
-#include "gravcal/decoders/decode_gt3x.hpp"
-#include "gravcal/decoders/decode_movisens.hpp"
-#include "gravcal/decoders/decode_parmay.hpp"
+#include "gravcal/decoders/decoder_table.hpp"
 #include "gz_source.h"
 #include "r_services.h"
 #include "zip_inflate.h"
 
 namespace gravcal_glue {
 
-using DecoderPtr = std::unique_ptr<gravcal::Decoder>;
-
-// One native decoder: its name, whether its bytes may come gzip-compressed,
-// and how to make it on a file's bytes (`name` tells the csv decoder which
-// layout to expect).
-struct DecoderKind {
-  const char* name;
-  bool gzip;
-  DecoderPtr (*make)(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                     const std::string& name);
-};
-
-inline DecoderPtr make_cwa(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                           const std::string&) {
-  return DecoderPtr(new gravcal::CwaDecoder(bytes, opts));
-}
-
-inline DecoderPtr make_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                           const std::string& name) {
-  return DecoderPtr(new gravcal::CsvDecoder(bytes, opts, name));
-}
-
-inline DecoderPtr make_geneactiv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                                 const std::string&) {
-  std::unique_ptr<gravcal::GeneactivDecoder> d(new gravcal::GeneactivDecoder(bytes, opts));
-  // GGIR resamples a rate that is not whole onto whole Hz (compat = 1;
-  // resample = 0 gives GGIRread::readGENEActiv's samples as they are)
-  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
-  if (!r.compat || opts.num("resample", 1) == 0) return d;
-  return DecoderPtr(new gravcal::GgirResampler(std::move(d), 0, r.interpolation, false, r.fused));
-}
-
-// An Axivity csv export: the csv decoder with the layout in the options;
-// GGIR resamples it block by block onto the rate found from its time
-// stamps (option grid_sf; compat = 1), gravcal's own reads keep it as it is.
-inline DecoderPtr make_axivity_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                                   const std::string& name) {
-  std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
-  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
-  if (!r.compat) return d;
-  return DecoderPtr(new gravcal::GgirResamplerOf<gravcal::CsvDecoder>(
-      std::move(d), opts.num("grid_sf", opts.num("sf", 0)), r.interpolation, false, r.fused));
-}
-
-// GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
-// rmc.check4timegaps and a time column (option timegaps > 0: the rate),
-// each block's time gaps filled as g.imputeTimegaps fills them; with
-// rmc.doresample and a UNIX time column (option grid_sf > 0; compat = 1),
-// resampled block by block onto that rate, the grid's last point kept
-// (after the gaps are filled, as read.myacc.csv does).
-template <class Inner>
-DecoderPtr adhoc_resampled(std::unique_ptr<Inner> d, const gravcal::Options& opts) {
-  const double grid = opts.num("grid_sf", 0);
-  const gravcal::ReadRules r = gravcal::ReadRules::of(opts);
-  if (!r.compat || !(grid > 0)) return DecoderPtr(d.release());
-  return DecoderPtr(new gravcal::GgirResamplerOf<Inner>(std::move(d), grid, r.interpolation, true,
-                                                        r.fused));
-}
-
-// With timegaps_carry = 1 (g.getmeta()'s reading), each block's filling
-// starts from the previous block's last sample and time, as read.myacc.csv's
-// does when g.readaccfile() hands it GGIR's PreviousLastValue and
-// PreviousLastTime; its counters are named "rmc_..." (g.getmeta()'s own
-// filling, over it, counts GGIR's QClog).
-inline DecoderPtr make_adhoc_csv(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                                 const std::string& name) {
-  std::unique_ptr<gravcal::CsvDecoder> d(new gravcal::CsvDecoder(bytes, opts, name));
-  const double gaps = opts.num("timegaps", 0);
-  if (!(gaps > 0)) return adhoc_resampled(std::move(d), opts);
-  gravcal::GgirTimegapsMode m;
-  if (opts.num("timegaps_carry", 0) != 0) {
-    m.carry = true;
-    m.counter_prefix = "rmc_";
-  }
-  if (r_long_double()) {
-    using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, long double>;
-    return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps, m)), opts);
-  }
-  using Gaps = gravcal::GgirTimegapsOf<gravcal::CsvDecoder, double>;
-  return adhoc_resampled(std::unique_ptr<Gaps>(new Gaps(std::move(d), gaps, m)), opts);
-}
-
-// .gt3x: the decoder reads the zip's entries itself, zlib inflating
-inline DecoderPtr make_gt3x(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                            const std::string&) {
-  static gravcal_glue::ZlibInflater inflater;
-  return DecoderPtr(new gravcal::Gt3xDecoder(bytes, opts, &inflater));
-}
-
-// A Parmay Matrix .bin: resampled onto its grid as GGIRread does (option
-// interpolation: GGIR's interpolationType; compat = 0 skips damaged packets)
-inline DecoderPtr make_parmay(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                              const std::string&) {
-  return DecoderPtr(new gravcal::ParmayDecoder(bytes, opts));
-}
-
-// A Movisens recording: `bytes` are its acc.bin; unisens.xml and temp.bin
-// come from the same folder (the folder of option file_path). The xml is read whole, up
-// to 16 MB (a real one is a few kB); temp.bin may be absent.
-inline DecoderPtr make_movisens(gravcal::ByteSource& bytes, const gravcal::Options& opts,
-                                const std::string&) {
-  const std::string path = opts.str("file_path", "acc.bin");
-  const std::size_t slash = path.find_last_of("/\\");
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
-  std::string xml;
-  gravcal::FileSource xf((dir + "/unisens.xml").c_str());
-  if (xf.is_open()) {
-    const std::size_t cap = 16u << 20;
-    unsigned char buf[65536];
-    std::size_t got = 0;
-    while ((got = xf.read(buf, sizeof buf)) > 0 && xml.size() < cap) {
-      xml.append(reinterpret_cast<const char*>(buf), got);
-    }
-    if (xml.size() >= cap) xml = "<toolong";
-  }
-  std::unique_ptr<gravcal::FileSource> temp(new gravcal::FileSource((dir + "/temp.bin").c_str()));
-  std::unique_ptr<gravcal::ByteSource> t;
-  if (temp->is_open()) t = std::move(temp);
-  return DecoderPtr(new gravcal::MovisensDecoder(bytes, opts, xml, std::move(t)));
-}
-
-// The table's row for `format`, or null when there is none.
-inline const DecoderKind* find_decoder(const std::string& format) {
-  static const DecoderKind kinds[] = {
-      {"actigraph_csv", true, make_csv},
-      {"csv", true, make_csv},
-      {"adhoc_csv", true, make_adhoc_csv},
-      {"axivity_csv", true, make_axivity_csv},
-      {"gt3x", false, make_gt3x},
-      {"cwa", false, make_cwa},
-      {"geneactiv", false, make_geneactiv},
-      {"parmay", false, make_parmay},
-      {"movisens", false, make_movisens},
-  };
-  for (const DecoderKind& k : kinds) {
-    if (format == k.name) return &k;
-  }
-  return nullptr;
-}
+using DecoderPtr = gravcal::DecoderPtr;
 
 // The bytes the decoder of `format` reads from `path` (the file itself, or
 // for a container format the entry inside it). Null, with `why`, on failure.
@@ -172,7 +24,7 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
                                                        const gravcal::Options& opts,
                                                        std::string& why) {
   (void)opts;
-  const DecoderKind* kind = find_decoder(format);
+  const gravcal::DecoderKind* kind = gravcal::find_decoder(format);
   if (kind != nullptr && kind->gzip && is_gzip(path.c_str())) {
     std::unique_ptr<GzSource> g(new GzSource(path.c_str()));
     if (!g->is_open()) {
@@ -189,61 +41,14 @@ inline std::unique_ptr<gravcal::ByteSource> open_bytes(const std::string& path,
   return f;
 }
 
-// Numbers in text, "a b a b ..." ("NaN" for NaN), as pairs.
-inline std::vector<double> number_pairs(const std::string& text, const char* what) {
-  std::vector<double> out;
-  std::size_t at = 0;
-  while (at < text.size()) {
-    std::size_t used = 0;
-    const std::string rest = text.substr(at);
-    double v = 0;
-    if (rest.compare(0, 3, "NaN") == 0) {
-      v = std::numeric_limits<double>::quiet_NaN();
-      used = 3;
-    } else {
-      v = std::stod(rest, &used);
-    }
-    out.push_back(v);
-    at += used;
-    while (at < text.size() && text[at] == ' ') ++at;
-  }
-  if (out.size() % 2 != 0) throw std::invalid_argument(std::string(what) + ": pairs of numbers");
-  return out;
-}
-
-// g.getmeta()'s time-gap imputation over a decoder (option getmeta_timegaps
-// = 1; GgirTimegapsOf's carry mode): getmeta_gap_limit (minutes), and
-// clock, GGIR's reader's clock shifts as text "second shift second shift
-// ..." (shift NaN: the clock time does not exist), up to clock_until; with
-// getmeta_epoch_gaps = 1 the gaps over the limit imputed at epoch level
-// (short_epoch, long_epoch seconds; local_zone: "second offset ..." of the
-// zone their times of day are read in).
-inline DecoderPtr getmeta_timegaps(DecoderPtr d, const gravcal::Options& opts) {
-  gravcal::GgirTimegapsMode m;
-  m.carry = true;
-  m.limit_minutes = opts.num("getmeta_gap_limit", 0);
-  m.clock = number_pairs(opts.str("clock", ""), "clock");
-  m.epoch_gaps = opts.num("getmeta_epoch_gaps", 0) != 0;
-  m.short_epoch = opts.num("short_epoch", 5);
-  m.long_epoch = opts.num("long_epoch", 900);
-  m.local = number_pairs(opts.str("local_zone", ""), "local_zone");
-  m.clock_until = opts.num("clock_until", std::numeric_limits<double>::infinity());
-  if (r_long_double()) {
-    using Gaps = gravcal::GgirTimegapsOf<gravcal::Decoder, long double>;
-    return DecoderPtr(new Gaps(std::move(d), 0, std::move(m)));
-  }
-  using Gaps = gravcal::GgirTimegapsOf<gravcal::Decoder, double>;
-  return DecoderPtr(new Gaps(std::move(d), 0, std::move(m)));
-}
-
 // The decoder for `format` on `bytes`, or null when there is none.
 inline DecoderPtr make_decoder(const std::string& format, gravcal::ByteSource& bytes,
                                const gravcal::Options& opts) {
-  const DecoderKind* kind = find_decoder(format);
-  if (kind == nullptr) return nullptr;
-  DecoderPtr d = kind->make(bytes, opts, format);
-  if (d && opts.num("getmeta_timegaps", 0) != 0) return getmeta_timegaps(std::move(d), opts);
-  return d;
+  static ZlibInflater inflater;
+  gravcal::DecoderHost host;
+  host.inflater = &inflater;
+  host.long_double = r_long_double();
+  return gravcal::make_decoder(format, bytes, opts, host);
 }
 
 }  // namespace gravcal_glue

@@ -1,5 +1,5 @@
 # The format registry (R/formats.R) and the native decoders' table
-# (src/decoders.h): every place that depends on a file's format reads them.
+# (inst/include/gravcal/decoders/decoder_table.hpp): every place that depends on a file's format reads them.
 
 test_that("a file's format comes from its extension and, for csv, its first line", {
   d <- snap_dir("formats")
