@@ -275,3 +275,20 @@ test_that("empty, truncated and unusual .bin files: errors that say why", {
   expect_snapshot(error = TRUE, calibrate(slow), transform = tr)
   expect_snapshot(error = TRUE, calibrate(slow, method = "ggir"), transform = tr)
 })
+
+test_that("the pump's options: an unknown key and a missing one are errors naming them", {
+  # each stage reads its option list once (OptionReader, src/glue_pipeline.cpp):
+  # a key no stage reads is a misspelling, never ignored
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  rec <- readRDS(gravcal_example())
+  write_recording(rec[1:3000, ], f, format = "actigraph_csv")
+  pump <- function() {
+    gravcal:::open_source(f, arg = "file", reader = "native", compat = FALSE)$pump()
+  }
+  expect_equal(nrow(as.data.frame(gravcal:::gc_pump(pump(), "samples", list(time = 0)))), 3000)
+  expect_error(gravcal:::gc_pump(pump(), "samples", list(time = 0, tiem = 1)),
+               "unknown option 'tiem'", fixed = TRUE)
+  expect_error(gravcal:::gc_pump(pump(), "windows", list(window_samples = 100)),
+               "option 'skip_zero' is missing", fixed = TRUE)
+})
