@@ -375,13 +375,23 @@ meta_nonwear <- function(src, p) {
        approach = p$nonwear_approach)
 }
 
+# as.numeric(as.character(v)), R's text of each number read back, taken
+# once per distinct value: R writes each element on its own (15 significant
+# digits), so equal values give equal text (NA and NaN are told apart by
+# unique() and match() as by the text). An epoch signal repeats its values
+# (ENMO's zeros at rest; 4 decimals): 2-17x faster than element by element.
+text_round_trip <- function(v) {
+  u <- unique(v)
+  as.numeric(as.character(u))[match(v, u)]
+}
+
 # GGIR's M from the blocks' values: the columns as GGIR's character
 # matrices hold them (R's text of each number, read back), time stamps in
 # desiredtz.
 meta_result <- function(short, long, asked, metnames, metricnames_long, starttime, wday,
                         wdayname, filetooshort, filecorrupt, p, ws3, ws2, QClog,
                         myfun = NULL) {
-  via_text <- function(v) as.numeric(as.character(v))
+  via_text <- text_round_trip
   bsc_qc <- data.frame(time = format(Sys.time()), size = gc()[2, 2], stringsAsFactors = FALSE)
   if (filecorrupt || filetooshort) {
     return(invisible(list(filecorrupt = filecorrupt, filetooshort = TRUE,

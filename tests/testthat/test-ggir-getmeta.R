@@ -880,3 +880,15 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   expect_error(gm(rmc.col.wear = 6), "rmc.col.wear")
   unlink(c(a$file, iso$file))
 })
+
+test_that("M's text round trip, taken once per distinct value, is R's element by element", {
+  # GGIR's character matrices: as.numeric(as.character(v)) on each column
+  set.seed(43)
+  v <- c(round(rnorm(2000, 0, 30), 4), rep(0, 500), -0, NA, NaN, Inf, -Inf, 1e15 + 0.5,
+         123456789.123456789, 1 / 3, .Machine$double.xmax, 5e-324, rep(c(0.1 + 0.2, 0.3), 50))
+  v <- sample(v)
+  expect_identical(text_round_trip(v), as.numeric(as.character(v)))
+  expect_identical(text_round_trip(numeric(0)), numeric(0))
+  # the text does not give back every value: the round trip is not the identity
+  expect_false(identical(text_round_trip(1 / 3), 1 / 3))
+})
