@@ -101,8 +101,8 @@ gc_ggir_filter <- function(b, a, x, conv_fused, rec_fused) {
     .Call(`_gravcal_gc_ggir_filter`, b, a, x, conv_fused, rec_fused)
 }
 
-gc_ggir_filtered_signal <- function(x, y, z, metrics, coefs, conv_fused, rec_fused) {
-    .Call(`_gravcal_gc_ggir_filtered_signal`, x, y, z, metrics, coefs, conv_fused, rec_fused)
+gc_ggir_filtered_signal <- function(x, y, z, metrics, coefs, conv_fused, rec_fused, chunk) {
+    .Call(`_gravcal_gc_ggir_filtered_signal`, x, y, z, metrics, coefs, conv_fused, rec_fused, chunk)
 }
 
 gc_fit_icp <- function(x, y, z, temp, use_temp, rule, max_iter, tol, max_weight, trace) {

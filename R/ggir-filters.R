@@ -52,9 +52,12 @@ ggir_filter <- function(coef, x) {
 # averages them per epoch; xyz: a block's calibrated samples (3 columns),
 # coefs: ggir_filter_coefs(). One metric: its signal; several: a list
 # named by them (each filter run once for all). `fused`: whether R's
-# stats::filter() fuses its multiply-adds (this R's, or as given).
-ggir_filtered_signal <- function(xyz, metric, coefs, fused = stats_filter_fused()) {
+# stats::filter() fuses its multiply-adds (this R's, or as given). `chunk`:
+# the parts of the block filtered at a time (g.getmeta()'s 4096), for
+# tests of the parts' seams.
+ggir_filtered_signal <- function(xyz, metric, coefs, fused = stats_filter_fused(),
+                                 chunk = 4096) {
   out <- gc_ggir_filtered_signal(as.double(xyz[, 1]), as.double(xyz[, 2]), as.double(xyz[, 3]),
-                                 metric, coefs, fused$conv, fused$rec)
+                                 metric, coefs, fused$conv, fused$rec, chunk)
   if (length(metric) == 1) out[[1]] else out
 }

@@ -308,8 +308,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_ggir_filtered_signal
-Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::CharacterVector& metrics, const Rcpp::List& coefs, bool conv_fused, bool rec_fused);
-RcppExport SEXP _gravcal_gc_ggir_filtered_signal(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP metricsSEXP, SEXP coefsSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
+Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y, const Rcpp::NumericVector& z, const Rcpp::CharacterVector& metrics, const Rcpp::List& coefs, bool conv_fused, bool rec_fused, double chunk);
+RcppExport SEXP _gravcal_gc_ggir_filtered_signal(SEXP xSEXP, SEXP ySEXP, SEXP zSEXP, SEXP metricsSEXP, SEXP coefsSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP chunkSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -319,7 +319,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::List& >::type coefs(coefsSEXP);
     Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
     Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_ggir_filtered_signal(x, y, z, metrics, coefs, conv_fused, rec_fused));
+    Rcpp::traits::input_parameter< double >::type chunk(chunkSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_ggir_filtered_signal(x, y, z, metrics, coefs, conv_fused, rec_fused, chunk));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -537,7 +538,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_meta_store_epochs", (DL_FUNC) &_gravcal_gc_meta_store_epochs, 12},
     {"_gravcal_gc_meta_store_gradient", (DL_FUNC) &_gravcal_gc_meta_store_gradient, 6},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
-    {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 7},
+    {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 8},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
     {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},

@@ -61,12 +61,13 @@ Rcpp::NumericVector gc_ggir_filter(const Rcpp::NumericVector& b, const Rcpp::Num
 // all of them (ggir_filtered_signals()): a list, one signal per metric.
 // coefs: list(band, low, high, zc = list(b, a) each, zc_sb), as
 // ggir_filter_coefs() gives. R's error for the first metric, in the order
-// given, that R could not compute.
+// given, that R could not compute. chunk: the parts the block is filtered in
+// (gravcal::kFilterChunk in g.getmeta()).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::NumericVector& y,
                                    const Rcpp::NumericVector& z,
                                    const Rcpp::CharacterVector& metrics, const Rcpp::List& coefs,
-                                   bool conv_fused, bool rec_fused) {
+                                   bool conv_fused, bool rec_fused, double chunk) {
   const R_xlen_t n = x.size();
   if (y.size() != n || z.size() != n) Rcpp::stop("x, y, z lengths differ");
   std::vector<gravcal::FilteredMetric> ms(static_cast<std::size_t>(metrics.size()));
@@ -81,15 +82,28 @@ Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::Num
   c.high = arma(coefs["high"], "coefs$high");
   c.zc = arma(coefs["zc"], "coefs$zc");
   c.zc_sb = Rcpp::as<double>(coefs["zc_sb"]);
-  Rcpp::List out(metrics.size());
+  std::vector<std::vector<double>> sig(ms.size());
   std::vector<gravcal::SignalStatus> status(ms.size(), gravcal::SignalStatus::ok);
-  gravcal::ggir_filtered_signals(
-      ms.data(), ms.size(), x.begin(), y.begin(), z.begin(), static_cast<std::size_t>(n), c,
-      arith_of(conv_fused, rec_fused),
-      [&](std::size_t i, gravcal::SignalStatus st, const double* sig) {
-        status[i] = st;
-        if (sig != nullptr) out[static_cast<R_xlen_t>(i)] = Rcpp::NumericVector(sig, sig + n);
-      });
+  struct Sink {
+    std::vector<std::vector<double>>& sig;
+    std::vector<gravcal::SignalStatus>& status;
+    void begin(std::size_t i, gravcal::SignalStatus st) {
+      status[i] = st;
+      sig[i].clear();
+    }
+    void values(std::size_t i, const double* v, std::size_t len) { sig[i].insert(sig[i].end(), v, v + len); }
+  } sink{sig, status};
+  if (chunk < 1) Rcpp::stop("`chunk` must be a positive number of samples");
+  gravcal::ggir_filtered_signals(ms.data(), ms.size(), x.begin(), y.begin(), z.begin(),
+                                 static_cast<std::size_t>(n), c, arith_of(conv_fused, rec_fused),
+                                 sink, static_cast<std::size_t>(chunk));
+  Rcpp::List out(metrics.size());
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    if (status[i] == gravcal::SignalStatus::ok) {
+      if (sig[i].size() != static_cast<std::size_t>(n)) Rcpp::stop("internal: a signal of the wrong length");
+      out[static_cast<R_xlen_t>(i)] = Rcpp::NumericVector(sig[i].begin(), sig[i].end());
+    }
+  }
   for (gravcal::SignalStatus s : status) {
     switch (s) {
       case gravcal::SignalStatus::ok: break;

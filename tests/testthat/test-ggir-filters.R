@@ -241,6 +241,51 @@ test_that("every filtered metric at once (each filter run once, the three axes s
   for (m in filtered_metrics) expect_same_bits(together[[m]], ref_signal(xyz, m, co))
 })
 
+test_that("the block filtered in parts (each filter's state carried across the seams) gives the whole block's bits", {
+  # g.getmeta() filters a block in parts of 4096 samples: the convolution
+  # reads the samples before the part, the recursion its last outputs, the
+  # zero crossings the sign before. Parts of every size (1 sample left at
+  # the end, parts shorter than the recursion's history, one part) must
+  # give R's own signal; a NA met after some parts were given starts the
+  # block over whole (R's NA rules), with R's values or R's error.
+  skip_if_no_filter_refs()
+  xyz <- ax3_xyz()[1:3000, ]
+  co <- gravcal:::ggir_filter_coefs(100)
+  inf_y <- xyz
+  inf_y[1500, 2] <- Inf                             # NaN from the middle on: met after parts
+  tail_z <- xyz
+  tail_z[1501:3000, 3] <- NA                        # recycled by R: met after parts
+  late_x <- xyz
+  late_x[2000, 1] <- NA                             # inside: R stops
+  arithmetics <- list(plain = list(conv = FALSE, rec = FALSE), fused = list(conv = TRUE, rec = TRUE))
+  whole <- function(b, fu) {
+    tryCatch(gravcal:::ggir_filtered_signal(b, filtered_metrics, co, fu, chunk = 1e6),
+             error = conditionMessage)
+  }
+  for (fu in names(arithmetics)) {
+    ref <- whole(xyz, arithmetics[[fu]])
+    for (k in c(2, 3, 7, 8, 9, 100, 2999, 3000)) {
+      parts <- gravcal:::ggir_filtered_signal(xyz, filtered_metrics, co, arithmetics[[fu]], chunk = k)
+      expect_identical(names(parts), filtered_metrics)
+      expect_same_bits(unlist(parts), unlist(ref))
+    }
+    for (b in list(inf_y, tail_z, late_x)) {
+      expect_identical(
+        tryCatch(gravcal:::ggir_filtered_signal(b, filtered_metrics, co, arithmetics[[fu]], chunk = 7),
+                 error = conditionMessage),
+        whole(b, arithmetics[[fu]]))
+    }
+  }
+  # R's own expressions, from parts of 7 (this R's arithmetic)
+  parts <- gravcal:::ggir_filtered_signal(xyz, filtered_metrics, co, chunk = 7)
+  for (m in filtered_metrics) expect_same_bits(parts[[m]], ref_signal(xyz, m, co))
+  expect_same_bits(gravcal:::ggir_filtered_signal(tail_z, "HFENplus", co, chunk = 7),
+                   ref_signal(tail_z, "HFENplus", co))
+  expect_error(gravcal:::ggir_filtered_signal(late_x, "BFX", co, chunk = 7), "internal NAs")
+  expect_true(anyNA(gravcal:::ggir_filtered_signal(inf_y, "LFY", co, chunk = 7)))
+  expect_error(gravcal:::ggir_filtered_signal(xyz, "BFX", co, chunk = 0), "chunk")
+})
+
 test_that("the per-sample signals, on a calibrated day block at 30 Hz (shared data)", {
   skip_if_no_filter_refs()
   skip_if_quick()

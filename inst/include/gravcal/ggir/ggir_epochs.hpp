@@ -101,37 +101,88 @@ inline std::vector<double> r_seq_by(double from, double to, double by) {
 inline double r_round0(double x) { return std::nearbyint(x); }
 
 // GGIR's averagePerEpoch() (mean = true) and sumPerEpoch() (mean = false)
-// of the values f(0), ..., f(n - 1) for epochs of `by` samples (sf * epoch
-// length, maybe not whole): the differences of R's cumsum(c(0, x)) (R's
-// accumulator Acc, each sum rounded to double) at round(seq(1, n + 1, by)),
-// divided by the epoch's length. The sums are taken as the values stream
-// (the rounded bounds never decrease), so that neither the values nor their
-// cumulative sums are held.
+// of a block's values v[0], ..., v[n - 1], given as they stream, for epochs
+// of `by` samples (sf * epoch length, maybe not whole): the differences of
+// R's cumsum(c(0, v)) (R's accumulator Acc, each sum rounded to double) at
+// round(seq(1, n + 1, by)), divided by the epoch's length. The running sum
+// is read as it passes each bound (the rounded bounds never decrease), so
+// neither the values nor their cumulative sums are held. Values past the
+// last bound are not needed (and not summed).
+template <class Acc>
+class EpochSums {
+ public:
+  EpochSums(std::size_t n, double by, bool mean) : mean_(mean) {
+    const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
+    if (sel.size() < 2) return;  // no epoch
+    bound_.resize(sel.size());
+    for (std::size_t k = 0; k < sel.size(); ++k) bound_[k] = r_round0(sel[k]);
+    out_.resize(sel.size() - 1);
+  }
+  // The next `count` values, value i (counted from the block's start) as
+  // f(i).
+  template <class F>
+  void feed(std::size_t count, F&& f) {
+    const std::size_t end = at_ + count;
+    while (at_ < end && k_ < bound_.size()) {
+      const std::size_t to = static_cast<std::size_t>(bound_[k_]) - 1;  // values before the bound
+      if (at_ == to) {
+        record();
+        continue;
+      }
+      const std::size_t stop = std::min(end, to);
+      Acc s = s_;
+      for (std::size_t i = at_; i < stop; ++i) s += f(i);
+      s_ = s;
+      at_ = stop;
+    }
+    at_ = end;
+    reached();
+  }
+  // The next `count` values from v[0].
+  void add(const double* v, std::size_t count) {
+    const std::size_t base = at_;
+    feed(count, [v, base](std::size_t i) { return v[i - base]; });
+  }
+  // The epochs' values; every value up to the last bound must have been
+  // given.
+  std::vector<double> finish() {
+    reached();
+    if (k_ < bound_.size()) throw std::logic_error("EpochSums: values missing before an epoch's bound");
+    return std::move(out_);
+  }
+
+ private:
+  // the running sum is cumsum(c(0, v))[bound] for every bound at the values
+  // given so far
+  void reached() {
+    while (k_ < bound_.size() && at_ == static_cast<std::size_t>(bound_[k_]) - 1) record();
+  }
+  void record() {
+    const double cur = bound_[k_];
+    const double c = static_cast<double>(s_);
+    if (k_ > 0) {
+      const double d = c - cprev_;
+      out_[k_ - 1] = mean_ ? d / std::fabs(cur - prev_) : d;
+    }
+    prev_ = cur;
+    cprev_ = c;
+    ++k_;
+  }
+  std::vector<double> bound_;  // round(seq(1, n + 1, by)), 1-based
+  std::vector<double> out_;
+  bool mean_;
+  Acc s_ = 0;
+  std::size_t at_ = 0;  // values given so far (the sum holds those before the next bound)
+  std::size_t k_ = 0;   // the next bound
+  double prev_ = 0, cprev_ = 0;
+};
+
+// EpochSums of the values f(0), ..., f(n - 1) (f called in that order).
 template <class Acc, class F>
 std::vector<double> per_epoch_of(std::size_t n, double by, bool mean, F&& f) {
-  const std::vector<double> sel = r_seq_by(1.0, static_cast<double>(n + 1), by);
-  std::vector<double> out;
-  if (sel.size() < 2) return out;
-  out.resize(sel.size() - 1);
-  Acc s = 0;
-  std::size_t at = 0;  // values summed so far: the sum is cumsum's [at]
-  // cumsum(c(0, x))[j] (1-based j within 1..n + 1)
-  auto cum = [&](double j) {
-    const std::size_t to = static_cast<std::size_t>(j) - 1;
-    for (; at < to; ++at) s += f(at);
-    return static_cast<double>(s);
-  };
-  double prev = r_round0(sel[0]);
-  double cprev = cum(prev);
-  for (std::size_t i = 1; i < sel.size(); ++i) {
-    const double cur = r_round0(sel[i]);
-    const double ccur = cum(cur);
-    const double d = ccur - cprev;
-    out[i - 1] = mean ? d / std::fabs(cur - prev) : d;
-    prev = cur;
-    cprev = ccur;
-  }
-  return out;
+  EpochSums<Acc> e(n, by, mean);
+  e.feed(n, f);
+  return e.finish();
 }
 
 template <class Acc>
@@ -588,16 +639,29 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
   }
   std::vector<SignalStatus> fstatus(names.size(), SignalStatus::ok);
   if (fc != nullptr && !fms.empty()) {
-    ggir_filtered_signals(fms.data(), fms.size(), x, y, z, n, *fc, arith,
-                          [&](std::size_t i, SignalStatus st, const double* sig) {
-                            const std::size_t k = fk[i];
-                            fstatus[k] = st;
-                            if (sig == nullptr) return;
-                            const FilteredMetric fm = fms[i];
-                            const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY ||
-                                            fm == FilteredMetric::ZCZ;
-                            out[k] = per_epoch<Acc>(sig, n, by, !zc);
-                          });
+    // each filtered signal summed per epoch as its parts come
+    std::vector<EpochSums<Acc>> sums;
+    sums.reserve(fms.size());
+    for (std::size_t i = 0; i < fms.size(); ++i) sums.emplace_back(n, by, true);
+    struct Sink {
+      const std::vector<FilteredMetric>& fms;
+      const std::vector<std::size_t>& fk;
+      std::vector<SignalStatus>& fstatus;
+      std::vector<EpochSums<Acc>>& sums;
+      std::size_t n;
+      double by;
+      void begin(std::size_t i, SignalStatus st) {  // (again: from the start)
+        fstatus[fk[i]] = st;
+        const FilteredMetric fm = fms[i];
+        const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY || fm == FilteredMetric::ZCZ;
+        sums[i] = EpochSums<Acc>(n, by, !zc);  // sumPerEpoch for ZC*
+      }
+      void values(std::size_t i, const double* v, std::size_t len) { sums[i].add(v, len); }
+    } sink{fms, fk, fstatus, sums, n, by};
+    ggir_filtered_signals(fms.data(), fms.size(), x, y, z, n, *fc, arith, sink);
+    for (std::size_t i = 0; i < fms.size(); ++i) {
+      if (fstatus[fk[i]] == SignalStatus::ok) out[fk[i]] = sums[i].finish();
+    }
   }
   for (std::size_t k = 0; k < names.size(); ++k) {
     const std::string& nm = names[k];

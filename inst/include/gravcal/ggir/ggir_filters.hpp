@@ -113,14 +113,16 @@ inline double madd(double acc, double p, double q) {
   return Fused ? kernels::replay_fma(p, q, acc) : acc + p * q;  // not contracted
 }
 
-// cfilter over c(rep(0, nb - 1), x), sides = 1, into y[0, n): output i
-// is z = 0, then z += f[j] * v[i - j] for j = 0, 1, ..., v[i - j] = x[i - j]
-// or a leading zero where i - j < 0; NA_real_ where an operand is NA. Past
-// the leading zeros the sum is taken without the tests, and taken again
-// with them only where it comes out NaN (a NA operand makes it NaN; an
-// overflow too, and the tests then give the same NaN).
+// cfilter over c(rep(0, nb - 1), x), sides = 1, outputs i in [from, to)
+// into y[i - from]: output i is z = 0, then z += f[j] * v[i - j] for j = 0,
+// 1, ..., v[i - j] = x[i - j] or a leading zero where i - j < 0 (x: the
+// block from its start); NA_real_ where an operand is NA. Past the leading
+// zeros the sum is taken without the tests, and taken again with them only
+// where it comes out NaN (a NA operand makes it NaN; an overflow too, and
+// the tests then give the same NaN).
 template <bool Fused>
-inline void convolve(const double* f, std::size_t nb, const double* x, std::size_t n, double* y) {
+inline void convolve(const double* f, std::size_t nb, const double* x, std::size_t from,
+                     std::size_t to, double* y) {
   const double na_real = r_na_real();
   auto tested = [&](std::size_t i) {
     double z = 0;
@@ -131,28 +133,29 @@ inline void convolve(const double* f, std::size_t nb, const double* x, std::size
     }
     return z;
   };
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = from; i < to; ++i) {
     if (i + 1 < nb) {
-      y[i] = tested(i);
+      y[i - from] = tested(i);
       continue;
     }
     double z = 0;
     for (std::size_t j = 0; j < nb; ++j) z = madd<Fused>(z, f[j], x[i - j]);
-    y[i] = std::isnan(z) ? tested(i) : z;
+    y[i - from] = std::isnan(z) ? tested(i) : z;
   }
 }
 
 // rfilter's output i taken with R's tests (recurse()): sum = v[first + i],
 // then sum += r[i - 1 - j] * g[j] for j = 0, ..., ng - 1 over the outputs r
-// (written over y from y[0]), zero before the start; NA_real_ where an
-// operand is NA.
+// (written over y from y[0]), zero before the start (with `at_start`; else
+// the outputs before y[0] are y[-1], y[-2], ...: a stream's history);
+// NA_real_ where an operand is NA.
 template <bool Fused>
 inline double recurse_tested(const double* g, std::size_t ng, const double* y, std::size_t first,
-                             std::size_t i) {
+                             std::size_t i, bool at_start = true) {
   double sum = y[first + i];
   if (!r_ok(sum)) return r_na_real();
   for (std::size_t j = 0; j < ng; ++j) {
-    const double tmp = i >= j + 1 ? y[i - 1 - j] : 0.0;
+    const double tmp = (!at_start || i >= j + 1) ? y[static_cast<std::ptrdiff_t>(i) - 1 - static_cast<std::ptrdiff_t>(j)] : 0.0;
     if (!r_ok(tmp)) return r_na_real();
     sum = madd<Fused>(sum, tmp, g[j]);
   }
@@ -161,44 +164,49 @@ inline double recurse_tested(const double* g, std::size_t ng, const double* y, s
 
 // rfilter in place: output i is written to y[i] over its input y[first +
 // i] (not yet overwritten: first + i >= i). Past the start, untested, as
-// convolve().
+// convolve(). Without `at_start`, y[-ng, 0) holds the outputs before y[0]
+// (first = 0).
 template <bool Fused>
 inline void recurse(const double* g, std::size_t ng, double* y, std::size_t first,
-                    std::size_t len) {
+                    std::size_t len, bool at_start = true) {
   for (std::size_t i = 0; i < len; ++i) {
-    if (i < ng) {
+    if (at_start && i < ng) {
       y[i] = recurse_tested<Fused>(g, ng, y, first, i);
       continue;
     }
     double sum = y[first + i];
-    for (std::size_t j = 0; j < ng; ++j) sum = madd<Fused>(sum, y[i - 1 - j], g[j]);
-    y[i] = std::isnan(sum) ? recurse_tested<Fused>(g, ng, y, first, i) : sum;
+    for (std::size_t j = 0; j < ng; ++j)
+      sum = madd<Fused>(sum, y[static_cast<std::ptrdiff_t>(i) - 1 - static_cast<std::ptrdiff_t>(j)], g[j]);
+    y[i] = std::isnan(sum) ? recurse_tested<Fused>(g, ng, y, first, i, at_start) : sum;
   }
 }
 
-// recurse() of three columns of len values, each from its start (first
-// = 0), side by side: the same operations on each column in the same
-// order, so the same bits, but three independent chains of sums where one
-// would wait on its last sum (rfilter's time is that chain's).
+// recurse() of three columns of len values (first = 0), side by side: the
+// same operations on each column in the same order, so the same bits, but
+// three independent chains of sums where one would wait on its last sum
+// (rfilter's time is that chain's).
 template <bool Fused>
-inline void recurse3(const double* g, std::size_t ng, double* const y[3], std::size_t len) {
+inline void recurse3(const double* g, std::size_t ng, double* const y[3], std::size_t len,
+                     bool at_start = true) {
   double* const a = y[0];
   double* const b = y[1];
   double* const c = y[2];
   for (std::size_t i = 0; i < len; ++i) {
-    if (i < ng) {
+    if (at_start && i < ng) {
       for (int k = 0; k < 3; ++k) y[k][i] = recurse_tested<Fused>(g, ng, y[k], 0, i);
       continue;
     }
+    const std::ptrdiff_t ii = static_cast<std::ptrdiff_t>(i);
     double sa = a[i], sb = b[i], sc = c[i];
     for (std::size_t j = 0; j < ng; ++j) {
-      sa = madd<Fused>(sa, a[i - 1 - j], g[j]);
-      sb = madd<Fused>(sb, b[i - 1 - j], g[j]);
-      sc = madd<Fused>(sc, c[i - 1 - j], g[j]);
+      const std::ptrdiff_t at = ii - 1 - static_cast<std::ptrdiff_t>(j);
+      sa = madd<Fused>(sa, a[at], g[j]);
+      sb = madd<Fused>(sb, b[at], g[j]);
+      sc = madd<Fused>(sc, c[at], g[j]);
     }
-    a[i] = std::isnan(sa) ? recurse_tested<Fused>(g, ng, a, 0, i) : sa;
-    b[i] = std::isnan(sb) ? recurse_tested<Fused>(g, ng, b, 0, i) : sb;
-    c[i] = std::isnan(sc) ? recurse_tested<Fused>(g, ng, c, 0, i) : sc;
+    a[i] = std::isnan(sa) ? recurse_tested<Fused>(g, ng, a, 0, i, at_start) : sa;
+    b[i] = std::isnan(sb) ? recurse_tested<Fused>(g, ng, b, 0, i, at_start) : sb;
+    c[i] = std::isnan(sc) ? recurse_tested<Fused>(g, ng, c, 0, i, at_start) : sc;
   }
 }
 
@@ -238,8 +246,8 @@ inline FilterResult filter_front(const DividedArma& d, const double* x, std::siz
     // cfilter over the nb - 1 zeros and x: its nb - 1 outputs before x's
     // first are NA (cut by na.omit); output i of the rest reads x[i - j],
     // or a leading zero
-    if (arith.conv_fused) convolve<true>(d.f.data(), nb, x, n, y);
-    else convolve<false>(d.f.data(), nb, x, n, y);
+    if (arith.conv_fused) convolve<true>(d.f.data(), nb, x, 0, n, y);
+    else convolve<false>(d.f.data(), nb, x, 0, n, y);
     // na.omit(): the leading and trailing NAs dropped
     while (*first < n && !r_ok(y[*first])) ++*first;
     if (*first == n) {  // all(is.na(x1)): x
@@ -462,10 +470,13 @@ inline SignalStatus first_failed(const SignalStatus* st, int axis) {
   return SignalStatus::ok;
 }
 
-// GGIR's zerocross() of a filtered axis v (overwritten) into out: |v| <
-// zc_sb set to 0; +1 where v >= 0, -1 below (NA stays NA: ifelse); then
-// |sign(s[k]) - sign(s[k - 1])| * 0.5, its first value repeated in front.
-inline void zero_crossings(double* v, std::size_t n, double zc_sb, double* out) {
+// GGIR's zerocross() of a filtered axis, n values of it in v (overwritten)
+// into out: |v| < zc_sb set to 0; +1 where v >= 0, -1 below (NA stays NA:
+// ifelse); then |sign(s[k]) - sign(s[k - 1])| * 0.5. At the block's start
+// (`at_start`, n >= 2) the first value is repeated in front; further on,
+// s[-1] is *last, the sign value the part before ended on. *last: v's last.
+inline void zero_crossings(double* v, std::size_t n, double zc_sb, double* out, bool at_start,
+                           double* last) {
   const double na_real = r_na_real();
   for (std::size_t i = 0; i < n; ++i) {
     double w = v[i];
@@ -473,100 +484,240 @@ inline void zero_crossings(double* v, std::size_t n, double zc_sb, double* out) 
     // ifelse(w >= 0, 1, -1): a NA test gives NA_real_
     v[i] = std::isnan(w) ? na_real : (w >= 0 ? 1.0 : -1.0);
   }
+  if (n == 0) return;
+  if (!at_start) out[0] = std::fabs(r_sign(v[0]) - r_sign(*last)) * 0.5;
   for (std::size_t i = 1; i < n; ++i) out[i] = std::fabs(r_sign(v[i]) - r_sign(v[i - 1])) * 0.5;
-  out[0] = out[1];
+  if (at_start) out[0] = out[1];
+  *last = v[n - 1];
 }
 
-}  // namespace ggir_filters_detail
+// What the metrics ms[] need filtered: per coefficient set (FilterGroup),
+// the axes; whether HFENplus is asked (it reads "low" too).
+struct FilterPlan {
+  bool need[kFilterGroups][3] = {};
+  bool plus = false;
+  bool any(int g) const { return need[g][0] || need[g][1] || need[g][2]; }
+  bool all(int g) const { return need[g][0] && need[g][1] && need[g][2]; }
+};
 
-// The per-sample signals of `count` metrics ms[] over a block of n samples
-// (x, y, z: calibrated axes), each filter run once per coefficient set and
-// axis however many metrics read it (a filtered axis is the same bits for
-// every metric that reads it). For each metric i, emit(i, status, signal):
-// signal, n values, valid during the call, when status is ok; null
-// otherwise (R stops there). Work space: the three filtered axes of one
-// coefficient set, one signal, and for HFENplus the low filter's part.
-template <class Emit>
-void ggir_filtered_signals(const FilteredMetric* ms, std::size_t count, const double* x,
-                           const double* y, const double* z, std::size_t n,
-                           const GgirFilterCoefs& c, RFilterArith arith, Emit&& emit) {
-  namespace d = ggir_filters_detail;
-  const double* axes[3] = {x, y, z};
+inline FilterPlan plan_filters(const FilteredMetric* ms, std::size_t count, std::size_t n) {
+  FilterPlan p;
+  for (std::size_t i = 0; i < count; ++i) {
+    const MetricUse u = metric_use(ms[i]);
+    if (u.group == FilterGroup::zc && n < 2) continue;  // zerocross() needs 2 samples: nothing is filtered
+    p.plus = p.plus || u.low_first;
+    for (int k = 0; k < 3; ++k) {
+      const bool on = u.axis < 0 || u.axis == k;
+      p.need[static_cast<int>(u.group)][k] = p.need[static_cast<int>(u.group)][k] || on;
+      if (u.low_first) p.need[static_cast<int>(FilterGroup::low)][k] = p.need[static_cast<int>(FilterGroup::low)][k] || on;
+    }
+  }
+  return p;
+}
+
+// Metric m's signal (not ZC*) over len samples from its group's filtered
+// axes f[] and, for HFENplus, GCP = EN(low) - 1.
+inline void derive_signal(FilteredMetric m, const MetricUse& u, const double* const f[3],
+                          const double* gcp, std::size_t len, double* out) {
+  if (u.axis >= 0) {
+    const double* v = f[u.axis];
+    for (std::size_t j = 0; j < len; ++j) out[j] = std::fabs(v[j]);
+  } else if (u.low_first) {  // HFENplus: EN(high) + GCP, below 0 set to 0
+    for (std::size_t j = 0; j < len; ++j) {
+      const double v = norm3(f[0][j], f[1][j], f[2][j], false) + gcp[j];
+      out[j] = v < 0 ? 0.0 : v;
+    }
+  } else if (m == FilteredMetric::LFENMO) {
+    for (std::size_t j = 0; j < len; ++j) {
+      const double v = norm3(f[0][j], f[1][j], f[2][j], true) - 1;
+      out[j] = v < 0 ? 0.0 : v;  // NA stays NA (which() skips it)
+    }
+  } else {  // BFEN, LFEN, HFEN
+    for (std::size_t j = 0; j < len; ++j) out[j] = norm3(f[0][j], f[1][j], f[2][j], true);
+  }
+}
+
+inline void gcp_of(const double* const f[3], std::size_t len, double* gcp) {
+  for (std::size_t i = 0; i < len; ++i) gcp[i] = norm3(f[0][i], f[1][i], f[2][i], false) - 1;
+}
+
+// The whole block at once, with R's NA rules (filter_front(): the NAs at
+// the ends omitted and recycled, R's stops): the three filtered axes of one
+// coefficient set at a time, one signal, and HFENplus's GCP, n values each.
+template <class Sink>
+void block_signals(const FilteredMetric* ms, std::size_t count, const double* const axes[3],
+                   std::size_t n, const GgirFilterCoefs& c, RFilterArith arith,
+                   const FilterPlan& plan, Sink& sink) {
   std::vector<double> work, sig, gcp;
   double* f[3] = {nullptr, nullptr, nullptr};
   SignalStatus low_status[3] = {SignalStatus::ok, SignalStatus::ok, SignalStatus::ok};
+  for (std::size_t i = 0; i < count; ++i) {
+    if (metric_use(ms[i]).group == FilterGroup::zc && n < 2) sink.begin(i, SignalStatus::too_short);
+  }
   for (int gi = 0; gi < kFilterGroups; ++gi) {
     const FilterGroup g = static_cast<FilterGroup>(gi);
-    // the axes this group's filter must give, and whether HFENplus is asked
-    bool need[3] = {false, false, false}, plus = false;
-    for (std::size_t i = 0; i < count; ++i) {
-      const d::MetricUse u = d::metric_use(ms[i]);
-      if (ms[i] == FilteredMetric::ZCX || ms[i] == FilteredMetric::ZCY || ms[i] == FilteredMetric::ZCZ) {
-        if (n < 2) continue;  // zerocross() needs 2 samples: nothing is filtered
-      }
-      plus = plus || u.low_first;
-      if (u.group != g && !(u.low_first && g == FilterGroup::low)) continue;
-      for (int k = 0; k < 3; ++k) need[k] = need[k] || u.axis < 0 || u.axis == k;
-    }
-    if (!need[0] && !need[1] && !need[2]) continue;
+    if (!plan.any(gi)) continue;
     if (work.empty()) {
       work.resize(3 * n);
       sig.resize(n);
       for (int k = 0; k < 3; ++k) f[k] = work.data() + k * n;
     }
     SignalStatus st[3] = {SignalStatus::ok, SignalStatus::ok, SignalStatus::ok};
-    const ArmaCoefs& co = d::group_coefs(c, g);
-    if (need[0] && need[1] && need[2]) {
+    const ArmaCoefs& co = group_coefs(c, g);
+    if (plan.all(gi)) {
       FilterResult r[3];
       filter_arma3(co, axes, n, f, arith, r);
-      for (int k = 0; k < 3; ++k) st[k] = d::assign_column(r[k], f[k], n);
+      for (int k = 0; k < 3; ++k) st[k] = assign_column(r[k], f[k], n);
     } else {
       for (int k = 0; k < 3; ++k)
-        if (need[k]) st[k] = d::filter_column(co, axes[k], n, f[k], arith);
+        if (plan.need[gi][k]) st[k] = filter_column(co, axes[k], n, f[k], arith);
     }
-    if (g == FilterGroup::low && plus) {
+    if (g == FilterGroup::low && plan.plus) {
       // HFENplus's GCP = EN(low) - gravity, not |.|, kept for the high filter
       for (int k = 0; k < 3; ++k) low_status[k] = st[k];
-      if (d::first_failed(st, -1) == SignalStatus::ok) {
+      if (first_failed(st, -1) == SignalStatus::ok) {
         gcp.resize(n);
-        for (std::size_t i = 0; i < n; ++i) gcp[i] = d::norm3(f[0][i], f[1][i], f[2][i], false) - 1;
+        gcp_of(f, n, gcp.data());
       }
     }
     for (std::size_t i = 0; i < count; ++i) {
       const FilteredMetric m = ms[i];
-      const d::MetricUse u = d::metric_use(m);
+      const MetricUse u = metric_use(m);
       if (u.group != g) continue;
-      if (g == FilterGroup::zc && n < 2) {
-        emit(i, SignalStatus::too_short, static_cast<const double*>(nullptr));
-        continue;
-      }
-      SignalStatus s = u.low_first ? d::first_failed(low_status, -1) : SignalStatus::ok;
-      if (s == SignalStatus::ok) s = d::first_failed(st, u.axis);
-      if (s != SignalStatus::ok) {
-        emit(i, s, static_cast<const double*>(nullptr));
-        continue;
-      }
+      SignalStatus s = u.low_first ? first_failed(low_status, -1) : SignalStatus::ok;
+      if (s == SignalStatus::ok) s = first_failed(st, u.axis);
+      sink.begin(i, s);
+      if (s != SignalStatus::ok) continue;
       double* out = sig.data();
       if (g == FilterGroup::zc) {
-        d::zero_crossings(f[u.axis], n, c.zc_sb, out);
-      } else if (u.axis >= 0) {
-        for (std::size_t j = 0; j < n; ++j) out[j] = std::fabs(f[u.axis][j]);
-      } else if (u.low_first) {  // HFENplus: EN(high) + GCP, below 0 set to 0
-        for (std::size_t j = 0; j < n; ++j) {
-          const double v = d::norm3(f[0][j], f[1][j], f[2][j], false) + gcp[j];
-          out[j] = v < 0 ? 0.0 : v;
-        }
-      } else if (m == FilteredMetric::LFENMO) {
-        for (std::size_t j = 0; j < n; ++j) {
-          const double v = d::norm3(f[0][j], f[1][j], f[2][j], true) - 1;
-          out[j] = v < 0 ? 0.0 : v;  // NA stays NA (which() skips it)
-        }
-      } else {  // BFEN, LFEN, HFEN
-        for (std::size_t j = 0; j < n; ++j) out[j] = d::norm3(f[0][j], f[1][j], f[2][j], true);
+        double last = 0;
+        zero_crossings(f[u.axis], n, c.zc_sb, out, true, &last);
+      } else {
+        derive_signal(m, u, f, gcp.data(), n, out);
       }
-      emit(i, SignalStatus::ok, static_cast<const double*>(out));
+      sink.values(i, static_cast<const double*>(out), n);
     }
   }
+}
+
+// The block in parts of `chunk` samples, each filter's state carried from
+// part to part (the convolution reads the block's samples before the part;
+// the recursion its last outputs, kept in front of the part's), the same
+// operations on each sample as block_signals(). Work space: for each
+// coefficient set, three axes of `chunk` values and the recursion's
+// history; one signal; HFENplus's GCP. false, after the sink has been given
+// some parts, when a filtered value comes out NA (a NA sample, or an
+// overflow): R's NA rules need the whole block (block_signals()).
+template <class Sink>
+bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* const axes[3],
+                    std::size_t n, const GgirFilterCoefs& c, RFilterArith arith,
+                    const FilterPlan& plan, std::size_t chunk, Sink& sink) {
+  struct Stage {
+    DividedArma d;
+    std::size_t hist = 0;     // the recursion's history in front of each axis's part
+    std::vector<double> buf;  // 3 x (hist + chunk)
+    double* f[3] = {nullptr, nullptr, nullptr};
+    explicit Stage(const ArmaCoefs& co) : d(co.b, co.nb, co.a, co.na) {}
+  };
+  std::vector<Stage> stages;
+  stages.reserve(kFilterGroups);
+  int stage_of[kFilterGroups] = {-1, -1, -1, -1};
+  for (int gi = 0; gi < kFilterGroups; ++gi) {
+    if (!plan.any(gi)) continue;
+    stage_of[gi] = static_cast<int>(stages.size());
+    stages.emplace_back(group_coefs(c, static_cast<FilterGroup>(gi)));
+    Stage& st = stages.back();
+    st.hist = st.d.g.size();
+    st.buf.assign(3 * (st.hist + chunk), 0.0);  // zeros before the block: R's start
+    for (int k = 0; k < 3; ++k) st.f[k] = st.buf.data() + k * (st.hist + chunk) + st.hist;
+  }
+  std::vector<double> sig(chunk), gcp(plan.plus ? chunk : 0);
+  double zc_last[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < count; ++i) sink.begin(i, SignalStatus::ok);
+  for (std::size_t from = 0; from < n; from += chunk) {
+    const std::size_t len = std::min(chunk, n - from);
+    const bool at_start = from == 0;
+    for (int gi = 0; gi < kFilterGroups; ++gi) {
+      if (stage_of[gi] < 0) continue;
+      const FilterGroup g = static_cast<FilterGroup>(gi);
+      Stage& st = stages[static_cast<std::size_t>(stage_of[gi])];
+      const std::vector<double>& fb = st.d.f;
+      const std::vector<double>& gg = st.d.g;
+      for (int k = 0; k < 3; ++k) {
+        if (!plan.need[gi][k]) continue;
+        if (arith.conv_fused) convolve<true>(fb.data(), fb.size(), axes[k], from, from + len, st.f[k]);
+        else convolve<false>(fb.data(), fb.size(), axes[k], from, from + len, st.f[k]);
+      }
+      if (!gg.empty()) {
+        // the history holds zeros at the start (R's zero initial state: the
+        // same operations as the tested start of recurse())
+        if (plan.all(gi)) {
+          if (arith.rec_fused) recurse3<true>(gg.data(), gg.size(), st.f, len, false);
+          else recurse3<false>(gg.data(), gg.size(), st.f, len, false);
+        } else {
+          for (int k = 0; k < 3; ++k) {
+            if (!plan.need[gi][k]) continue;
+            if (arith.rec_fused) recurse<true>(gg.data(), gg.size(), st.f[k], 0, len, false);
+            else recurse<false>(gg.data(), gg.size(), st.f[k], 0, len, false);
+          }
+        }
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (!plan.need[gi][k]) continue;
+        for (std::size_t i = 0; i < len; ++i)
+          if (std::isnan(st.f[k][i])) return false;
+        // the last outputs, the next part's history
+        if (st.hist > 0) std::copy(st.f[k] + len - st.hist, st.f[k] + len, st.f[k] - st.hist);
+      }
+      if (g == FilterGroup::low && plan.plus) gcp_of(st.f, len, gcp.data());
+      for (std::size_t i = 0; i < count; ++i) {
+        const FilteredMetric m = ms[i];
+        const MetricUse u = metric_use(m);
+        if (u.group != g) continue;
+        if (g == FilterGroup::zc) {
+          zero_crossings(st.f[u.axis], len, c.zc_sb, sig.data(), at_start, &zc_last[u.axis]);
+        } else {
+          derive_signal(m, u, st.f, gcp.data(), len, sig.data());
+        }
+        sink.values(i, static_cast<const double*>(sig.data()), len);
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace ggir_filters_detail
+
+// The parts a block is filtered in (ggir_filtered_signals()): the work
+// space stays in the processor's cache.
+constexpr std::size_t kFilterChunk = 4096;
+
+// The per-sample signals of `count` metrics ms[] over a block of n samples
+// (x, y, z: calibrated axes), each filter run once per coefficient set and
+// axis however many metrics read it (a filtered axis is the same bits for
+// every metric that reads it). The sink is told, for each metric i,
+// sink.begin(i, status): ok, or why R stops there; then, when ok, the
+// signal in consecutive parts, sink.values(i, values, len), valid during
+// the call, n values in all. A block whose filtered values come out NA
+// anywhere is taken again whole (R's NA rules): the sink is then told
+// begin() again for every metric, and must start over.
+// The block goes in parts of `chunk` samples (at least 2) where it can:
+// the work space is that of the parts, not of the block.
+template <class Sink>
+void ggir_filtered_signals(const FilteredMetric* ms, std::size_t count, const double* x,
+                           const double* y, const double* z, std::size_t n,
+                           const GgirFilterCoefs& c, RFilterArith arith, Sink& sink,
+                           std::size_t chunk = kFilterChunk) {
+  namespace d = ggir_filters_detail;
+  const double* const axes[3] = {x, y, z};
+  const d::FilterPlan plan = d::plan_filters(ms, count, n);
+  chunk = std::max<std::size_t>(chunk, 2);
+  bool parts = n >= 2;  // (ZC* of one sample: R's stop, from the block)
+  for (int gi = 0; gi < kFilterGroups && parts; ++gi) {
+    if (plan.any(gi) && d::group_coefs(c, static_cast<FilterGroup>(gi)).nb == 0) parts = false;
+  }
+  if (parts && d::stream_signals(ms, count, axes, n, c, arith, plan, chunk, sink)) return;
+  d::block_signals(ms, count, axes, n, c, arith, plan, sink);
 }
 
 // One metric's per-sample signal over a block of n samples into out[0, n).
@@ -575,13 +726,21 @@ inline SignalStatus ggir_filtered_signal(FilteredMetric m, const double* x, cons
                                          const double* z, std::size_t n,
                                          const GgirFilterCoefs& c, double* out,
                                          RFilterArith arith = RFilterArith()) {
-  SignalStatus status = SignalStatus::ok;
-  ggir_filtered_signals(&m, 1, x, y, z, n, c, arith,
-                        [&](std::size_t, SignalStatus s, const double* sig) {
-                          status = s;
-                          if (sig != nullptr) std::copy(sig, sig + n, out);
-                        });
-  return status;
+  struct Copy {
+    double* out;
+    std::size_t at = 0;
+    SignalStatus status = SignalStatus::ok;
+    void begin(std::size_t, SignalStatus s) {
+      status = s;
+      at = 0;
+    }
+    void values(std::size_t, const double* v, std::size_t len) {
+      std::copy(v, v + len, out + at);
+      at += len;
+    }
+  } copy{out};
+  ggir_filtered_signals(&m, 1, x, y, z, n, c, arith, copy);
+  return copy.status;
 }
 
 }  // namespace gravcal
