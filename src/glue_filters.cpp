@@ -92,6 +92,7 @@ Rcpp::List gc_ggir_filtered_signal(const Rcpp::NumericVector& x, const Rcpp::Num
       sig[i].clear();
     }
     void values(std::size_t i, const double* v, std::size_t len) { sig[i].insert(sig[i].end(), v, v + len); }
+    void end_part() {}
   } sink{sig, status};
   if (chunk < 1) Rcpp::stop("`chunk` must be a positive number of samples");
   gravcal::ggir_filtered_signals(ms.data(), ms.size(), x.begin(), y.begin(), z.begin(),

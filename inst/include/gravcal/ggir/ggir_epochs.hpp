@@ -37,7 +37,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -143,6 +145,21 @@ class EpochSums {
     const std::size_t base = at_;
     feed(count, [v, base](std::size_t i) { return v[i - base]; });
   }
+  // add() of the next `count` values of k sums at once, sums e[q] taking
+  // v[q][0, count): sums of the same block and epochs (the same n and by),
+  // at the same place. Each sum in its own order (the same bits as add()),
+  // up to four side by side: independent chains of additions.
+  static void add_many(EpochSums* const* e, const double* const* v, std::size_t k,
+                       std::size_t count) {
+    for (std::size_t q = 0; q < k; q += 4) {
+      switch (std::min<std::size_t>(4, k - q)) {
+        case 4: feed_k<4>(e + q, v + q, count); break;
+        case 3: feed_k<3>(e + q, v + q, count); break;
+        case 2: feed_k<2>(e + q, v + q, count); break;
+        default: e[q]->add(v[q], count); break;
+      }
+    }
+  }
   // The epochs' values; every value up to the last bound must have been
   // given.
   std::vector<double> finish() {
@@ -152,6 +169,47 @@ class EpochSums {
   }
 
  private:
+  template <int K>  // 2 to 4
+  static void feed_k(EpochSums* const* e, const double* const* v, std::size_t count) {
+    EpochSums& lead = *e[0];
+    for (int q = 1; q < K; ++q) {
+      if (e[q]->at_ != lead.at_ || e[q]->k_ != lead.k_ || e[q]->bound_.size() != lead.bound_.size())
+        throw std::logic_error("EpochSums::add_many: sums at different places");
+    }
+    const std::size_t base = lead.at_;
+    const std::size_t end = base + count;
+    std::size_t at = base;
+    while (at < end && lead.k_ < lead.bound_.size()) {
+      const std::size_t to = static_cast<std::size_t>(lead.bound_[lead.k_]) - 1;
+      if (at == to) {
+        for (int q = 0; q < K; ++q) e[q]->record();
+        continue;
+      }
+      const std::size_t stop = std::min(end, to);
+      // the sums in named variables (registers), the unused ones idle
+      const double* w0 = v[0] - base;
+      const double* w1 = v[K > 1 ? 1 : 0] - base;
+      const double* w2 = v[K > 2 ? 2 : 0] - base;
+      const double* w3 = v[K > 3 ? 3 : 0] - base;
+      Acc s0 = e[0]->s_, s1 = e[K > 1 ? 1 : 0]->s_, s2 = e[K > 2 ? 2 : 0]->s_,
+          s3 = e[K > 3 ? 3 : 0]->s_;
+      for (std::size_t i = at; i < stop; ++i) {
+        s0 += w0[i];
+        if (K > 1) s1 += w1[i];
+        if (K > 2) s2 += w2[i];
+        if (K > 3) s3 += w3[i];
+      }
+      e[0]->s_ = s0;
+      if (K > 1) e[1]->s_ = s1;
+      if (K > 2) e[2]->s_ = s2;
+      if (K > 3) e[3]->s_ = s3;
+      at = stop;
+    }
+    for (int q = 0; q < K; ++q) {
+      e[q]->at_ = end;
+      e[q]->reached();
+    }
+  }
   // the running sum is cumsum(c(0, v))[bound] for every bound at the values
   // given so far
   void reached() {
@@ -656,8 +714,22 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
         const bool zc = fm == FilteredMetric::ZCX || fm == FilteredMetric::ZCY || fm == FilteredMetric::ZCZ;
         sums[i] = EpochSums<Acc>(n, by, !zc);  // sumPerEpoch for ZC*
       }
-      void values(std::size_t i, const double* v, std::size_t len) { sums[i].add(v, len); }
-    } sink{fms, fk, fstatus, sums, n, by};
+      // a part's values, summed when the part is whole (end_part()): the
+      // metrics' sums side by side
+      std::vector<EpochSums<Acc>*> pe;
+      std::vector<const double*> pv;
+      std::size_t plen = 0;
+      void values(std::size_t i, const double* v, std::size_t len) {
+        pe.push_back(&sums[i]);
+        pv.push_back(v);
+        plen = len;
+      }
+      void end_part() {
+        EpochSums<Acc>::add_many(pe.data(), pv.data(), pe.size(), plen);
+        pe.clear();
+        pv.clear();
+      }
+    } sink{fms, fk, fstatus, sums, n, by, {}, {}, 0};
     ggir_filtered_signals(fms.data(), fms.size(), x, y, z, n, *fc, arith, sink);
     for (std::size_t i = 0; i < fms.size(); ++i) {
       if (fstatus[fk[i]] == SignalStatus::ok) out[fk[i]] = sums[i].finish();

@@ -133,11 +133,27 @@ inline void convolve(const double* f, std::size_t nb, const double* x, std::size
     }
     return z;
   };
-  for (std::size_t i = from; i < to; ++i) {
-    if (i + 1 < nb) {
-      y[i - from] = tested(i);
-      continue;
+  std::size_t i = from;
+  for (; i < to && i + 1 < nb; ++i) y[i - from] = tested(i);
+  // four outputs side by side: each one's sum in its own order, so the
+  // same bits as one at a time, but four independent chains
+  for (; i + 4 <= to; i += 4) {
+    double z0 = 0, z1 = 0, z2 = 0, z3 = 0;
+    for (std::size_t j = 0; j < nb; ++j) {
+      const double fj = f[j];
+      const double* v = x + (i - j);
+      z0 = madd<Fused>(z0, fj, v[0]);
+      z1 = madd<Fused>(z1, fj, v[1]);
+      z2 = madd<Fused>(z2, fj, v[2]);
+      z3 = madd<Fused>(z3, fj, v[3]);
     }
+    double* out = y + (i - from);
+    out[0] = std::isnan(z0) ? tested(i) : z0;
+    out[1] = std::isnan(z1) ? tested(i + 1) : z1;
+    out[2] = std::isnan(z2) ? tested(i + 2) : z2;
+    out[3] = std::isnan(z3) ? tested(i + 3) : z3;
+  }
+  for (; i < to; ++i) {
     double z = 0;
     for (std::size_t j = 0; j < nb; ++j) z = madd<Fused>(z, f[j], x[i - j]);
     y[i - from] = std::isnan(z) ? tested(i) : z;
@@ -596,6 +612,7 @@ void block_signals(const FilteredMetric* ms, std::size_t count, const double* co
         derive_signal(m, u, f, gcp.data(), n, out);
       }
       sink.values(i, static_cast<const double*>(out), n);
+      sink.end_part();
     }
   }
 }
@@ -631,7 +648,7 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
     st.buf.assign(3 * (st.hist + chunk), 0.0);  // zeros before the block: R's start
     for (int k = 0; k < 3; ++k) st.f[k] = st.buf.data() + k * (st.hist + chunk) + st.hist;
   }
-  std::vector<double> sig(chunk), gcp(plan.plus ? chunk : 0);
+  std::vector<double> sig(count * chunk), gcp(plan.plus ? chunk : 0);  // a part of each signal
   double zc_last[3] = {0, 0, 0};
   for (std::size_t i = 0; i < count; ++i) sink.begin(i, SignalStatus::ok);
   for (std::size_t from = 0; from < n; from += chunk) {
@@ -664,8 +681,14 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
       }
       for (int k = 0; k < 3; ++k) {
         if (!plan.need[gi][k]) continue;
-        for (std::size_t i = 0; i < len; ++i)
-          if (std::isnan(st.f[k][i])) return false;
+        // a NA: the recursion carries it to every later output (R's tests
+        // give NA for a NA operand), so the part's last tells
+        if (gg.empty()) {
+          for (std::size_t i = 0; i < len; ++i)
+            if (std::isnan(st.f[k][i])) return false;
+        } else if (std::isnan(st.f[k][len - 1])) {
+          return false;
+        }
         // the last outputs, the next part's history
         if (st.hist > 0) std::copy(st.f[k] + len - st.hist, st.f[k] + len, st.f[k] - st.hist);
       }
@@ -674,14 +697,16 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
         const FilteredMetric m = ms[i];
         const MetricUse u = metric_use(m);
         if (u.group != g) continue;
+        double* out = sig.data() + i * chunk;
         if (g == FilterGroup::zc) {
-          zero_crossings(st.f[u.axis], len, c.zc_sb, sig.data(), at_start, &zc_last[u.axis]);
+          zero_crossings(st.f[u.axis], len, c.zc_sb, out, at_start, &zc_last[u.axis]);
         } else {
-          derive_signal(m, u, st.f, gcp.data(), len, sig.data());
+          derive_signal(m, u, st.f, gcp.data(), len, out);
         }
-        sink.values(i, static_cast<const double*>(sig.data()), len);
+        sink.values(i, static_cast<const double*>(out), len);
       }
     }
+    sink.end_part();
   }
   return true;
 }
@@ -697,8 +722,9 @@ constexpr std::size_t kFilterChunk = 4096;
 // axis however many metrics read it (a filtered axis is the same bits for
 // every metric that reads it). The sink is told, for each metric i,
 // sink.begin(i, status): ok, or why R stops there; then, when ok, the
-// signal in consecutive parts, sink.values(i, values, len), valid during
-// the call, n values in all. A block whose filtered values come out NA
+// signal in consecutive parts, sink.values(i, values, len), n values in
+// all; sink.end_part() after each part (of one metric, or of all), up to
+// which the values given since the last stay valid. A block whose filtered values come out NA
 // anywhere is taken again whole (R's NA rules): the sink is then told
 // begin() again for every metric, and must start over.
 // The block goes in parts of `chunk` samples (at least 2) where it can:
@@ -738,6 +764,7 @@ inline SignalStatus ggir_filtered_signal(FilteredMetric m, const double* x, cons
       std::copy(v, v + len, out + at);
       at += len;
     }
+    void end_part() {}
   } copy{out};
   ggir_filtered_signals(&m, 1, x, y, z, n, c, arith, copy);
   return copy.status;
