@@ -511,6 +511,7 @@ inline void zero_crossings(double* v, std::size_t n, double zc_sb, double* out, 
 // the axes; whether HFENplus is asked (it reads "low" too).
 struct FilterPlan {
   bool need[kFilterGroups][3] = {};
+  bool norm[kFilterGroups] = {};  // a metric reads the three axes' norm
   bool plus = false;
   bool any(int g) const { return need[g][0] || need[g][1] || need[g][2]; }
   bool all(int g) const { return need[g][0] && need[g][1] && need[g][2]; }
@@ -522,6 +523,8 @@ inline FilterPlan plan_filters(const FilteredMetric* ms, std::size_t count, std:
     const MetricUse u = metric_use(ms[i]);
     if (u.group == FilterGroup::zc && n < 2) continue;  // zerocross() needs 2 samples: nothing is filtered
     p.plus = p.plus || u.low_first;
+    if (u.axis < 0) p.norm[static_cast<int>(u.group)] = true;
+    if (u.low_first) p.norm[static_cast<int>(FilterGroup::low)] = true;
     for (int k = 0; k < 3; ++k) {
       const bool on = u.axis < 0 || u.axis == k;
       p.need[static_cast<int>(u.group)][k] = p.need[static_cast<int>(u.group)][k] || on;
@@ -531,30 +534,35 @@ inline FilterPlan plan_filters(const FilteredMetric* ms, std::size_t count, std:
   return p;
 }
 
+// The norm of a coefficient set's three filtered axes over len samples,
+// sqrt((x^2 + y^2) + z^2): the same bits whether GGIR takes |.| of the axes
+// first (BFEN, LFEN, LFENMO, HFEN) or not (HFENplus): |v| * |v| is v * v.
+inline void norm_of(const double* const f[3], std::size_t len, double* out) {
+  for (std::size_t j = 0; j < len; ++j) out[j] = norm3(f[0][j], f[1][j], f[2][j], false);
+}
+
 // Metric m's signal (not ZC*) over len samples from its group's filtered
-// axes f[] and, for HFENplus, GCP = EN(low) - 1.
+// axes f[], their norm `nrm` (norm_of(); for the metrics of all three axes)
+// and, for HFENplus, the low filter's norm `low_nrm` (GCP = that norm - 1).
 inline void derive_signal(FilteredMetric m, const MetricUse& u, const double* const f[3],
-                          const double* gcp, std::size_t len, double* out) {
+                          const double* nrm, const double* low_nrm, std::size_t len, double* out) {
   if (u.axis >= 0) {
     const double* v = f[u.axis];
     for (std::size_t j = 0; j < len; ++j) out[j] = std::fabs(v[j]);
   } else if (u.low_first) {  // HFENplus: EN(high) + GCP, below 0 set to 0
     for (std::size_t j = 0; j < len; ++j) {
-      const double v = norm3(f[0][j], f[1][j], f[2][j], false) + gcp[j];
+      const double gcp = low_nrm[j] - 1;
+      const double v = nrm[j] + gcp;
       out[j] = v < 0 ? 0.0 : v;
     }
   } else if (m == FilteredMetric::LFENMO) {
     for (std::size_t j = 0; j < len; ++j) {
-      const double v = norm3(f[0][j], f[1][j], f[2][j], true) - 1;
+      const double v = nrm[j] - 1;
       out[j] = v < 0 ? 0.0 : v;  // NA stays NA (which() skips it)
     }
   } else {  // BFEN, LFEN, HFEN
-    for (std::size_t j = 0; j < len; ++j) out[j] = norm3(f[0][j], f[1][j], f[2][j], true);
+    std::copy(nrm, nrm + len, out);
   }
-}
-
-inline void gcp_of(const double* const f[3], std::size_t len, double* gcp) {
-  for (std::size_t i = 0; i < len; ++i) gcp[i] = norm3(f[0][i], f[1][i], f[2][i], false) - 1;
 }
 
 // The whole block at once, with R's NA rules (filter_front(): the NAs at
@@ -564,7 +572,7 @@ template <class Sink>
 void block_signals(const FilteredMetric* ms, std::size_t count, const double* const axes[3],
                    std::size_t n, const GgirFilterCoefs& c, RFilterArith arith,
                    const FilterPlan& plan, Sink& sink) {
-  std::vector<double> work, sig, gcp;
+  std::vector<double> work, sig, nrm, low_nrm;
   double* f[3] = {nullptr, nullptr, nullptr};
   SignalStatus low_status[3] = {SignalStatus::ok, SignalStatus::ok, SignalStatus::ok};
   for (std::size_t i = 0; i < count; ++i) {
@@ -588,13 +596,15 @@ void block_signals(const FilteredMetric* ms, std::size_t count, const double* co
       for (int k = 0; k < 3; ++k)
         if (plan.need[gi][k]) st[k] = filter_column(co, axes[k], n, f[k], arith);
     }
+    if (plan.norm[gi] && first_failed(st, -1) == SignalStatus::ok) {
+      nrm.resize(n);
+      norm_of(f, n, nrm.data());
+    }
     if (g == FilterGroup::low && plan.plus) {
-      // HFENplus's GCP = EN(low) - gravity, not |.|, kept for the high filter
+      // HFENplus's GCP = EN(low) - gravity: the low filter's norm kept for
+      // the high filter
       for (int k = 0; k < 3; ++k) low_status[k] = st[k];
-      if (first_failed(st, -1) == SignalStatus::ok) {
-        gcp.resize(n);
-        gcp_of(f, n, gcp.data());
-      }
+      if (first_failed(st, -1) == SignalStatus::ok) low_nrm = nrm;
     }
     for (std::size_t i = 0; i < count; ++i) {
       const FilteredMetric m = ms[i];
@@ -609,7 +619,7 @@ void block_signals(const FilteredMetric* ms, std::size_t count, const double* co
         double last = 0;
         zero_crossings(f[u.axis], n, c.zc_sb, out, true, &last);
       } else {
-        derive_signal(m, u, f, gcp.data(), n, out);
+        derive_signal(m, u, f, nrm.data(), low_nrm.data(), n, out);
       }
       sink.values(i, static_cast<const double*>(out), n);
       sink.end_part();
@@ -621,8 +631,8 @@ void block_signals(const FilteredMetric* ms, std::size_t count, const double* co
 // part to part (the convolution reads the block's samples before the part;
 // the recursion its last outputs, kept in front of the part's), the same
 // operations on each sample as block_signals(). Work space: for each
-// coefficient set, three axes of `chunk` values and the recursion's
-// history; one signal; HFENplus's GCP. false, after the sink has been given
+// coefficient set, three axes of `chunk` values, the recursion's history
+// and their norm; a part of each signal. false, after the sink has been given
 // some parts, when a filtered value comes out NA (a NA sample, or an
 // overflow): R's NA rules need the whole block (block_signals()).
 template <class Sink>
@@ -634,6 +644,7 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
     std::size_t hist = 0;     // the recursion's history in front of each axis's part
     std::vector<double> buf;  // 3 x (hist + chunk)
     double* f[3] = {nullptr, nullptr, nullptr};
+    std::vector<double> nrm;  // the three axes' norm (chunk), where a metric reads it
     explicit Stage(const ArmaCoefs& co) : d(co.b, co.nb, co.a, co.na) {}
   };
   std::vector<Stage> stages;
@@ -647,8 +658,9 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
     st.hist = st.d.g.size();
     st.buf.assign(3 * (st.hist + chunk), 0.0);  // zeros before the block: R's start
     for (int k = 0; k < 3; ++k) st.f[k] = st.buf.data() + k * (st.hist + chunk) + st.hist;
+    if (plan.norm[gi]) st.nrm.resize(chunk);
   }
-  std::vector<double> sig(count * chunk), gcp(plan.plus ? chunk : 0);  // a part of each signal
+  std::vector<double> sig(count * chunk);  // a part of each signal
   double zc_last[3] = {0, 0, 0};
   for (std::size_t i = 0; i < count; ++i) sink.begin(i, SignalStatus::ok);
   for (std::size_t from = 0; from < n; from += chunk) {
@@ -692,7 +704,9 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
         // the last outputs, the next part's history
         if (st.hist > 0) std::copy(st.f[k] + len - st.hist, st.f[k] + len, st.f[k] - st.hist);
       }
-      if (g == FilterGroup::low && plan.plus) gcp_of(st.f, len, gcp.data());
+      if (!st.nrm.empty()) norm_of(st.f, len, st.nrm.data());
+      const double* low_nrm =
+          plan.plus ? stages[static_cast<std::size_t>(stage_of[static_cast<int>(FilterGroup::low)])].nrm.data() : nullptr;
       for (std::size_t i = 0; i < count; ++i) {
         const FilteredMetric m = ms[i];
         const MetricUse u = metric_use(m);
@@ -701,7 +715,7 @@ bool stream_signals(const FilteredMetric* ms, std::size_t count, const double* c
         if (g == FilterGroup::zc) {
           zero_crossings(st.f[u.axis], len, c.zc_sb, out, at_start, &zc_last[u.axis]);
         } else {
-          derive_signal(m, u, st.f, gcp.data(), len, out);
+          derive_signal(m, u, st.f, st.nrm.data(), low_nrm, len, out);
         }
         sink.values(i, static_cast<const double*>(out), len);
       }
