@@ -57,9 +57,13 @@
 // where the two differ (R/ggir-filters.R stats_filter_fused()). Nothing
 // here depends on long double.
 //
-// Header-only; no R; the caller owns the signal buffers (allocated here:
-// the divided coefficients, and the work space of the convenience overload
-// of ggir_filtered_signal()).
+// A block is filtered in parts (kFilterChunk samples), each filter's state
+// carried from part to part, the signals handed to a sink part by part; a
+// block whose filtered values come out NA anywhere is taken again whole,
+// with R's NA rules (ggir_filtered_signals()).
+//
+// Header-only; no R. Allocated here: the divided coefficients and the
+// parts' work space (or, for a block taken whole, the block's).
 #ifndef GRAVCAL_GGIR_FILTERS_HPP
 #define GRAVCAL_GGIR_FILTERS_HPP
 
