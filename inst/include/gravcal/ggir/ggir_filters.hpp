@@ -30,8 +30,7 @@
 //    (-a[j]) / a[1]): pass signal::butter()'s b and a untouched.
 // 2. ggir_filtered_signals(): what g.applymetrics computes per sample before
 //    averaging, for metrics (FilteredMetric), from the three axes, each
-//    filter run once per axis for all the metrics that read it
-//    (ggir_filtered_signal(): one metric):
+//    filter run once per axis for all the metrics that read it:
 //      BFX/BFY/BFZ |band(lb, hb)| per axis; BFEN their norm;
 //      LFX/LFY/LFZ |low(hb)|; LFEN their norm; LFENMO that norm - 1, values
 //        below 0 set to 0;
@@ -762,30 +761,6 @@ void ggir_filtered_signals(const FilteredMetric* ms, std::size_t count, const do
   }
   if (parts && d::stream_signals(ms, count, axes, n, c, arith, plan, chunk, sink)) return;
   d::block_signals(ms, count, axes, n, c, arith, plan, sink);
-}
-
-// One metric's per-sample signal over a block of n samples into out[0, n).
-// On a status other than ok, out holds nothing defined (R stops there).
-inline SignalStatus ggir_filtered_signal(FilteredMetric m, const double* x, const double* y,
-                                         const double* z, std::size_t n,
-                                         const GgirFilterCoefs& c, double* out,
-                                         RFilterArith arith = RFilterArith()) {
-  struct Copy {
-    double* out;
-    std::size_t at = 0;
-    SignalStatus status = SignalStatus::ok;
-    void begin(std::size_t, SignalStatus s) {
-      status = s;
-      at = 0;
-    }
-    void values(std::size_t, const double* v, std::size_t len) {
-      std::copy(v, v + len, out + at);
-      at += len;
-    }
-    void end_part() {}
-  } copy{out};
-  ggir_filtered_signals(&m, 1, x, y, z, n, c, arith, copy);
-  return copy.status;
 }
 
 }  // namespace gravcal
