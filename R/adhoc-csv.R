@@ -108,7 +108,11 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
       v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
       if (length(v) == 1 && is.finite(v)) opts$start_time <- v / opts$time_div + origin
     } else if (unit == "ActivPAL") {
-      opts$time_div <- 1 / 86400  # days since 1899-12-30
+      # days since 1899-12-30, as read.myacc.csv() reads them: v * 86400
+      # from the origin, then forced into desiredtz (time_utc_offset, set
+      # by rmc_time_opts() below: a zone of one offset over the recording)
+      opts$time_div <- 1
+      opts$time_mul <- 86400
       opts$time_offset <- as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))
     } else {
       line <- if (length(first) > skip) first[skip + 1] else NA_character_
@@ -140,6 +144,13 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
     g <- rmc_time_opts(p, file, skip, tz, what)
     opts[names(g)] <- g
   }
+  if (identical(opts$time_mul, 86400)) {
+    line <- if (length(first) > skip) first[skip + 1] else NA_character_
+    v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
+    if (length(v) == 1 && is.finite(v)) {
+      opts$start_time <- (v * opts$time_mul + opts$time_offset) - (opts$time_utc_offset %||% 0)
+    }
+  }
   if (gaps) opts$timegaps <- as.numeric(sf)
   if (gaps && stamps) opts$timegaps_carry <- 1
   list(opts = opts, sf = sf, skip = skip, header = header,
@@ -158,6 +169,11 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
 rmc_with_zone <- function(rmc, p) {
   attr(rmc, "tz") <- if (length(p$configtz)) p$configtz else p$desiredtz %||% ""
   attr(rmc, "tz_arg") <- if (length(p$configtz)) "configtz" else "desiredtz"
+  # ActivPAL days are forced into desiredtz (read.myacc.csv(): a deprecated
+  # rmc.desiredtz takes the place of a desiredtz of "")
+  desired <- p$desiredtz %||% ""
+  if (!nzchar(desired) && !is.null(rmc$rmc.desiredtz)) desired <- rmc$rmc.desiredtz
+  attr(rmc, "desiredtz") <- desired
   rmc
 }
 
@@ -182,13 +198,14 @@ rmc_zone_conflict <- function(rmc, p) {
 # read the time stamps as GGIR's gap imputation and resampling see them
 # (options time_format and time_utc_offset for text time), or an error
 # naming `what` and what gravcal does not reproduce. GGIR reads text time
-# (and ActivPAL days) in the zone configtz, else desiredtz: a zone whose UTC
-# offset changes (daylight saving) within 25 months of the first stamp is
-# refused; a fixed offset is subtracted from the stamps, as as.POSIXct()
-# does (the resampling's grid starts at the first stamp: its value counts).
+# in the zone configtz, else desiredtz: a fixed offset is subtracted from
+# the stamps, as as.POSIXct() does (the resampling's grid starts at the
+# first stamp: its value counts); a zone whose offset changes is followed
+# minute by minute (R/zone.R). ActivPAL days: rmc_activpal_zone().
 rmc_time_opts <- function(p, file, skip, tz, what) {
   unit <- p$rmc.unit.time
   if (unit %in% c("UNIXsec", "UNIXmsec")) return(list())
+  if (unit == "ActivPAL") return(rmc_activpal_zone(p, file, skip, tz, what))
   zone <- attr(p, "tz") %||% p$rmc.configtz %||% p$rmc.desiredtz %||% tz
   lines <- fread_lines(file, skip + 1000)
   lines <- lines[seq_along(lines) > skip]
@@ -198,9 +215,7 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
     abort(lead, " with `rmc.unit.time` = \"", unit, "\" is not supported by ",
           "gravcal (", why, "); GGIR reads such files.")
   }
-  if (unit == "ActivPAL") {
-    t <- suppressWarnings(as.numeric(stamps)) * 86400 - 25569 * 86400
-  } else {
+  {
     fmt <- p$rmc.format.time
     d <- regmatches(fmt, gregexpr("%O?.", fmt))[[1]]
     bad <- setdiff(d, c("%Y", "%y", "%m", "%d", "%H", "%M", "%S", "%OS", "%T", "%%"))
@@ -245,15 +260,9 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
   txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
   off <- at - as.numeric(as.POSIXct(txt, tz = zone))
   if (!anyNA(off) && all(off == off[1])) {
-    if (unit == "ActivPAL") return(list())
     return(list(time_format = p$rmc.format.time, time_utc_offset = off[1]))
   }
   zone_name <- paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)")
-  # ActivPAL days: GGIR moves them into the zone with lubridate::force_tz()
-  if (unit == "ActivPAL") {
-    refuse(paste0(zone_name, " changes its UTC offset; give desiredtz / configtz a zone of fixed ",
-                  "offset"))
-  }
   # a zone whose offset changes: text time read in it as as.POSIXct() reads
   # it, minute by minute (R/zone.R); GGIR converts a block's stamps in
   # order, so a stamp that exists twice or not at all in the zone takes the
@@ -267,6 +276,43 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
                   "to 2063 only"))
   }
   c(list(time_format = p$rmc.format.time, time_utc_offset = 0), zone_options(zone))
+}
+
+# ActivPAL days (rmc_time_opts()): read.myacc.csv() forces them into
+# desiredtz with lubridate::force_tz(), which subtracts the zone's UTC
+# offset at each stamp's clock time. Over a recording that sees one offset
+# (its first and last stamps, a day either side, every half hour) that is
+# the option time_utc_offset; a recording across a change of offset
+# (daylight saving) is refused, naming `what`: force_tz() moves the stamps
+# after the change by the change, and gravcal does not reproduce it.
+rmc_activpal_zone <- function(p, file, skip, tz, what) {
+  zone <- attr(p, "desiredtz") %||% p$rmc.desiredtz %||% tz
+  lines <- fread_lines(file, skip + 1)
+  first <- if (length(lines) > skip) lines[skip + 1] else NA_character_
+  day <- function(line) suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
+  origin <- as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))
+  t <- c(day(first), day(file_last_line(file))) * 86400 + origin
+  lead <- if (grepl("^rmc[.]", what)) paste0("`", what, "` = TRUE") else what
+  if (!is.finite(t[1])) {
+    abort(lead, " with `rmc.unit.time` = \"ActivPAL\": the time column (", p$rmc.col.time,
+          ") of \"", file, "\" does not start with a number of days (\"",
+          rmc_fields(first)[p$rmc.col.time], "\").")
+  }
+  # (a last line that is not a stamp: 25 months from the first, as for text)
+  if (!is.finite(t[2])) t[2] <- t[1] + 25 * 30.44 * 86400
+  span <- range(t)
+  at <- floor(seq(span[1] - 86400, span[2] + 86400, by = 1800))
+  fmt <- "%Y-%m-%d %H:%M:%S"
+  off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+  if (anyNA(off) || any(off != off[1])) {
+    zone_name <- paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)")
+    abort(lead, " with `rmc.unit.time` = \"ActivPAL\" is not supported by gravcal for \"",
+          basename(file), "\": ", zone_name, " (desiredtz, into which GGIR forces ActivPAL ",
+          "days) changes its UTC offset during the recording (daylight saving), moving the ",
+          "stamps after the change; give desiredtz a zone without a change there (\"UTC\", ",
+          "or a fixed offset such as \"Etc/GMT-1\"). GGIR reads such files.")
+  }
+  list(time_utc_offset = off[1])
 }
 
 # Whether data.table::fread() reads column `col` of `lines` as date-times

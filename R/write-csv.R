@@ -162,7 +162,8 @@ write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
 # lines ("name,value"), a column-name line (`colnames`), then one line per
 # sample: [time,] x, y, z[, temperature]. `unit`: "g" (`digits` decimals),
 # "mg" (`digits` - 3 decimals) or "bit" (unsigned counts of `bitrate` bits
-# over +-`dynamic_range` g); `time`: "none", "UNIXsec", "UNIXmsec" or
+# over +-`dynamic_range` g); `time`: "none", "UNIXsec", "UNIXmsec",
+# "ActivPAL" (days since 1899-12-30, the clock's time of `start` on) or
 # "POSIX" ("%Y-%m-%d %H:%M:%OS" text, millisecond decimals) or "character"
 # ("%d/%m/%Y %H:%M:%OS" text, millisecond decimals); `drop`: the indices of
 # samples left out (a time gap where their time stamps would be); `temp_unit`:
@@ -191,6 +192,7 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
   tcol <- switch(time, none = NULL,
     UNIXsec = round(t, 3),
     UNIXmsec = round(t * 1000),
+    ActivPAL = (t - as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))) / 86400,
     POSIX = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,
                    "%Y-%m-%d %H:%M:%OS3"),
     character = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,

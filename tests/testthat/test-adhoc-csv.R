@@ -441,6 +441,46 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
   }
 })
 
+test_that("ActivPAL days: time stamps equal read.myacc.csv's to the bit, forced into desiredtz", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  n <- 3700
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  # gap_lines()'s times as ActivPAL exports write them: days since
+  # 1899-12-30 with 10 decimals, the device's clock
+  d <- gap_lines(n)
+  d$time <- sprintf("%.10f", (as.numeric(d$time) + 2209161600) / 86400)
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  pr <- list(rmc.firstrow.acc = 2, rmc.col.acc = 2:4, rmc.col.temp = 5, rmc.col.time = 1,
+             rmc.sf = 10, rmc.unit.time = "ActivPAL", rmc.check4timegaps = TRUE)
+  B <- 185
+  # GGIR: v * 86400 from 1899-12-30, then lubridate::force_tz() into
+  # desiredtz (+05:30, +05:45, and a zone with daylight saving in winter)
+  for (tz in c("Asia/Kolkata", "Asia/Kathmandu", "Europe/Berlin")) {
+    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = tz, ggir = FALSE)
+    expect_identical(lay$opts$time_mul, 86400)
+    h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = 1), lay$opts))
+    for (i in seq_len(n / B)) {
+      G <- do.call(GGIR:::read.myacc.csv, c(list(rmc.file = f, rmc.nrow = B, rmc.skip = (i - 1) * B,
+                                                 desiredtz = tz), pr))$data
+      g <- gravcal:::native_block(h, max_units = B, time = TRUE, capacity = 10000)
+      expect_equal(g$to, nrow(G), label = paste(tz, "block", i))
+      expect_identical(g$cols$time[seq_len(g$to)], G$time, label = paste(tz, "block", i, "time"))
+      expect_identical(g$cols$x[seq_len(g$to)], G$x, label = paste(tz, "block", i, "x"))
+    }
+    gravcal:::gc_decoder_close(h$ptr)
+  }
+  # a recording across a change of desiredtz's UTC offset: refused, naming it
+  d$time <- sprintf("%.10f", (as.numeric(as.POSIXct("2024-03-31 00:59:00", tz = "UTC")) +
+                                (seq_len(n) - 1) / 10 + 2209161600) / 86400)
+  utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+  expect_error(gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "Europe/London", ggir = FALSE),
+               "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"ActivPAL\".*Europe/London")
+  expect_identical(gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "Asia/Tokyo",
+                                        ggir = FALSE)$opts$time_utc_offset, 32400)
+})
+
 test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with gaps", {
   skip_if_quick()
   skip_if_not_installed("GGIR")

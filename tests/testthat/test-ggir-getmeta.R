@@ -784,6 +784,22 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   b <- meta_both(a$file, list(params_rawdata = c(a$pr, list(imputeTimegaps = FALSE))))
   expect_same_meta(b)
   expect_null(b$gravcal$QClog)
+  # ActivPAL days (read.myacc.csv(): v * 86400 from 1899-12-30, forced
+  # into desiredtz with lubridate::force_tz()): in Asia/Kolkata (+05:30),
+  # the gaps filled by g.getmeta(); in Europe/London in winter (a zone with
+  # daylight saving, one offset over the recording) with a deprecated
+  # rmc.desiredtz (GGIR's ActivPAL zone where desiredtz is ""), the gaps
+  # filled by rmc.check4timegaps
+  a <- meta_adhoc(time = "ActivPAL", drop = drop, start = "2024-01-01 10:00:00")
+  b <- meta_both(a$file, list(params_rawdata = a$pr,
+                              params_general = list(desiredtz = "Asia/Kolkata")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-01-01T10:15:00+0530")
+  expect_identical(b$gravcal$QClog$timegaps_n, c(3L, 2L))
+  pr <- c(a$pr, list(rmc.check4timegaps = TRUE, rmc.desiredtz = "Europe/London"))
+  b <- meta_both(a$file, list(params_rawdata = pr))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2024-01-01T10:15:00+0000")
   # rmc.check4timegaps (read.myacc.csv fills them first, each block from
   # the block before), text time, idle-sleep zeros
   # (g.getmeta()'s own filling then finds one gap: GGIR's slipped times)
@@ -860,7 +876,12 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.desiredtz = "UTC")),
                                   params_general = list(desiredtz = "Europe/Amsterdam"),
                                   verbose = FALSE), "rmc.desiredtz")
-  expect_error(gm(rmc.unit.time = "ActivPAL"), "rmc.unit.time")
+  # ActivPAL days across a change of desiredtz's offset (force_tz() moves
+  # the stamps after it)
+  ap <- meta_adhoc(hours = 0.2, time = "ActivPAL", start = "2024-10-27 00:55:00")
+  expect_error(gravcal::g.getmeta(ap$file, params_rawdata = ap$pr, desiredtz = "Europe/Paris",
+                                  verbose = FALSE),
+               "rmc.unit.time` = \"ActivPAL\".*\"Europe/Paris\".*changes its UTC offset")
   expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample.*imputeTimegaps")
   expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
   expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.noise = NULL)),
@@ -878,7 +899,7 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   expect_error(gm(I = list(monc = 4, dformc = 4, sf = 10)), "inspectfileobject")
   # a wear column GGIR would take its non-wear from
   expect_error(gm(rmc.col.wear = 6), "rmc.col.wear")
-  unlink(c(a$file, iso$file))
+  unlink(c(a$file, iso$file, ap$file))
 })
 
 test_that("M's text round trip, taken once per distinct value, is R's element by element", {

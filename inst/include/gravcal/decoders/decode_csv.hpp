@@ -30,7 +30,9 @@
 // time_utc_offset seconds subtracted: a zone of fixed offset), for GGIR's
 // gap imputation, or time_iso = 1: ISO 8601 text as data.table::fread reads
 // it into date-times, less time_utc_offset (csv_text::FreadDateTime; an
-// Axivity csv export's text time)), time_offset (seconds added to numeric time), dec
+// Axivity csv export's text time)), time_mul (numeric time multiplied by
+// it instead: 86400 for ActivPAL days), time_offset (seconds added to
+// numeric time; time_utc_offset then subtracted from it too), dec
 // ("," for decimal commas), sf (required), and the units: acc_div (1000
 // for mg), acc_scale, bit (1 unsigned, 2 signed) with bit_pow (2^bitrate)
 // and bit_range, temp_unit (1 K, 2 F). Values are converted as GGIR's

@@ -7,8 +7,9 @@
 //
 // CsvTimeStamps turns the time field of a data line into seconds since 1970
 // and follows the sequence of those times. A time field is read in one of
-// four ways: as a number (plain csv, or an ad hoc csv's time_div column,
-// divided by time_div and shifted by time_offset), as a date-time in the
+// four ways: as a number (plain csv, or an ad hoc csv's numeric column,
+// divided by time_div or multiplied by time_mul, shifted by time_offset,
+// less time_utc_offset), as a date-time in the
 // ActiGraph header's date order, as text by an ad hoc csv's strptime()
 // format (time_format), or as ISO 8601 text the way data.table::fread reads
 // it (time_iso). The sequence of times is checked line by line: a stamp
@@ -59,6 +60,7 @@ class CsvTimeStamps {
     if (adhoc_) {
       adhoc_skip_ = static_cast<std::int64_t>(opts.num("skip", 0));
       time_div_ = opts.num("time_div", 0);
+      time_mul_ = opts.num("time_mul", 0);
       time_offset_ = opts.num("time_offset", 0);
       time_fmt_ = opts.str("time_format", "");
       time_iso_ = opts.num("time_iso", 0) != 0;
@@ -108,14 +110,24 @@ class CsvTimeStamps {
       } else if (!csv_text::parse_number(f.b, f.e, layout_.dec, number_rule_, t)) {
         return false;
       }
-      if (adhoc_) {
-        // (t / 1 is t: the division only for milliseconds and days)
-        if (time_div_ != 1) t = t / time_div_;
-        t = t + time_offset_;
-      }
+      if (adhoc_) t = adhoc_number(t);
       return true;
     }
     return dt_.parse(f.b, f.e, t, frac_digits);
+  }
+
+  // An ad hoc csv's numeric time stamp `v` in seconds since 1970, in
+  // GGIR's operations and order: v / time_div (milliseconds; v / 1 is v:
+  // not taken), or v * time_mul (ActivPAL days: read.myacc.csv's
+  // v * 86400), plus time_offset (the origin), less time_utc_offset (a
+  // zone of fixed offset GGIR forces the stamps into: lubridate::force_tz()
+  // on whole seconds, whose result is the rounded (t - offset) as well).
+  double adhoc_number(double v) const {
+    if (time_mul_ != 0) v = v * time_mul_;
+    else if (time_div_ != 1) v = v / time_div_;
+    v = v + time_offset_;
+    if (time_utc_offset_ != 0) v = v - time_utc_offset_;
+    return v;
   }
 
   // The time of a stamped line: its stamp (plus k / sf for the k-th line of
@@ -157,10 +169,7 @@ class CsvTimeStamps {
   // conversion, and the checks with its resolution (time_of() gives 9
   // decimals: res 0, never coarse).
   GRAVCAL_CSV_INLINE double number_stamp(double s, std::int64_t number, std::int64_t offset) {
-    if (adhoc_) {
-      if (time_div_ != 1) s = s / time_div_;
-      s = s + time_offset_;
-    }
+    if (adhoc_) s = adhoc_number(s);
     if (s == last_stamp_) ++run_;
     else run_ = 0;
     last_stamp_ = s;
@@ -306,7 +315,7 @@ class CsvTimeStamps {
   std::int64_t run_ = 0;  // lines since the stamp last changed
   // ad hoc csv (format "adhoc_csv"): how its time column is read, from options
   std::int64_t adhoc_skip_ = 0;  // lines before the data
-  double time_div_ = 0, time_offset_ = 0;
+  double time_div_ = 0, time_mul_ = 0, time_offset_ = 0;
   std::string time_fmt_;  // text time stamps' strptime() format ("": not read)
   bool time_iso_ = false;  // text time stamps read as fread reads ISO 8601 date-times
   csv_text::FreadDateTime iso_;
