@@ -22,6 +22,7 @@
 #include "gravcal/decoders/decode_cwa.hpp"
 #include "gravcal/decoders/decode_geneactiv.hpp"
 #include "gravcal/ggir/ggir_blocks.hpp"
+#include "gravcal/ggir/ggir_epochs.hpp"
 #include "gravcal/gravcal.hpp"
 #include "gravcal/host/segmenter.hpp"
 #include "gravcal/ggir/icp.hpp"
@@ -945,6 +946,60 @@ static void test_cwa_word_sum() {
   CHECK(bad == 0);
 }
 
+// GGIR's running median (ggir_epochs.hpp's rolling_median(), zoo's
+// rollmedian with fill 0) against the plain rule: each window sorted
+// stably (equal values, -0 and +0 among them, in their order in time),
+// its middle value, to the bit; NaN where the window holds one. Sensor-like
+// data with many ties, signed zeros, NaN runs, widths 1 to 51.
+static void test_rolling_median() {
+  std::mt19937 rng(2024);
+  std::uniform_int_distribution<int> level(-40, 40);
+  std::uniform_real_distribution<double> u(0, 1);
+  int bad = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::size_t N = 50 + static_cast<std::size_t>(trial) * 37;
+    std::vector<double> v(N);
+    for (std::size_t i = 0; i < N; ++i) {
+      const double r = u(rng);
+      if (r < 0.1) v[i] = 0.0;
+      else if (r < 0.2) v[i] = -0.0;
+      else if (r < 0.6) v[i] = level(rng) / 256.0;  // ties, as a 8-bit sensor gives
+      else v[i] = u(rng) - 0.5;
+    }
+    if (trial % 4 == 3) {
+      for (std::size_t i = N / 3; i < N / 3 + 5 && i < N; ++i) v[i] = std::nan("");
+    }
+    for (std::size_t k = 1; k <= 51; k += 2) {
+      std::vector<double> out;
+      gravcal::ggir_part1::rolling_median(v, k, out);
+      if (out.size() != N) {
+        ++bad;
+        continue;
+      }
+      const std::size_t m = k / 2;
+      for (std::size_t i = 0; i < N; ++i) {
+        double want = 0.0;
+        if (k <= N && i >= m && i + m < N) {
+          std::vector<double> w(v.begin() + static_cast<std::ptrdiff_t>(i - m),
+                                v.begin() + static_cast<std::ptrdiff_t>(i + m + 1));
+          bool nan = false;
+          for (double a : w) nan = nan || std::isnan(a);
+          if (nan) {
+            want = std::nan("");
+          } else {
+            std::stable_sort(w.begin(), w.end());
+            want = w[m];
+          }
+        }
+        const bool same = (std::isnan(want) && std::isnan(out[i])) ||
+                          std::memcmp(&want, &out[i], sizeof want) == 0;
+        if (!same) ++bad;
+      }
+    }
+  }
+  CHECK(bad == 0);
+}
+
 int main(int argc, char** argv) {
   if (argc > 1 && std::strcmp(argv[1], "--digest") == 0) {
     // --digest baseline: without the AVX2 paths
@@ -965,6 +1020,7 @@ int main(int argc, char** argv) {
   test_model();
   test_segmenter();
   test_bins();
+  test_rolling_median();
   test_gradient<double>(1e-4);
   test_gradient<float>(5e-3);
   std::printf("core: %s\n", failures ? "FAILED" : "all checks passed");
