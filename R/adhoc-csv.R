@@ -44,11 +44,6 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
   }
   gaps <- isTRUE(p$rmc.check4timegaps) && length(p$rmc.col.time) > 0
   resample <- isTRUE(p$rmc.doresample) && length(p$rmc.col.time) > 0
-  if (resample && !p$rmc.unit.time %in% c("UNIXsec", "UNIXmsec", "character", "POSIX")) {
-    refuse("rmc.doresample", paste0("resampled with a time column in UNIX seconds or ",
-                                    "milliseconds, or text, not rmc.unit.time = \"",
-                                    p$rmc.unit.time, "\""))
-  }
   header <- rmc_header(p, file)
   sf <- rmc_sf(p, header, file)
   from_header <- function(nm) {

@@ -150,7 +150,7 @@ ggir_param_table <- function() {
                   "ISO 8601 text as \"POSIX\", repeated whole-second stamps, ActivPAL days ",
                   "across a change of desiredtz's UTC offset, a block whose first stamp exists twice or ",
                   "not at all in the zone, and reader = \"reference\" refused")),
-      list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX or text time column: honoured (block by block resampling; text time as for rmc.check4timegaps); ActivPAL days refused"),
+      list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX, ActivPAL or text time column: honoured (block by block resampling; time as for rmc.check4timegaps)"),
       # a wear column: g.calibrate() does not use it
       list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),
       list("rmc.dec", ".", rmc_choice(c(".", ",")), "the decimal mark"),

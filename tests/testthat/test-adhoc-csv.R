@@ -153,6 +153,12 @@ test_that("rmc.doresample: every block resampled from its time stamps, as GGIR d
   pr$rmc.sf <- 10
   pr$rmc.doresample <- TRUE
   expect_adhoc_same(f, c(pr, noise, list(chunksize = 0.5)))
+  # ActivPAL days (v * 86400 from 1899-12-30, in the session's zone)
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10.3, unit = "g", time = "ActivPAL")
+  pr$rmc.sf <- 10
+  pr$rmc.doresample <- TRUE
+  b <- expect_adhoc_same(f, c(pr, noise))
+  expect_gt(b$ggir$npoints, 100)
   # GGIR's own reader through data.table (reader = "reference") does not
   # resample: an error naming the parameter
   expect_error(suppressWarnings(gravcal::g.calibrate(
@@ -341,11 +347,9 @@ test_that("rmc.* parameters gravcal does not implement, or cannot use, are error
   # through fread, which drops the fractions of a second (see the gap tests)
   expect_error(gc(rmc.check4timegaps = TRUE),
                "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"POSIX\" is not supported")
-  # rmc.doresample: the same ISO 8601 text, and ActivPAL days
+  # rmc.doresample: the same ISO 8601 text
   expect_error(gc(rmc.doresample = TRUE),
                "`rmc.doresample` = TRUE with `rmc.unit.time` = \"POSIX\" is not supported", fixed = TRUE)
-  expect_error(gc(rmc.doresample = TRUE, rmc.unit.time = "ActivPAL"),
-               "not rmc.unit.time = \"ActivPAL\"", fixed = TRUE)
   expect_error(gc(rmc.unit.acc = "kg"), "`rmc.unit.acc` must be one of \"g\", \"mg\", \"bit\"")
   expect_error(gc(rmc.unit.acc = "bit"), "`rmc.unit.acc` = \"bit\" needs `rmc.bitrate`")
   expect_error(gc(rmc.col.acc = c(2, 2, 3)), "`rmc.col.acc` must be 3 different column numbers")
@@ -441,7 +445,7 @@ test_that("rmc.check4timegaps: samples equal read.myacc.csv's, block by block", 
   }
 })
 
-test_that("ActivPAL days: time stamps equal read.myacc.csv's to the bit, forced into desiredtz", {
+test_that("ActivPAL days: time stamps equal read.myacc.csv's to the bit, forced into desiredtz, resampled", {
   skip_if_not_installed("GGIR")
   skip_if_not_installed("data.table")
   n <- 3700
@@ -456,20 +460,27 @@ test_that("ActivPAL days: time stamps equal read.myacc.csv's to the bit, forced 
              rmc.sf = 10, rmc.unit.time = "ActivPAL", rmc.check4timegaps = TRUE)
   B <- 185
   # GGIR: v * 86400 from 1899-12-30, then lubridate::force_tz() into
-  # desiredtz (+05:30, +05:45, and a zone with daylight saving in winter)
+  # desiredtz (+05:30, +05:45, and a zone with daylight saving in winter);
+  # and each block resampled from its first stamp (rmc.doresample; gaps
+  # filled first)
   for (tz in c("Asia/Kolkata", "Asia/Kathmandu", "Europe/Berlin")) {
-    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = tz, ggir = FALSE)
-    expect_identical(lay$opts$time_mul, 86400)
-    h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = 1), lay$opts))
-    for (i in seq_len(n / B)) {
-      G <- do.call(GGIR:::read.myacc.csv, c(list(rmc.file = f, rmc.nrow = B, rmc.skip = (i - 1) * B,
-                                                 desiredtz = tz), pr))$data
-      g <- gravcal:::native_block(h, max_units = B, time = TRUE, capacity = 10000)
-      expect_equal(g$to, nrow(G), label = paste(tz, "block", i))
-      expect_identical(g$cols$time[seq_len(g$to)], G$time, label = paste(tz, "block", i, "time"))
-      expect_identical(g$cols$x[seq_len(g$to)], G$x, label = paste(tz, "block", i, "x"))
+    for (rs in c(FALSE, TRUE)) {
+      p <- c(pr, list(rmc.doresample = rs))
+      lay <- gravcal:::rmc_layout(gravcal:::rmc_values(p), f, tz = tz, ggir = FALSE)
+      expect_identical(lay$opts$time_mul, 86400)
+      h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = 1), lay$opts))
+      for (i in seq_len(n / B)) {
+        G <- do.call(GGIR:::read.myacc.csv, c(list(rmc.file = f, rmc.nrow = B, rmc.skip = (i - 1) * B,
+                                                   desiredtz = tz), p))$data
+        g <- gravcal:::native_block(h, max_units = B, time = TRUE, capacity = 10000)
+        lab <- paste(tz, rs, "block", i)
+        expect_equal(g$to, nrow(G), label = lab)
+        for (v in c("time", "x", "temperature")) {
+          expect_identical(g$cols[[v]][seq_len(g$to)], G[[v]], label = paste(lab, v))
+        }
+      }
+      gravcal:::gc_decoder_close(h$ptr)
     }
-    gravcal:::gc_decoder_close(h$ptr)
   }
   # a recording across a change of desiredtz's UTC offset: refused, naming it
   d$time <- sprintf("%.10f", (as.numeric(as.POSIXct("2024-03-31 00:59:00", tz = "UTC")) +

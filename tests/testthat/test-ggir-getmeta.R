@@ -825,6 +825,13 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(windowsizes = c(5, 600, 3600))))
   expect_same_meta(b)
   expect_lt(nrow(b$gravcal$metashort), 4 * 720)
+  # the same clock's time as ActivPAL days, forced into Asia/Kolkata
+  a <- meta_adhoc(time = "ActivPAL", true_sf = 10.3, start = "2024-01-01 10:00:00")
+  pr <- utils::modifyList(a$pr, list(rmc.sf = 10, rmc.doresample = TRUE))
+  b <- meta_both(a$file, list(params_rawdata = pr, params_general = list(
+    windowsizes = c(5, 600, 3600), desiredtz = "Asia/Kolkata")))
+  expect_same_meta(b)
+  expect_lt(nrow(b$gravcal$metashort), 4 * 720)
   # and rmc.check4timegaps before it (imputeTimegaps = FALSE: GGIR carries
   # read.myacc.csv's last sample before the resampling to the next block)
   a <- meta_adhoc(time = "UNIXsec", true_sf = 10.3, drop = drop, zeros = 20000:20050)
