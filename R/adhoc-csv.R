@@ -97,11 +97,6 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
     if (unit %in% c("UNIXsec", "UNIXmsec")) {
       opts$time_div <- if (unit == "UNIXmsec") 1000 else 1
       opts$time_offset <- origin
-      # the first stamp, for what needs the start before the samples are
-      # read (g.getmeta()'s zone table of long gaps: meta_source())
-      line <- if (length(first) > skip) first[skip + 1] else NA_character_
-      v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
-      if (length(v) == 1 && is.finite(v)) opts$start_time <- v / opts$time_div + origin
     } else if (unit == "ActivPAL") {
       # days since 1899-12-30, as read.myacc.csv() reads them: v * 86400
       # from the origin, then forced into desiredtz (time_utc_offset, set
@@ -139,12 +134,13 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
     g <- rmc_time_opts(p, file, skip, tz, what)
     opts[names(g)] <- g
   }
-  if (identical(opts$time_mul, 86400)) {
+  # a numeric time column's first stamp, for what needs the start before
+  # the samples are read (g.getmeta()'s zone table of long gaps:
+  # meta_source()), converted as the decoder converts every stamp
+  if (!is.null(opts$time_offset)) {
     line <- if (length(first) > skip) first[skip + 1] else NA_character_
     v <- suppressWarnings(as.numeric(rmc_fields(line)[p$rmc.col.time]))
-    if (length(v) == 1 && is.finite(v)) {
-      opts$start_time <- (v * opts$time_mul + opts$time_offset) - (opts$time_utc_offset %||% 0)
-    }
+    if (length(v) == 1 && is.finite(v)) opts$start_time <- rmc_number_time(v, opts)
   }
   if (gaps) opts$timegaps <- as.numeric(sf)
   if (gaps && stamps) opts$timegaps_carry <- 1
@@ -152,6 +148,17 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
        serial = if (length(p$rmc.headername.sn)) {
          header$value[match(p$rmc.headername.sn[1], header$name)]
        })
+}
+
+# A numeric time stamp `v` in seconds since 1970 as the decoder's
+# adhoc_number() (decode_csv_time.hpp) converts it from the options `o`, in
+# GGIR's operations and order: v / time_div (v / 1 not taken) or
+# v * time_mul, + time_offset, - time_utc_offset (when not 0).
+rmc_number_time <- function(v, o) {
+  v <- if (!is.null(o$time_mul)) v * o$time_mul else if (o$time_div != 1) v / o$time_div else v
+  v <- v + o$time_offset
+  if (!is.null(o$time_utc_offset) && o$time_utc_offset != 0) v <- v - o$time_utc_offset
+  v
 }
 
 # `rmc` (the rmc.* parameters) with the zone GGIR reads text time in
@@ -210,50 +217,47 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
     abort(lead, " with `rmc.unit.time` = \"", unit, "\" is not supported by ",
           "gravcal (", why, "); GGIR reads such files.")
   }
-  {
-    fmt <- p$rmc.format.time
-    d <- regmatches(fmt, gregexpr("%O?.", fmt))[[1]]
-    bad <- setdiff(d, c("%Y", "%y", "%m", "%d", "%H", "%M", "%S", "%OS", "%T", "%%"))
-    if (length(bad)) {
-      refuse(paste0("its text time is read with `rmc.format.time` directives ",
-                    "%Y %y %m %d %H %M %S %OS %T only, not ", paste(bad, collapse = " ")))
-    }
-    t <- as.numeric(as.POSIXct(stamps, format = fmt, tz = "UTC"))
-    # GGIR spreads whole-second stamps that repeat over the second
-    # ("POSIX"): not reproduced. What GGIR 3.3-9's read.myacc.csv() does,
-    # per block of lines, when the block's first 1000 stamps repeat one and
-    # sf is given: with b the ends of the runs of equal stamps (1 first,
-    # duplicates dropped, the block's last line last; so a first run of one
-    # line merges with the next) and L = diff(b) (the first "run" counted one
-    # short), in this order, each an addition to the stamps, with d =
-    # (0:(sf - 1)) * (1 / sf) (seq()'s products, not quotients): runs with
-    # L == sf get d (the first run from its second line on); a first run
-    # with L != sf gets seq(1 - b[2] / sf, 1 - 1 / sf, by = 1 / sf); a last
-    # run with L != sf gets d[1:L] (NA beyond sf); with more than four b,
-    # every run after the first with L != sf (the last one again) gets
-    # d[1:L], d[sf] repeated beyond sf. A streaming wrapper under
-    # GgirTimegapsOf could replay it holding the first 1000 lines and four
-    # runs.
-    w <- t[!is.na(t)]
-    if (unit == "POSIX" && all(w == floor(w)) && anyDuplicated(w)) {
-      refuse("whole-second time stamps that repeat are spread over the second by GGIR")
-    }
-    # "POSIX": GGIR formats what fread gives; fread reads ISO 8601 stamps as
-    # date-times, whose format() drops the fraction of a second (and GGIR
-    # then spreads the repeated whole seconds)
-    if (unit == "POSIX" && any(grepl("[0-9]:[0-9]{2}[.,][0-9]", stamps)) &&
-        rmc_fread_datetime(lines[seq_len(min(5, length(lines)))], p$rmc.col.time)) {
-      refuse(paste0("GGIR reads ISO 8601 text time like \"", stamps[1], "\" through ",
-                    "data.table::fread(), losing its fractions of a second; with ",
-                    "rmc.unit.time = \"character\" GGIR keeps them and gravcal follows"))
-    }
+  fmt <- p$rmc.format.time
+  d <- regmatches(fmt, gregexpr("%O?.", fmt))[[1]]
+  bad <- setdiff(d, c("%Y", "%y", "%m", "%d", "%H", "%M", "%S", "%OS", "%T", "%%"))
+  if (length(bad)) {
+    refuse(paste0("its text time is read with `rmc.format.time` directives ",
+                  "%Y %y %m %d %H %M %S %OS %T only, not ", paste(bad, collapse = " ")))
+  }
+  t <- as.numeric(as.POSIXct(stamps, format = fmt, tz = "UTC"))
+  # GGIR spreads whole-second stamps that repeat over the second
+  # ("POSIX"): not reproduced. What GGIR 3.3-9's read.myacc.csv() does,
+  # per block of lines, when the block's first 1000 stamps repeat one and
+  # sf is given: with b the ends of the runs of equal stamps (1 first,
+  # duplicates dropped, the block's last line last; so a first run of one
+  # line merges with the next) and L = diff(b) (the first "run" counted one
+  # short), in this order, each an addition to the stamps, with d =
+  # (0:(sf - 1)) * (1 / sf) (seq()'s products, not quotients): runs with
+  # L == sf get d (the first run from its second line on); a first run
+  # with L != sf gets seq(1 - b[2] / sf, 1 - 1 / sf, by = 1 / sf); a last
+  # run with L != sf gets d[1:L] (NA beyond sf); with more than four b,
+  # every run after the first with L != sf (the last one again) gets
+  # d[1:L], d[sf] repeated beyond sf. A streaming wrapper under
+  # GgirTimegapsOf could replay it holding the first 1000 lines and four
+  # runs.
+  w <- t[!is.na(t)]
+  if (unit == "POSIX" && all(w == floor(w)) && anyDuplicated(w)) {
+    refuse("whole-second time stamps that repeat are spread over the second by GGIR")
+  }
+  # "POSIX": GGIR formats what fread gives; fread reads ISO 8601 stamps as
+  # date-times, whose format() drops the fraction of a second (and GGIR
+  # then spreads the repeated whole seconds)
+  if (unit == "POSIX" && any(grepl("[0-9]:[0-9]{2}[.,][0-9]", stamps)) &&
+      rmc_fread_datetime(lines[seq_len(min(5, length(lines)))], p$rmc.col.time)) {
+    refuse(paste0("GGIR reads ISO 8601 text time like \"", stamps[1], "\" through ",
+                  "data.table::fread(), losing its fractions of a second; with ",
+                  "rmc.unit.time = \"character\" GGIR keeps them and gravcal follows"))
   }
   t0 <- t[!is.na(t)][1]
   if (is.na(t0)) refuse("the time column's first values cannot be read")
   # (whole seconds: the text below has none of the first stamp's fraction)
   at <- floor(t0) + (0:25) * 30.44 * 86400
-  txt <- format(as.POSIXct(at, origin = "1970-01-01", tz = "UTC"), "%Y-%m-%d %H:%M:%S")
-  off <- at - as.numeric(as.POSIXct(txt, tz = zone))
+  off <- civil_offset(at, zone)
   if (!anyNA(off) && all(off == off[1])) {
     return(list(time_format = p$rmc.format.time, time_utc_offset = off[1]))
   }
@@ -297,8 +301,7 @@ rmc_activpal_zone <- function(p, file, skip, tz, what) {
   if (!is.finite(t[2])) t[2] <- t[1] + 25 * 30.44 * 86400
   span <- range(t)
   at <- floor(seq(span[1] - 86400, span[2] + 86400, by = 1800))
-  fmt <- "%Y-%m-%d %H:%M:%S"
-  off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+  off <- civil_offset(at, zone)
   if (anyNA(off) || any(off != off[1])) {
     zone_name <- paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)")
     abort(lead, " with `rmc.unit.time` = \"ActivPAL\" is not supported by gravcal for \"",

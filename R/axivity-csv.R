@@ -177,9 +177,7 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     "the session's time zone (GGIR's when desiredtz and configtz are \"\")"
   if (time$kind == "text") {
     if (!is.null(zone_table(zone))) return(c(list(time_utc_offset = 0), zone_options(zone)))
-    fmt <- "%Y-%m-%d %H:%M:%S"
-    at <- time$first
-    off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+    off <- civil_offset(time$first, zone)
     if (is.na(off)) abort(zone_name, ": R cannot convert the recording's times in this zone.")
     return(list(time_utc_offset = off))
   }
@@ -188,9 +186,7 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     # it (fread's date-times; for UNIX seconds a constant that changes
     # nothing, not applied)
     if (time$kind == "unix") return(list())
-    fmt <- "%Y-%m-%d %H:%M:%S"
-    at <- time$first
-    off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+    off <- civil_offset(time$first, zone)
     return(if (is.na(off)) list() else list(time_utc_offset = off))
   }
   # a zone whose offset changes: the recording's span (from its first and
@@ -199,8 +195,7 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
   t1 <- axivity_stamp_seconds(trimws(strsplit(last, ",", fixed = TRUE)[[1]][1]), time)
   span <- range(c(time$first, t1), na.rm = TRUE)
   at <- seq(span[1] - 86400, span[2] + 86400, by = 1800)
-  fmt <- "%Y-%m-%d %H:%M:%S"
-  off <- at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = zone))
+  off <- civil_offset(at, zone)
   if (anyNA(off) || any(off != off[1])) {
     abort(zone_name, ": the Axivity csv export \"", basename(file), "\" spans a change of UTC ",
           "offset in that zone (daylight saving), into which GGIR forces its ",

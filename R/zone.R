@@ -34,13 +34,17 @@ zone_table <- function(tz) {
   table
 }
 
+# By how much as.POSIXct() of each calendar time `at` (seconds, read as
+# UTC; whole seconds: the text has no fraction) in the zone `tz` moves it,
+# converted in the order given: the zone's UTC offset at that clock time,
+# as R gives it (NA where R cannot convert).
+civil_offset <- function(at, tz) {
+  fmt <- "%Y-%m-%d %H:%M:%S"
+  at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = tz))
+}
+
 zone_table_make <- function(tz) {
-  # by how much as.POSIXct() of each calendar time (seconds, read as UTC)
-  # in the zone moves it, converted in the order given
-  off_of <- function(at) {
-    fmt <- "%Y-%m-%d %H:%M:%S"
-    at - as.numeric(as.POSIXct(format(.POSIXct(at, tz = "UTC"), fmt), format = fmt, tz = tz))
-  }
+  off_of <- function(at) civil_offset(at, tz)
   changes <- function(v) which(v[-1] != v[-length(v)])
   lo <- as.numeric(as.POSIXct("2000-01-01", tz = "UTC"))
   hi <- as.numeric(as.POSIXct("2064-01-01", tz = "UTC"))
