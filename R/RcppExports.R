@@ -57,8 +57,8 @@ gc_crc32 <- function(bytes) {
     .Call(`_gravcal_gc_crc32`, bytes)
 }
 
-gc_meta_store <- function(temperature, time, light) {
-    .Call(`_gravcal_gc_meta_store`, temperature, time, light)
+gc_meta_store <- function(temperature, time, light, wear) {
+    .Call(`_gravcal_gc_meta_store`, temperature, time, light, wear)
 }
 
 gc_meta_store_read <- function(ptr, decoder, units, capacity, want_time) {

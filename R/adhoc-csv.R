@@ -76,6 +76,18 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
   opts$col_y <- cols[2]
   opts$col_z <- cols[3]
   if (length(p$rmc.col.temp)) opts$col_temp <- as.numeric(p$rmc.col.temp)
+  # a wear column, read as GGIR's reader reads it (TRUE/FALSE: the decoder's
+  # wear_of()): g.getmeta()'s non-wear from it; GGIR's reader stops on
+  # values that are not TRUE/FALSE (rmc_check_wear()) and on a resampled
+  # block's (the resampled column is numbers)
+  if (ggir && length(p$rmc.col.wear)) {
+    if (resample) {
+      abort("`rmc.col.wear` with `rmc.doresample` = TRUE: GGIR's reader stops on such a file ",
+            "(\"Corrupt file\": the resampled wear column is no longer TRUE/FALSE), and so ",
+            "does gravcal's. Leave out one of the two.")
+    }
+    opts$col_wear <- as.numeric(p$rmc.col.wear)
+  }
   if (p$rmc.dec == ",") opts$dec <- ","
   # the first data line: after the column-name line, if any (GGIR's test:
   # the first field of line rmc.firstrow.acc read as a number)
@@ -475,4 +487,22 @@ source_adhoc <- function(file, sf, chunksize, arg, layout, format) {
          }
          list(data = d, last = nrow(d) < B)
        })
+}
+
+# GGIR's reader stops on a block whose wear column (rmc.col.wear) fread()
+# does not read as TRUE/FALSE ("Corrupt file"); the decoder counts such
+# values ("wear_not_logical"): an error, as GGIR's stop.
+rmc_check_wear <- function(src) {
+  if (is.null(src$report)) return(invisible())
+  r <- src$report()
+  n <- unname(r$counters["wear_not_logical"])
+  if (isTRUE(n > 0)) {
+    first <- grep("wear value", r$notes, value = TRUE, fixed = TRUE)
+    abort("\"", basename(src$filename), "\": its wear column (`rmc.col.wear`) holds ", format(n),
+          " value", if (n > 1) "s", " that GGIR's reader does not read as TRUE/FALSE (it takes ",
+          "TRUE/FALSE, true/false or True/False, one spelling in each of its blocks, and ",
+          "empty or NA for none)", if (length(first)) paste0("; first: ", first[1]),
+          ". GGIR stops on such a file (\"Corrupt file\"), and so does gravcal.")
+  }
+  invisible()
 }

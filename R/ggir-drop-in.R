@@ -96,7 +96,8 @@
 #' | `rmc.dec` | honoured (`","` with `;` or tab separated fields) |
 #' | `rmc.noise` | honoured: rest is sd below `1.2 * rmc.noise` (GGIR's default 13 when not given) |
 #' | `rmc.col.time`, `rmc.unit.time`, `rmc.format.time`, `rmc.origin` | accepted (the calibration does not use time, except with `rmc.doresample` and `rmc.check4timegaps`); a text time that `rmc.format.time` does not read is an error (GGIR then reads no data) |
-#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid`, `rmc.col.wear` | accepted: no effect on the calibration (text time is read in `configtz`, else `desiredtz`, as GGIR's g.readaccfile() hands them to read.myacc.csv, whatever `rmc.configtz` and `rmc.desiredtz` say) |
+#' | `rmc.desiredtz`, `rmc.configtz`, `rmc.headername.sn`, `rmc.headername.recordingid` | accepted: no effect on the calibration (text time is read in `configtz`, else `desiredtz`, as GGIR's g.readaccfile() hands them to read.myacc.csv, whatever `rmc.configtz` and `rmc.desiredtz` say) |
+#' | `rmc.col.wear` | its flags read as GGIR's reader reads them (TRUE/FALSE, true/false or True/False, one spelling per block; empty or NA for none): no effect on the calibration; flags it does not read as TRUE/FALSE (1/0, say), or with `rmc.doresample`, an error, as GGIR's reader stops ("Corrupt file") |
 #' | `rmc.doresample = TRUE` with a time column | honoured for UNIX seconds or milliseconds, ActivPAL days (as for `rmc.check4timegaps`) and text time (`"character"`, `"POSIX"`, read by `rmc.format.time` as for `rmc.check4timegaps`): every block resampled from its first time stamp to its last at the rate, as `interpolationType` says; the time `rmc.check4timegaps` refuses, refused with an error |
 #' | `rmc.check4timegaps = TRUE` with a time column | honoured: in each block of lines, samples with x = y = z = 0 dropped (the block's first becomes 0, 0, 1, its last takes the values before it) and every step of at least 0.25 s (or 2 / sf) filled by repeating the sample before it (normalised when its norm exceeds 1.005), as GGIR's `g.imputeTimegaps()` does, before `rmc.doresample`; a gap between two blocks stays, as in GGIR. For UNIX seconds or milliseconds, ActivPAL days, and text time read by `rmc.format.time` with `%Y %y %m %d %H %M %S %OS %T` in the zone `configtz`, else `desiredtz` (across changes of its UTC offset too, as for `.cwa`). Refused with an error: other directives, ActivPAL days across a change of UTC offset of `desiredtz` (into which GGIR forces them), a block of GGIR's reading whose first stamp exists twice or not at all in the zone, ISO 8601 text time as `"POSIX"` with fractions of a second (GGIR reads it through `fread()`, which drops them; `"character"` keeps them), whole-second text stamps that repeat, `reader = "reference"` |
 #'
@@ -195,6 +196,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                         printsummary = pr$printsummary)
   if (identical(src$format, rmc_format()) && !is.null(rmc)) {
     ggir_check_zone_read(src, attr(rmc, "tz") %||% "", attr(rmc, "tz_arg"))
+    rmc_check_wear(src)
   } else {
     ggir_check_zone_read(src, tz %||% "", tz_arg)
   }

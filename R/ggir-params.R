@@ -151,8 +151,11 @@ ggir_param_table <- function() {
                   "across a change of desiredtz's UTC offset, a block whose first stamp exists twice or ",
                   "not at all in the zone, and reader = \"reference\" refused")),
       list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX, ActivPAL or text time column: honoured (block by block resampling; time as for rmc.check4timegaps)"),
-      # a wear column: g.calibrate() does not use it
-      list("rmc.col.wear", NULL, rmc_whole, "a wear column (not used by g.calibrate())"),
+      # a wear column: g.calibrate() does not use its flags, but GGIR's
+      # reader stops on flags that are not TRUE/FALSE (rmc_check_wear())
+      list("rmc.col.wear", NULL, rmc_whole,
+           paste0("a wear column: its flags read as GGIR reads them, not used by g.calibrate(); ",
+                  "flags that are not TRUE/FALSE, or with rmc.doresample, an error as GGIR's reader stops")),
       list("rmc.dec", ".", rmc_choice(c(".", ",")), "the decimal mark"),
       list("rmc.scalefactor.acc", 1, function(x, arg) check_number(x, arg),
            "a factor on the acceleration")

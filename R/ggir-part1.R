@@ -41,12 +41,15 @@
 #' UNIX seconds or milliseconds, text by `rmc.format.time` in `configtz`,
 #' else `desiredtz`, or ActivPAL days forced into `desiredtz` (a recording
 #' across a change of its UTC offset refused); GGIR's AD_HOC non-wear, sd below `1.2 * rmc.noise`, and
-#' clipping beyond `rmc.dynamic_range`, none without it; time gaps filled by
+#' clipping beyond `rmc.dynamic_range`, none without it; with `rmc.col.wear`,
+#' GGIR's non-wear from the wear flags (each long epoch's most frequent flag
+#' in its non-wear window, times 3; flags GGIR's reader stops on, or a
+#' window without one, an error as GGIR stops); time gaps filled by
 #' `imputeTimegaps` and `rmc.check4timegaps`, each block from the block
 #' before, GGIR's times slipping by two rows after a single sample between
 #' two gaps as they do in GGIR; `rmc.doresample`). Refused with an error
 #' naming it: no `rmc.col.time` (GGIR's g.getmeta() stops without time
-#' stamps), `rmc.noise` empty (GGIR stops), `rmc.col.wear`, `rmc.check4timegaps` with `rmc.doresample` and `imputeTimegaps`
+#' stamps), `rmc.noise` empty (GGIR stops), `rmc.check4timegaps` with `rmc.doresample` and `imputeTimegaps`
 #' (GGIR fills each block from the resampled block before), `rmc.dynamic_range`
 #' naming a header row without `dynrange`, a deprecated `rmc.configtz` or
 #' `rmc.desiredtz` other than the zone GGIR hands its reader (GGIR's reads
@@ -289,10 +292,6 @@ meta_rmc <- function(p) {
   if (!length(rmc$rmc.noise)) {
     abort("`rmc.noise` is not given: GGIR's g.getmeta() stops on an ad hoc csv file ",
           "without it (its non-wear sd criterion is 1.2 * rmc.noise), and so does gravcal's.")
-  }
-  if (length(rmc$rmc.col.wear)) {
-    refuse("rmc.col.wear", paste0("GGIR's non-wear from a wear column is not reproduced by ",
-                                  "gravcal's g.getmeta(); use GGIR::g.getmeta()"))
   }
   # (with imputeTimegaps = FALSE GGIR carries read.myacc.csv's own last
   # sample, before the resampling, as the decoder does)

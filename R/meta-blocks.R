@@ -114,11 +114,12 @@ meta_clock_table <- function(zone, start, days = 400) {
 meta_store <- function(src, time) {
   cols <- if (!is.null(src$native)) {
     c(temperature = isTRUE(src$native$info$temperature),
-      light = isTRUE(src$native$info$light))
+      light = isTRUE(src$native$info$light), wear = isTRUE(src$native$info$wear))
   } else {
-    c(temperature = !is.null(src$samples$temperature), light = !is.null(src$samples$light))
+    c(temperature = !is.null(src$samples$temperature), light = !is.null(src$samples$light),
+      wear = FALSE)
   }
-  store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]])
+  store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]], cols[["wear"]])
   want_time <- !isFALSE(format_entry(src$format)$ggir_time)
   if (!is.null(src$native)) {
     read <- function() gc_meta_store_read(store, src$native$ptr, src$units, 2^20, want_time)
@@ -134,7 +135,7 @@ meta_store <- function(src, time) {
     }
   }
   list(store = store, read = read, temperature = cols[["temperature"]],
-       light = cols[["light"]], keep_time = time, want_time = want_time)
+       light = cols[["light"]], wear = cols[["wear"]], keep_time = time, want_time = want_time)
 }
 
 # Rows `i` of a block (a list of equal-length columns).
@@ -221,6 +222,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     size_before <- gc_meta_store_size(store)
     info <- ms$read()
+    if (ms$wear) rmc_check_wear(src)
     nr <- info$n
     marked <- FALSE
     if (isTRUE(src$epoch_gaps)) {

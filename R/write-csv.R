@@ -170,13 +170,18 @@ write_axivity_csv <- function(x, file, true_sf, start = "2024-01-01 00:00:00",
 # "C", "K" (written as GGIR reads it back: t - 272.15) or "F"; `sep` and
 # `dec`: separator and decimal mark. The sampling rate goes to rmc.sf, or
 # with `sf_header = TRUE` to a header line "sample_rate_hz,<sf>" read by
-# rmc.headername.sf.
+# rmc.headername.sf. `wear`: a wear flag's text per sample ("TRUE",
+# "FALSE", NA for none, ...), written as the last column (rmc.col.wear).
 write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
                             unit = "g", time = "none", temperature = TRUE,
                             temp_unit = "C", bitrate = 12, dynamic_range = 8,
                             digits = 4, sep = ",", dec = ".", sf_header = FALSE,
-                            start = "2024-01-01 00:00:00", drop = integer()) {
+                            start = "2024-01-01 00:00:00", drop = integer(), wear = NULL) {
   s <- as_samples(x)
+  if (!is.null(wear) && (!is.character(wear) || length(wear) != s$n)) {
+    abort("`wear` must be a character vector with a value per sample (\"TRUE\", \"FALSE\", NA ...), not ",
+          describe(wear), ".")
+  }
   if (sf_header) header <- c(header, paste0("sample_rate_hz", sep, format(sf)))
   acc <- switch(unit,
     g = function(a) round(a, digits),
@@ -198,6 +203,7 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
     character = format(as.POSIXct(t, origin = "1970-01-01", tz = "UTC") + 5e-5,
                        "%d/%m/%Y %H:%M:%OS3"))
   if (!is.null(tcol)) d <- c(list(time = tcol), d)
+  if (!is.null(wear)) d$wear <- wear
   if (length(drop)) d <- lapply(d, function(v) v[-drop])
   writeLines(c(header, if (colnames) paste(names(d), collapse = sep)), file)
   data.table::fwrite(d, file, append = TRUE, col.names = FALSE, sep = sep, dec = dec)
@@ -209,6 +215,7 @@ write_adhoc_csv <- function(x, file, sf, header = character(), colnames = TRUE,
     p$rmc.col.temp <- k + 4
     p$rmc.unit.temp <- temp_unit
   }
+  if (!is.null(wear)) p$rmc.col.wear <- length(d)
   if (!is.null(tcol)) {
     p$rmc.col.time <- 1
     p$rmc.unit.time <- time

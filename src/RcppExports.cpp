@@ -163,14 +163,15 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_meta_store
-SEXP gc_meta_store(bool temperature, bool time, bool light);
-RcppExport SEXP _gravcal_gc_meta_store(SEXP temperatureSEXP, SEXP timeSEXP, SEXP lightSEXP) {
+SEXP gc_meta_store(bool temperature, bool time, bool light, bool wear);
+RcppExport SEXP _gravcal_gc_meta_store(SEXP temperatureSEXP, SEXP timeSEXP, SEXP lightSEXP, SEXP wearSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< bool >::type temperature(temperatureSEXP);
     Rcpp::traits::input_parameter< bool >::type time(timeSEXP);
     Rcpp::traits::input_parameter< bool >::type light(lightSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_meta_store(temperature, time, light));
+    Rcpp::traits::input_parameter< bool >::type wear(wearSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store(temperature, time, light, wear));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -527,7 +528,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_close", (DL_FUNC) &_gravcal_gc_decoder_close, 1},
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
-    {"_gravcal_gc_meta_store", (DL_FUNC) &_gravcal_gc_meta_store, 3},
+    {"_gravcal_gc_meta_store", (DL_FUNC) &_gravcal_gc_meta_store, 4},
     {"_gravcal_gc_meta_store_read", (DL_FUNC) &_gravcal_gc_meta_store_read, 5},
     {"_gravcal_gc_meta_store_put", (DL_FUNC) &_gravcal_gc_meta_store_put, 3},
     {"_gravcal_gc_meta_store_rows", (DL_FUNC) &_gravcal_gc_meta_store_rows, 3},

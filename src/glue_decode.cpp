@@ -90,7 +90,7 @@ Rcpp::List info_list(const gravcal::DeviceInfo& d) {
       Rcpp::Named("start_time") = d.start_time,
       Rcpp::Named("temperature") = d.has_temperature,
       Rcpp::Named("time") = d.has_time, Rcpp::Named("light") = d.has_light,
-      Rcpp::Named("range_g") = d.range_g, Rcpp::Named("header_text") = d.header_text);
+      Rcpp::Named("wear") = d.has_wear, Rcpp::Named("range_g") = d.range_g, Rcpp::Named("header_text") = d.header_text);
 }
 
 }  // namespace

@@ -77,11 +77,11 @@ std::size_t rows_used(const Store& s, double n_use) {
 
 }  // namespace
 
-// A store for one of g.getmeta()'s blocks, with a temperature, time and
-// light column where asked.
+// A store for one of g.getmeta()'s blocks, with a temperature, time,
+// light and wear column where asked.
 // [[Rcpp::export(rng = false)]]
-SEXP gc_meta_store(bool temperature, bool time, bool light) {
-  return Rcpp::XPtr<Store>(new Store(temperature, time, light), true);
+SEXP gc_meta_store(bool temperature, bool time, bool light, bool wear) {
+  return Rcpp::XPtr<Store>(new Store(temperature, time, light, wear), true);
 }
 
 // One block from an open decoder (gc_decoder_open()'s ptr) appended to the
@@ -109,11 +109,11 @@ Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capac
 // Rows given from R (samples in memory) appended, or (`from` >= 0) put in
 // place of the rows from `from` on (R's imputation of the rows read): a
 // list of columns x, y, z and, where the store keeps them, temperature,
-// time, light (absent: NA). Returns what gc_meta_store_read() returns.
+// time, light, wear (absent: NA). Returns what gc_meta_store_read() returns.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_meta_store_put(SEXP ptr, const Rcpp::List& cols, double from) {
   Store* s = store(ptr);
-  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light"};
+  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light", "wear"};
   const R_xlen_t n = Rf_xlength(cols["x"]);
   const double* src[Store::kCols];
   for (int c = 0; c < Store::kCols; ++c) {
@@ -139,7 +139,7 @@ Rcpp::List gc_meta_store_rows(SEXP ptr, double from, double count) {
   if (!(from >= 0) || !(count >= 0) || from + count > static_cast<double>(s->size()))
     Rcpp::stop("rows beyond the block");
   const std::size_t a = static_cast<std::size_t>(from), k = static_cast<std::size_t>(count);
-  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light"};
+  const char* names[Store::kCols] = {"x", "y", "z", "temperature", "time", "light", "wear"};
   Rcpp::List out;
   for (int c = 0; c < Store::kCols; ++c) {
     if (!s->has(c)) continue;
@@ -299,6 +299,9 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   arith.rec_fused = rec_fused;
   gravcal::ggir_part1::RunColumn::Cursor lcur(li ? *li : empty);
   auto light_at = [&lcur](std::size_t i) { return lcur(i); };
+  // an ad hoc csv file's wear flags: GGIR's non-wear from them
+  const gravcal::ggir_part1::RunColumn* we = s->runs(Store::kWear);
+  const std::function<double(std::size_t)> wear_at = [we](std::size_t i) { return we->at(i); };
   Rcpp::List shorts(metrics.size());
   Rcpp::List out;
   try {
@@ -310,7 +313,7 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
       const double* xyz[3] = {cx, cy, cz};
-      const p1::NonwearResult r = p1::nonwear_clipping<Acc>(xyz, un, nw);
+      const p1::NonwearResult r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
       const double M = windowsizes[1] * sf;
       out = Rcpp::List::create(
           Rcpp::Named("short") = shorts, Rcpp::Named("nonwear") = as_r(r.nonwear),

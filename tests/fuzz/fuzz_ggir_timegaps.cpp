@@ -14,7 +14,9 @@
 // g.getmeta()'s mode instead: the previous block carried, a 1-minute limit
 // beyond which gaps are imputed as whole epochs (checked: each reported at
 // a sample given, with more than one epoch left), times of day read in a
-// zone whose offset changes.
+// zone whose offset changes. With a temperature column and the last byte's
+// bit 6 set, a wear column after it (rmc.col.wear): every flag given is 1,
+// 0 or NaN, and a resampled block asks for none (its decoder has none).
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -61,6 +63,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.set("col_y", 3.0);
   o.set("col_z", 4.0);
   if (mode & 4) o.set("col_temp", 5.0);
+  const bool wear = (mode & 4) && (data[size - 1] & 0x40) != 0;
+  if (wear) o.set("col_wear", 6.0);
   o.set("buffer", 64.0 + 61.0 * (mode >> 5));
   std::unique_ptr<gravcal::CsvDecoder> csv(new gravcal::CsvDecoder(src, o, "adhoc_csv"));
   const bool resample = (mode & 8) != 0;
@@ -82,8 +86,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     dec.reset(gaps.release());
   }
   if (!dec->open()) return 0;
+  if (dec->info().has_wear != (wear && !resample)) __builtin_trap();
   const std::size_t cap = 1 + (mode >> 3);  // 1 .. 32
-  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap), w(cap, 0.5);
   const std::int64_t max_units = (mode & 0x40) ? -1 : 1 + (mode >> 5) * 3;
   const double k = std::fmax(0.25, 2 / sf);
   std::int64_t given = 0;
@@ -92,6 +97,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (int calls = 0; calls < 50000 && !dec->done() && given < 200000; ++calls) {
     gravcal::SampleBuffer b;
     b.x = x.data(); b.y = y.data(); b.z = z.data(); b.t = t.data(); b.time = tm.data();
+    if (dec->info().has_wear) b.wear = w.data();
     b.capacity = cap;
     const std::int64_t u = dec->read(b, max_units);
     if (b.n > cap) __builtin_trap();
@@ -99,6 +105,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (u == 0 && b.n == 0 && !dec->done()) __builtin_trap();  // no progress
     for (std::size_t i = 0; i < b.n; ++i) {
       if (!resample && x[i] == 0 && y[i] == 0 && z[i] == 0) __builtin_trap();
+      if (b.wear != nullptr && !(w[i] == 0 || w[i] == 1 || std::isnan(w[i]))) __builtin_trap();
       const double step = tm[i] - last;
       // a filled gap leaves steps of 1 / sf; one of k or more only where its
       // fill would pass the limit (1e8 samples) or the times are not finite

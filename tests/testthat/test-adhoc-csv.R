@@ -125,6 +125,39 @@ test_that("ad hoc csv with idle-sleep zeros and a time column is GGIR's", {
   expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
 })
 
+test_that("a wear column (rmc.col.wear): g.calibrate() is GGIR's, and stops where GGIR's reader stops", {
+  skip_if_quick()
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("data.table")
+  # the flags do not enter the calibration; GGIR's reader (g.readaccfile())
+  # stops on a block whose flags fread() does not read as TRUE/FALSE
+  rec <- adhoc_rec(seed = 23)
+  n <- nrow(rec)
+  flags <- rep("TRUE", n)
+  flags[1:5000] <- "FALSE"
+  flags[7000:7100] <- NA
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  pr <- gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "UNIXsec", wear = flags)
+  expect_identical(pr$rmc.col.wear, 6L)
+  expect_adhoc_same(f, c(pr, list(rmc.noise = 0.013 / 1.2)))
+  stop_both <- function(wear, p, msg) {
+    gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "UNIXsec", wear = wear)
+    pg <- utils::modifyList(GGIR::load_params()$params_rawdata, p)
+    I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pg))
+    expect_error(utils::capture.output(GGIR::g.calibrate(f, params_rawdata = pg, inspectfileobject = I,
+                                                         verbose = FALSE)),
+                 "Corrupt file. The wear column")
+    expect_error(gravcal::g.calibrate(f, params_rawdata = p, verbose = FALSE), msg)
+  }
+  # 1 and 0 (fread() reads numbers); "false" among "TRUE" (text)
+  stop_both(ifelse(flags %in% "TRUE", "1", "0"), pr,
+            "wear column \\(`rmc.col.wear`\\) holds [0-9]+ values .*first: line 2 ")
+  stop_both(replace(flags, 3000, "false"), pr, "holds 1 value .*line 3001 .*not spelt as")
+  # a resampled block's flags are numbers: GGIR's reader stops
+  stop_both(flags, c(pr, list(rmc.doresample = TRUE)), "`rmc.col.wear` with `rmc.doresample` = TRUE")
+})
+
 test_that("rmc.doresample: every block resampled from its time stamps, as GGIR does", {
   skip_if_quick()
   skip_if_not_installed("GGIR")

@@ -683,8 +683,10 @@ test_that("g.getmeta() refuses the Parmay Matrix files GGIR's reader fails on, s
 # `drop` left out (time gaps) and samples `zeros` set to 0, 0, 0. Returns
 # the file and its rmc.* list with chunksize 0.1 (at 10 Hz, GGIR's blocks
 # of g.getmeta() are 87000 lines: a recording of 4 hours is two of them).
+# `wear`: a function of the number of samples giving a wear column's text
+# (rmc.col.wear), or NULL.
 meta_adhoc <- function(..., hours = 4, true_sf = 10, seed = 31, drop = integer(),
-                       zeros = integer()) {
+                       zeros = integer(), wear = NULL) {
   rec <- simulate_recording(hours = hours, sf = 10, seed = seed,
                             tempoffset = c(0.001, -0.002, 0.0005))
   n <- nrow(rec)
@@ -696,7 +698,7 @@ meta_adhoc <- function(..., hours = 4, true_sf = 10, seed = 31, drop = integer()
   rec[zeros, c("x", "y", "z")] <- 0
   f <- tempfile(fileext = ".csv")
   pr <- gravcal:::write_adhoc_csv(rec, f, sf = true_sf, header = c("device,sim", "serial,S1"),
-                                  drop = drop, ...)
+                                  drop = drop, wear = if (!is.null(wear)) wear(n), ...)
   list(file = f, pr = c(pr, list(chunksize = 0.1)))
 }
 
@@ -876,7 +878,6 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   }
   # GGIR's g.getmeta() stops without time stamps ("Timestamps not found")
   expect_error(gm(rmc.col.time = NULL, rmc.col.acc = 2:4), "`rmc.col.time` is not given")
-  expect_error(gm(rmc.col.wear = 5), "rmc.col.wear")
   # GGIR's reads stop on a zone of the deprecated rmc.* parameters other
   # than the one g.readaccfile() hands read.myacc.csv
   expect_error(gm(rmc.configtz = "Asia/Kolkata"), "`rmc.configtz` = \"Asia/Kolkata\"")
@@ -904,9 +905,78 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   # an inspectfileobject of another rate, or of a file read otherwise
   expect_error(gm(I = list(monc = 0, dformc = 5, sf = 20)), "inspectfileobject\\$sf")
   expect_error(gm(I = list(monc = 4, dformc = 4, sf = 10)), "inspectfileobject")
-  # a wear column GGIR would take its non-wear from
-  expect_error(gm(rmc.col.wear = 6), "rmc.col.wear")
   unlink(c(a$file, iso$file, ap$file))
+})
+
+test_that("g.getmeta() takes non-wear from a wear column (rmc.col.wear) as GGIR does", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  # GGIR's rule (detect_nonwear_clipping()): each long epoch's score is the
+  # most frequent flag in its non-wear window, times 3 (a tie goes to
+  # TRUE), whatever the axes say. The flags: TRUE, FALSE over a quarter of
+  # the recording (across the axes' own non-wear, 30-60 %), missing (empty)
+  # over 2 %; the block's rows repeated and dropped with the samples'
+  flags <- function(n) {
+    w <- rep("TRUE", n)
+    w[round(0.25 * n):round(0.5 * n)] <- "FALSE"
+    w[round(0.7 * n):round(0.72 * n)] <- NA
+    w
+  }
+  drop <- c(5000:5002, 5004:5100, 40000:40600, 87702:87751, 100000:100003)
+  # gaps and zero samples filled by g.getmeta()'s imputeTimegaps, the gap
+  # between GGIR's two blocks from the first block's last row (nonwear
+  # approach "2023", GGIR's default)
+  a <- meta_adhoc(time = "UNIXsec", drop = drop, zeros = 20000:20050, wear = flags)
+  b <- meta_both(a$file, c(list(params_rawdata = a$pr), cal_args))
+  expect_same_meta(b)
+  nw <- b$gravcal$metalong$nonwearscore
+  expect_setequal(unique(nw), c(0, 3))
+  # (GGIR's counts: the zero samples are a gap more in the first block)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(4L, 2L))
+  # rmc.check4timegaps (read.myacc.csv's filling, text time), approach
+  # "2013", other windows
+  a2 <- meta_adhoc(time = "character", drop = drop[drop < 1e5], zeros = 20000:20050, wear = flags)
+  expect_same_meta(meta_both(a2$file, list(
+    params_rawdata = c(a2$pr, list(rmc.check4timegaps = TRUE)),
+    params_cleaning = list(nonwear_approach = "2013"),
+    params_general = list(windowsizes = c(5, 600, 1800)))))
+  # ties (TRUE and FALSE alternate: every window is scored 3); the
+  # spelling true/false, changing to TRUE/FALSE from GGIR's second block
+  # (fread() reads each block's column on its own)
+  alt <- meta_adhoc(time = "UNIXsec", hours = 2.5,
+                    wear = function(n) ifelse(seq_len(n) %% 2 == 0, "TRUE", "FALSE"))
+  b <- meta_both(alt$file, list(params_rawdata = alt$pr))
+  expect_same_meta(b)
+  expect_true(all(b$gravcal$metalong$nonwearscore == 3))
+  sp <- meta_adhoc(time = "UNIXsec", wear = function(n) {
+    w <- flags(n)
+    w[1:87000] <- tolower(w[1:87000])
+    w
+  })
+  expect_same_meta(meta_both(sp$file, list(params_rawdata = sp$pr)))
+  # what GGIR stops on, gravcal stops on: flags fread() reads as numbers
+  # (1/0) or as text (two spellings in a block): GGIR's reader's "Corrupt
+  # file"; a non-wear window without a flag (GGIR's empty table)
+  stops <- function(wear, msg) {
+    s <- meta_adhoc(time = "UNIXsec", hours = 2.5, wear = wear)
+    pr <- utils::modifyList(GGIR::load_params()$params_rawdata, s$pr)
+    I <- meta_quiet(GGIR::g.inspectfile(s$file, params_rawdata = pr))
+    expect_error(meta_quiet(GGIR::g.getmeta(s$file, params_rawdata = pr, inspectfileobject = I,
+                                            verbose = FALSE)))
+    expect_error(meta_quiet(gravcal::g.getmeta(s$file, params_rawdata = pr, verbose = FALSE)), msg)
+    unlink(s$file)
+  }
+  stops(function(n) ifelse(flags(n) %in% "TRUE", "1", "0"),
+        "wear column .*`rmc.col.wear`.* holds [0-9]+ values.*\"1\" is not TRUE, FALSE or empty")
+  stops(function(n) replace(flags(n), 100, "true"),
+        "1 value .*line 103 .*\"true\" is not spelt as the block's other")
+  stops(function(n) replace(flags(n), 1:40000, NA),
+        "no TRUE/FALSE value in the non-wear window of long epoch 1 .*GGIR's g.getmeta\\(\\) stops")
+  # a resampled wear column (GGIR's reader stops: no longer TRUE/FALSE)
+  expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.doresample = TRUE)),
+                                  verbose = FALSE),
+               "`rmc.col.wear` with `rmc.doresample` = TRUE")
+  unlink(c(a$file, a2$file, alt$file, sp$file))
 })
 
 test_that("M's text round trip, taken once per distinct value, is R's element by element", {

@@ -1,7 +1,7 @@
 # The block store of g.getmeta() and epoch_signals() (ggir_block_store.hpp,
 # gc_meta_store*()): a block held in the core must give back, bit for bit,
 # the samples R would have held (GGIR's data[...] of each step), whatever
-# the runs of its temperature and light.
+# the runs of its temperature, light and wear flags.
 
 store_cols <- function(n, seed = 1) {
   set.seed(seed)
@@ -11,7 +11,9 @@ store_cols <- function(n, seed = 1) {
          ceiling(seq_len(n) / 120)],
        time = 1.7e9 + (seq_len(n) - 1) / 100,
        # a value per sample: kept as plain values
-       light = stats::runif(n))
+       light = stats::runif(n),
+       # wear flags (an ad hoc csv file's): long runs of 1, 0 and NaN
+       wear = rep(c(1, 0, NaN, 1), length.out = ceiling(n / 700))[ceiling(seq_len(n) / 700)])
 }
 
 same_bits <- function(a, b) {
@@ -22,7 +24,7 @@ same_bits <- function(a, b) {
 
 test_that("rows put in come back bit for bit, after keep and replace too", {
   d <- store_cols(5000)
-  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE, TRUE)
   info <- gravcal:::gc_meta_store_put(st, d, -1)
   expect_identical(info$n, 5000)
   expect_identical(info$first_time, d$time[1])
@@ -44,7 +46,7 @@ test_that("rows put in come back bit for bit, after keep and replace too", {
   r <- gravcal:::gc_meta_store_rows(st, 0, gravcal:::gc_meta_store_size(st))
   for (k in names(d)) same_bits(r[[k]], c(d[[k]][1235:2734], f[[k]]))
   # columns a store does not keep are absent; absent columns given are NA
-  st2 <- gravcal:::gc_meta_store(TRUE, FALSE, FALSE)
+  st2 <- gravcal:::gc_meta_store(TRUE, FALSE, FALSE, FALSE)
   gravcal:::gc_meta_store_put(st2, d[c("x", "y", "z")], -1)
   r <- gravcal:::gc_meta_store_rows(st2, 0, 10)
   expect_named(r, c("x", "y", "z", "temperature"))
@@ -55,7 +57,7 @@ test_that("rows put in come back bit for bit, after keep and replace too", {
 
 test_that("GGIR's gap fill: the carry's last row normalised and repeated, every column", {
   d <- store_cols(1000)
-  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE, TRUE)
   gravcal:::gc_meta_store_put(st, d, -1)
   gravcal:::gc_meta_store_put(st, store_cols(10, seed = 9), -1)
   gravcal:::gc_meta_store_fill_gap(st, 1000, 37)
@@ -68,7 +70,7 @@ test_that("GGIR's gap fill: the carry's last row normalised and repeated, every 
   for (k in c("x", "y", "z")) {
     expect_identical(r[[k]][1001:1037], rep(r[[k]][1000], 37))
   }
-  for (k in c("temperature", "time", "light")) {
+  for (k in c("temperature", "time", "light", "wear")) {
     same_bits(r[[k]][1000:1037], rep(d[[k]][1000], 38))
   }
   same_bits(r$light[1038:1047], store_cols(10, seed = 9)$light)
@@ -99,7 +101,7 @@ test_that("a block read from a decoder is the samples the decoder gives, in GGIR
   ref <- decoded(20)
   h2 <- gravcal:::gc_decoder_open(f, "cwa", list())
   on.exit(gravcal:::gc_decoder_close(h2$ptr), add = TRUE)
-  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE)
+  st <- gravcal:::gc_meta_store(TRUE, TRUE, TRUE, TRUE)
   n <- 0
   repeat {
     info <- gravcal:::gc_meta_store_read(st, h2$ptr, 20, 1000, TRUE)
@@ -114,7 +116,7 @@ test_that("a block read from a decoder is the samples the decoder gives, in GGIR
   ref <- decoded(40)
   h3 <- gravcal:::gc_decoder_open(f, "cwa", list())
   on.exit(gravcal:::gc_decoder_close(h3$ptr), add = TRUE)
-  st3 <- gravcal:::gc_meta_store(TRUE, FALSE, TRUE)
+  st3 <- gravcal:::gc_meta_store(TRUE, FALSE, TRUE, FALSE)
   info <- gravcal:::gc_meta_store_read(st3, h3$ptr, 40, 1000, TRUE)
   expect_identical(info$first_time, ref$time[1])
   expect_identical(info$tail_time, rev(ref$time[info$n - 1:0]))

@@ -210,6 +210,9 @@ struct DeviceInfo {
   // the decoder gives a light value per sample (SampleBuffer::light): .cwa
   // and GENEActiv .bin; its units are the format decoder's (see there)
   bool has_light = false;
+  // the decoder gives a wear flag per sample (SampleBuffer::wear: 1, 0, NaN
+  // for none): an ad hoc csv file's wear column (option col_wear)
+  bool has_wear = false;
   double range_g = std::numeric_limits<double>::quiet_NaN();  // +- full scale, g
   // the file's own text header, as stored, where the format has one (.gt3x:
   // info.txt; at most gt3x::kMaxInfo bytes); "" otherwise
@@ -268,6 +271,8 @@ struct SampleBuffer {
   double* t = nullptr;      // temperature, degrees C
   double* time = nullptr;   // seconds since 1970-01-01 UTC
   double* light = nullptr;  // the device's light value (DeviceInfo::has_light)
+  // a wear flag (DeviceInfo::has_wear), asked and written as light is
+  double* wear = nullptr;
   std::size_t capacity = 0;
   std::size_t n = 0;
   bool full() const { return n >= capacity; }

@@ -23,7 +23,8 @@
 //
 // Ad hoc csv (format "adhoc_csv", GGIR's rmc.* files): no detection; the
 // layout comes in options: skip (lines before the data), col_x, col_y,
-// col_z, col_temp, col_time (1-based; 0: none), time_div (1: the time
+// col_z, col_temp, col_time, col_wear (1-based; 0: none; the wear flags
+// TRUE/FALSE as fread() reads them: CsvDecoder::wear_of()), time_div (1: the time
 // column holds seconds, 1000: milliseconds; 0: text, not read: time is
 // start_time + i / sf, unless time_format is given: text read by that
 // strptime() format (%Y %y %m %d %H %M %S %OS %T and literal characters;
@@ -144,10 +145,11 @@ class CsvDecoder : public Decoder {
         opener_(lines_, times_, layout_, info_, error_, opts, format, rules_.compat) {
     fast_ = opts.num("fast", 1) != 0;
     if (adhoc_) {
-      const double c[5] = {opts.num("col_x", 1), opts.num("col_y", 2), opts.num("col_z", 3),
-                           opts.num("col_temp", 0), opts.num("col_time", 0)};
-      int* const to[5] = {&layout_.col_x, &layout_.col_y, &layout_.col_z, &layout_.col_temp, &layout_.col_time};
-      for (int i = 0; i < 5; ++i) *to[i] = c[i] >= 1 && c[i] <= kMaxFields ? static_cast<int>(c[i]) - 1 : -1;
+      const double c[6] = {opts.num("col_x", 1), opts.num("col_y", 2), opts.num("col_z", 3),
+                           opts.num("col_temp", 0), opts.num("col_time", 0), opts.num("col_wear", 0)};
+      int* const to[6] = {&layout_.col_x, &layout_.col_y, &layout_.col_z, &layout_.col_temp, &layout_.col_time,
+                          &layout_.col_wear};
+      for (int i = 0; i < 6; ++i) *to[i] = c[i] >= 1 && c[i] <= kMaxFields ? static_cast<int>(c[i]) - 1 : -1;
       // text time: not read (start_time + i / sf) unless a format is given
       if (!times_.reads_adhoc_time()) layout_.col_time = -1;
       layout_.time_text = false;
@@ -165,6 +167,7 @@ class CsvDecoder : public Decoder {
     if (!opener_.open()) return false;
     info_.has_time = layout_.col_time >= 0 || (std::isfinite(info_.start_time) && info_.sf > 0);
     info_.has_temperature = layout_.col_temp >= 0;
+    info_.has_wear = layout_.col_wear >= 0;
     learn_roles();
     opened_ = true;
     done_ = lines_.exhausted();
@@ -238,7 +241,8 @@ class CsvDecoder : public Decoder {
   // more, the commonest layout, which has a loop of its own).
   void learn_roles() {
     plain_ = 0;
-    if (!fast_ || layout_.nfields < 3 || layout_.nfields > kMaxFields) return;
+    // (a wear column's lines go through take_line(): its text is not a number)
+    if (!fast_ || layout_.nfields < 3 || layout_.nfields > kMaxFields || layout_.col_wear >= 0) return;
     std::fill(role_, role_ + kMaxFields, kSkip);
     const int cols[5] = {layout_.col_x, layout_.col_y, layout_.col_z, layout_.col_temp, layout_.col_time};
     const Role roles[5] = {kX, kY, kZ, kTemp, kTime};
@@ -430,8 +434,49 @@ class CsvDecoder : public Decoder {
       z = adhoc_acc(z);
       temp = adhoc_temp(temp);
     }
+    if (layout_.col_wear >= 0) {
+      const double w = wear_of(f[layout_.col_wear], ln);
+      if (out.wear != nullptr) out.wear[out.n] = w;
+    }
     out.put(x, y, z, temp, t);
     ++report_.samples;
+  }
+
+  // A wear flag as data.table's fread() (1.14) reads a column of them in
+  // one of GGIR's blocks: TRUE/FALSE, true/false or True/False, one of the
+  // three spellings in the block (a mix is text to fread), "" and NA
+  // missing (NaN); 1 or 0. Anything else (1/0 as well: fread reads those
+  // as numbers) is counted and noted ("wear_not_logical"; GGIR's reader
+  // stops on such a block) and given as NaN.
+  double wear_of(const csv_text::Field& f, const Line& ln) {
+    const std::size_t n = static_cast<std::size_t>(f.e - f.b);
+    auto is = [&](const char* w) { return n == std::strlen(w) && std::memcmp(f.b, w, n) == 0; };
+    if (n == 0 || is("NA")) return std::numeric_limits<double>::quiet_NaN();
+    static const char* const kSpell[3][2] = {{"TRUE", "FALSE"}, {"true", "false"}, {"True", "False"}};
+    int style = 0;
+    double v = 0;
+    for (int k = 0; k < 3 && style == 0; ++k) {
+      for (int b = 0; b < 2; ++b) {
+        if (is(kSpell[k][b])) {
+          style = k + 1;
+          v = b == 0 ? 1 : 0;
+        }
+      }
+    }
+    const std::int64_t block = times_.block_of(ln.number);
+    if (block != wear_block_) {
+      wear_block_ = block;
+      wear_style_ = 0;
+    }
+    if (style != 0 && (wear_style_ == 0 || wear_style_ == style)) {
+      wear_style_ = style;
+      return v;
+    }
+    report_.count("wear_not_logical");
+    report_.note("line " + std::to_string(ln.number) + " (byte " + std::to_string(ln.offset) + "): the wear value \"" +
+                 csv_text::excerpt(f.b, n) + "\" is not " +
+                 (style != 0 ? "spelt as the block's other TRUE/FALSE values" : "TRUE, FALSE or empty"));
+    return std::numeric_limits<double>::quiet_NaN();
   }
 
 
@@ -463,6 +508,9 @@ class CsvDecoder : public Decoder {
   // an ad hoc csv's units, from options
   double acc_div_ = 1, acc_scale_ = 1, bit_pow_ = 1, bit_range_ = 1;
   int bit_ = 0, temp_unit_ = 0;
+  // the wear column's spelling in the current block (wear_of())
+  std::int64_t wear_block_ = -1;
+  int wear_style_ = 0;
 };
 
 }  // namespace gravcal

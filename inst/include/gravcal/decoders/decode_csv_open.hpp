@@ -353,7 +353,8 @@ class CsvOpener {
       return fail("decimal commas (rmc.dec = \",\") in a file whose fields are separated by commas");
     }
     layout_.dec = adhoc_dec_;
-    const int cols[5] = {layout_.col_x, layout_.col_y, layout_.col_z, layout_.col_temp, layout_.col_time};
+    const int cols[6] = {layout_.col_x, layout_.col_y, layout_.col_z, layout_.col_temp, layout_.col_time,
+                         layout_.col_wear};
     for (int c : cols) {
       if (c >= layout_.nfields) {
         return fail("column " + std::to_string(c + 1) + " asked for, but data lines have " +

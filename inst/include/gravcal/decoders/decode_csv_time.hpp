@@ -41,6 +41,7 @@ struct CsvLayout {
   char sep = ',', dec = '.';
   int nfields = 0;
   int col_x = -1, col_y = -1, col_z = -1, col_time = -1, col_temp = -1;
+  int col_wear = -1;  // an ad hoc csv file's wear column (TRUE/FALSE)
   // the time column holds text (a date-time), not a number
   bool time_text = true;
   double step = 0;  // the sample period, 1 / sf
@@ -68,6 +69,14 @@ class CsvTimeStamps {
       zone_ = ZoneTable(opts);
       block_lines_ = static_cast<std::int64_t>(opts.num("block_lines", 0));
     }
+  }
+
+  // Which of GGIR's blocks (of block_lines lines after the skipped ones,
+  // counted from 0) data line `line` (1-based, in the file) belongs to; 0
+  // without blocks.
+  std::int64_t block_of(std::int64_t line) const {
+    if (block_lines_ <= 0 || line <= adhoc_skip_) return 0;
+    return (line - 1 - adhoc_skip_) / block_lines_;
   }
 
   // The ActiGraph header's date-time reader (its date order is set from the

@@ -103,6 +103,9 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
       info_.sf = grid_rate_ > 0 ? grid_rate_ : std::nearbyint(rate);
       walk_.grid.by = 1.0 / info_.sf;
       raw_.assign(kRawCols * kRawChunk, 0.0);
+      // a wear flag is not resampled (GGIR's reader stops on a resampled
+      // one: it is no longer TRUE/FALSE)
+      info_.has_wear = false;
     }
     return true;
   }

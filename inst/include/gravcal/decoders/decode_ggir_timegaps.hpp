@@ -161,7 +161,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
 
  private:
   static constexpr std::size_t kRawChunk = 4096;
-  static constexpr std::size_t kCols = 5;  // x, y, z, t, time
+  static constexpr std::size_t kCols = 6;  // x, y, z, t, time, wear
   static constexpr double kMaxGapRows = 1e8;
   // an epoch-level gap longer than this is not imputed (GGIR would build
   // its epochs in memory): 400 days
@@ -194,6 +194,9 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
 
   bool refill() {
     SampleBuffer b = SampleBuffer::columns(raw_.data(), kRawChunk, true, true);
+    // (a wear flag is another column of the row: GGIR repeats and drops it
+    // with the row's x, y, z)
+    if (inner_->info().has_wear) b.wear = raw_.data() + 5 * kRawChunk;
     const std::int64_t u = this->read_inner(b);
     raw_n_ = b.n;
     raw_at_ = 0;
@@ -284,6 +287,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
     const double* z = y + kRawChunk;
     const double* tc = z + kRawChunk;
     const double* time = tc + kRawChunk;
+    const double* wear = time + kRawChunk;
     while (raw_at_ < raw_n_ && !out.full()) {
       const std::size_t i = raw_at_;
       if (x[i] == 0 && y[i] == 0 && z[i] == 0) return;
@@ -293,7 +297,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
       last_time_ = held_[4];
       ++queued_;
       const double t = held_[4] + 0.0 * by_;
-      out.put(held_[0], held_[1], held_[2], held_[3], t);
+      give(out, held_, t);
       last_given_ = t;
       ++this->given_;
       held_[0] = x[i];
@@ -301,8 +305,16 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
       held_[2] = z[i];
       held_[3] = tc[i];
       held_[4] = time[i];
+      held_[5] = wear[i];
       ++raw_at_;
     }
+  }
+
+  // a row given at time t: x, y, z, temperature (v[0..3]) and the wear
+  // flag (v[5]) where asked
+  static void give(SampleBuffer& out, const double* v, double t) {
+    if (out.wear != nullptr) out.wear[out.n] = v[5];
+    out.put(v[0], v[1], v[2], v[3], t);
   }
 
   void hold(const double* s) {
@@ -460,7 +472,7 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
           t = slip_.front();
           slip_.pop_front();
         }
-        out.put(r.v[0], r.v[1], r.v[2], r.v[3], t);
+        give(out, r.v, t);
         last_given_ = t;
         ++this->given_;
       }
@@ -494,8 +506,8 @@ class GgirTimegapsOf : public ForwardingDecoder<Inner, GgirTimegapsOf<Inner, Acc
   std::vector<double> raw_;
   std::size_t raw_n_ = 0, raw_at_ = 0;
   bool in_call_ = false, first_ = true, have_held_ = false, have_zero_ = false;
-  double held_[kCols] = {0, 0, 0, 0, 0};
-  double zero_[kCols] = {0, 0, 0, 0, 0};
+  double held_[kCols] = {0, 0, 0, 0, 0, 0};
+  double zero_[kCols] = {0, 0, 0, 0, 0, 0};
   std::vector<Run> runs_;
   std::size_t head_ = 0;
   std::int64_t gaps_ = 0, rows_added_ = 0, zeros_dropped_ = 0;

@@ -15,8 +15,8 @@
 //   each part freed as it is copied; the next blocks are read into those
 //   arrays (their carry moved to the front), in parts again only beyond
 //   them. Nothing is sized by a number read from the file.
-// * temperature and light (a value per page in .cwa and GENEActiv files)
-//   are kept as runs of one value (RunColumn), as plain values only when
+// * temperature and light (a value per page in .cwa and GENEActiv files),
+//   and an ad hoc csv file's wear flags, are kept as runs of one value (RunColumn), as plain values only when
 //   their runs are short.
 // * time stamps are kept as a column only when asked (GGIR's time-gap
 //   imputation needs them); otherwise the block's first time and its last
@@ -248,18 +248,19 @@ class RunColumn {
 
 class BlockStore {
  public:
-  static constexpr int kX = 0, kY = 1, kZ = 2, kT = 3, kTime = 4, kLight = 5, kCols = 6;
+  static constexpr int kX = 0, kY = 1, kZ = 2, kT = 3, kTime = 4, kLight = 5, kWear = 6, kCols = 7;
   // rows of a part a block is read into when the columns have no room: 40
   // MB a column, above the size from which allocators map memory of its
   // own (glibc: 32 MB at most), so that a part freed is memory given back,
   // not kept in the heap
   static constexpr std::size_t kPartRows = std::size_t{5} << 20;
 
-  BlockStore(bool temperature, bool time, bool light) {
+  BlockStore(bool temperature, bool time, bool light, bool wear = false) {
     has_[kX] = has_[kY] = has_[kZ] = true;
     has_[kT] = temperature;
     has_[kTime] = time;
     has_[kLight] = light;
+    has_[kWear] = wear;
   }
 
   bool has(int c) const { return has_[c]; }
@@ -267,8 +268,8 @@ class BlockStore {
   // x, y, z and time: arrays of size() values
   double* col(int c) { return has_[c] && !is_run(c) ? cols_[c].get() : nullptr; }
   const double* col(int c) const { return has_[c] && !is_run(c) ? cols_[c].get() : nullptr; }
-  // temperature and light (nullptr when not kept)
-  const RunColumn* runs(int c) const { return has_[c] && is_run(c) ? &runs_[c == kT ? 0 : 1] : nullptr; }
+  // temperature, light and the wear flag (nullptr when not kept)
+  const RunColumn* runs(int c) const { return has_[c] && is_run(c) ? &runs_[run_of(c)] : nullptr; }
   double value(int c, std::size_t i) const { return is_run(c) ? runs(c)->at(i) : cols_[c][i]; }
 
   // The times GGIR's block logic reads, whether or not a time column is
@@ -296,17 +297,18 @@ class BlockStore {
     const bool ask_time = want_time && d.info().has_time;
     const bool ask_t = has_[kT] && d.info().has_temperature;
     const bool ask_light = has_[kLight] && d.info().has_light;
+    const bool ask_wear = has_[kWear] && d.info().has_wear;
     const bool col_time = ask_time && has_[kTime];
     const std::size_t part_rows = std::max(kPartRows, chunk);
     // (not zeroed: the pages a part does not use are never touched)
     std::vector<std::unique_ptr<double[]>> parts[kCols];
     std::vector<std::size_t> used;  // rows in each part
     std::vector<double> t_buf(ask_t ? chunk : 0), light_buf(ask_light ? chunk : 0),
-        time_buf(ask_time && !col_time ? chunk : 0);
+        wear_buf(ask_wear ? chunk : 0), time_buf(ask_time && !col_time ? chunk : 0);
     std::size_t got_all = 0;
     for (;;) {
       SampleBuffer out;
-      double* dst[kCols] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+      double* dst[kCols] = {};
       if (used.empty() && cap_ - n_ >= chunk) {
         for (int c = 0; c < kCols; ++c) {
           if (cols_[c]) dst[c] = cols_[c].get() + n_;
@@ -327,6 +329,7 @@ class BlockStore {
       out.z = dst[kZ];
       if (ask_t) out.t = t_buf.data();
       if (ask_light) out.light = light_buf.data();
+      if (ask_wear) out.wear = wear_buf.data();
       if (ask_time) out.time = col_time ? dst[kTime] : time_buf.data();
       out.capacity = chunk;
       const std::int64_t u = d.read(out, left);
@@ -338,8 +341,9 @@ class BlockStore {
         } else {
           used.back() += got;
         }
-        if (has_[kT]) push_or_nan(runs_[0], out.t, got);
-        if (has_[kLight]) push_or_nan(runs_[1], out.light, got);
+        if (has_[kT]) push_or_nan(runs_[run_of(kT)], out.t, got);
+        if (has_[kLight]) push_or_nan(runs_[run_of(kLight)], out.light, got);
+        if (has_[kWear]) push_or_nan(runs_[run_of(kWear)], out.wear, got);
         if (out.time != nullptr) {
           if (got_all == 0) first_time_ = out.time[0];
           note_tail(out.time, got);
@@ -363,7 +367,7 @@ class BlockStore {
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
       if (is_run(c)) {
-        push_or_nan(runs_[c == kT ? 0 : 1], src[c], k);
+        push_or_nan(runs_[run_of(c)], src[c], k);
       } else if (src[c] != nullptr) {
         std::copy(src[c], src[c] + k, cols_[c].get() + n_);
       } else {
@@ -380,8 +384,8 @@ class BlockStore {
   // Rows [from, n) replaced by `k` rows of `src`.
   void replace_tail(std::size_t from, const double* const src[kCols], std::size_t k) {
     if (from > n_) throw std::out_of_range("replace_tail beyond the block");
-    for (int c = kT; c <= kLight; c += kLight - kT) {
-      if (has_[c]) runs_[c == kT ? 0 : 1].keep(0, from);
+    for (int c = 0; c < kCols; ++c) {
+      if (has_[c] && is_run(c)) runs_[run_of(c)].keep(0, from);
     }
     n_ = from;
     tail_time_[0] = tail_time_[1] = nan();
@@ -407,7 +411,7 @@ class BlockStore {
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
       if (is_run(c)) {
-        runs_[c == kT ? 0 : 1].repeat_row(last, reps);
+        runs_[run_of(c)].repeat_row(last, reps);
         continue;
       }
       double* v = cols_[c].get();
@@ -434,7 +438,7 @@ class BlockStore {
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c]) continue;
       if (is_run(c)) {
-        runs_[c == kT ? 0 : 1].keep(from, count);
+        runs_[run_of(c)].keep(from, count);
       } else if (from > 0 && count > 0) {
         std::memmove(cols_[c].get(), cols_[c].get() + from, count * sizeof(double));
       }
@@ -445,7 +449,9 @@ class BlockStore {
 
  private:
   static double nan() { return std::numeric_limits<double>::quiet_NaN(); }
-  static bool is_run(int c) { return c == kT || c == kLight; }
+  static bool is_run(int c) { return c == kT || c == kLight || c == kWear; }
+  // runs_'s index of a run column
+  static int run_of(int c) { return c == kT ? 0 : c == kLight ? 1 : 2; }
 
   static void push_or_nan(RunColumn& r, const double* p, std::size_t k) {
     if (p != nullptr) {
@@ -502,9 +508,9 @@ class BlockStore {
     }
   }
 
-  bool has_[kCols] = {false, false, false, false, false, false};
-  std::unique_ptr<double[]> cols_[kCols];  // x, y, z, time (temperature and light: runs_)
-  RunColumn runs_[2];                      // temperature, light
+  bool has_[kCols] = {};
+  std::unique_ptr<double[]> cols_[kCols];  // x, y, z, time (temperature, light, wear: runs_)
+  RunColumn runs_[3];                      // temperature, light, wear
   std::size_t n_ = 0, cap_ = 0;
   double first_time_ = nan();
   // tail_time_[0]: the last row's time, [1]: the one before

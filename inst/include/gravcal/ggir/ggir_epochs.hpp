@@ -534,8 +534,14 @@ inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
   }
 }
 
+// With `wear` (an ad hoc csv file's wear flags, row i's as wear(i): 1, 0
+// or NaN), a window's non-wear score is its flags' most frequent value
+// times 3 (GGIR's rule: over (1 + nwstart):nwend, NA left out, a tie goes
+// to 1), whatever the axes say; a window without a flag is an error (GGIR
+// stops there: its table of flags is empty).
 template <class Acc>
-NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, const NonwearConfig& cf) {
+NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, const NonwearConfig& cf,
+                               const std::function<double(std::size_t)>* wear = nullptr) {
   NonwearResult r;
   const double M = cf.ws2 * cf.sf;  // MediumEpochSize
   const double L = cf.ws * cf.sf;   // LongEpochSize
@@ -628,6 +634,20 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
     r.clipping[static_cast<std::size_t>(h - 1)] = cmax;
     const std::size_t b = static_cast<std::size_t>(h - 1) * 3;
     r.nonwear[static_cast<std::size_t>(h - 1)] = nwlog[b] + nwlog[b + 1] + nwlog[b + 2];
+    if (wear != nullptr) {
+      double n0 = 0, n1 = 0;
+      at_r_indices(r_colon(1 + nwstart, nwend), nrow, [&](std::size_t j) {
+        const double w = (*wear)(j);
+        if (w == 0) n0 += 1;
+        else if (w == 1) n1 += 1;
+      });
+      if (n0 + n1 == 0) {
+        throw std::runtime_error("the wear column (rmc.col.wear) has no TRUE/FALSE value in the non-wear window of "
+                                 "long epoch " + std::to_string(h) + " of a block: GGIR's g.getmeta() stops there "
+                                 "too (its table of the window's wear values is empty)");
+      }
+      r.nonwear[static_cast<std::size_t>(h - 1)] = n1 >= n0 ? 3 : 0;
+    }
   }
   // an isolated 1 between two scores above 1 becomes 2
   for (std::size_t i = 1; i + 1 < r.nonwear.size(); ++i) {
