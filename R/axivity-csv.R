@@ -177,7 +177,7 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     "the session's time zone (GGIR's when desiredtz and configtz are \"\")"
   if (time$kind == "text") {
     if (!is.null(zone_table(zone))) return(c(list(time_utc_offset = 0), zone_options(zone)))
-    off <- civil_offset(time$first, zone)
+    off <- civil_offset(floor(time$first), zone)
     if (is.na(off)) abort(zone_name, ": R cannot convert the recording's times in this zone.")
     return(list(time_utc_offset = off))
   }
@@ -186,7 +186,9 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     # it (fread's date-times; for UNIX seconds a constant that changes
     # nothing, not applied)
     if (time$kind == "unix") return(list())
-    off <- civil_offset(time$first, zone)
+    # (at the first stamp's whole second: civil_offset() reads whole
+    # seconds, a fraction would be taken for part of the offset)
+    off <- civil_offset(floor(time$first), zone)
     return(if (is.na(off)) list() else list(time_utc_offset = off))
   }
   # a zone whose offset changes: the recording's span (from its first and
@@ -194,7 +196,7 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
   last <- file_last_line(file)
   t1 <- axivity_stamp_seconds(trimws(strsplit(last, ",", fixed = TRUE)[[1]][1]), time)
   span <- range(c(time$first, t1), na.rm = TRUE)
-  at <- seq(span[1] - 86400, span[2] + 86400, by = 1800)
+  at <- floor(seq(span[1] - 86400, span[2] + 86400, by = 1800))
   off <- civil_offset(at, zone)
   if (anyNA(off) || any(off != off[1])) {
     abort(zone_name, ": the Axivity csv export \"", basename(file), "\" spans a change of UTC ",

@@ -32,7 +32,7 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
   if (is.numeric(start) && length(start) == 1 && is.finite(start)) {
     ro$local_zone <- meta_local_zone(start)
   }
-  tab <- if (identical(fe$local_clock, "sample") && !isFALSE(fe$ggir_time) &&
+  tab <- if (identical(format_local_clock(src$format, datafile), "sample") && !isFALSE(fe$ggir_time) &&
              is.numeric(start) && length(start) == 1 && is.finite(start)) {
     meta_clock_table(zone, start)
   }
@@ -214,7 +214,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   metricnames_long <- NULL
   short_rows <- src$short_rows %||% 0
   zone <- if (length(p$configtz)) p$configtz else p$desiredtz
-  clock <- fe$local_clock
+  clock <- format_local_clock(src$format, src$path)
   i <- 1
   LD <- 2
   QClog <- NULL

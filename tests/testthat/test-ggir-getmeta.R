@@ -263,6 +263,31 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
   b <- meta_both(f, cal_args[c("offset", "scale")])
   expect_same_meta(b)
   expect_lt(nrow(b$gravcal$metashort), 30 * 720)
+  # text and ISO 8601 stamps, a first stamp a fraction of a second past the
+  # whole second, in zones (GGIR forces fread()'s date-times into the zone,
+  # reads other text in it with as.POSIXct(): the decoder does both, and
+  # the block logic must not move them again; gravcal gave each stamp the
+  # zone's offset twice, and the fraction once more)
+  short <- simulate_recording(hours = 5, sf = 10, seed = 22, temperature = FALSE)
+  t0 <- as.POSIXct("2024-01-01 00:07:00", tz = "UTC") + 0.25
+  styles <- list(
+    list(tz = "Asia/Kolkata"),                                          # 2024-01-01 00:07:00.250
+    list(tz = "Europe/Amsterdam", time_format = "%Y/%m/%d %H:%M:%S"),   # as.POSIXct()'s path
+    list(tz = "Europe/Amsterdam", suffix = "Z", decimals = 2),
+    list(tz = "Asia/Kolkata", suffix = "+01:00"),
+    list(tz = "Europe/Amsterdam", start = "2024-03-30 23:00:00",        # across the spring change
+         time_format = "%Y/%m/%d %H:%M:%S"))
+  for (s in styles) {
+    do.call(gravcal:::write_axivity_csv,
+            c(list(short, f, true_sf = 10.03, stamps = "text", start = s$start %||% t0),
+              s[setdiff(names(s), c("tz", "start"))]))
+    b <- meta_both(f, list(params_general = list(desiredtz = s$tz)))
+    expect_same_meta(b)
+    if (is.null(s$suffix)) {
+      at <- if (is.null(s$start)) "2024-01-01T00:15:00" else "2024-03-30T23:00:00"
+      expect_identical(substr(b$gravcal$metashort$timestamp[1], 1, 19), at)
+    }
+  }
   # GGIR's own test file: too short for GGIR, and for gravcal
   csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
   b <- meta_both(csv)
