@@ -20,9 +20,8 @@
 
 # The table for `tz` over the years a .cwa calendar can hold (2000 to
 # 2063): list(at, off, amb_lo, amb_hi) in seconds (calendar read as UTC),
-# or NULL when the offset never changes there (a fixed offset moves every
-# time by the same whole seconds, which leaves GGIR's result unchanged, and
-# the decoder reads in UTC). Cached for the session, by zone.
+# or NULL when the offset never changes there (zone_options() gives the
+# decoder that one offset). Cached for the session, by zone.
 zone_table <- function(tz) {
   # "": the session's zone, which TZ names when set (else the system's,
   # fixed for the session)
@@ -94,10 +93,15 @@ zone_table_make <- function(tz) {
   list(at = at[keep], off = off[keep], amb_lo = lo_span, amb_hi = hi_span)
 }
 
-# The decoder options for the table of `tz` (none for a fixed offset).
+# The decoder options for the table of `tz`; a fixed offset is a table of
+# one step (the times move by it: GGIR's time stamps in g.getmeta(), where
+# g.calibrate()'s result would not change).
 zone_options <- function(tz) {
   z <- zone_table(tz)
-  if (is.null(z)) return(list())
+  if (is.null(z)) {
+    lo <- as.numeric(as.POSIXct("2000-01-01", tz = "UTC"))
+    return(list(tz_n = 1, tz_amb_n = 0, tz_at_0 = lo, tz_off_0 = civil_offset(lo, tz)))
+  }
   n <- length(z$at)
   na <- length(z$amb_lo)
   if (n > 4096 || na > 4096) {

@@ -80,6 +80,33 @@ test_that("g.getmeta() is GGIR's on a .cwa recording: defaults, calibrated", {
   expect_identical(names(M$metashort), c("timestamp", "anglez", "ENMO"))
 })
 
+test_that("g.getmeta() is GGIR's on a .cwa recording in zones of one offset (Asia/Kolkata, Asia/Tokyo)", {
+  skip_if_quick()
+  # GGIRread reads a .cwa file's calendar in the zone, whatever its rules;
+  # gravcal's decoder read it as UTC in a zone whose offset never changes
+  # (g.calibrate()'s result is the same either way), so M's time stamps
+  # were the zone's offset late there. A start a fraction past the second
+  f <- meta_recording("cwa", 25, 5, seed = 12, start = "2024-01-01 00:07:13.37")
+  for (tz in c("Asia/Kolkata", "Asia/Tokyo")) {
+    b <- meta_both(f, list(params_general = list(desiredtz = tz)))
+    expect_same_meta(b)
+    expect_identical(substr(b$gravcal$metashort$timestamp[1], 1, 19), "2024-01-01T00:15:00")
+  }
+  # configtz of one offset, desiredtz another
+  b <- meta_both(f, list(params_general = list(desiredtz = "America/New_York", configtz = "Asia/Kolkata")))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$metashort$timestamp[1], "2023-12-31T13:45:00-0500")
+  # and g.calibrate() there, GGIR's to the bit (the decoder's times moved)
+  pg <- utils::modifyList(GGIR::load_params()$params_general, list(desiredtz = "Asia/Kolkata"))
+  pr <- GGIR::load_params()$params_rawdata
+  I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+  R <- meta_quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg, inspectfileobject = I,
+                                    verbose = FALSE))
+  G <- meta_quiet(gravcal::g.calibrate(f, params_rawdata = pr, params_general = pg, verbose = FALSE))
+  for (nm in setdiff(names(R), "bsc_qc")) expect_identical(G[[nm]], R[[nm]], label = nm)
+  unlink(f)
+})
+
 test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter blocks", {
   skip_if_quick()
   skip_if_not_installed("signal")
