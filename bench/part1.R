@@ -18,8 +18,9 @@
 # GRAVCAL_BENCH_DATA: where the week files are written and kept (default: a
 # folder beside tempdir()). GRAVCAL_BENCH_FORMATS ("cwa,bin,gt3x") and
 # GRAVCAL_BENCH_CONTENDERS (a regular expression on the contenders' names)
-# run some of them; GRAVCAL_BENCH_NAME names the results (default "part1":
-# bench/results/part1.md and part1.csv).
+# run some of them; GRAVCAL_BENCH_EVERY ("cwa,bin,gt3x", default "cwa")
+# the formats of the every-metric pairs; GRAVCAL_BENCH_NAME names the
+# results (default "part1": bench/results/part1.md and part1.csv).
 suppressPackageStartupMessages(library(gravcal))
 sf <- 100
 days <- as.numeric(Sys.getenv("GRAVCAL_BENCH_DAYS", "7"))
@@ -99,10 +100,13 @@ contenders[["gravcal g.part1, every metric"]] <- c(quiet, every,
 pick <- Sys.getenv("GRAVCAL_BENCH_CONTENDERS")
 if (nzchar(pick)) contenders <- contenders[grepl(pick, names(contenders))]
 name <- Sys.getenv("GRAVCAL_BENCH_NAME", "part1")
+# the formats of the every-metric pairs (GGIR takes 4 to 12 minutes a week
+# for each): GRAVCAL_BENCH_EVERY, comma-separated, default the .cwa only
+every_formats <- strsplit(Sys.getenv("GRAVCAL_BENCH_EVERY", "cwa"), ",", fixed = TRUE)[[1]]
 rows <- list()
 for (fmt in names(files)) {
   for (nm in names(contenders)) {
-    if (grepl("every metric", nm) && fmt != "cwa") next
+    if (grepl("every metric", nm) && !fmt %in% every_formats) next
     say(fmt, nm)
     r <- run(contenders[[nm]], files[[fmt]], folders[[fmt]])
     rows[[length(rows) + 1]] <- data.frame(format = fmt, contender = nm, seconds = r[["seconds"]],
