@@ -454,11 +454,12 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   rep <- if (!is.null(src$report)) src$report() else list()
   # (a format whose reader's log is M$QClog keeps its damaged units as
   # GGIR's reader keeps them, and logs them there)
-  if (is.null(fe$ggir_qclog) &&
-      (isTRUE(rep$counters["imputed_spans"] > 0) || isTRUE(rep$skipped > 0))) {
+  imputed <- if ("imputed_spans" %in% names(rep$counters)) unname(rep$counters["imputed_spans"]) else 0
+  if (is.null(fe$ggir_qclog) && (imputed > 0 || isTRUE(rep$skipped > 0))) {
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
-            unit_name(src$format, 2), " skipped or imputed; GGIR's QClog of them is not ",
-            "reproduced (M$QClog is NULL).", call. = FALSE)
+            unit_name(src$format, 2), " skipped, ", imputed, " span", if (imputed != 1) "s",
+            " imputed (as GGIR's reader imputes them: damage, or time stamps that jump); ",
+            "GGIR's QClog of them is not reproduced (M$QClog is NULL).", call. = FALSE)
   }
   M <- meta_result(short, long, cols, metnames, metricnames_long, starttime, wday, wdayname,
                    filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun)

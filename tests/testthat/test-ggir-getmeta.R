@@ -107,6 +107,27 @@ test_that("g.getmeta() is GGIR's on a .cwa recording in zones of one offset (Asi
   unlink(f)
 })
 
+test_that("a .cwa recording across the spring change: M is GGIR's, its QClog not reproduced, with a warning", {
+  skip_if_quick()
+  # the device's calendar passes the hour Europe/Amsterdam skips: GGIRread
+  # sees its block times step back and imputes every block from there on
+  # (gravcal's decoder too), logging each in QClog, which gravcal does not
+  # reproduce (NULL) and says so
+  f <- meta_recording("cwa", 25, 5, seed = 12, start = "2024-03-30 22:00:00")
+  args <- list(params_general = list(desiredtz = "Europe/Amsterdam"))
+  b <- meta_both(f, args)
+  n_log <- nrow(b$ggir$QClog)
+  expect_gt(n_log, 100)
+  expect_null(b$gravcal$QClog)
+  b$ggir$QClog <- NULL
+  b$gravcal$QClog <- NULL
+  expect_same_meta(b)
+  # (as many spans as GGIR logs blocks)
+  expect_warning(do.call(gravcal::g.getmeta, c(list(f, verbose = FALSE), args)),
+                 paste0("0 damaged blocks skipped, ", n_log, " spans imputed .*QClog of them is not reproduced"))
+  unlink(f)
+})
+
 test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter blocks", {
   skip_if_quick()
   skip_if_not_installed("signal")
