@@ -144,18 +144,24 @@ test_that("a wear column (rmc.col.wear): g.calibrate() is GGIR's, and stops wher
   stop_both <- function(wear, p, msg) {
     gravcal:::write_adhoc_csv(rec, f, sf = 10, time = "UNIXsec", wear = wear)
     pg <- utils::modifyList(GGIR::load_params()$params_rawdata, p)
-    I <- suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pg))
-    expect_error(utils::capture.output(GGIR::g.calibrate(f, params_rawdata = pg, inspectfileobject = I,
-                                                         verbose = FALSE)),
+    I <- keep_warn(suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pg)))
+    # (keep_warn(): GGIR's g.calibrate() turns warnings off while it reads,
+    # and leaves them off when its reader stops)
+    expect_error(keep_warn(utils::capture.output(GGIR::g.calibrate(f, params_rawdata = pg,
+                                                                   inspectfileobject = I,
+                                                                   verbose = FALSE))),
                  "Corrupt file. The wear column")
     expect_error(gravcal::g.calibrate(f, params_rawdata = p, verbose = FALSE), msg)
   }
+  warn <- getOption("warn")
   # 1 and 0 (fread() reads numbers); "false" among "TRUE" (text)
   stop_both(ifelse(flags %in% "TRUE", "1", "0"), pr,
             "wear column \\(`rmc.col.wear`\\) holds [0-9]+ values .*first: line 2 ")
   stop_both(replace(flags, 3000, "false"), pr, "holds 1 value .*line 3001 .*not spelt as")
   # a resampled block's flags are numbers: GGIR's reader stops
   stop_both(flags, c(pr, list(rmc.doresample = TRUE)), "`rmc.col.wear` with `rmc.doresample` = TRUE")
+  # the session's warnings as they were
+  expect_identical(getOption("warn"), warn)
 })
 
 test_that("rmc.doresample: every block resampled from its time stamps, as GGIR does", {

@@ -100,8 +100,8 @@ test_that("g.getmeta() is GGIR's on a .cwa recording in zones of one offset (Asi
   pg <- utils::modifyList(GGIR::load_params()$params_general, list(desiredtz = "Asia/Kolkata"))
   pr <- GGIR::load_params()$params_rawdata
   I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
-  R <- meta_quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg, inspectfileobject = I,
-                                    verbose = FALSE))
+  R <- keep_warn(meta_quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
+                                              inspectfileobject = I, verbose = FALSE)))
   G <- meta_quiet(gravcal::g.calibrate(f, params_rawdata = pr, params_general = pg, verbose = FALSE))
   for (nm in setdiff(names(R), "bsc_qc")) expect_identical(G[[nm]], R[[nm]], label = nm)
   unlink(f)
@@ -1033,9 +1033,10 @@ test_that("g.getmeta() takes non-wear from a wear column (rmc.col.wear) as GGIR 
   stops <- function(wear, msg) {
     s <- meta_adhoc(time = "UNIXsec", hours = 2.5, wear = wear)
     pr <- utils::modifyList(GGIR::load_params()$params_rawdata, s$pr)
-    I <- meta_quiet(GGIR::g.inspectfile(s$file, params_rawdata = pr))
-    expect_error(meta_quiet(GGIR::g.getmeta(s$file, params_rawdata = pr, inspectfileobject = I,
-                                            verbose = FALSE)))
+    # (keep_warn(): GGIR's functions that stop may leave warnings off)
+    I <- keep_warn(meta_quiet(GGIR::g.inspectfile(s$file, params_rawdata = pr)))
+    expect_error(keep_warn(meta_quiet(GGIR::g.getmeta(s$file, params_rawdata = pr, inspectfileobject = I,
+                                                      verbose = FALSE))))
     expect_error(meta_quiet(gravcal::g.getmeta(s$file, params_rawdata = pr, verbose = FALSE)), msg)
     unlink(s$file)
   }
