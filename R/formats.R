@@ -33,6 +33,9 @@
 #   (g.imputeTimegaps(), when imputeTimegaps = TRUE);
 # * ggir_qclog(src): the QClog GGIR's reader gives with the first block
 #   (g.getmeta() returns it in M$QClog), from the open native source;
+# * ggir_block_qclog(src, from): the QClog GGIR's reader gives with each of
+#   its blocks: the rows its native decoder logged after the first `from`
+#   (a data frame, or NULL when none);
 # * ggir_stops(src): why GGIR's reader stops on the file (g.getmeta() then
 #   refuses it, saying so), or NULL;
 # * own_rate: TRUE for a device format whose file records its sampling
@@ -255,6 +258,7 @@ recording_formats <- list(
       }
       options
     },
+    ggir_block_qclog = function(src, from) cwa_qclog(src, from),
     label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
     block_units = function(sf, chunksize, part) round(12 * 3600 * sf / 80 * chunksize),

@@ -218,6 +218,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   i <- 1
   LD <- 2
   QClog <- NULL
+  logged <- 0  # rows of the reader's log taken
   while (LD > 1) {
     if (verbose) cat(if (i == 1) "\nLoading chunk: 1" else paste0(" ", i))
     size_before <- gc_meta_store_size(store)
@@ -275,6 +276,13 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       }
     } else if (nr < short_rows) {
       isLastBlock <- TRUE
+    }
+    if (!is.null(fe$ggir_block_qclog)) {
+      # the reader's log of this block (.cwa: readAxivity's), kept as GGIR
+      # keeps it: when the block's samples are
+      rows <- fe$ggir_block_qclog(src, logged)
+      logged <- logged + NROW(rows)
+      if (have) QClog <- rbind(QClog, rows)
     }
     if (have && impute) {
       # GGIR's QClog of the block: its start (the clock's when the file has
@@ -454,12 +462,27 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   rep <- if (!is.null(src$report)) src$report() else list()
   # (a format whose reader's log is M$QClog keeps its damaged units as
   # GGIR's reader keeps them, and logs them there)
-  imputed <- if ("imputed_spans" %in% names(rep$counters)) unname(rep$counters["imputed_spans"]) else 0
-  if (is.null(fe$ggir_qclog) && (imputed > 0 || isTRUE(rep$skipped > 0))) {
+  counter <- function(nm) if (nm %in% names(rep$counters)) unname(rep$counters[nm]) else 0
+  imputed <- counter("imputed_spans")
+  if (is.null(fe$ggir_qclog) && is.null(fe$ggir_block_qclog) &&
+      (imputed > 0 || isTRUE(rep$skipped > 0))) {
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
             unit_name(src$format, 2), " skipped, ", imputed, " span", if (imputed != 1) "s",
             " imputed (as GGIR's reader imputes them: damage, or time stamps that jump); ",
             "GGIR's QClog of them is not reproduced (M$QClog is NULL).", call. = FALSE)
+  }
+  if (!is.null(fe$ggir_block_qclog) && isTRUE(rep$skipped > 0)) {
+    # (GGIR's reader warns of each)
+    warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
+            unit_name(src$format, rep$skipped), " skipped, as GGIR's reader skips them ",
+            "(M$QClog logs them).", call. = FALSE)
+  }
+  if (!is.null(fe$ggir_block_qclog) && counter("qclog_not_reproduced") > 0) {
+    warning("\"", basename(src$filename), "\": ", counter("qclog_not_reproduced"),
+            " place", if (counter("qclog_not_reproduced") != 1) "s", " where GGIR's reader stops ",
+            "(damage it does not skip, a gap over 3 days or more than 20 bad ",
+            unit_name(src$format, 2), " in a row); M$QClog does not log ",
+            "what GGIR's reader would have logged there.", call. = FALSE)
   }
   M <- meta_result(short, long, cols, metnames, metricnames_long, starttime, wday, wdayname,
                    filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun)

@@ -113,6 +113,32 @@ parmay_qclog <- function(src) {
              observed_packets = rep(n, n), acc_recorded = rep(TRUE, n))
 }
 
+# GGIR's M$QClog rows for a .cwa file's block (GGIRread's readAxivity()
+# log, which g.getmeta() binds block after block): the rows the decoder
+# logged after its first `from`, in readAxivity's types. Its data frame
+# per block of reading has R's integer block numbers where readAxivity
+# reads them from the blocks, and doubles where it counts them (a bad
+# block's place, which readAxivity takes from its `start` argument at a
+# block's start and as its loop's integer plus 1 within one); binding
+# keeps a double once there is one, as rbind() does. NULL when there are
+# no new rows.
+cwa_qclog <- function(src, from) {
+  log <- gc_decoder_unit_log(src$native$ptr)
+  n <- length(log$kind)
+  if (n <= from) return(NULL)
+  k <- (from + 1):n
+  kind <- log$kind[k]
+  id <- function(v, double) if (double) v else as.integer(v)
+  data.frame(checksum_pass = log$checksum_pass[k] == 1,
+             blockID_current = id(log$blockID_current[k], any(kind == 0)),
+             blockID_next = id(log$blockID_next[k], any(kind < 2)),
+             start = log$start[k], end = log$end[k],
+             blockLengthSeconds = log$blockLengthSeconds[k],
+             frequency_blockheader = log$frequency_blockheader[k],
+             frequency_observed = log$frequency_observed[k],
+             imputed = log$imputed[k] == 1)
+}
+
 # Why GGIR's reader of Parmay Matrix files (GGIRread's readParmayMatrix())
 # gives no result to reproduce where gravcal's decoder reads on, or NULL:
 # a packet too short for its header (at the file's end, a file cut inside

@@ -12,6 +12,8 @@ ggirread_file <- function(name) {
 }
 
 # readAxivity called window after window as GGIR does; NULL data ends.
+# attr "QClog": its logs bound window after window, as GGIR's g.getmeta()
+# binds them.
 ref_windows <- function(f, B) {
   old <- Sys.getenv("TZ", unset = NA)
   Sys.setenv(TZ = "UTC")  # GGIR's configtz = "" is the machine's zone
@@ -19,6 +21,7 @@ ref_windows <- function(f, B) {
   out <- list()
   s <- 0
   header <- NULL
+  qclog <- NULL
   repeat {
     P <- tryCatch(suppressWarnings(GGIRread::readAxivity(
       f, start = s, end = s + B, progressBar = FALSE, desiredtz = "",
@@ -26,6 +29,7 @@ ref_windows <- function(f, B) {
       header = header)), error = function(e) NULL)
     if (is.null(P) || is.null(P$data)) break
     header <- P$header
+    qclog <- rbind(qclog, P$QClog)
     out[[length(out) + 1]] <- P$data[, c("x", "y", "z", "temp", "time", "light")]
     s <- s + B
   }
@@ -33,26 +37,35 @@ ref_windows <- function(f, B) {
   if (is.null(d)) return(NULL)
   names(d)[4] <- "temperature"
   rownames(d) <- NULL
+  attr(d, "QClog") <- qclog
   d
 }
 
 # The native decoder, read(out, B) after read(out, B), `cap` samples at a
 # time; light too (native_block()'s default), as readAxivity gives it.
+# attr "QClog": the decoder's log as g.getmeta() takes it, window by window.
 nat_windows <- function(f, B, cap = B * 120 + 1000, compat = 1) {
   h <- native_open(f, "cwa", list(compat = compat))
   on.exit(gc_decoder_close(h$ptr))
+  src <- list(native = h)
   out <- list()
   units <- numeric(0)
+  qclog <- NULL
+  logged <- 0
   repeat {
     b <- native_block(h, B, cap, TRUE, TRUE)
     n <- b$to
     if (n > 0) out[[length(out) + 1]] <- as.data.frame(lapply(b$cols, `[`, seq_len(n)))
     units <- c(units, b$units)
+    rows <- cwa_qclog(src, logged)
+    logged <- logged + NROW(rows)
+    qclog <- rbind(qclog, rows)
     if (b$done || (n == 0 && b$units == 0)) break
   }
   d <- do.call(rbind, out)
   attr(d, "units") <- units
   attr(d, "report") <- native_report(h)
+  attr(d, "QClog") <- qclog
   d
 }
 
@@ -131,7 +144,10 @@ test_that("compat = 1 gives GGIR's readAxivity windows to the bit (GGIRread's fi
       ref <- ref_windows(f, B)
       nat <- nat_windows(f, B)
       expect_gt(nrow(ref), 11000)
-      expect_identical(strip(nat), ref, label = paste(name, "B =", B))
+      expect_identical(strip(nat), strip(ref), label = paste(name, "B =", B))
+      # readAxivity's log (the corrupt file: blocks 0, 13 and 14 skipped, the
+      # span before them imputed; 142-144 end the file, never read)
+      expect_identical(attr(nat, "QClog"), attr(ref, "QClog"), label = paste(name, "B =", B))
     }
   }
 })
@@ -173,13 +189,13 @@ test_that("raw samples are the written ones at their times; the reference reads 
     expect_lt(max(abs(d$time - (1.7e9 + 0.25 + (seq_len(n) - 1) / 100))), 2^-15)
     temp_raw <- round((20 + seq(1, n, by = 120) / 100 / 1000 + 50) * 256 / 75)
     expect_identical(d$temperature, rep(temp_raw * 75 / 256 - 50, each = 120))
-    expect_identical(strip(nat_windows(s$file, 54000)), ref_windows(s$file, 54000))
-    expect_identical(strip(nat_windows(s$file, 7)), ref_windows(s$file, 7))
+    expect_identical(strip(nat_windows(s$file, 54000)), strip(ref_windows(s$file, 54000)))
+    expect_identical(strip(nat_windows(s$file, 7)), strip(ref_windows(s$file, 7)))
   }
   s <- synth(blocks = 10, ax6 = TRUE)
   d <- native_read_all(s$file, "cwa", list(compat = 0))
   expect_identical(unname(as.matrix(d[, 1:3])), round(s$x * 4096) / 4096)
-  expect_identical(strip(nat_windows(s$file, 13)), ref_windows(s$file, 13))
+  expect_identical(strip(nat_windows(s$file, 13)), strip(ref_windows(s$file, 13)))
 })
 
 test_that("max_units: raw mode one block a unit; compat resumes a window when out fills", {
@@ -247,7 +263,7 @@ test_that("compat = 1 on damaged files is readAxivity's output where it reads th
   for (case in c("corrupt", "checksum", "first", "last3", "seqgap")) {
     g <- with_bytes(cases[[case]])
     for (B in c(54000, 9)) {
-      ref <- ref_windows(g, B)
+      ref <- strip(ref_windows(g, B))
       expect_identical(strip(nat_windows(g, B)), ref, label = paste(case, B))
     }
   }
@@ -280,10 +296,57 @@ test_that("a jump in time is a reported gap; compat imputes it as readAxivity do
   expect_match(r$notes, "time gap of 100.0000.. s before block 25", all = FALSE)
   for (B in c(54000, 10)) {
     nat <- nat_windows(f, B)
-    expect_identical(strip(nat), ref_windows(f, B), label = paste("B =", B))
+    ref <- ref_windows(f, B)
+    expect_identical(strip(nat), strip(ref), label = paste("B =", B))
+    expect_identical(attr(nat, "QClog"), attr(ref, "QClog"), label = paste("B =", B))
   }
+  expect_true(all(attr(nat, "QClog")$imputed))
   # 100 s at 100 Hz filled in (block 24's span and the gap, less a grid point)
   expect_gt(attr(nat, "report")$counters[["imputed_samples"]], 10000)
+})
+
+test_that("compat = 1 logs what readAxivity logs (its QClog), window by window", {
+  # bad checksums at a window's start, within one and at its end, a
+  # sequence break, a block whose rate is 6 % off (logged, not imputed) and
+  # one 20 % off (imputed); the time jump of the test above. readAxivity's
+  # own logs, bound window after window as GGIR binds them, are the
+  # reference: identical(), types (integer or double block numbers) too.
+  s <- synth(blocks = 60)
+  cases <- damage_cases(s)[c("corrupt", "checksum", "first", "last3", "seqgap")]
+  rate_off <- function(b, k, samples) {
+    # block k starts `samples` samples earlier (cwa.h's timestampOffset,
+    # bytes 26-27): the block before spans that much less, k that much more
+    at <- block_at(k) + 27:28
+    v <- readBin(b[at], integer(), size = 2, signed = TRUE, endian = "little")
+    b[at] <- writeBin(as.integer(v + samples), raw(), size = 2, endian = "little")[1:2]
+    cwa_fix_checksum(b, k)
+  }
+  cases$rate6 <- rate_off(s$bytes, 33, 7)     # 106 Hz: logged (the next, 95 Hz, not)
+  cases$rate20 <- rate_off(s$bytes, 41, -25)  # 83 and 126 Hz: imputed
+  cases$mixed <- flip(flip(rate_off(cases$seqgap, 12, 7), block_at(27) + 90), block_at(0) + 90)
+  logged <- 0
+  for (case in names(cases)) {
+    g <- with_bytes(cases[[case]])
+    for (B in c(54000, 9, 5)) {
+      nat <- nat_windows(g, B)
+      ref <- ref_windows(g, B)
+      expect_identical(strip(nat), strip(ref), label = paste(case, B))
+      expect_identical(attr(nat, "QClog"), attr(ref, "QClog"), label = paste(case, B))
+      expect_false("qclog_not_reproduced" %in% names(attr(nat, "report")$counters))
+      logged <- logged + NROW(attr(ref, "QClog"))
+    }
+  }
+  # every kind of row is there: a bad block (at a start and inside), a
+  # break, a rate logged but not imputed
+  ref <- attr(ref_windows(with_bytes(cases$mixed), 9), "QClog")
+  expect_true(all(c(FALSE, TRUE) %in% ref$checksum_pass))
+  expect_true(is.double(ref$blockID_current) && is.double(ref$blockID_next))
+  expect_true(any(ref$checksum_pass & !ref$imputed))
+  ref <- attr(ref_windows(with_bytes(cases$rate6), 54000), "QClog")
+  expect_identical(nrow(ref), 1L)
+  expect_false(ref$imputed)
+  expect_true(is.integer(ref$blockID_current))
+  expect_gt(logged, 40)
 })
 
 test_that("a truncated file keeps its whole blocks and says so", {
@@ -296,7 +359,7 @@ test_that("a truncated file keeps its whole blocks and says so", {
     r <- attr(d, "report")
     expect_true(r$truncated)
     expect_match(r$notes[2], paste("after block", whole), fixed = TRUE)
-    expect_identical(strip(nat_windows(g, 54000)), ref_windows(g, 54000))
+    expect_identical(strip(nat_windows(g, 54000)), strip(ref_windows(g, 54000)))
   }
 })
 

@@ -107,25 +107,68 @@ test_that("g.getmeta() is GGIR's on a .cwa recording in zones of one offset (Asi
   unlink(f)
 })
 
-test_that("a .cwa recording across the spring change: M is GGIR's, its QClog not reproduced, with a warning", {
+test_that("a .cwa recording across the spring and autumn changes: M is GGIR's, QClog too", {
   skip_if_quick()
-  # the device's calendar passes the hour Europe/Amsterdam skips: GGIRread
-  # sees its block times step back and imputes every block from there on
-  # (gravcal's decoder too), logging each in QClog, which gravcal does not
-  # reproduce (NULL) and says so
+  # spring: the device's calendar passes the hour Europe/Amsterdam skips;
+  # GGIRread sees its block times step back and imputes every block from
+  # there on (gravcal's decoder too), logging each in QClog (750 rows).
+  # Autumn: the calendar's hour from 02:00 is read once, in summer time, so
+  # the block after it starts an hour late: readAxivity imputes the hour
+  # and logs two blocks. Before gravcal reproduced readAxivity's log, M$QClog
+  # was NULL here (and a warning said so)
   f <- meta_recording("cwa", 25, 5, seed = 12, start = "2024-03-30 22:00:00")
   args <- list(params_general = list(desiredtz = "Europe/Amsterdam"))
   b <- meta_both(f, args)
-  n_log <- nrow(b$ggir$QClog)
-  expect_gt(n_log, 100)
-  expect_null(b$gravcal$QClog)
-  b$ggir$QClog <- NULL
-  b$gravcal$QClog <- NULL
+  expect_gt(nrow(b$ggir$QClog), 100)
   expect_same_meta(b)
-  # (as many spans as GGIR logs blocks)
-  expect_warning(do.call(gravcal::g.getmeta, c(list(f, verbose = FALSE), args)),
-                 paste0("0 damaged blocks skipped, ", n_log, " spans imputed .*QClog of them is not reproduced"))
+  expect_no_warning(utils::capture.output(do.call(gravcal::g.getmeta, c(list(f, verbose = FALSE), args))))
   unlink(f)
+  f <- meta_recording("cwa", 25, 5, seed = 12, start = "2024-10-27 00:30:00")
+  b <- meta_both(f, args)
+  expect_identical(nrow(b$ggir$QClog), 2L)
+  expect_true(all(b$ggir$QClog$imputed))
+  expect_same_meta(b)
+  unlink(f)
+})
+
+test_that("a damaged .cwa recording: M is GGIR's, readAxivity's log of the damage (QClog) too", {
+  skip_if_quick()
+  # 16 hours at 25 Hz, 120 samples a block (12,000 blocks); chunksize 0.2
+  # reads it in windows of 5,400 blocks (GGIR's get_nw_clip_block_params():
+  # round(24 * 3600 * sf / 80 * chunksize)), chunksize 1 in one. Bad
+  # checksums at the file's start, inside a window, on both sides of the
+  # windows' edges (readAxivity's end block search runs over them, the next
+  # window starts on them again) and at the file's end (never read); a
+  # sequence break; a block starting 7 samples early (the rate of the one
+  # before 6 % off: logged, not imputed) and one 25 samples late (imputed)
+  f <- meta_recording("cwa", 25, 16, seed = 31, start = "2024-03-04 09:07:23")
+  b <- readBin(f, raw(), file.size(f))
+  at <- function(k) 1024 + 512 * k
+  bad <- c(0, 1, 700:702, 5399:5401, 10800, 11998, 11999)
+  for (k in bad) b[at(k) + 100] <- as.raw(bitwXor(as.integer(b[at(k) + 100]), 0x10))
+  for (k in 8000:11999) {  # the sequence number jumps by 3 at block 8000
+    id <- readBin(b[at(k) + 11:14], integer(), size = 4, endian = "little")
+    b[at(k) + 11:14] <- writeBin(as.integer(id + 3), raw(), size = 4, endian = "little")
+    if (!k %in% bad) b <- cwa_fix_checksum(b, k)
+  }
+  for (m in list(c(3000, 7), c(9000, -25))) {
+    o <- readBin(b[at(m[1]) + 27:28], integer(), size = 2, signed = TRUE, endian = "little")
+    b[at(m[1]) + 27:28] <- writeBin(as.integer(o + m[2]), raw(), size = 2, endian = "little")[1:2]
+    b <- cwa_fix_checksum(b, m[1])
+  }
+  g <- tempfile(fileext = ".cwa")
+  writeBin(b, g)
+  for (cs in c(0.2, 1)) {
+    bb <- meta_both(g, list(params_rawdata = list(chunksize = cs)))
+    expect_same_meta(bb)
+    log <- bb$ggir$QClog
+    expect_true(any(!log$checksum_pass) && any(log$imputed) && any(log$checksum_pass & !log$imputed))
+    expect_false(any(log$blockID_current %in% c(11998, 11999)))
+  }
+  # the damage said (GGIR's reader warns of each block)
+  expect_warning(utils::capture.output(gravcal::g.getmeta(g, verbose = FALSE)),
+                 "11 damaged blocks skipped, as GGIR's reader skips them")
+  unlink(c(f, g))
 })
 
 test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter blocks", {

@@ -98,6 +98,7 @@ constexpr int data_offset = 30;             // first sample byte
 constexpr std::size_t buffer_blocks = 64;   // blocks read at once
 constexpr int max_bad_run = 20;             // readAxivity maxAllowedCorruptBlocks
 constexpr double frequency_tol = 0.1;       // GGIR's default frequency_tol
+constexpr double frequency_log = 0.05;      // readAxivity logs a rate off by more than this
 constexpr double max_impute_s = 259200.0;   // readAxivity refuses gaps over 3 days
 constexpr double gap_tol_s = 1.0;           // a late block beyond this is a gap
 constexpr double anchor_dt = 0.00001;       // readAxivity's first anchor, before the first sample
@@ -266,6 +267,14 @@ class CwaDecoder : public Decoder {
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
   bool done() const override { return done_; }
   std::size_t max_samples_per_unit() const override { return cwa::max_samples; }
+  // compat = 1: readAxivity's QClog, a row per block it logs, in its order
+  // over the windows read so far (see QcRow); "kind" 0: a bad checksum at a
+  // window's start (its block numbers R's doubles), 1: within a window
+  // (the next block's number a double), 2: a block whose successor's
+  // number does not follow or whose rate is off by more than 5 % (both
+  // numbers R's integers). Where readAxivity would stop instead of
+  // logging, counted as "qclog_not_reproduced".
+  UnitLog unit_log() const override;
 
  private:
   enum class Got { block, bad, end };
@@ -273,10 +282,12 @@ class CwaDecoder : public Decoder {
   // --- block input
   Got fetch(std::int64_t index, const unsigned char*& raw);
   bool refill();
-  Got next_good(std::int64_t& index, std::int64_t stop, cwa::Block& b, bool own, bool count);
+  Got next_good(std::int64_t& index, std::int64_t stop, cwa::Block& b, bool own, bool count,
+                bool log = false);
   bool decode(const unsigned char* raw, std::int64_t index, const cwa::Params* p,
               cwa::Block& b, bool count, bool keep_bytes = false);
   void skip(cwa::Status s, std::int64_t index);
+  void log_bad_block(std::int64_t index, bool window_start);
   void check_time(const cwa::Block& b);
   void zone_check(const cwa::Block& b);
 
@@ -357,6 +368,17 @@ class CwaDecoder : public Decoder {
   int span_len_ = 0, source_ = 1;
   std::int64_t last_ = 0;
   double imputed_[3] = {0, 0, 1};
+
+  // readAxivity's QClog (compat = 1)
+  struct QcRow {
+    int kind;  // 0, 1, 2: see unit_log()
+    bool checksum_pass, imputed;
+    double current, next, start, end, length_s, f_header, f_observed;
+  };
+  std::vector<QcRow> qclog_;
+  std::vector<QcRow> qclog_pending_;  // bad blocks since the last good one in a window
+  std::int32_t next_id_ = 0;  // the sequence number of the block after the span
+  cwa::Status last_status_ = cwa::Status::ok;  // decode()'s last verdict
 };
 
 // ---------------------------------------------------------------------------
@@ -485,6 +507,7 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
     if (!cwa::layout_ok(b.h, use) || !(f > 0) || !std::isfinite(f)) s = cwa::Status::bad_content;
   }
   if (s == cwa::Status::ok && !cwa::calendar(b.h.coded, T)) s = cwa::Status::bad_timestamp;
+  last_status_ = s;
   if (s != cwa::Status::ok) {
     if (count) skip(s, index);
     return false;
@@ -507,13 +530,42 @@ inline bool CwaDecoder::decode(const unsigned char* raw, std::int64_t index, con
 // The first good block from `index` on (before `stop` unless negative) into
 // b; index is left at it. Bad blocks are skipped (counted when `count`).
 inline CwaDecoder::Got CwaDecoder::next_good(std::int64_t& index, std::int64_t stop,
-                                             cwa::Block& b, bool own, bool count) {
+                                             cwa::Block& b, bool own, bool count, bool log) {
   for (; stop < 0 || index < stop; ++index) {
     const unsigned char* raw = nullptr;
     if (fetch(index, raw) != Got::block) return Got::end;
     if (decode(raw, index, own ? nullptr : &wp_, b, count)) return Got::block;
+    if (log) log_bad_block(index, true);
   }
   return Got::bad;
+}
+
+// readAxivity's QClog row of a block it skips (a bad checksum; it stops on
+// any other damage, and on more than 20 bad blocks in a row): the block's
+// place in the file and the next, zeros, not imputed. Within a window the
+// row waits for the next good block: bad blocks at the file's end are
+// never read by readAxivity (it ends the file at the last good block).
+inline void CwaDecoder::log_bad_block(std::int64_t index, bool window_start) {
+  if (last_status_ != cwa::Status::bad_checksum) {
+    report_.count("qclog_not_reproduced");
+    return;
+  }
+  const double i = static_cast<double>(index);
+  (window_start ? qclog_ : qclog_pending_).push_back({window_start ? 0 : 1, false, false, i, i + 1, 0, 0, 0, 0, 0});
+}
+
+inline Decoder::UnitLog CwaDecoder::unit_log() const {
+  UnitLog log;
+  log.names = {"kind", "checksum_pass", "blockID_current", "blockID_next", "start", "end",
+               "blockLengthSeconds", "frequency_blockheader", "frequency_observed", "imputed"};
+  log.columns.assign(log.names.size(), std::vector<double>());
+  for (auto& c : log.columns) c.reserve(qclog_.size());
+  for (const QcRow& r : qclog_) {
+    const double v[] = {static_cast<double>(r.kind), r.checksum_pass ? 1.0 : 0.0, r.current, r.next,
+                        r.start, r.end, r.length_s, r.f_header, r.f_observed, r.imputed ? 1.0 : 0.0};
+    for (std::size_t k = 0; k < log.columns.size(); ++k) log.columns[k].push_back(v[k]);
+  }
+  return log;
 }
 
 // Counts good block b and reports a sequence break or a jump in time
@@ -690,7 +742,8 @@ inline bool CwaDecoder::start_window(std::int64_t max_units) {
   span_open_ = false;
   std::int64_t i = s;
   cwa::Block& b = blk_[prev_];
-  const Got g = next_good(i, e, b, true, true);
+  const Got g = next_good(i, e, b, true, true, rules_.compat);
+  if (i - s > cwa::max_bad_run) report_.count("qclog_not_reproduced");  // readAxivity stops
   if (g != Got::block) {  // readAxivity: "All requested blocks are corrupt"
     win_done_ = true;
     win_eof_ = g == Got::end;
@@ -763,6 +816,7 @@ inline bool CwaDecoder::step_window() {
   const unsigned char* raw = nullptr;
   span_blk_ = prev_;
   if (fetch(ii_, raw) != Got::block) {  // the file's last good block
+    qclog_pending_.clear();
     const bool alone = first_iter_;
     begin_span(final_time(), alone, true, false);
     win_done_ = true;
@@ -772,13 +826,17 @@ inline bool CwaDecoder::step_window() {
   cwa::Block& cur = blk_[1 - prev_];
   const std::int64_t i = ii_++;
   if (!decode(raw, i, &wp_, cur, true)) {
+    log_bad_block(i, false);
     if (++bad_run_ > cwa::max_bad_run && bad_run_ == cwa::max_bad_run + 1) {
+      report_.count("qclog_not_reproduced");
       report_.note("more than 20 bad blocks in a row before block " + std::to_string(i + 1) +
                    " (readAxivity stops here)");
     }
     return true;
   }
   bad_run_ = 0;
+  qclog_.insert(qclog_.end(), qclog_pending_.begin(), qclog_pending_.end());
+  qclog_pending_.clear();
   cur.start = cwa::block_start(minute_cache_time(cur), cur.h, wp_);
   check_time(cur);
   const cwa::Block& p = blk_[prev_];
@@ -786,6 +844,7 @@ inline bool CwaDecoder::step_window() {
                                                   static_cast<std::int32_t>(p.h.id) != 1;
   prev_start_ = p.start;
   prev_len_ = p.h.count;
+  next_id_ = static_cast<std::int32_t>(cur.h.id);
   begin_span(cur.start, false, false, seq_break);
   prev_ = 1 - prev_;
   if (regrid_) {  // a gap readAxivity would refuse: restart the grid here
@@ -816,6 +875,19 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   if (final_block && alone) observed = p.frequency;
   const double bias = std::fabs(observed - p.frequency) / p.frequency;
   impute_ = (!final_block && seq_break) || bias > frequency_tol_;
+  if (impute_ || bias > cwa::frequency_log) {
+    // readAxivity's log of block p: after the file's last block, its
+    // "next" is p itself (the block last read)
+    if (alone) {
+      report_.count("qclog_not_reproduced");  // readAxivity stops there
+    } else {
+      const double id = static_cast<double>(static_cast<std::int32_t>(p.h.id));
+      const double next_id = final_block ? id : static_cast<double>(next_id_);
+      const double end = final_block ? prev_start_ : next_time;
+      qclog_.push_back({2, true, impute_, id, next_id, prev_start_, end, end - prev_start_,
+                        p.frequency, observed});
+    }
+  }
   std::int64_t last = std::min(pos_ + 200, nr_ - 1);
   if (raw_t_[len] > grid(last)) {
     const double add = std::floor((raw_t_[len] - grid(last)) * p.frequency);
@@ -824,6 +896,7 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   }
   if (impute_ && static_cast<double>(last - pos_) > p.frequency * cwa::max_impute_s) {
     report_.count("gaps_not_imputed");
+    report_.count("qclog_not_reproduced");
     report_.note("gap over 3 days after block " + std::to_string(p.index) +
                  " not imputed, grid restarted (readAxivity stops here)");
     regrid_ = true;
