@@ -6,7 +6,9 @@
 // the buffer's capacity, the report's counts agree with what was given, the
 // decoder always makes progress, and the samples are the same, to the bit,
 // whether pulled through a large buffer or a 7-sample one, and with or
-// without the AVX2 paths.
+// without the AVX2 paths; readAxivity's log (compat: unit_log()) holds rows
+// of its three kinds only, the same whatever the buffer, none without
+// compat.
 #include <cstring>
 #include <string>
 #include <vector>
@@ -22,6 +24,8 @@ struct Run {
   std::vector<double> v;  // x, y, z, t, time of each sample
   std::int64_t units = 0;
   gravcal::Report report;
+  gravcal::Decoder::UnitLog log;
+  bool done = false;
 };
 
 bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t window,
@@ -75,6 +79,8 @@ bool run(const std::vector<unsigned char>& file, bool compat, std::int64_t windo
     if (idle > 2) __builtin_trap();  // no progress and not done
   }
   r.report = dec.report();
+  r.log = dec.unit_log();
+  r.done = dec.done();
   return true;
 }
 
@@ -84,6 +90,14 @@ void check(const Run& r, bool compat, std::size_t blocks) {
   if (rep.units < 0 || rep.skipped < 0 || rep.gaps < 0 || !(rep.gap_seconds >= 0)) __builtin_trap();
   if (static_cast<std::size_t>(rep.units + rep.skipped) > blocks) __builtin_trap();
   if (!compat && rep.samples > 120 * rep.units) __builtin_trap();
+  const std::vector<std::vector<double>>& c = r.log.columns;
+  if (!compat && !c.empty() && !c[0].empty()) __builtin_trap();
+  for (std::size_t k = 0; !c.empty() && k < c[0].size(); ++k) {
+    const double kind = c[0][k], pass = c[1][k], imputed = c[9][k];
+    if (!(kind == 0 || kind == 1 || kind == 2)) __builtin_trap();
+    if ((kind == 2) != (pass == 1) || !(imputed == 0 || imputed == 1)) __builtin_trap();
+    if (kind < 2 && (imputed != 0 || c[3][k] != c[2][k] + 1)) __builtin_trap();
+  }
 }
 
 bool same(const Run& a, const Run& b) {
@@ -137,5 +151,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   check(big, compat, blocks);
   check(small, compat, blocks);
   if (!same(big, small)) __builtin_trap();
+  if (big.done && small.done && big.log.columns != small.log.columns) __builtin_trap();
   return 0;
 }
