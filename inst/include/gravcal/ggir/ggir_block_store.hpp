@@ -10,11 +10,14 @@
 // blocks), the store does what they ask.
 //
 // Memory, about the block's x, y and z and no more:
-// * the first block is read in parts of a fixed size, then put together in
+// * each axis is one array with room for the block's units at its
+//   decoder's most samples per unit (up to kReserveRows rows: pages not
+//   written are never touched); beyond that room (a larger bound, gaps
+//   filled) a block is read in parts of a fixed size, then put together in
 //   one array per axis of exactly its length (and room for two reads more),
-//   each part freed as it is copied; the next blocks are read into those
-//   arrays (their carry moved to the front), in parts again only beyond
-//   them. Nothing is sized by a number read from the file.
+//   each part freed as it is copied. The next blocks are read into those
+//   arrays (their carry moved to the front). Nothing is sized by a number
+//   read from the file.
 // * temperature and light (a value per page in .cwa and GENEActiv files),
 //   and an ad hoc csv file's wear flags, are kept as runs of one value (RunColumn), as plain values only when
 //   their runs are short.
@@ -254,6 +257,13 @@ class BlockStore {
   // own (glibc: 32 MB at most), so that a part freed is memory given back,
   // not kept in the heap
   static constexpr std::size_t kPartRows = std::size_t{5} << 20;
+  // the most rows a column is given room for before a block is read (256
+  // MB): a block of `units` units bounded by its decoder's samples per
+  // unit fits, unless time gaps are filled in it, and is written straight
+  // into the columns: no parts, no copy into place, its memory touched
+  // once. Pages the block does not fill are never touched (the allocator
+  // maps them, the system backs them on first write).
+  static constexpr std::size_t kReserveRows = std::size_t{1} << 25;
 
   BlockStore(bool temperature, bool time, bool light, bool wear = false) {
     has_[kX] = has_[kY] = has_[kZ] = true;
@@ -300,6 +310,13 @@ class BlockStore {
     const bool ask_wear = has_[kWear] && d.info().has_wear;
     const bool col_time = ask_time && has_[kTime];
     const std::size_t part_rows = std::max(kPartRows, chunk);
+    if (units > 0) {
+      const double bound = static_cast<double>(units) * static_cast<double>(d.max_samples_per_unit()) +
+                           2.0 * static_cast<double>(chunk);
+      if (bound <= static_cast<double>(kReserveRows) && static_cast<std::size_t>(bound) > cap_) {
+        grow(static_cast<std::size_t>(bound));
+      }
+    }
     // (not zeroed: the pages a part does not use are never touched)
     std::vector<std::unique_ptr<double[]>> parts[kCols];
     std::vector<std::size_t> used;  // rows in each part
