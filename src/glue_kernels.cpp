@@ -66,6 +66,17 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
       return Rcpp::List::create(Rcpp::_["end"] = static_cast<double>(f(v, i, n)));
     });
   }
+  if (name == "sorted_counts") {
+    const double* w = col(a, "w");
+    const std::size_t n = len(a, "w");
+    const double o = Rcpp::as<double>(a["o"]), av = Rcpp::as<double>(a["a"]);
+    return each_variant(k::sorted_counts_variants, [&](k::SortedCountsFn f) {
+      std::size_t below = 0, upto = 0;
+      f(w, n, o, av, &below, &upto);
+      return Rcpp::List::create(Rcpp::_["below"] = static_cast<double>(below),
+                                Rcpp::_["upto"] = static_cast<double>(upto));
+    });
+  }
   const double* x = col(a, "x");
   const double* y = col(a, "y");
   const double* z = col(a, "z");

@@ -2,7 +2,7 @@
 # write_recording() and write_axivity_csv() write, through time zones
 # (desiredtz: UTC, one fixed offset, zones with daylight saving; configtz
 # given or not) and starts a fraction past the second or across a spring
-# change: the identity of M (all but bsc_qc, and QClog's wall-clock start
+# or an autumn change: the identity of M (all but bsc_qc, and QClog's wall-clock start
 # and end for formats without time stamps). GGIR runs here, live: a few
 # minutes. Not part of make test (its cases that found bugs are tests in
 # test-ggir-getmeta.R); run it after a change to time stamps or zones:
@@ -57,7 +57,8 @@ run <- function(label, file, tzs = c("UTC", "Asia/Kolkata", "America/New_York"),
 }
 `%||%` <- function(a, b) if (is.null(a)) b else a
 
-starts <- c(fraction = "2024-01-01 00:07:13.37", spring = "2024-03-30 22:00:00")
+starts <- c(fraction = "2024-01-01 00:07:13.37", spring = "2024-03-30 22:00:00",
+            autumn = "2024-10-27 00:30:00")
 devices <- list(cwa = list(ext = ".cwa", sf = 25), geneactiv = list(ext = ".bin", sf = 30),
                 gt3x = list(ext = ".gt3x", sf = 30), actigraph_csv = list(ext = ".csv", sf = 30),
                 movisens = list(ext = "", sf = 64), parmay = list(ext = ".bin", sf = 30))

@@ -339,6 +339,35 @@ test_that("first_zero: the first idle-sleep sample of the reference", {
   expect_identical(kernel_diffs("first_zero", cases), character(0))
 })
 
+test_that("sorted_counts: the running median's places, as the reference counts them", {
+  # sorted windows of 0 to 60 values (the median's is 51 at 10 Hz) with
+  # ties, signed zeros, infinities, subnormals; the values leaving and
+  # entering drawn from the window (ties with it), from tricky values
+  # (never NaN: the median keeps NaN out of its window) and between
+  set.seed(8)
+  pool <- tricky[!is.na(tricky)]
+  cases <- list()
+  for (n in 0:60) {
+    for (kind in c("ordinary", "ties", "tricky")) {
+      w <- sort(switch(kind,
+        ordinary = 0.6 + 0.01 * stats::rnorm(n),
+        ties = sample(c(-0, 0, 0.25, 0.5, 1), n, replace = TRUE),
+        tricky = sample(pool, n, replace = TRUE)))
+      from <- c(w, pool, 0.6 + 0.01 * stats::rnorm(3))
+      for (r in 1:3) {
+        cases[[paste(kind, n, r)]] <- list(w = as.double(w), o = sample(from, 1), a = sample(from, 1))
+      }
+    }
+  }
+  expect_identical(kernel_diffs("sorted_counts", cases), character(0))
+  # the reference is the rule itself
+  for (cs in cases[c("ties 60 1", "tricky 33 2", "ordinary 51 3")]) {
+    out <- gc_kernel_check("sorted_counts", cs)$scalar
+    expect_identical(out$below, as.double(sum(cs$w < cs$o)))
+    expect_identical(out$upto, as.double(sum(cs$w <= cs$a)))
+  }
+})
+
 test_that(".cwa kernels: checksum, packed samples, sample times and resampling", {
   set.seed(7)
   sums <- lapply(0:16, function(k) list(bytes = as.raw(sample(0:255, 32 * k, replace = TRUE))))
@@ -401,7 +430,7 @@ test_that("the kernel table holds one variant per kernel, chosen once", {
   k <- gc_kernels()
   expect_true(all(k %in% c("scalar", "sse2", "avx2")))
   expect_setequal(names(k), c("run_end", "stream_window", "r_scan", "r_var_means3",
-                              "first_zero", "word_sum", "scale_packed", "span_times",
+                              "first_zero", "sorted_counts", "word_sum", "scale_packed", "span_times",
                               "cwa_interp", "hex_counts"))
   # GRAVCAL_KERNELS forces a kernel to its scalar reference in a new process
   skip_if_no_avx2()

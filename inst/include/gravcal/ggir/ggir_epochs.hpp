@@ -46,6 +46,7 @@
 
 #include "gravcal/ggir/ggir_filters.hpp"
 #include "gravcal/host/r_arith.hpp"
+#include "gravcal/kernels/kernels.hpp"
 
 namespace gravcal {
 namespace ggir_part1 {
@@ -311,6 +312,7 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
   std::vector<double> win;
   win.reserve(k);
   std::size_t nans = 0;
+  const kernels::SortedCountsFn counts = kernels::active().sorted_counts;
   auto add = [&](double a) {
     if (std::isnan(a)) {
       ++nans;
@@ -330,9 +332,10 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
   // drop() finds it: at the count of values below it) and the one entering
   // takes the place add() would give it (after its equals: at the count of
   // the other values not above it), the values between moved by one. Both
-  // counts in one pass without branches: a binary search's branches
-  // mispredict on sensor data (bench/ab.sh, a week's .cwa g.getmeta(): 0.96
-  // of the CPU of lower_bound() and moves one by one).
+  // counts in one pass without branches (the kernel sorted_counts, four or
+  // two lanes at a time where the processor has them): a binary search's
+  // branches mispredict on sensor data (bench/ab.sh, a week's .cwa
+  // g.getmeta(): 0.96 of the CPU of lower_bound() and moves one by one).
   auto slide = [&](double o, double a) {
     if (std::isnan(o) || std::isnan(a)) {
       drop(o);
@@ -342,10 +345,7 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
     double* w = win.data();
     const std::size_t len = win.size();
     std::size_t below_o = 0, upto_a = 0;
-    for (std::size_t j = 0; j < len; ++j) {
-      below_o += static_cast<std::size_t>(w[j] < o);
-      upto_a += static_cast<std::size_t>(w[j] <= a);
-    }
+    counts(w, len, o, a, &below_o, &upto_a);
     const std::size_t pos = below_o;
     const std::size_t to = upto_a - static_cast<std::size_t>(o <= a);  // o itself not counted
     if (to > pos) std::memmove(w + pos, w + pos + 1, (to - pos) * sizeof(double));

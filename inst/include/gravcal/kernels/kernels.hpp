@@ -48,6 +48,7 @@ struct Table {
   RScanFn r_scan = nullptr;
   RVarMeans3Fn r_var_means3 = nullptr;
   FirstZeroFn first_zero = nullptr;
+  SortedCountsFn sorted_counts = nullptr;  // the running median (ggir_epochs.hpp)
   // device decoders (kernels/decode.hpp)
   WordSumFn word_sum = nullptr;
   ScalePackedFn scale_packed = nullptr;
@@ -64,6 +65,7 @@ constexpr void each_kernel(T& t, Visit&& visit) {
   visit(t.r_scan, r_scan_variants, "r_scan");
   visit(t.r_var_means3, r_var_means3_variants, "r_var_means3");
   visit(t.first_zero, first_zero_variants, "first_zero");
+  visit(t.sorted_counts, sorted_counts_variants, "sorted_counts");
   visit(t.word_sum, word_sum_variants, "word_sum");
   visit(t.scale_packed, scale_packed_variants, "scale_packed");
   visit(t.span_times, span_times_variants, "span_times");

@@ -644,6 +644,77 @@ using FirstZeroFn = std::size_t (*)(const double*, const double*, const double*,
 constexpr Variants<FirstZeroFn> first_zero_variants = {
     first_zero_scalar, GRAVCAL_IF_SSE2(first_zero_sse2), GRAVCAL_IF_AVX2(first_zero_avx2)};
 
+// ---------------------------------------------------------------------------
+// sorted_counts(w, n, o, a, &below, &upto): over the n values of a running
+// median's sorted window (ggir_epochs.hpp rolling_median(); no NaN), how
+// many are below o and how many are not above a: where the value leaving
+// sits and where the one entering goes. Counts are exact in every variant.
+
+inline void sorted_counts_scalar(const double* w, std::size_t n, double o, double a,
+                                 std::size_t* below, std::size_t* upto) {
+  std::size_t b = 0, u = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    b += static_cast<std::size_t>(w[j] < o);
+    u += static_cast<std::size_t>(w[j] <= a);
+  }
+  *below = b;
+  *upto = u;
+}
+
+#if defined(GRAVCAL_SSE2)
+inline void sorted_counts_sse2(const double* w, std::size_t n, double o, double a,
+                               std::size_t* below, std::size_t* upto) {
+  // a true lane is all ones, -1 as an integer: subtracted, it counts one
+  const __m128d vo = _mm_set1_pd(o), va = _mm_set1_pd(a);
+  __m128i cb = _mm_setzero_si128(), cu = _mm_setzero_si128();
+  std::size_t j = 0;
+  for (; j + 2 <= n; j += 2) {
+    const __m128d v = _mm_loadu_pd(w + j);
+    cb = _mm_sub_epi64(cb, _mm_castpd_si128(_mm_cmplt_pd(v, vo)));
+    cu = _mm_sub_epi64(cu, _mm_castpd_si128(_mm_cmple_pd(v, va)));
+  }
+  std::int64_t lb[2], lu[2];
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(lb), cb);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(lu), cu);
+  std::size_t b = static_cast<std::size_t>(lb[0] + lb[1]), u = static_cast<std::size_t>(lu[0] + lu[1]);
+  for (; j < n; ++j) {
+    b += static_cast<std::size_t>(w[j] < o);
+    u += static_cast<std::size_t>(w[j] <= a);
+  }
+  *below = b;
+  *upto = u;
+}
+#endif
+
+#if defined(GRAVCAL_AVX2)
+GRAVCAL_TARGET_AVX2 inline void sorted_counts_avx2(const double* w, std::size_t n, double o, double a,
+                                                   std::size_t* below, std::size_t* upto) {
+  const __m256d vo = _mm256_set1_pd(o), va = _mm256_set1_pd(a);
+  __m256i cb = _mm256_setzero_si256(), cu = _mm256_setzero_si256();
+  std::size_t j = 0;
+  for (; j + 4 <= n; j += 4) {
+    const __m256d v = _mm256_loadu_pd(w + j);
+    cb = _mm256_sub_epi64(cb, _mm256_castpd_si256(_mm256_cmp_pd(v, vo, _CMP_LT_OQ)));
+    cu = _mm256_sub_epi64(cu, _mm256_castpd_si256(_mm256_cmp_pd(v, va, _CMP_LE_OQ)));
+  }
+  std::int64_t lb[4], lu[4];
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(lb), cb);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(lu), cu);
+  std::size_t b = static_cast<std::size_t>(lb[0] + lb[1] + lb[2] + lb[3]);
+  std::size_t u = static_cast<std::size_t>(lu[0] + lu[1] + lu[2] + lu[3]);
+  for (; j < n; ++j) {
+    b += static_cast<std::size_t>(w[j] < o);
+    u += static_cast<std::size_t>(w[j] <= a);
+  }
+  *below = b;
+  *upto = u;
+}
+#endif
+
+using SortedCountsFn = void (*)(const double*, std::size_t, double, double, std::size_t*, std::size_t*);
+constexpr Variants<SortedCountsFn> sorted_counts_variants = {
+    sorted_counts_scalar, GRAVCAL_IF_SSE2(sorted_counts_sse2), GRAVCAL_IF_AVX2(sorted_counts_avx2)};
+
 }  // namespace kernels
 }  // namespace gravcal
 
