@@ -99,9 +99,11 @@ test_that("g.getmeta() is GGIR's on a .cwa recording in zones of one offset (Asi
   # and g.calibrate() there, GGIR's to the bit (the decoder's times moved)
   pg <- utils::modifyList(GGIR::load_params()$params_general, list(desiredtz = "Asia/Kolkata"))
   pr <- GGIR::load_params()$params_rawdata
-  I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
-  R <- keep_warn(meta_quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
-                                              inspectfileobject = I, verbose = FALSE)))
+  R <- ggir_cached("g.calibrate", f, list(params_rawdata = pr, params_general = pg), {
+    I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+    keep_warn(meta_quiet(GGIR::g.calibrate(f, params_rawdata = pr, params_general = pg,
+                                           inspectfileobject = I, verbose = FALSE)))
+  })
   G <- meta_quiet(gravcal::g.calibrate(f, params_rawdata = pr, params_general = pg, verbose = FALSE))
   for (nm in setdiff(names(R), "bsc_qc")) expect_identical(G[[nm]], R[[nm]], label = nm)
   unlink(f)

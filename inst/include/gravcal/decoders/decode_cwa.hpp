@@ -551,7 +551,8 @@ inline void CwaDecoder::log_bad_block(std::int64_t index, bool window_start) {
     return;
   }
   const double i = static_cast<double>(index);
-  (window_start ? qclog_ : qclog_pending_).push_back({window_start ? 0 : 1, false, false, i, i + 1, 0, 0, 0, 0, 0});
+  const QcRow row{window_start ? 0 : 1, false, false, i, i + 1, 0, 0, 0, 0, 0};
+  (window_start ? qclog_ : qclog_pending_).push_back(row);
 }
 
 inline Decoder::UnitLog CwaDecoder::unit_log() const {
@@ -877,16 +878,13 @@ inline void CwaDecoder::begin_span(double next_time, bool alone, bool final_bloc
   impute_ = (!final_block && seq_break) || bias > frequency_tol_;
   if (impute_ || bias > cwa::frequency_log) {
     // readAxivity's log of block p: after the file's last block, its
-    // "next" is p itself (the block last read)
-    if (alone) {
-      report_.count("qclog_not_reproduced");  // readAxivity stops there
-    } else {
-      const double id = static_cast<double>(static_cast<std::int32_t>(p.h.id));
-      const double next_id = final_block ? id : static_cast<double>(next_id_);
-      const double end = final_block ? prev_start_ : next_time;
-      qclog_.push_back({2, true, impute_, id, next_id, prev_start_, end, end - prev_start_,
-                        p.frequency, observed});
-    }
+    // "next" is p itself (the block last read). (A window of one block
+    // is never logged: its rate is taken as observed.)
+    const double id = static_cast<double>(static_cast<std::int32_t>(p.h.id));
+    const double next_id = final_block ? id : static_cast<double>(next_id_);
+    const double end = final_block ? prev_start_ : next_time;
+    qclog_.push_back({2, true, impute_, id, next_id, prev_start_, end, end - prev_start_,
+                      p.frequency, observed});
   }
   std::int64_t last = std::min(pos_ + 200, nr_ - 1);
   if (raw_t_[len] > grid(last)) {
