@@ -32,7 +32,8 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
   if (is.numeric(start) && length(start) == 1 && is.finite(start)) {
     ro$local_zone <- meta_local_zone(start)
   }
-  tab <- if (identical(format_local_clock(src$format, datafile), "sample") && !isFALSE(fe$ggir_time) &&
+  per_sample <- identical(format_local_clock(src$format, datafile), "sample")
+  tab <- if (per_sample && !isFALSE(fe$ggir_time) &&
              is.numeric(start) && length(start) == 1 && is.finite(start)) {
     meta_clock_table(zone, start)
   }
@@ -466,10 +467,15 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   imputed <- counter("imputed_spans")
   if (is.null(fe$ggir_qclog) && is.null(fe$ggir_block_qclog) &&
       (imputed > 0 || isTRUE(rep$skipped > 0))) {
+    # (GGIRread's GENEActiv reader, for one, keeps what it can decode of a
+    # damaged page, garbled digits read as far as they go, and closes up
+    # its time count after it: gravcal's decoder skips the page whole)
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
-            unit_name(src$format, 2), " skipped, ", imputed, " span", if (imputed != 1) "s",
-            " imputed (as GGIR's reader imputes them: damage, or time stamps that jump); ",
-            "GGIR's QClog of them is not reproduced (M$QClog is NULL).", call. = FALSE)
+            unit_name(src$format, rep$skipped), " skipped, ", imputed, " span",
+            if (imputed != 1) "s", " imputed (damage, or time stamps that jump); GGIR's reader ",
+            "may keep part of a damaged ", unit_name(src$format, 1),
+            ", so M can differ from GGIR's from there on, ",
+            "and GGIR's QClog of them is not reproduced (M$QClog is NULL).", call. = FALSE)
   }
   if (!is.null(fe$ggir_block_qclog) && isTRUE(rep$skipped > 0)) {
     # (GGIR's reader warns of each)

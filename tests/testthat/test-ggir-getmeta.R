@@ -10,6 +10,13 @@ meta_quiet <- function(expr) {
   out
 }
 
+# (its printed output dropped, its warnings kept)
+meta_quiet_keep_warnings <- function(expr) {
+  out <- NULL
+  utils::capture.output(out <- expr)
+  out
+}
+
 # GGIR's and gravcal's M for `file` with the same arguments (a list:
 # params_metrics, params_rawdata, params_general, params_cleaning, offset,
 # scale, tempoffset, meantempcal, daylimit; missing lists are GGIR's
@@ -170,6 +177,24 @@ test_that("a damaged .cwa recording: M is GGIR's, readAxivity's log of the damag
   # the damage said (GGIR's reader warns of each block)
   expect_warning(utils::capture.output(gravcal::g.getmeta(g, verbose = FALSE)),
                  "11 damaged blocks skipped, as GGIR's reader skips them")
+  unlink(c(f, g))
+})
+
+test_that("a GENEActiv page with garbled digits: skipped whole, and the warning says M can differ", {
+  # GGIRread's reader keeps the samples before the first group std::stoll
+  # cannot read (garbled digits read as far as they go) and closes up its
+  # time count; gravcal's decoder skips the page whole
+  # (decode_geneactiv.hpp), so M differs from GGIR's after it: the warning
+  # says so rather than only that QClog is not reproduced
+  f <- meta_recording("geneactiv", 30, 3, seed = 5)
+  txt <- readLines(f)
+  hex <- grep("^Recorded Data", txt)[100] + 9
+  substr(txt[hex], 21, 24) <- "ZZZZ"
+  g <- tempfile(fileext = ".bin")
+  writeLines(txt, g)
+  expect_warning(M <- meta_quiet_keep_warnings(gravcal::g.getmeta(g, verbose = FALSE)),
+                 "1 damaged page skipped, 0 spans imputed .*M can differ from GGIR's from there on")
+  expect_gt(nrow(M$metashort), 1000)
   unlink(c(f, g))
 })
 
