@@ -676,13 +676,9 @@ inline void sorted_counts_sse2(const double* w, std::size_t n, double o, double 
   std::int64_t lb[2], lu[2];
   _mm_storeu_si128(reinterpret_cast<__m128i*>(lb), cb);
   _mm_storeu_si128(reinterpret_cast<__m128i*>(lu), cu);
-  std::size_t b = static_cast<std::size_t>(lb[0] + lb[1]), u = static_cast<std::size_t>(lu[0] + lu[1]);
-  for (; j < n; ++j) {
-    b += static_cast<std::size_t>(w[j] < o);
-    u += static_cast<std::size_t>(w[j] <= a);
-  }
-  *below = b;
-  *upto = u;
+  sorted_counts_scalar(w + j, n - j, o, a, below, upto);  // the rest
+  *below += static_cast<std::size_t>(lb[0] + lb[1]);
+  *upto += static_cast<std::size_t>(lu[0] + lu[1]);
 }
 #endif
 
@@ -700,14 +696,9 @@ GRAVCAL_TARGET_AVX2 inline void sorted_counts_avx2(const double* w, std::size_t 
   std::int64_t lb[4], lu[4];
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(lb), cb);
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(lu), cu);
-  std::size_t b = static_cast<std::size_t>(lb[0] + lb[1] + lb[2] + lb[3]);
-  std::size_t u = static_cast<std::size_t>(lu[0] + lu[1] + lu[2] + lu[3]);
-  for (; j < n; ++j) {
-    b += static_cast<std::size_t>(w[j] < o);
-    u += static_cast<std::size_t>(w[j] <= a);
-  }
-  *below = b;
-  *upto = u;
+  sorted_counts_scalar(w + j, n - j, o, a, below, upto);  // the rest
+  *below += static_cast<std::size_t>(lb[0] + lb[1] + lb[2] + lb[3]);
+  *upto += static_cast<std::size_t>(lu[0] + lu[1] + lu[2] + lu[3]);
 }
 #endif
 
