@@ -307,25 +307,48 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
   try {
     gravcal::with_r_acc(ld, [&](auto acc) {
       using Acc = decltype(acc);
+      // the long epochs' means of the norm, the temperature and the light,
+      // in the short metrics' pass
+      const double M = windowsizes[1] * sf;
+      using Sum = p1::PassSum<Acc>;
+      std::vector<Sum> longs;
+      longs.reserve(3);
+      longs.push_back(Sum{p1::EpochSums<Acc>(un, M, true),
+                          [](std::size_t from, std::size_t to, const double* en, double* o) {
+                            std::copy(en, en + (to - from), o);
+                          },
+                          true});
+      auto column = [&](const p1::RunColumn* col) {
+        longs.push_back(Sum{p1::EpochSums<Acc>(un, M, true),
+                            [cur = p1::RunColumn::Cursor(*col)](std::size_t from, std::size_t to, const double*,
+                                                                double* o) mutable {
+                              for (std::size_t i = from; i < to; ++i) o[i - from] = cur(i);
+                            },
+                            false});
+      };
+      if (t) column(t);
+      if (li) column(li);
+      Sum* lp[3] = {&longs[0], longs.size() > 1 ? &longs[1] : nullptr, longs.size() > 2 ? &longs[2] : nullptr};
       const std::vector<std::vector<double>> sm =
           p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
-                                 have_f ? &fc : nullptr, arith);
+                                 have_f ? &fc : nullptr, arith, lp, longs.size());
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
       const double* xyz[3] = {cx, cy, cz};
       const p1::NonwearResult r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
-      const double M = windowsizes[1] * sf;
+      std::size_t next = 1;
+      auto finished = [&](bool have) {
+        return have ? Rcpp::RObject(as_r(longs[next++].sums.finish())) : Rcpp::RObject();
+      };
+      const Rcpp::RObject en = as_r(longs[0].sums.finish());
+      const Rcpp::RObject temperature = finished(t != nullptr);
+      const Rcpp::RObject lightmean = finished(li != nullptr);
       out = Rcpp::List::create(
           Rcpp::Named("short") = shorts, Rcpp::Named("nonwear") = as_r(r.nonwear),
           Rcpp::Named("clipping") = as_r(r.clipping),
           Rcpp::Named("epochs") = static_cast<double>(r.epochs),
-          Rcpp::Named("en") = as_r(p1::per_epoch_of<Acc>(un, M, true, [cx, cy, cz](std::size_t i) {
-            return p1::r_norm(cx[i], cy[i], cz[i]);
-          })),
-          Rcpp::Named("temperature") =
-              t ? Rcpp::RObject(as_r(p1::per_epoch_of<Acc>(un, M, true, temp_at))) : Rcpp::RObject(),
-          Rcpp::Named("lightmean") =
-              li ? Rcpp::RObject(as_r(p1::per_epoch_of<Acc>(un, M, true, light_at))) : Rcpp::RObject(),
+          Rcpp::Named("en") = en, Rcpp::Named("temperature") = temperature,
+          Rcpp::Named("lightmean") = lightmean,
           Rcpp::Named("lightpeak") =
               li ? Rcpp::RObject(as_r(p1::light_peaks(light_at, un, M))) : Rcpp::RObject());
       return 0;

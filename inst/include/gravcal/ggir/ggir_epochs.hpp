@@ -147,13 +147,17 @@ class EpochSums {
     feed(count, [v, base](std::size_t i) { return v[i - base]; });
   }
   // add() of the next `count` values of k sums at once, sums e[q] taking
-  // v[q][0, count): sums of the same block and epochs (the same n and by),
-  // at the same place. Each sum in its own order (the same bits as add()),
-  // up to four side by side: independent chains of additions.
+  // v[q][0, count): sums of the same block (all given the same values so
+  // far), their epochs maybe of different lengths. Each sum in its own
+  // order (the same bits as add()), up to six side by side: independent
+  // chains of additions (six long doubles and an operand fill seven of the
+  // x87's eight registers).
   static void add_many(EpochSums* const* e, const double* const* v, std::size_t k,
                        std::size_t count) {
-    for (std::size_t q = 0; q < k; q += 4) {
-      switch (std::min<std::size_t>(4, k - q)) {
+    for (std::size_t q = 0; q < k; q += 6) {
+      switch (std::min<std::size_t>(6, k - q)) {
+        case 6: feed_k<6>(e + q, v + q, count); break;
+        case 5: feed_k<5>(e + q, v + q, count); break;
         case 4: feed_k<4>(e + q, v + q, count); break;
         case 3: feed_k<3>(e + q, v + q, count); break;
         case 2: feed_k<2>(e + q, v + q, count); break;
@@ -170,46 +174,50 @@ class EpochSums {
   }
 
  private:
-  template <int K>  // 2 to 4
+  template <int K>  // 2 to 6
   static void feed_k(EpochSums* const* e, const double* const* v, std::size_t count) {
-    EpochSums& lead = *e[0];
+    const std::size_t base = e[0]->at_;
     for (int q = 1; q < K; ++q) {
-      if (e[q]->at_ != lead.at_ || e[q]->k_ != lead.k_ || e[q]->bound_.size() != lead.bound_.size())
-        throw std::logic_error("EpochSums::add_many: sums at different places");
+      if (e[q]->at_ != base) throw std::logic_error("EpochSums::add_many: sums at different places");
     }
-    const std::size_t base = lead.at_;
     const std::size_t end = base + count;
     std::size_t at = base;
-    while (at < end && lead.k_ < lead.bound_.size()) {
-      const std::size_t to = static_cast<std::size_t>(lead.bound_[lead.k_]) - 1;
-      if (at == to) {
-        for (int q = 0; q < K; ++q) e[q]->record();
-        continue;
+    // the sums' pointers as named variables (registers), the unused ones idle
+    const double* w0 = v[0] - base;
+    const double* w1 = v[K > 1 ? 1 : 0] - base;
+    const double* w2 = v[K > 2 ? 2 : 0] - base;
+    const double* w3 = v[K > 3 ? 3 : 0] - base;
+    const double* w4 = v[K > 4 ? 4 : 0] - base;
+    const double* w5 = v[K > 5 ? 5 : 0] - base;
+    for (;;) {
+      // record the bounds reached; run to the nearest bound ahead
+      std::size_t stop = end;
+      for (int q = 0; q < K; ++q) {
+        EpochSums& s = *e[q];
+        s.at_ = at;
+        s.reached();
+        if (s.k_ < s.bound_.size()) stop = std::min(stop, static_cast<std::size_t>(s.bound_[s.k_]) - 1);
       }
-      const std::size_t stop = std::min(end, to);
-      // the sums in named variables (registers), the unused ones idle
-      const double* w0 = v[0] - base;
-      const double* w1 = v[K > 1 ? 1 : 0] - base;
-      const double* w2 = v[K > 2 ? 2 : 0] - base;
-      const double* w3 = v[K > 3 ? 3 : 0] - base;
+      if (at >= stop) break;  // at the end (a sum past its last bound adds values no epoch reads)
       Acc s0 = e[0]->s_, s1 = e[K > 1 ? 1 : 0]->s_, s2 = e[K > 2 ? 2 : 0]->s_,
-          s3 = e[K > 3 ? 3 : 0]->s_;
+          s3 = e[K > 3 ? 3 : 0]->s_, s4 = e[K > 4 ? 4 : 0]->s_, s5 = e[K > 5 ? 5 : 0]->s_;
       for (std::size_t i = at; i < stop; ++i) {
         s0 += w0[i];
         if (K > 1) s1 += w1[i];
         if (K > 2) s2 += w2[i];
         if (K > 3) s3 += w3[i];
+        if (K > 4) s4 += w4[i];
+        if (K > 5) s5 += w5[i];
       }
       e[0]->s_ = s0;
       if (K > 1) e[1]->s_ = s1;
       if (K > 2) e[2]->s_ = s2;
       if (K > 3) e[3]->s_ = s3;
+      if (K > 4) e[4]->s_ = s4;
+      if (K > 5) e[5]->s_ = s5;
       at = stop;
     }
-    for (int q = 0; q < K; ++q) {
-      e[q]->at_ = end;
-      e[q]->reached();
-    }
+    for (int q = 0; q < K; ++q) e[q]->at_ = end;
   }
   // the running sum is cumsum(c(0, v))[bound] for every bound at the values
   // given so far
@@ -247,6 +255,51 @@ std::vector<double> per_epoch_of(std::size_t n, double by, bool mean, F&& f) {
 template <class Acc>
 std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
   return per_epoch_of<Acc>(n, by, mean, [x](std::size_t i) { return x[i]; });
+}
+
+// One sum of a pass over a block's rows (run_pass()): its epochs, and how
+// its values are made: fill(from, to, norm, out) writes the values of rows
+// [from, to) to out[0, to - from), asked for rows in increasing order;
+// norm holds r_norm() of the same rows when the sum says it needs them
+// (nullptr otherwise).
+template <class Acc>
+struct PassSum {
+  EpochSums<Acc> sums;
+  std::function<void(std::size_t, std::size_t, const double*, double*)> fill;
+  bool needs_norm = false;
+};
+
+inline double r_norm(double x, double y, double z);
+
+// The sums of one block of n rows (x, y, z: the calibrated axes) in one
+// pass, a chunk of rows at a time: each sum's values for the chunk are made
+// into a buffer (the norm once for all that need it), then added, up to
+// six sums side by side (EpochSums::add_many()). Each sum's bits are
+// those of its own pass (the same values added in the same order); the
+// pass reads the block once where separate passes read it once per sum.
+template <class Acc>
+void run_pass(PassSum<Acc>* const* ps, std::size_t k, const double* x, const double* y,
+              const double* z, std::size_t n) {
+  if (k == 0) return;
+  constexpr std::size_t C = 1024;  // rows per chunk: the buffers fit the first-level cache
+  bool norm = false;
+  for (std::size_t q = 0; q < k; ++q) norm = norm || ps[q]->needs_norm;
+  std::vector<double> buf((k + 1) * C);
+  double* nb = buf.data() + k * C;
+  std::vector<EpochSums<Acc>*> e(k);
+  std::vector<const double*> v(k);
+  for (std::size_t q = 0; q < k; ++q) {
+    e[q] = &ps[q]->sums;
+    v[q] = buf.data() + q * C;
+  }
+  for (std::size_t from = 0; from < n; from += C) {
+    const std::size_t to = std::min(n, from + C);
+    if (norm) {
+      for (std::size_t i = from; i < to; ++i) nb[i - from] = r_norm(x[i], y[i], z[i]);
+    }
+    for (std::size_t q = 0; q < k; ++q) ps[q]->fill(from, to, ps[q]->needs_norm ? nb : nullptr, buf.data() + q * C);
+    EpochSums<Acc>::add_many(e.data(), v.data(), k, to - from);
+  }
 }
 
 // The calibration as g.getmeta applies it, in place: v = (v + offset) /
@@ -688,15 +741,25 @@ std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
 // "ENMOa"; with filter coefficients `fc`, also the filtered metrics of
 // ggir_filters.hpp ("BFEN", "LFENMO", "ZCX", ...: zero crossings summed
 // per epoch, the others averaged). Each asked name gets its epoch values
-// (unrounded), in the order asked. Unknown names are an error.
+// (unrounded), in the order asked. Unknown names are an error. The
+// caller's own sums of the block (`extra`: the long epochs' means) are
+// made in the same pass as the metrics' (run_pass()); the caller finishes
+// them.
 template <class Acc>
 std::vector<std::vector<double>> short_metrics(const double* x, const double* y, const double* z,
                                                std::size_t n, double sf, double ws3,
                                                const std::vector<std::string>& names,
                                                const GgirFilterCoefs* fc = nullptr,
-                                               RFilterArith arith = {}) {
+                                               RFilterArith arith = {},
+                                               PassSum<Acc>* const* extra = nullptr,
+                                               std::size_t n_extra = 0) {
   const double by = sf * ws3;
   std::vector<std::vector<double>> out(names.size());
+  // the sums of the metrics computed sample by sample, made in one pass
+  // (run_pass()) after the loop over the names, and the names they are for
+  std::vector<PassSum<Acc>> pass;
+  std::vector<std::size_t> pass_k;
+  pass.reserve(names.size());
   RollMed rm[3];
   bool have_rm = false;
   auto need_rm = [&]() {
@@ -779,15 +842,24 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       axis = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
     }
     const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
+    using Fill = std::function<void(std::size_t, std::size_t, const double*, double*)>;
+    auto sum = [&](bool needs_norm, Fill fill) {
+      pass.push_back(PassSum<Acc>{EpochSums<Acc>(n, by, true), std::move(fill), needs_norm});
+      pass_k.push_back(k);
+    };
     if (base == "roll_med_acc" && axis >= 0) {
       need_rm();
       const RollMed& r = rm[axis];
-      out[k] = per_epoch_of<Acc>(n, by, true, [&r](std::size_t i) { return r[i]; });
+      sum(false, [&r](std::size_t from, std::size_t to, const double*, double* o) {
+        for (std::size_t i = from; i < to; ++i) o[i - from] = r[i];
+      });
     } else if (base == "dev_roll_med_acc" && axis >= 0) {
       need_rm();
       const double* v = axis == 0 ? x : axis == 1 ? y : z;
       const RollMed& r = rm[axis];
-      out[k] = per_epoch_of<Acc>(n, by, true, [v, &r](std::size_t i) { return std::fabs(v[i] - r[i]); });
+      sum(false, [v, &r](std::size_t from, std::size_t to, const double*, double* o) {
+        for (std::size_t i = from; i < to; ++i) o[i - from] = std::fabs(v[i] - r[i]);
+      });
     } else if (base == "angle" && axis >= 0) {
       need_rm();
       const RollMed& a = rm[axis];
@@ -805,30 +877,41 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       // once per subsample value (the same inputs, the same result)
       const bool held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr &&
                         a.step == p.step && a.step == q.step && a.LN == p.LN && a.LN == q.LN;
-      // (per_epoch_of() asks for i = 0, 1, ... in turn: the value is new
-      // where i reaches the next multiple of the step)
-      std::size_t next = 0;
-      double value = 0;
-      out[k] = per_epoch_of<Acc>(n, by, true, [&](std::size_t i) {
-        if (!held || i >= a.LN) return angle(i);
-        if (i >= next) {
-          next = (i / a.step + 1) * a.step;
-          value = angle(i);
+      // (rows come in increasing order: the value is new where a row
+      // reaches the next multiple of the step)
+      sum(false, [angle, held, &a, next = std::size_t(0), value = 0.0](
+                     std::size_t from, std::size_t to, const double*, double* o) mutable {
+        for (std::size_t i = from; i < to; ++i) {
+          if (!held || i >= a.LN) {
+            o[i - from] = angle(i);
+            continue;
+          }
+          if (i >= next) {
+            next = (i / a.step + 1) * a.step;
+            value = angle(i);
+          }
+          o[i - from] = value;
         }
-        return value;
       });
     } else if (nm == "ENMO") {
-      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) {
-        const double e = en(i) - 1;
-        return e < 0 ? 0 : e;
+      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
+        for (std::size_t i = 0; i < to - from; ++i) {
+          const double e = en[i] - 1;
+          o[i] = e < 0 ? 0 : e;
+        }
       });
     } else if (nm == "EN") {
-      out[k] = per_epoch_of<Acc>(n, by, true, en);
+      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
+        std::copy(en, en + (to - from), o);
+      });
     } else if (nm == "ENMOa") {
-      out[k] = per_epoch_of<Acc>(n, by, true, [&en](std::size_t i) { return std::fabs(en(i) - 1); });
+      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
+        for (std::size_t i = 0; i < to - from; ++i) o[i] = std::fabs(en[i] - 1);
+      });
     } else if (nm == "MAD") {
       // rep(epoch means, each = sf * ws3) (each truncated to an integer),
-      // recycled against EN as R's `-` recycles
+      // recycled against EN as R's `-` recycles: a pass of its own, after
+      // the means
       const std::vector<double> means = per_epoch_of<Acc>(n, by, true, en);
       const std::size_t each = static_cast<std::size_t>(by);
       const std::size_t m = means.size() * each;
@@ -840,6 +923,12 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       throw std::runtime_error("unknown GGIR metric: " + nm);
     }
   }
+  // the other metrics and the caller's sums in one pass
+  std::vector<PassSum<Acc>*> all;
+  for (PassSum<Acc>& q : pass) all.push_back(&q);
+  for (std::size_t i = 0; i < n_extra; ++i) all.push_back(extra[i]);
+  run_pass<Acc>(all.data(), all.size(), x, y, z, n);
+  for (std::size_t j = 0; j < pass.size(); ++j) out[pass_k[j]] = pass[j].sums.finish();
   return out;
 }
 
