@@ -37,12 +37,24 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
+
+// A standard library without threads (libstdc++ built for the win32
+// threads model, as Debian's default mingw compiler): the epoch signals
+// on one thread (short_metrics()).
+#if defined(__GLIBCXX__) && !defined(_GLIBCXX_HAS_GTHREADS)
+#define GRAVCAL_NO_THREADS 1
+#endif
+#ifndef GRAVCAL_NO_THREADS
+#include <thread>
+#endif
 
 #include "gravcal/ggir/ggir_filters.hpp"
 #include "gravcal/host/r_arith.hpp"
@@ -606,42 +618,64 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
   r.clipping.assign(static_cast<std::size_t>(N), 0.0);
   const double minimumEpochCount = ((L / M) / 2) + 1;
   const double stride = std::ceil(cf.sf / 5);
-  std::vector<double> vals;
-  for (std::int64_t h = 1; h <= N; ++h) {
+  // long epoch h's windows: clipping's, non-wear's, and the epochs its
+  // non-wear flags
+  struct Window {
+    double clipstart, clipend, nwstart, nwend;
+    std::int64_t flag_from, flag_to;
+  };
+  auto window = [&](std::int64_t h) {
     const double hd = static_cast<double>(h);
-    const double clipstart = (((hd - 1) * M) + M * 0.5) - M * 0.5;
-    const double clipend = (((hd - 1) * M) + M * 0.5) + M * 0.5;
-    double nwstart = 0, nwend = 0;
-    std::int64_t flag_from = h, flag_to = h;
+    Window w;
+    w.clipstart = (((hd - 1) * M) + M * 0.5) - M * 0.5;
+    w.clipend = (((hd - 1) * M) + M * 0.5) + M * 0.5;
+    w.flag_from = w.flag_to = h;
     if (!cf.approach_2023) {
       if (hd <= minimumEpochCount) {
-        nwstart = 1;
-        nwend = L;
+        w.nwstart = 1;
+        w.nwend = L;
       } else if (hd >= (static_cast<double>(N) - minimumEpochCount)) {
-        nwstart = (static_cast<double>(N) - minimumEpochCount) * M;
-        nwend = static_cast<double>(N) * M;
+        w.nwstart = (static_cast<double>(N) - minimumEpochCount) * M;
+        w.nwend = static_cast<double>(N) * M;
       } else {
-        nwstart = (((hd - 1) * M) + M * 0.5) - L * 0.5;
-        nwend = (((hd - 1) * M) + M * 0.5) + L * 0.5;
+        w.nwstart = (((hd - 1) * M) + M * 0.5) - L * 0.5;
+        w.nwend = (((hd - 1) * M) + M * 0.5) + L * 0.5;
       }
     } else {
       // h:(h + L / M - 1), those beyond N left out
       const RColon fc = r_colon(hd, hd + L / M - 1);
-      flag_from = h;
-      flag_to = h;
       if (fc.n > 0) {
         const double lastv = fc.at(fc.n - 1);
-        flag_to = static_cast<std::int64_t>(std::min(lastv, static_cast<double>(N)));
+        w.flag_to = static_cast<std::int64_t>(std::min(lastv, static_cast<double>(N)));
       }
-      nwstart = hd * M - M;
-      nwend = nwstart + L;
-      if (nwend > static_cast<double>(nrow)) nwend = static_cast<double>(nrow);
+      w.nwstart = hd * M - M;
+      w.nwend = w.nwstart + L;
+      if (w.nwend > static_cast<double>(nrow)) w.nwend = static_cast<double>(nrow);
     }
-    double cmax = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double* v = xyz[a];
+    return w;
+  };
+  // approach "2023" reads every stride-th row of windows that overlap
+  // (ws / ws2 of them hold each row): where the windows start on one
+  // lattice of rows (whole stride and long epoch, the epoch a multiple of
+  // the stride), the axis's rows on it are copied once, in order, and the
+  // windows read the copy (the same values, the axis read once rather than
+  // once per window a row out of every few cache lines)
+  const bool on_lattice = cf.approach_2023 && stride >= 1 && stride < 1e9 && M == std::floor(M) &&
+                          std::fmod(M, stride) == 0;
+  std::vector<double> lattice;
+  std::vector<double> vals;
+  for (int a = 0; a < 3; ++a) {
+    const double* v = xyz[a];
+    if (on_lattice) {
+      const std::size_t st = static_cast<std::size_t>(stride);
+      lattice.clear();
+      lattice.reserve(nrow / st + 1);
+      for (std::size_t j = 0; j < nrow; j += st) lattice.push_back(v[j]);
+    }
+    for (std::int64_t h = 1; h <= N; ++h) {
+      const Window w = window(h);
       // clipping: values beyond clipthres in (1 + clipstart):clipend
-      const RColon cc = r_colon(1 + clipstart, clipend);
+      const RColon cc = r_colon(1 + w.clipstart, w.clipend);
       double count = 0;
       bool extreme = false;
       at_r_indices(cc, nrow, [&](std::size_t j) {
@@ -652,16 +686,29 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
         }
       });
       if (count > 0 && extreme) count = M;
-      cmax = a == 0 ? count / M : std::max(cmax, count / M);
+      // R's max(c(...)) of the three clipping fractions
+      double& cm = r.clipping[static_cast<std::size_t>(h - 1)];
+      cm = a == 0 ? count / M : std::max(cm, count / M);
       // non-wear: range, then sd, of the window's values
       vals.clear();
       if (!cf.approach_2023) {
-        at_r_indices(r_colon(1 + nwstart, nwend), nrow, [&](std::size_t j) { vals.push_back(v[j]); });
+        at_r_indices(r_colon(1 + w.nwstart, w.nwend), nrow, [&](std::size_t j) { vals.push_back(v[j]); });
       } else {
-        const std::vector<double> s = r_seq_by(1 + nwstart, nwend, stride);
-        for (double d : s) {
-          const std::int64_t j = static_cast<std::int64_t>(d);
-          if (j >= 1 && j <= static_cast<std::int64_t>(nrow)) vals.push_back(v[static_cast<std::size_t>(j - 1)]);
+        const std::vector<double> s = r_seq_by(1 + w.nwstart, w.nwend, stride);
+        const double from = s.empty() ? 0 : s[0];
+        if (on_lattice && from >= 1 && from == std::floor(from) && std::fmod(from - 1, stride) == 0) {
+          // the rows from, from + stride, ... within 1..nrow: the copy's
+          const std::size_t j0 = static_cast<std::size_t>((from - 1) / stride);
+          const std::size_t stop = std::min(lattice.size(), j0 + s.size());
+          if (j0 < stop) {
+            vals.insert(vals.end(), lattice.begin() + static_cast<std::ptrdiff_t>(j0),
+                        lattice.begin() + static_cast<std::ptrdiff_t>(stop));
+          }
+        } else {
+          for (double d : s) {
+            const std::int64_t j = static_cast<std::int64_t>(d);
+            if (j >= 1 && j <= static_cast<std::int64_t>(nrow)) vals.push_back(v[static_cast<std::size_t>(j - 1)]);
+          }
         }
       }
       double mx = -std::numeric_limits<double>::infinity();
@@ -677,22 +724,23 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
           for (double e : vals) f(e);
         });
         if (ms.sd < cf.sdcriter) {
-          for (std::int64_t g = flag_from; g <= flag_to; ++g) {
+          for (std::int64_t g = w.flag_from; g <= w.flag_to; ++g) {
             nwlog[static_cast<std::size_t>(g - 1) * 3 + static_cast<std::size_t>(a)] = 1;
           }
         }
       }
     }
-    // R's max(c(...)) of the three clipping fractions
-    r.clipping[static_cast<std::size_t>(h - 1)] = cmax;
+  }
+  for (std::int64_t h = 1; h <= N; ++h) {
     const std::size_t b = static_cast<std::size_t>(h - 1) * 3;
     r.nonwear[static_cast<std::size_t>(h - 1)] = nwlog[b] + nwlog[b + 1] + nwlog[b + 2];
     if (wear != nullptr) {
+      const Window w = window(h);
       double n0 = 0, n1 = 0;
-      at_r_indices(r_colon(1 + nwstart, nwend), nrow, [&](std::size_t j) {
-        const double w = (*wear)(j);
-        if (w == 0) n0 += 1;
-        else if (w == 1) n1 += 1;
+      at_r_indices(r_colon(1 + w.nwstart, w.nwend), nrow, [&](std::size_t j) {
+        const double wv = (*wear)(j);
+        if (wv == 0) n0 += 1;
+        else if (wv == 1) n1 += 1;
       });
       if (n0 + n1 == 0) {
         throw std::runtime_error("the wear column (rmc.col.wear) has no TRUE/FALSE value in the non-wear window of "
@@ -744,7 +792,14 @@ std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
 // (unrounded), in the order asked. Unknown names are an error. The
 // caller's own sums of the block (`extra`: the long epochs' means) are
 // made in the same pass as the metrics' (run_pass()); the caller finishes
-// them.
+// them. `beside`, when given, is the caller's other work on the block (it
+// reads x, y, z and writes none of what is here).
+//
+// With `threads` 2, the running medians of GGIR's angles (a fifth of a
+// block's time) and the sums that read them are made on a second thread,
+// beside the rest (the filters, the other sums, `beside`): each sum is
+// made whole by one thread, in its order, so the bits do not depend on
+// the threads.
 template <class Acc>
 std::vector<std::vector<double>> short_metrics(const double* x, const double* y, const double* z,
                                                std::size_t n, double sf, double ws3,
@@ -752,38 +807,159 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
                                                const GgirFilterCoefs* fc = nullptr,
                                                RFilterArith arith = {},
                                                PassSum<Acc>* const* extra = nullptr,
-                                               std::size_t n_extra = 0) {
+                                               std::size_t n_extra = 0, int threads = 1,
+                                               const std::function<void()>& beside = {}) {
   const double by = sf * ws3;
   std::vector<std::vector<double>> out(names.size());
   // the sums of the metrics computed sample by sample, made in one pass
-  // (run_pass()) after the loop over the names, and the names they are for
+  // (run_pass()) after the loop over the names: the names they are for,
+  // and whether they read the running medians
   std::vector<PassSum<Acc>> pass;
   std::vector<std::size_t> pass_k;
+  std::vector<bool> pass_rm;
   pass.reserve(names.size());
   RollMed rm[3];
-  bool have_rm = false;
-  auto need_rm = [&]() {
-    if (have_rm) return;
+  auto make_rm = [&]() {
     const double* v[3] = {x, y, z};
     for (int a = 0; a < 3; ++a) rm[a] = ggir_rollmed(v[a], n, sf);
     RollMed* p[3] = {&rm[0], &rm[1], &rm[2]};
     fill_na_last(p, n);
-    have_rm = true;
   };
   auto en = [x, y, z](std::size_t i) { return r_norm(x[i], y[i], z[i]); };
   const double deg = 3.141592653589793238462643383280 / 180;  // R: pi / 180
-  // the filtered metrics first, each filter run once for all of them
-  // (ggir_filtered_signals()); their errors are raised below, in the
-  // order asked
   std::vector<FilteredMetric> fms;
-  std::vector<std::size_t> fk;  // their places among names
+  std::vector<std::size_t> fk;    // their places among names
+  std::vector<std::size_t> mad_k;  // MAD's places: a pass of its own
   for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string& nm = names[k];
     FilteredMetric fm;
-    if (filtered_metric_from_name(names[k].c_str(), &fm)) {
+    if (filtered_metric_from_name(nm.c_str(), &fm)) {
+      if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
       fms.push_back(fm);
       fk.push_back(k);
+      continue;
+    }
+    int axis = -1;
+    if (nm.size() > 2 && nm[nm.size() - 2] == '_') {
+      const char c = nm.back();
+      axis = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
+    }
+    const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
+    using Fill = std::function<void(std::size_t, std::size_t, const double*, double*)>;
+    auto sum = [&](bool needs_norm, bool reads_rm, Fill fill) {
+      pass.push_back(PassSum<Acc>{EpochSums<Acc>(n, by, true), std::move(fill), needs_norm});
+      pass_k.push_back(k);
+      pass_rm.push_back(reads_rm);
+    };
+    if (base == "roll_med_acc" && axis >= 0) {
+      const RollMed& r = rm[axis];
+      sum(false, true, [&r](std::size_t from, std::size_t to, const double*, double* o) {
+        for (std::size_t i = from; i < to; ++i) o[i - from] = r[i];
+      });
+    } else if (base == "dev_roll_med_acc" && axis >= 0) {
+      const double* v = axis == 0 ? x : axis == 1 ? y : z;
+      const RollMed& r = rm[axis];
+      sum(false, true, [v, &r](std::size_t from, std::size_t to, const double*, double* o) {
+        for (std::size_t i = from; i < to; ++i) o[i - from] = std::fabs(v[i] - r[i]);
+      });
+    } else if (base == "angle" && axis >= 0) {
+      const RollMed& a = rm[axis];
+      const RollMed& b = rm[(axis + 1) % 3];
+      const RollMed& c = rm[(axis + 2) % 3];
+      // GGIR's order: angle_x: atan(x / sqrt(y^2 + z^2)); angle_y: y over
+      // x, z; angle_z: z over x, y
+      const RollMed& p = axis == 1 ? c : b;  // first in the sum
+      const RollMed& q = axis == 1 ? b : c;
+      auto angle = [&a, &p, &q, deg](std::size_t i) {
+        const double pi = p[i], qi = q[i];
+        return std::atan(a[i] / (std::sqrt(pi * pi + qi * qi))) / deg;
+      };
+      // the medians hold for `step` samples (10 Hz): their angle is taken
+      // once per subsample value (the same inputs, the same result); rows
+      // come in increasing order: the value is new where a row reaches the
+      // next multiple of the step (whether the medians are held is known
+      // once they are made: at the first row)
+      sum(false, true, [angle, &a, &p, &q, held = false, next = std::size_t(0), value = 0.0](
+                           std::size_t from, std::size_t to, const double*, double* o) mutable {
+        if (from == 0) {
+          held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr && a.step == p.step &&
+                 a.step == q.step && a.LN == p.LN && a.LN == q.LN;
+        }
+        for (std::size_t i = from; i < to; ++i) {
+          if (!held || i >= a.LN) {
+            o[i - from] = angle(i);
+            continue;
+          }
+          if (i >= next) {
+            next = (i / a.step + 1) * a.step;
+            value = angle(i);
+          }
+          o[i - from] = value;
+        }
+      });
+    } else if (nm == "ENMO") {
+      sum(true, false, [](std::size_t from, std::size_t to, const double* e, double* o) {
+        for (std::size_t i = 0; i < to - from; ++i) {
+          const double d = e[i] - 1;
+          o[i] = d < 0 ? 0 : d;
+        }
+      });
+    } else if (nm == "EN") {
+      sum(true, false, [](std::size_t from, std::size_t to, const double* e, double* o) {
+        std::copy(e, e + (to - from), o);
+      });
+    } else if (nm == "ENMOa") {
+      sum(true, false, [](std::size_t from, std::size_t to, const double* e, double* o) {
+        for (std::size_t i = 0; i < to - from; ++i) o[i] = std::fabs(e[i] - 1);
+      });
+    } else if (nm == "MAD") {
+      mad_k.push_back(k);
+    } else {
+      throw std::runtime_error("unknown GGIR metric: " + nm);
     }
   }
+  std::vector<PassSum<Acc>*> near, far;  // the sums without and with the medians
+  for (std::size_t j = 0; j < pass.size(); ++j) (pass_rm[j] ? far : near).push_back(&pass[j]);
+  for (std::size_t i = 0; i < n_extra; ++i) near.push_back(extra[i]);
+  // the second thread: the medians and the sums that read them; joined
+  // before any exception of this thread leaves (the guard), its own
+  // exception raised here after the join
+#ifndef GRAVCAL_NO_THREADS
+  std::exception_ptr far_error;
+  std::thread side;
+  struct Join {
+    std::thread& t;
+    ~Join() {
+      if (t.joinable()) t.join();
+    }
+  } join{side};
+  bool two = threads >= 2 && !far.empty();
+#else
+  const bool two = false;
+  (void)threads;
+#endif
+#ifndef GRAVCAL_NO_THREADS
+  if (two) {
+    try {
+      side = std::thread([&]() {
+        try {
+          make_rm();
+          run_pass<Acc>(far.data(), far.size(), x, y, z, n);
+        } catch (...) {
+          far_error = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {
+      two = false;  // no thread to be had: all on this one
+    }
+  }
+#endif
+  if (!two && !far.empty()) {
+    make_rm();
+    for (PassSum<Acc>* f : far) near.push_back(f);  // all in one pass
+  }
+  // the filtered metrics, each filter run once for all of them
+  // (ggir_filtered_signals()); their errors raised in the order asked
   std::vector<SignalStatus> fstatus(names.size(), SignalStatus::ok);
   if (fc != nullptr && !fms.empty()) {
     // each filtered signal summed per epoch as its parts come
@@ -824,110 +1000,32 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       if (fstatus[fk[i]] == SignalStatus::ok) out[fk[i]] = sums[i].finish();
     }
   }
-  for (std::size_t k = 0; k < names.size(); ++k) {
-    const std::string& nm = names[k];
-    FilteredMetric fm;
-    if (filtered_metric_from_name(nm.c_str(), &fm)) {
-      if (fc == nullptr) throw std::runtime_error("no filter coefficients for " + nm);
-      const SignalStatus st = fstatus[k];
-      if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
-      if (st == SignalStatus::replacement_length)
-        throw std::runtime_error("number of items to replace is not a multiple of replacement length");
-      if (st == SignalStatus::too_short) throw std::runtime_error("GGIR's zero crossings need at least 2 samples");
-      continue;
-    }
-    int axis = -1;
-    if (nm.size() > 2 && nm[nm.size() - 2] == '_') {
-      const char c = nm.back();
-      axis = c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1;
-    }
-    const std::string base = axis >= 0 ? nm.substr(0, nm.size() - 2) : nm;
-    using Fill = std::function<void(std::size_t, std::size_t, const double*, double*)>;
-    auto sum = [&](bool needs_norm, Fill fill) {
-      pass.push_back(PassSum<Acc>{EpochSums<Acc>(n, by, true), std::move(fill), needs_norm});
-      pass_k.push_back(k);
-    };
-    if (base == "roll_med_acc" && axis >= 0) {
-      need_rm();
-      const RollMed& r = rm[axis];
-      sum(false, [&r](std::size_t from, std::size_t to, const double*, double* o) {
-        for (std::size_t i = from; i < to; ++i) o[i - from] = r[i];
-      });
-    } else if (base == "dev_roll_med_acc" && axis >= 0) {
-      need_rm();
-      const double* v = axis == 0 ? x : axis == 1 ? y : z;
-      const RollMed& r = rm[axis];
-      sum(false, [v, &r](std::size_t from, std::size_t to, const double*, double* o) {
-        for (std::size_t i = from; i < to; ++i) o[i - from] = std::fabs(v[i] - r[i]);
-      });
-    } else if (base == "angle" && axis >= 0) {
-      need_rm();
-      const RollMed& a = rm[axis];
-      const RollMed& b = rm[(axis + 1) % 3];
-      const RollMed& c = rm[(axis + 2) % 3];
-      // GGIR's order: angle_x: atan(x / sqrt(y^2 + z^2)); angle_y: y over
-      // x, z; angle_z: z over x, y
-      const RollMed& p = axis == 1 ? c : b;  // first in the sum
-      const RollMed& q = axis == 1 ? b : c;
-      auto angle = [&a, &p, &q, deg](std::size_t i) {
-        const double pi = p[i], qi = q[i];
-        return std::atan(a[i] / (std::sqrt(pi * pi + qi * qi))) / deg;
-      };
-      // the medians hold for `step` samples (10 Hz): their angle is taken
-      // once per subsample value (the same inputs, the same result)
-      const bool held = a.raw == nullptr && p.raw == nullptr && q.raw == nullptr &&
-                        a.step == p.step && a.step == q.step && a.LN == p.LN && a.LN == q.LN;
-      // (rows come in increasing order: the value is new where a row
-      // reaches the next multiple of the step)
-      sum(false, [angle, held, &a, next = std::size_t(0), value = 0.0](
-                     std::size_t from, std::size_t to, const double*, double* o) mutable {
-        for (std::size_t i = from; i < to; ++i) {
-          if (!held || i >= a.LN) {
-            o[i - from] = angle(i);
-            continue;
-          }
-          if (i >= next) {
-            next = (i / a.step + 1) * a.step;
-            value = angle(i);
-          }
-          o[i - from] = value;
-        }
-      });
-    } else if (nm == "ENMO") {
-      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
-        for (std::size_t i = 0; i < to - from; ++i) {
-          const double e = en[i] - 1;
-          o[i] = e < 0 ? 0 : e;
-        }
-      });
-    } else if (nm == "EN") {
-      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
-        std::copy(en, en + (to - from), o);
-      });
-    } else if (nm == "ENMOa") {
-      sum(true, [](std::size_t from, std::size_t to, const double* en, double* o) {
-        for (std::size_t i = 0; i < to - from; ++i) o[i] = std::fabs(en[i] - 1);
-      });
-    } else if (nm == "MAD") {
-      // rep(epoch means, each = sf * ws3) (each truncated to an integer),
-      // recycled against EN as R's `-` recycles: a pass of its own, after
-      // the means
-      const std::vector<double> means = per_epoch_of<Acc>(n, by, true, en);
-      const std::size_t each = static_cast<std::size_t>(by);
-      const std::size_t m = means.size() * each;
-      const std::size_t len = (n == 0 || m == 0) ? 0 : std::max(n, m);
-      out[k] = per_epoch_of<Acc>(len, by, true, [&en, &means, n, m, each](std::size_t i) {
-        return std::fabs(en(i % n) - means[(i % m) / each]);
-      });
-    } else {
-      throw std::runtime_error("unknown GGIR metric: " + nm);
-    }
+  for (std::size_t k : fk) {
+    const SignalStatus st = fstatus[k];
+    if (st == SignalStatus::internal_na) throw std::runtime_error("time series contains internal NAs");
+    if (st == SignalStatus::replacement_length)
+      throw std::runtime_error("number of items to replace is not a multiple of replacement length");
+    if (st == SignalStatus::too_short) throw std::runtime_error("GGIR's zero crossings need at least 2 samples");
   }
-  // the other metrics and the caller's sums in one pass
-  std::vector<PassSum<Acc>*> all;
-  for (PassSum<Acc>& q : pass) all.push_back(&q);
-  for (std::size_t i = 0; i < n_extra; ++i) all.push_back(extra[i]);
-  run_pass<Acc>(all.data(), all.size(), x, y, z, n);
+  for (std::size_t k : mad_k) {
+    // rep(epoch means, each = sf * ws3) (each truncated to an integer),
+    // recycled against EN as R's `-` recycles
+    const std::vector<double> means = per_epoch_of<Acc>(n, by, true, en);
+    const std::size_t each = static_cast<std::size_t>(by);
+    const std::size_t m = means.size() * each;
+    const std::size_t len = (n == 0 || m == 0) ? 0 : std::max(n, m);
+    out[k] = per_epoch_of<Acc>(len, by, true, [&en, &means, n, m, each](std::size_t i) {
+      return std::fabs(en(i % n) - means[(i % m) / each]);
+    });
+  }
+  run_pass<Acc>(near.data(), near.size(), x, y, z, n);
+  if (beside) beside();
+#ifndef GRAVCAL_NO_THREADS
+  if (two) {
+    side.join();
+    if (far_error) std::rethrow_exception(far_error);
+  }
+#endif
   for (std::size_t j = 0; j < pass.size(); ++j) out[pass_k[j]] = pass[j].sums.finish();
   return out;
 }
