@@ -89,8 +89,8 @@ gc_meta_store_keep <- function(ptr, from, count) {
     .Call(`_gravcal_gc_meta_store_keep`, ptr, from, count)
 }
 
-gc_meta_store_epochs <- function(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use) {
-    .Call(`_gravcal_gc_meta_store_epochs`, ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use)
+gc_meta_store_epochs <- function(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use, threads) {
+    .Call(`_gravcal_gc_meta_store_epochs`, ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use, threads)
 }
 
 gc_meta_store_gradient <- function(ptr, n_use, sf, ws3, cal, temperature) {

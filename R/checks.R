@@ -209,3 +209,15 @@ match_choice <- function(x, arg, choices = NULL) {
   }
   x
 }
+
+# The threads g.getmeta() (and so g.part1() and epoch_signals()) uses
+# within a recording: the option `gravcal.threads`, 1 or 2 (more counts as
+# 2: a second thread makes the running medians of GGIR's angles beside
+# the other epoch signals), 2 where it is not set. The results do not
+# depend on it. A cohort run on a plan with several workers sets 1 in them.
+gravcal_threads <- function() {
+  o <- getOption("gravcal.threads")
+  if (is.null(o)) return(2L)
+  check_number(o, "options(gravcal.threads)", min = 1, integer = TRUE)
+  as.integer(min(o, 2))
+}

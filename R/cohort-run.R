@@ -53,13 +53,18 @@ run_cohort <- function(todo, worker, labels) {
     for (i in todo) tryCatch(worker(i, p), error = failed(i))
     return(failures)
   }
+  # several workers: one thread each (options(gravcal.threads))
+  one <- future::nbrOfWorkers() > 1
   run <- function(queue) {
     fs <- list()
     unstarted <- integer(0)
     for (i in queue) {
       f <- tryCatch(
-        future::future(worker(i, p), globals = list(worker = worker, i = i, p = p),
-                       packages = "gravcal", seed = TRUE, label = labels[i]),
+        future::future({
+          if (one) options(gravcal.threads = 1L)
+          worker(i, p)
+        }, globals = list(worker = worker, i = i, p = p, one = one),
+        packages = "gravcal", seed = TRUE, label = labels[i]),
         error = function(e) e)
       if (inherits(f, "FutureError")) {
         # the worker it went to had died with an earlier recording

@@ -18,7 +18,11 @@
 #' as GGIR passes them.
 #'
 #' The file is read once, by gravcal's decoders, in the blocks GGIR's
-#' readers give; the per-sample work is C++.
+#' readers give; the per-sample work is C++. Two threads by default: a
+#' second one makes the running medians of GGIR's angles beside the other
+#' signals. `options(gravcal.threads = 1)` keeps to one (M is the same
+#' bits either way); a cohort run on a plan with several workers keeps each
+#' worker to one.
 #'
 #' @section What this version covers:
 #' Formats: Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x` and csv

@@ -15,6 +15,11 @@
 #' Set the environment variable `GRAVCAL_NO_AVX2=1` before gravcal is first
 #' used in an R session to run the baseline versions only (for comparisons,
 #' or to rule the AVX2 versions out when chasing a problem).
+#' @section Threads:
+#' [g.getmeta()], [g.part1()] and [epoch_signals()] use two threads (the
+#' running medians of GGIR's angles beside the other epoch signals), with
+#' the same results as one. `options(gravcal.threads = 1)` keeps them to
+#' one. Cohort runs on a plan with several workers keep each worker to one.
 #' @keywords internal
 #' @useDynLib gravcal, .registration = TRUE
 #' @importFrom Rcpp evalCpp

@@ -216,6 +216,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   short_rows <- src$short_rows %||% 0
   zone <- if (length(p$configtz)) p$configtz else p$desiredtz
   clock <- format_local_clock(src$format, src$path)
+  threads <- gravcal_threads()
   i <- 1
   LD <- 2
   QClog <- NULL
@@ -386,7 +387,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
           rm(xyz)
         }
         r <- gc_meta_store_epochs(store, cal_b, lin, use.temp, sf, p$windowsizes, asked, nwc,
-                                  filters, fused$conv, fused$rec, n_use)
+                                  filters, fused$conv, fused$rec, n_use, threads)
         n_block <- if (length(asked)) length(r$short[[1]]) else NROW(counts)
         if (!is.null(counts) && length(asked) && nrow(counts) != n_block) {
           abort("actilifecounts::get_counts() gave ", nrow(counts), " epochs for a block of ",

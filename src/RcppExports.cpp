@@ -259,8 +259,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_meta_store_epochs
-Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal, Rcpp::Nullable<Rcpp::List> model, bool use_temp, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused, double n_use);
-RcppExport SEXP _gravcal_gc_meta_store_epochs(SEXP ptrSEXP, SEXP calSEXP, SEXP modelSEXP, SEXP use_tempSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP n_useSEXP) {
+Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal, Rcpp::Nullable<Rcpp::List> model, bool use_temp, double sf, const Rcpp::NumericVector& windowsizes, const Rcpp::CharacterVector& metrics, const Rcpp::List& nonwear, Rcpp::Nullable<Rcpp::List> filters, bool conv_fused, bool rec_fused, double n_use, int threads);
+RcppExport SEXP _gravcal_gc_meta_store_epochs(SEXP ptrSEXP, SEXP calSEXP, SEXP modelSEXP, SEXP use_tempSEXP, SEXP sfSEXP, SEXP windowsizesSEXP, SEXP metricsSEXP, SEXP nonwearSEXP, SEXP filtersSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP, SEXP n_useSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
@@ -275,7 +275,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< bool >::type conv_fused(conv_fusedSEXP);
     Rcpp::traits::input_parameter< bool >::type rec_fused(rec_fusedSEXP);
     Rcpp::traits::input_parameter< double >::type n_use(n_useSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_meta_store_epochs(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use));
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_meta_store_epochs(ptr, cal, model, use_temp, sf, windowsizes, metrics, nonwear, filters, conv_fused, rec_fused, n_use, threads));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -536,7 +537,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_meta_store_set_xyz", (DL_FUNC) &_gravcal_gc_meta_store_set_xyz, 4},
     {"_gravcal_gc_meta_store_fill_gap", (DL_FUNC) &_gravcal_gc_meta_store_fill_gap, 3},
     {"_gravcal_gc_meta_store_keep", (DL_FUNC) &_gravcal_gc_meta_store_keep, 3},
-    {"_gravcal_gc_meta_store_epochs", (DL_FUNC) &_gravcal_gc_meta_store_epochs, 12},
+    {"_gravcal_gc_meta_store_epochs", (DL_FUNC) &_gravcal_gc_meta_store_epochs, 13},
     {"_gravcal_gc_meta_store_gradient", (DL_FUNC) &_gravcal_gc_meta_store_gradient, 6},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 8},

@@ -207,8 +207,10 @@ double gc_meta_store_keep(SEXP ptr, double from, double count) {
 // the short-epoch metric names (ggir_epochs.hpp short_metrics()), non-wear
 // settings (list: clipthres, sdcriter, racriter, approach "2013"/"2023"),
 // the filters (ggir_filter_coefs() or NULL) and whether R's stats::filter()
-// fuses. Returns list(short = named list of epoch means, nonwear,
-// clipping, epochs, en, temperature, lightmean, lightpeak), unrounded.
+// fuses; threads: 1, or 2 for the running medians of the angles on a
+// second thread (short_metrics()). Returns list(short = named list of
+// epoch means, nonwear, clipping, epochs, en, temperature, lightmean,
+// lightpeak), unrounded.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
                                 Rcpp::Nullable<Rcpp::List> model, bool use_temp, double sf,
@@ -216,12 +218,13 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
                                 const Rcpp::CharacterVector& metrics,
                                 const Rcpp::List& nonwear,
                                 Rcpp::Nullable<Rcpp::List> filters, bool conv_fused,
-                                bool rec_fused, double n_use) {
+                                bool rec_fused, double n_use, int threads) {
   namespace p1 = gravcal::ggir_part1;
   Store* s = store(ptr);
   const std::size_t un = rows_used(*s, n_use);
   if (windowsizes.size() != 3) Rcpp::stop("windowsizes must have 3 values");
   if (!(sf > 0)) Rcpp::stop("sf must be positive");
+  if (threads < 1) Rcpp::stop("threads must be at least 1");
   double* cx = s->col(Store::kX);
   double* cy = s->col(Store::kY);
   double* cz = s->col(Store::kZ);
@@ -329,13 +332,20 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       if (t) column(t);
       if (li) column(li);
       Sum* lp[3] = {&longs[0], longs.size() > 1 ? &longs[1] : nullptr, longs.size() > 2 ? &longs[2] : nullptr};
+      // non-wear, clipping and the light's peaks beside the metrics (on
+      // this thread while a second makes the running medians)
+      const double* xyz[3] = {cx, cy, cz};
+      p1::NonwearResult r;
+      std::vector<double> peaks;
+      const std::function<void()> beside = [&]() {
+        r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
+        if (li) peaks = p1::light_peaks(light_at, un, M);
+      };
       const std::vector<std::vector<double>> sm =
           p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
-                                 have_f ? &fc : nullptr, arith, lp, longs.size());
+                                 have_f ? &fc : nullptr, arith, lp, longs.size(), threads, beside);
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
-      const double* xyz[3] = {cx, cy, cz};
-      const p1::NonwearResult r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
       std::size_t next = 1;
       auto finished = [&](bool have) {
         return have ? Rcpp::RObject(as_r(longs[next++].sums.finish())) : Rcpp::RObject();
@@ -349,8 +359,7 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
           Rcpp::Named("epochs") = static_cast<double>(r.epochs),
           Rcpp::Named("en") = en, Rcpp::Named("temperature") = temperature,
           Rcpp::Named("lightmean") = lightmean,
-          Rcpp::Named("lightpeak") =
-              li ? Rcpp::RObject(as_r(p1::light_peaks(light_at, un, M))) : Rcpp::RObject());
+          Rcpp::Named("lightpeak") = li ? Rcpp::RObject(as_r(peaks)) : Rcpp::RObject());
       return 0;
     });
   } catch (const std::exception& e) {

@@ -21,7 +21,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-_build/win}"
 host=x86_64-w64-mingw32
-cxx="${MINGW_CXX:-$host-g++}"
+# the posix threads model, as Rtools' compilers (std::thread: g.getmeta()'s
+# second thread); Debian's default mingw g++ is the win32 model, which has
+# none (the core then builds on one thread: GRAVCAL_NO_THREADS)
+cxx="${MINGW_CXX:-$(command -v $host-g++-posix || echo $host-g++)}"
 rscript="${RSCRIPT:-Rscript}"
 
 r_inc=$("$rscript" -e 'cat(R.home("include"))')

@@ -70,3 +70,36 @@ test_that("epoch_signals() says what is wrong with its arguments", {
   short <- simulate_recording(hours = 1, sf = 10, seed = 24)
   expect_error(epoch_signals(short), "too short")
 })
+
+test_that("g.getmeta() gives the same M on one thread and on two; options(gravcal.threads) is checked", {
+  # the running medians of the angles are made on a second thread beside
+  # the other signals (ggir_epochs.hpp short_metrics()): every sum whole on
+  # one thread, so M may not depend on the threads. 8 hours at 50 Hz in
+  # blocks of about 2 hours (chunksize 0.1), the medians' metrics, a
+  # filtered one and MAD beside ENMO
+  rec <- simulate_recording(hours = 8, sf = 50, seed = 31,
+                            start = as.POSIXct("2024-03-04 09:00:00", tz = "UTC"))
+  f <- tempfile(fileext = ".cwa")
+  on.exit(unlink(f), add = TRUE)
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = 50,
+                      start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  meta <- function(threads) {
+    old <- options(gravcal.threads = threads)
+    on.exit(options(old))
+    gravcal::g.getmeta(f, chunksize = 0.1, do.anglex = TRUE, do.angley = TRUE,
+                       do.roll_med_acc_y = TRUE, do.dev_roll_med_acc_z = TRUE, do.mad = TRUE,
+                       do.bfen = TRUE, desiredtz = "UTC", verbose = FALSE)
+  }
+  one <- meta(1)
+  two <- meta(2)
+  expect_gt(nrow(one$metashort), 5000)
+  expect_true(all(c("anglex", "angley", "anglez", "roll_med_acc_y", "dev_roll_med_acc_z",
+                    "MAD", "BFEN", "ENMO") %in% names(one$metashort)))
+  expect_gt(stats::sd(one$metashort$anglez), 1)  # angles that move
+  # (all but bsc_qc, which has the time of the run, as in the comparisons with GGIR)
+  for (k in setdiff(names(one), "bsc_qc")) expect_identical(two[[k]], one[[k]], label = k)
+  expect_identical(meta(5)$metashort, one$metashort)  # (more counts as 2)
+  old <- options(gravcal.threads = 0)
+  on.exit(options(old), add = TRUE)
+  expect_error(gravcal::g.getmeta(f, verbose = FALSE), "options\\(gravcal.threads\\)` must be a whole number >= 1")
+})
