@@ -12,6 +12,8 @@ decoder_open <- function(file, format, options = list()) {
   options$zone <- NULL
   add <- format_entry(format)$r_options
   if (!is.null(add)) options <- add(file, options, zone)
+  # (a second thread inflates a .gt3x's data ahead of the decoder)
+  if (is.null(options$threads)) options$threads <- gravcal_threads()
   gc_decoder_open(path.expand(file), format, with_resample_fused(options, format))
 }
 

@@ -7,9 +7,11 @@
 
 #include <cstring>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "gravcal/decoders/decode_gt3x.hpp"
+#include "gravcal/decoders/read_ahead.hpp"
 
 namespace gravcal_glue {
 
@@ -68,11 +70,19 @@ class InflateSource : public gravcal::ByteSource {
   std::int64_t pos_ = 0;
 };
 
+// `ahead`: each entry inflated on a second thread, ahead of its reader
+// (gravcal/decoders/read_ahead.hpp).
 class ZlibInflater : public gravcal::EntryInflater {
  public:
+  explicit ZlibInflater(bool ahead = false) : ahead_(ahead) {}
   std::unique_ptr<gravcal::ByteSource> open(gravcal::ByteSource& raw) override {
-    return std::unique_ptr<gravcal::ByteSource>(new InflateSource(raw));
+    std::unique_ptr<gravcal::ByteSource> z(new InflateSource(raw));
+    if (!ahead_) return z;
+    return std::unique_ptr<gravcal::ByteSource>(new gravcal::ReadAheadSource(std::move(z)));
   }
+
+ private:
+  bool ahead_;
 };
 
 }  // namespace gravcal_glue

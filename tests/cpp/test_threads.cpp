@@ -1,9 +1,11 @@
-// gravcal: GGIR part 1's epoch signals on one thread and on two
-// (ggir_epochs.hpp short_metrics(): the running medians of the angles and
-// the sums that read them on a second thread). The two must give the same
-// bits, for every mix of metrics and block shapes here; built also with
-// ThreadSanitizer (make test: test_threads_tsan), which fails the run on a
-// data race between the threads.
+// gravcal: the work on a second thread. GGIR part 1's epoch signals on one
+// thread and on two (ggir_epochs.hpp short_metrics(): the running medians
+// of the angles and the sums that read them on a second thread): the same
+// bits, for every mix of metrics and block shapes here. A byte source read
+// ahead (read_ahead.hpp): the inner source's bytes, end and failure, for
+// any sizes of buffer and read, and stopped before its end. Built also
+// with ThreadSanitizer (make test: test_threads_tsan), which fails the run
+// on a data race between the threads.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "gravcal/decoders/read_ahead.hpp"
 #include "gravcal/ggir/ggir_epochs.hpp"
 
 namespace p1 = gravcal::ggir_part1;
@@ -79,7 +82,80 @@ static void check(const char* what, std::size_t n, double sf, bool with_nan,
   }
 }
 
+// An inner source that gives its bytes in pieces of `piece` and, with
+// `fail_at`, fails there (a read error: fewer bytes, then failed()).
+class PieceSource : public gravcal::ByteSource {
+ public:
+  PieceSource(const std::vector<unsigned char>& b, std::size_t piece, std::size_t fail_at)
+      : b_(b), piece_(piece), end_(std::min(fail_at, b.size())), fails_(fail_at < b.size()) {}
+  std::size_t read(unsigned char* buf, std::size_t n) override {
+    const std::size_t k = std::min({n, piece_, end_ - at_});
+    if (k) std::memcpy(buf, b_.data() + at_, k);
+    at_ += k;
+    return k;
+  }
+  bool failed() const override { return fails_ && at_ >= end_; }
+  std::int64_t position() const override { return static_cast<std::int64_t>(at_); }
+
+ private:
+  const std::vector<unsigned char>& b_;
+  std::size_t piece_, end_;
+  bool fails_;
+  std::size_t at_ = 0;
+};
+
+static void check_read_ahead() {
+  std::vector<unsigned char> bytes(300007);
+  std::uint32_t r = 12345;
+  for (unsigned char& c : bytes) {
+    r = r * 1103515245u + 12345u;
+    c = static_cast<unsigned char>(r >> 24);
+  }
+  const std::size_t lens[] = {0, 1, 4096, 300007};
+  for (std::size_t len : lens) {
+    for (std::size_t chunk : {1, 7, 4096, 65536, 400000}) {
+      for (std::size_t want : {1, 3, 1000, 500000}) {
+        for (std::size_t fail_at : {static_cast<std::size_t>(-1), len / 2}) {
+          if (fail_at == len / 2 && len == 0) continue;
+          const std::vector<unsigned char> b(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(len));
+          std::unique_ptr<gravcal::ByteSource> inner(new PieceSource(b, 5000, fail_at));
+          gravcal::ReadAheadSource ra(std::move(inner), chunk, 3);
+          std::vector<unsigned char> got, buf(want);
+          for (;;) {
+            const std::size_t k = ra.read(buf.data(), want);
+            if (k == 0) break;
+            got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(k));
+          }
+          const std::size_t expect = std::min(fail_at, len);
+          const bool ok = got.size() == expect && std::equal(got.begin(), got.end(), b.begin()) &&
+                          ra.read(buf.data(), want) == 0 && ra.failed() == (fail_at < len) &&
+                          ra.position() == static_cast<std::int64_t>(expect);
+          if (!ok) {
+            std::printf("FAIL read ahead: %zu bytes, buffers of %zu, reads of %zu, failing at %zu: %zu bytes, failed %d\n",
+                        len, chunk, want, fail_at, got.size(), static_cast<int>(ra.failed()));
+            ++failures;
+          }
+        }
+      }
+    }
+  }
+  // stopped before the end (destroyed with the thread waiting on full
+  // buffers, and before any read: no thread)
+  for (std::size_t reads : {0, 1, 2}) {
+    std::unique_ptr<gravcal::ByteSource> inner(new gravcal::MemorySource(bytes.data(), bytes.size()));
+    gravcal::ReadAheadSource ra(std::move(inner), 1000, 2);
+    unsigned char b[10];
+    for (std::size_t i = 0; i < reads; ++i) {
+      if (ra.read(b, sizeof b) != sizeof b || b[0] != bytes[i * sizeof b]) {
+        std::printf("FAIL read ahead stopped early: read %zu\n", i);
+        ++failures;
+      }
+    }
+  }
+}
+
 int main() {
+  check_read_ahead();
   const std::vector<std::string> dflt = {"ENMO", "angle_z"};
   const std::vector<std::string> all = {"angle_x", "angle_y", "angle_z", "roll_med_acc_x", "dev_roll_med_acc_y",
                                         "ENMO", "EN", "ENMOa", "MAD"};

@@ -46,12 +46,7 @@
 #include <system_error>
 #include <vector>
 
-// A standard library without threads (libstdc++ built for the win32
-// threads model, as Debian's default mingw compiler): the epoch signals
-// on one thread (short_metrics()).
-#if defined(__GLIBCXX__) && !defined(_GLIBCXX_HAS_GTHREADS)
-#define GRAVCAL_NO_THREADS 1
-#endif
+#include "gravcal/host/threads.hpp"
 #ifndef GRAVCAL_NO_THREADS
 #include <thread>
 #endif

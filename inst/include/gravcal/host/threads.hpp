@@ -1,0 +1,16 @@
+// gravcal: whether the host's C++ library has threads. Where it has none
+// (libstdc++ built for the win32 threads model, as Debian's default mingw
+// compiler), GRAVCAL_NO_THREADS is defined and the work that would take a
+// second thread (ggir_epochs.hpp short_metrics(), read_ahead.hpp) runs on
+// the caller's. Define it to build without threads anywhere. Header-only,
+// standard headers only.
+#ifndef GRAVCAL_HOST_THREADS_HPP
+#define GRAVCAL_HOST_THREADS_HPP
+
+#include <cstddef>  // (a standard header first: libstdc++'s configuration macros)
+
+#if defined(__GLIBCXX__) && !defined(_GLIBCXX_HAS_GTHREADS) && !defined(GRAVCAL_NO_THREADS)
+#define GRAVCAL_NO_THREADS 1
+#endif
+
+#endif  // GRAVCAL_HOST_THREADS_HPP
