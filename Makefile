@@ -164,7 +164,7 @@ flags-check: setup-test
 	mkdir -p $(BUILD)/lib-native $(BUILD)/lib-clang-fast
 	printf 'CXX17FLAGS = $(FLAGS_NATIVE)\nCXXFLAGS = $(FLAGS_NATIVE)\n' > $(BUILD)/native.mk
 	printf 'CXX17 = clang++\nCXX17FLAGS = $(FLAGS_CLANG)\nCXXFLAGS = $(FLAGS_CLANG)\n' > $(BUILD)/clang-fast.mk
-	R_MAKEVARS_USER=$(abspath $(BUILD)/native.mk) $(R) CMD INSTALL --preclean --no-multiarch \
+	GRAVCAL_KEEP_SYMBOLS=1 R_MAKEVARS_USER=$(abspath $(BUILD)/native.mk) $(R) CMD INSTALL --preclean --no-multiarch \
 	  -l $(BUILD)/lib-native . > $(BUILD)/native-install.log 2>&1 || (tail -40 $(BUILD)/native-install.log; exit 1)
 	sh tools/fma-count.sh $(BUILD)/lib-native/gravcal/libs/gravcal.so
 	R_LIBS="$(abspath $(BUILD)/lib-native)$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) \

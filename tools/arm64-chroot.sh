@@ -193,7 +193,7 @@ if [ "$(cat "$root/gravcal-lib/.source-sha256" 2>/dev/null)" != "$sum" ]; then
   in_chroot install "
     set -e
     cd /gravcal
-    R CMD INSTALL --no-multiarch -l /gravcal-lib .
+    GRAVCAL_KEEP_SYMBOLS=1 R CMD INSTALL --no-multiarch -l /gravcal-lib .
     echo; R CMD config CXX17; R CMD config CXX17FLAGS
     sh /tmp/gravcal-tools/fma-count.sh /gravcal-lib/gravcal/libs/gravcal.so
   "
