@@ -20,6 +20,8 @@
 #' running medians of GGIR's angles beside the other epoch signals), with
 #' the same results as one. `options(gravcal.threads = 1)` keeps them to
 #' one. Cohort runs on a plan with several workers keep each worker to one.
+#' The second thread also inflates a `.gt3x` file's data ahead of its
+#' decoder, wherever gravcal reads one (the same option turns it off).
 #' @keywords internal
 #' @useDynLib gravcal, .registration = TRUE
 #' @importFrom Rcpp evalCpp
