@@ -165,10 +165,12 @@ rmc_layout <- function(p, file, tz = "", ggir = TRUE, stamps = FALSE) {
 # A numeric time stamp `v` in seconds since 1970 as the decoder's
 # adhoc_number() (decode_csv_time.hpp) converts it from the options `o`, in
 # GGIR's operations and order: v / time_div (v / 1 not taken) or
-# v * time_mul, + time_offset, - time_utc_offset (when not 0).
+# v * time_mul, + time_offset, - time_utc_offset (when not 0), or less the
+# offset of force_tz()'s table (zone_force_options(); NA where none).
 rmc_number_time <- function(v, o) {
   v <- if (!is.null(o$time_mul)) v * o$time_mul else if (o$time_div != 1) v / o$time_div else v
   v <- v + o$time_offset
+  if (!is.null(o$tz_na_n)) return(v - zone_force_offset(v, o))
   if (!is.null(o$time_utc_offset) && o$time_utc_offset != 0) v <- v - o$time_utc_offset
   v
 }
@@ -293,9 +295,12 @@ rmc_time_opts <- function(p, file, skip, tz, what) {
 # desiredtz with lubridate::force_tz(), which subtracts the zone's UTC
 # offset at each stamp's clock time. Over a recording that sees one offset
 # (its first and last stamps, a day either side, every half hour) that is
-# the option time_utc_offset; a recording across a change of offset
-# (daylight saving) is refused, naming `what`: force_tz() moves the stamps
-# after the change by the change, and gravcal does not reproduce it.
+# the option time_utc_offset. Across a change of offset (daylight saving)
+# the decoder follows force_tz()'s table (zone_force_options()): the stamps
+# after the change move by it, those in an hour the clocks skip are NA.
+# GGIR's gap filling (rmc.check4timegaps) and resampling (rmc.doresample)
+# of NA stamps are not reproduced: with either (`what`), a recording
+# through such an hour is refused, naming it.
 rmc_activpal_zone <- function(p, file, skip, tz, what) {
   zone <- attr(p, "desiredtz") %||% p$rmc.desiredtz %||% tz
   lines <- fread_lines(file, skip + 1)
@@ -314,15 +319,22 @@ rmc_activpal_zone <- function(p, file, skip, tz, what) {
   span <- range(t)
   at <- floor(seq(span[1] - 86400, span[2] + 86400, by = 1800))
   off <- civil_offset(at, zone)
-  if (anyNA(off) || any(off != off[1])) {
+  if (!anyNA(off) && all(off == off[1])) return(list(time_utc_offset = off[1]))
+  o <- zone_force_options(zone, span[1], span[2])
+  if (is.null(o)) return(list(time_utc_offset = off[1]))
+  skipped <- vapply(seq_len(o$tz_na_n), function(j) {
+    o[[paste0("tz_na_lo_", j - 1L)]] <= span[2] && o[[paste0("tz_na_hi_", j - 1L)]] > span[1]
+  }, TRUE)
+  if (any(skipped) && grepl("^rmc[.]", what)) {
     zone_name <- paste0("the time zone \"", zone, "\"", if (!nzchar(zone)) " (the session's)")
     abort(lead, " with `rmc.unit.time` = \"ActivPAL\" is not supported by gravcal for \"",
-          basename(file), "\": ", zone_name, " (desiredtz, into which GGIR forces ActivPAL ",
-          "days) changes its UTC offset during the recording (daylight saving), moving the ",
-          "stamps after the change; give desiredtz a zone without a change there (\"UTC\", ",
-          "or a fixed offset such as \"Etc/GMT-1\"). GGIR reads such files.")
+          basename(file), "\": the recording's clock passes through an hour that ", zone_name,
+          " (desiredtz, into which GGIR forces ActivPAL days) skips (daylight saving), where ",
+          "lubridate::force_tz() gives no time (NA), and gravcal does not reproduce GGIR's ",
+          "`", what, "` of NA time stamps. Without it, or in a zone without that change ",
+          "(\"UTC\", or a fixed offset such as \"Etc/GMT-1\"), gravcal reads the file.")
   }
-  list(time_utc_offset = off[1])
+  c(list(time_utc_offset = 0), o)
 }
 
 # Whether data.table::fread() reads column `col` of `lines` as date-times

@@ -148,7 +148,7 @@ ggir_param_table <- function() {
                   "zero samples dropped, as g.imputeTimegaps; UNIX s/ms, ActivPAL, text ",
                   "time read by %Y %y %m %d %H %M %S %OS %T, in a zone with daylight saving too); ",
                   "ISO 8601 text as \"POSIX\", repeated whole-second stamps, ActivPAL days ",
-                  "across a change of desiredtz's UTC offset, a block whose first stamp exists twice or ",
+                  "through an hour desiredtz's clocks skip, a block whose first stamp exists twice or ",
                   "not at all in the zone, and reader = \"reference\" refused")),
       list("rmc.doresample", FALSE, check_flag, "TRUE with a UNIX, ActivPAL or text time column: honoured (block by block resampling; time as for rmc.check4timegaps)"),
       # a wear column: g.calibrate() does not use its flags, but GGIR's

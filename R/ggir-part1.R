@@ -43,8 +43,10 @@
 #' csv files (`rmc.firstrow.acc` and the other `rmc.*` parameters, as for
 #' [g.calibrate()]; the time column read stamp by stamp as GGIR reads it,
 #' UNIX seconds or milliseconds, text by `rmc.format.time` in `configtz`,
-#' else `desiredtz`, or ActivPAL days forced into `desiredtz` (a recording
-#' across a change of its UTC offset refused); GGIR's AD_HOC non-wear, sd below `1.2 * rmc.noise`, and
+#' else `desiredtz`, or ActivPAL days forced into `desiredtz` as
+#' `lubridate::force_tz()` forces them, across changes of its UTC offset too
+#' (the hour its clocks repeat at the later offset, the hour they skip NA:
+#' where GGIR's start or a block's edge is NA, an error, as GGIR stops); GGIR's AD_HOC non-wear, sd below `1.2 * rmc.noise`, and
 #' clipping beyond `rmc.dynamic_range`, none without it; with `rmc.col.wear`,
 #' GGIR's non-wear from the wear flags (each long epoch's most frequent flag
 #' in its non-wear window, times 3; flags GGIR's reader stops on, or a

@@ -190,6 +190,12 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       not_filled = g("timegaps_not_filled"))
   }
   before <- if (impute) counters()
+  na_times <- function() {
+    if (!isTRUE(fe$rmc) || is.null(src$report)) return(FALSE)
+    k <- src$report()$counters
+    "time_not_existing" %in% names(k) && k[["time_not_existing"]] > 0
+  }
+  last_read <- NA_real_  # the last time stamp of the block before
   ms <- meta_store(src, time = FALSE)
   store <- ms$store
   # GGIR's metashort and metalong (R/meta-sheet.R): the metrics (by
@@ -261,6 +267,23 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     if (!is.null(clock) && !is.na(times[1]) && !isTRUE(src$clock_shifted)) {
       times <- meta_zone_shift(times, zone, per_sample = identical(clock, "sample"))
     }
+    # ActivPAL days through an hour desiredtz's clocks skip: NA time stamps
+    # (lubridate::force_tz()), on which GGIR stops where its start, or a
+    # block's first or the last before it, is one
+    if (info$n > 0 && ms$want_time && na_times()) {
+      if (i == 1 && is.na(times[1])) {
+        abort("\"", basename(src$filename), "\" starts in an hour the clocks of `desiredtz` = \"",
+              zone, "\" skip (daylight saving), where GGIR's time stamps are NA ",
+              "(lubridate::force_tz()): GGIR's g.getmeta() stops on it too.")
+      }
+      if (i > 1 && (is.na(times[1]) || is.na(last_read)) && (impute || carry > 0)) {
+        abort("\"", basename(src$filename), "\": a block of GGIR's reading starts or ends in ",
+              "an hour the clocks of `desiredtz` = \"", zone, "\" skip (daylight saving), ",
+              "where GGIR's time stamps are NA (lubridate::force_tz()): GGIR's g.getmeta() stops ",
+              "there too (its time gap between blocks is NA).")
+      }
+    }
+    last_read <- times[3]
     isLastBlock <- FALSE
     have <- TRUE
     if (nr == 0) {

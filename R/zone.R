@@ -117,3 +117,67 @@ zone_options <- function(tz) {
   }
   opts
 }
+
+# lubridate::force_tz()'s reading of clock times in the zone `tz` (GGIR's
+# ActivPAL days, read.myacc.csv()), as decoder options for the calendar
+# seconds [lo, hi] (read as UTC): the clock time less the zone's offset at
+# that clock time; a clock time that exists twice (clocks go back) takes
+# the later offset, one that does not exist (clocks go forward) is NA
+# (force_tz()'s roll_dst = c("NA", "post"), lubridate 1.9.0 and later).
+# Worked out from the UTC offsets R gives each instant in the zone: at each
+# change from o1 to o2 (at the instant T), the clock times [T + o1, T + o2)
+# do not exist where o2 > o1, and from T + o2 on o2 holds. Options tz_n,
+# tz_at_i, tz_off_i, tz_na_n, tz_na_lo_k, tz_na_hi_k (decode.hpp
+# ZoneTable), or NULL when the offset does not change over [lo, hi].
+zone_force_options <- function(tz, lo, hi) {
+  gmtoff <- function(u) as.POSIXlt(.POSIXct(u, tz = "UTC"), tz = tz)$gmtoff
+  # the instants half an hour apart, a day either side (offsets change at
+  # most once in half an hour in every zone R knows)
+  u <- seq(floor(lo) - 2 * 86400, ceiling(hi) + 2 * 86400, by = 1800)
+  g <- gmtoff(u)
+  if (anyNA(g)) {
+    abort("`desiredtz` = \"", tz, "\": R gives no UTC offset in this zone for some of the ",
+          "recording's times.")
+  }
+  k <- which(g[-1] != g[-length(g)])
+  if (!length(k)) return(NULL)
+  at <- u[1] + g[1] - 1e9  # before every clock time of the recording
+  off <- g[1]
+  na_lo <- na_hi <- numeric(0)
+  for (i in k) {
+    # the instant of the change, to the second: the first with the new offset
+    a <- u[i]
+    b <- u[i + 1]
+    while (b - a > 1) {
+      m <- floor((a + b) / 2)
+      if (gmtoff(m) == g[i]) a <- m else b <- m
+    }
+    o1 <- g[i]
+    o2 <- g[i + 1]
+    if (o2 > o1) {
+      na_lo <- c(na_lo, b + o1)
+      na_hi <- c(na_hi, b + o2)
+    }
+    at <- c(at, b + o2)
+    off <- c(off, o2)
+  }
+  named <- function(v, nm) {
+    if (length(v)) stats::setNames(as.list(as.numeric(v)), paste0(nm, seq_along(v) - 1L))
+  }
+  c(list(tz_n = length(at), tz_amb_n = 0, tz_na_n = length(na_lo)), named(at, "tz_at_"),
+    named(off, "tz_off_"), named(na_lo, "tz_na_lo_"), named(na_hi, "tz_na_hi_"))
+}
+
+# The offset zone_force_options()'s table `o` gives clock times `v`
+# (seconds read as UTC): NA where they do not exist.
+zone_force_offset <- function(v, o) {
+  at <- unlist(o[paste0("tz_at_", seq_len(o$tz_n) - 1L)])
+  off <- unlist(o[paste0("tz_off_", seq_len(o$tz_n) - 1L)])
+  r <- off[pmax(findInterval(v, at), 1L)]
+  for (j in seq_len(o$tz_na_n)) {
+    lo <- o[[paste0("tz_na_lo_", j - 1L)]]
+    hi <- o[[paste0("tz_na_hi_", j - 1L)]]
+    r[v >= lo & v < hi] <- NA_real_
+  }
+  r
+}

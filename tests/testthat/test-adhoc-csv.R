@@ -529,6 +529,44 @@ test_that("ActivPAL days: time stamps equal read.myacc.csv's to the bit, forced 
                "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"ActivPAL\".*Europe/London")
   expect_identical(gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "Asia/Tokyo",
                                         ggir = FALSE)$opts$time_utc_offset, 32400)
+  # without gap filling, across both changes of Europe/London's offset in
+  # 2024: stamps a second apart from 00:30, in blocks of an hour; the
+  # clock's hour skipped (March 31, 01:00 to 02:00) NA in GGIR's and
+  # gravcal's, the hour repeated (October 27) read at the later offset
+  pr$rmc.check4timegaps <- NULL
+  for (start in c("2024-03-31 00:30:00", "2024-10-27 00:30:00")) {
+    n <- 7200
+    d <- gap_lines(n)
+    d$time <- sprintf("%.10f", (as.numeric(as.POSIXct(start, tz = "UTC")) + seq_len(n) - 1 +
+                                  2209161600) / 86400)
+    utils::write.table(d, f, sep = ",", quote = FALSE, row.names = FALSE)
+    lay <- gravcal:::rmc_layout(gravcal:::rmc_values(pr), f, tz = "Europe/London", ggir = FALSE,
+                                stamps = TRUE)
+    expect_identical(lay$opts$tz_na_n, if (start < "2024-06") 1L else 0L)
+    h <- gravcal:::native_open(f, "adhoc_csv", c(list(compat = 1, interpolation = 1), lay$opts))
+    nas <- 0L
+    for (i in 1:2) {
+      G <- do.call(GGIR:::read.myacc.csv, c(list(rmc.file = f, rmc.nrow = 3600,
+                                                 rmc.skip = (i - 1) * 3600,
+                                                 desiredtz = "Europe/London"), pr))$data
+      g <- gravcal:::native_block(h, max_units = 3600, time = TRUE, capacity = 10000)
+      tg <- g$cols$time[seq_len(g$to)]
+      expect_identical(is.na(tg), is.na(G$time), label = paste(start, "block", i, "NA"))
+      expect_identical(tg[!is.na(tg)], G$time[!is.na(G$time)], label = paste(start, "block", i))
+      nas <- nas + sum(is.na(G$time))
+    }
+    # (the stamps whose clock time, day * 86400 from 1899-12-30, is in the
+    # skipped hour: 02:00:00 written to 10 decimals of a day can fall in it)
+    clock <- as.numeric(d$time) * 86400 + as.numeric(as.POSIXct("1899-12-30", tz = "UTC"))
+    skipped <- clock >= as.numeric(as.POSIXct("2024-03-31 01:00:00", tz = "UTC")) &
+      clock < as.numeric(as.POSIXct("2024-03-31 02:00:00", tz = "UTC"))
+    expect_identical(nas, sum(skipped))
+    expect_gte(nas, if (start < "2024-06") 3600 else 0)
+    k <- gravcal:::gc_decoder_report(h$ptr)$counters
+    expect_identical(if ("time_not_existing" %in% names(k)) k[["time_not_existing"]] else 0,
+                     as.numeric(nas))
+    gravcal:::gc_decoder_close(h$ptr)
+  }
 })
 
 test_that("rmc.check4timegaps: g.calibrate() is GGIR's on a 30-hour file with gaps", {

@@ -1013,6 +1013,59 @@ test_that("g.getmeta() is GGIR's on ad hoc csv files with time gaps, zeros and r
   long_gap(8, 30000:116999, c(5, 1200, 3600), "Asia/Kathmandu")
 })
 
+test_that("ActivPAL days across daylight saving: GGIR's M, force_tz()'s NA hour and jump", {
+  skip_if_quick()
+  skip_if_not_installed("data.table")
+  # read.myacc.csv() forces ActivPAL days into desiredtz with
+  # lubridate::force_tz(): the clock's hour that Europe/London skips
+  # (2024-03-31 01:00 to 02:00) is NA, inside GGIR's first block of
+  # reading here (its blocks: 87000 lines, 2 h 25 min); the hour it
+  # repeats (2024-10-27 01:00 to 02:00) takes the later offset, so the
+  # stamps jump an hour: a gap g.getmeta() fills (imputeTimegaps), or
+  # read.myacc.csv() does first (rmc.check4timegaps)
+  gen <- list(desiredtz = "Europe/London")
+  spring <- meta_adhoc(time = "ActivPAL", start = "2024-03-31 00:00:00")
+  for (pr in list(list(), list(imputeTimegaps = FALSE))) {
+    b <- meta_both(spring$file, list(params_rawdata = c(spring$pr, pr), params_general = gen))
+    expect_same_meta(b)
+    M <- b$gravcal
+    expect_identical(M$metashort$timestamp[c(1, nrow(M$metashort))],
+                     c("2024-03-31T00:00:00+0000", "2024-03-31T04:59:55+0100"))
+  }
+  fall <- meta_adhoc(time = "ActivPAL", start = "2024-10-27 00:10:00")
+  b <- meta_both(fall$file, list(params_rawdata = fall$pr, params_general = gen))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
+  expect_identical(b$gravcal$metashort$timestamp[nrow(b$gravcal$metashort)],
+                   "2024-10-27T03:59:55+0000")
+  b <- meta_both(fall$file, list(params_rawdata = c(fall$pr, list(rmc.check4timegaps = TRUE)),
+                                 params_general = gen))
+  expect_same_meta(b)
+  expect_identical(b$gravcal$QClog$timegaps_n, c(0L, 0L))
+  # where GGIR's start, or a block's first stamp or the last before it, is
+  # NA, GGIR's g.getmeta() stops (g.imputeTimegaps(): "missing value where
+  # TRUE/FALSE needed"): an error saying so
+  gm <- function(a) {
+    gravcal::g.getmeta(a$file, params_rawdata = a$pr, desiredtz = "Europe/London", verbose = FALSE)
+  }
+  ggir <- function(a) {
+    pr <- utils::modifyList(GGIR::load_params()$params_rawdata, a$pr)
+    I <- meta_quiet(GGIR::g.inspectfile(a$file, params_rawdata = pr,
+                                        params_general = list(desiredtz = "Europe/London")))
+    meta_quiet(GGIR::g.getmeta(a$file, params_rawdata = pr, desiredtz = "Europe/London",
+                               inspectfileobject = I, verbose = FALSE))
+  }
+  for (start in c("2024-03-31 01:10:00", "2024-03-30 23:05:00")) {
+    a <- meta_adhoc(time = "ActivPAL", start = start, hours = 3)
+    expect_error(ggir(a), "missing value where TRUE/FALSE needed")
+    expect_error(gm(a), if (start == "2024-03-31 01:10:00") {
+      "starts in an hour the clocks of `desiredtz` = \"Europe/London\" skip"
+    } else {
+      "a block of GGIR's reading starts or ends in an hour the clocks"
+    })
+  }
+})
+
 test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an error naming it", {
   a <- meta_adhoc(hours = 0.2, time = "character")
   gm <- function(..., I = c()) {
@@ -1027,12 +1080,12 @@ test_that("g.getmeta() on ad hoc csv files: what it does not reproduce is an err
   expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.desiredtz = "UTC")),
                                   params_general = list(desiredtz = "Europe/Amsterdam"),
                                   verbose = FALSE), "rmc.desiredtz")
-  # ActivPAL days across a change of desiredtz's offset (force_tz() moves
-  # the stamps after it)
-  ap <- meta_adhoc(hours = 0.2, time = "ActivPAL", start = "2024-10-27 00:55:00")
-  expect_error(gravcal::g.getmeta(ap$file, params_rawdata = ap$pr, desiredtz = "Europe/Paris",
-                                  verbose = FALSE),
-               "rmc.unit.time` = \"ActivPAL\".*\"Europe/Paris\".*changes its UTC offset")
+  # ActivPAL days through the hour desiredtz's clocks skip: GGIR's gap
+  # filling of NA time stamps (lubridate::force_tz()'s) is not reproduced
+  ap <- meta_adhoc(hours = 0.2, time = "ActivPAL", start = "2024-03-31 01:55:00")
+  expect_error(gravcal::g.getmeta(ap$file, params_rawdata = c(ap$pr, list(rmc.check4timegaps = TRUE)),
+                                  desiredtz = "Europe/Paris", verbose = FALSE),
+               "`rmc.check4timegaps` = TRUE with `rmc.unit.time` = \"ActivPAL\".*\"Europe/Paris\".*skips")
   expect_error(gm(rmc.check4timegaps = TRUE, rmc.doresample = TRUE), "rmc.doresample.*imputeTimegaps")
   expect_error(gm(rmc.dynamic_range = "range"), "rmc.dynamic_range")
   expect_error(gravcal::g.getmeta(a$file, params_rawdata = c(a$pr, list(rmc.noise = NULL)),

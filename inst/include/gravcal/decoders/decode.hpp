@@ -367,7 +367,10 @@ struct ReadRules {
 // (R/zone.R) and passes it as options: tz_n
 // steps (tz_at_i: the calendar second from which tz_off_i holds; before
 // the first, the first's offset), tz_amb_n marked spans [tz_amb_lo_j,
-// tz_amb_hi_j). None: the calendar read as UTC.
+// tz_amb_hi_j). None: the calendar read as UTC. lubridate::force_tz()'s
+// table (ActivPAL days; R/adhoc-csv.R) has no marks but spans of calendar
+// times that do not exist in the zone, [tz_na_lo_k, tz_na_hi_k) for k <
+// tz_na_n, whose offset is NaN (force_tz() gives NA there).
 class ZoneTable {
  public:
   static constexpr int kMax = 4096;
@@ -384,11 +387,20 @@ class ZoneTable {
       const std::string k = std::to_string(j);
       amb_.emplace_back(opts.num(("tz_amb_lo_" + k).c_str(), 0), opts.num(("tz_amb_hi_" + k).c_str(), 0));
     }
+    const double nn = opts.num("tz_na_n", 0);
+    if (!(nn >= 0 && nn <= kMax)) return;
+    for (int j = 0; j < static_cast<int>(nn); ++j) {
+      const std::string k = std::to_string(j);
+      na_.emplace_back(opts.num(("tz_na_lo_" + k).c_str(), 0), opts.num(("tz_na_hi_" + k).c_str(), 0));
+    }
   }
   bool empty() const { return at_.empty(); }
   // the offset for calendar time c (seconds, read as UTC)
   double offset(double c) const {
     if (at_.empty()) return 0;
+    for (const auto& a : na_) {
+      if (c >= a.first && c < a.second) return std::numeric_limits<double>::quiet_NaN();
+    }
     std::size_t lo = 0, hi = at_.size();  // the last step at or before c
     while (hi - lo > 1) {
       const std::size_t mid = lo + (hi - lo) / 2;
@@ -407,6 +419,7 @@ class ZoneTable {
  private:
   std::vector<double> at_, off_;
   std::vector<std::pair<double, double>> amb_;
+  std::vector<std::pair<double, double>> na_;  // calendar times that do not exist (force_tz())
 };
 
 // The interface every format's decoder implements. A decoder is built on a

@@ -119,7 +119,11 @@ class CsvTimeStamps {
       } else if (!csv_text::parse_number(f.b, f.e, layout_.dec, number_rule_, t)) {
         return false;
       }
-      if (adhoc_) t = adhoc_number(t);
+      if (adhoc_) {
+        t = adhoc_number(t);
+        // (ActivPAL days in an hour the zone's clocks skip: force_tz()'s NA)
+        if (std::isnan(t)) report_.count("time_not_existing");
+      }
       return true;
     }
     return dt_.parse(f.b, f.e, t, frac_digits);
@@ -130,11 +134,14 @@ class CsvTimeStamps {
   // not taken), or v * time_mul (ActivPAL days: read.myacc.csv's
   // v * 86400), plus time_offset (the origin), less time_utc_offset (a
   // zone of fixed offset GGIR forces the stamps into: lubridate::force_tz()
-  // on whole seconds, whose result is the rounded (t - offset) as well).
+  // on whole seconds, whose result is the rounded (t - offset) as well), or
+  // less the offset of force_tz()'s zone table at that clock time (ActivPAL
+  // days in a zone whose offset changes: NaN where the time does not exist).
   double adhoc_number(double v) const {
     if (time_mul_ != 0) v = v * time_mul_;
     else if (time_div_ != 1) v = v / time_div_;
     v = v + time_offset_;
+    if (!zone_.empty()) return v - zone_.offset(v);
     if (time_utc_offset_ != 0) v = v - time_utc_offset_;
     return v;
   }
