@@ -329,9 +329,13 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
                             },
                             false});
       };
+      // (their places in `longs`: the norm's first, then those present)
+      const std::size_t t_at = longs.size();
       if (t) column(t);
+      const std::size_t li_at = longs.size();
       if (li) column(li);
-      Sum* lp[3] = {&longs[0], longs.size() > 1 ? &longs[1] : nullptr, longs.size() > 2 ? &longs[2] : nullptr};
+      std::vector<Sum*> lp;
+      for (Sum& l : longs) lp.push_back(&l);
       // non-wear, clipping and the light's peaks beside the metrics (on
       // this thread while a second makes the running medians)
       const double* xyz[3] = {cx, cy, cz};
@@ -343,16 +347,15 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       };
       const std::vector<std::vector<double>> sm =
           p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
-                                 have_f ? &fc : nullptr, arith, lp, longs.size(), threads, beside);
+                                 have_f ? &fc : nullptr, arith, lp.data(), lp.size(), threads, beside);
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
-      std::size_t next = 1;
-      auto finished = [&](bool have) {
-        return have ? Rcpp::RObject(as_r(longs[next++].sums.finish())) : Rcpp::RObject();
+      auto finished = [&](bool have, std::size_t at) {
+        return have ? Rcpp::RObject(as_r(longs[at].sums.finish())) : Rcpp::RObject();
       };
       const Rcpp::RObject en = as_r(longs[0].sums.finish());
-      const Rcpp::RObject temperature = finished(t != nullptr);
-      const Rcpp::RObject lightmean = finished(li != nullptr);
+      const Rcpp::RObject temperature = finished(t != nullptr, t_at);
+      const Rcpp::RObject lightmean = finished(li != nullptr, li_at);
       out = Rcpp::List::create(
           Rcpp::Named("short") = shorts, Rcpp::Named("nonwear") = as_r(r.nonwear),
           Rcpp::Named("clipping") = as_r(r.clipping),
