@@ -34,7 +34,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
              GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-ggir-own test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -338,3 +338,12 @@ test-arm64:
 # bench/results/part2to5.md and fails when a report differs.
 test-part2to5: install setup-test
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/part2to5-check.R 74 bench/results/part2to5.md
+
+# GGIR's own unit tests that reach part 1, with gravcal's g.part1(),
+# g.calibrate() and g.getmeta() in GGIR's namespace, against the same tests
+# with GGIR's: needs GGIR's source tree (GGIR_SOURCE, a checkout or a git
+# directory; its tests are not installed with GGIR), not part of make test;
+# writes bench/results/ggir-own-tests.md and fails when a test passes with
+# GGIR's part 1 only.
+test-ggir-own: install setup-test
+	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/ggir-own-tests.R bench/results/ggir-own-tests.md

@@ -216,6 +216,12 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
     for (nm in names(v)) p[nm] <- list(v[[nm]])
   }
   for (nm in names(dots)) p[nm] <- list(dots[[nm]])
+  # nonwear_approach as a number (GGIR's config.csv read back gives 2023):
+  # GGIR's %in% and == read it as its text
+  na <- p$nonwear_approach
+  if (is.numeric(na) && length(na) == 1 && as.character(na) %in% c("2013", "2023")) {
+    p$nonwear_approach <- as.character(na)
+  }
   # GGIR's ad hoc csv files (rmc.*): the parameters checked, those not
   # honoured refused (meta_rmc())
   p$.rmc <- meta_rmc(p)

@@ -355,6 +355,17 @@ test_that("g.getmeta() refuses what it does not compute, naming it", {
   expect_error(gravcal::g.getmeta(f, windowsizes = c(5, 900), verbose = FALSE), "windowsizes")
   expect_error(gravcal::g.getmeta(f, nonwear_approach = "2019", verbose = FALSE),
                "nonwear_approach")
+  expect_error(gravcal::g.getmeta(f, nonwear_approach = 2019, verbose = FALSE),
+               "nonwear_approach")
+  # a number (GGIR's config.csv read back gives 2023, and GGIR's own
+  # test_recordingEndSleepHour.R runs part 1 so): GGIR's %in% and == read
+  # it as its text, and so does gravcal
+  for (a in c("2013", "2023")) {
+    M1 <- gravcal::g.getmeta(f, nonwear_approach = as.numeric(a), verbose = FALSE)
+    M2 <- gravcal::g.getmeta(f, nonwear_approach = a, verbose = FALSE)
+    M1$bsc_qc <- M2$bsc_qc <- NULL
+    expect_identical(M1, M2)
+  }
   expect_error(gravcal::g.getmeta(f, offset = c(0, 0), verbose = FALSE), "offset")
   expect_error(gravcal::g.getmeta(f, rmc.firstrow.acc = 2, verbose = FALSE), "rmc.col.time")
   expect_warning(gravcal::g.getmeta(f, do.enmoo = TRUE, verbose = FALSE), "`do.enmoo`")
