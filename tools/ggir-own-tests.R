@@ -79,7 +79,8 @@ writeLines(c(
   "    assign(nm, w, envir = globalenv())",
   "  })",
   "}",
-  "raw <- tryCatch(testthat::test_file(file, reporter = 'silent', package = 'GGIR', stop_on_failure = FALSE),",
+  "raw <- tryCatch(testthat::test_file(file, reporter = 'silent', package = 'GGIR',",
+  "                                    stop_on_failure = FALSE),",
   "                error = function(e) e)",
   "if (inherits(raw, 'error')) {",
   "  res <- data.frame(test = '(the file)', failed = 1L, error = TRUE, skipped = FALSE,",
@@ -139,7 +140,8 @@ for (f in files) {
     }
     rows[[length(rows) + 1]] <- data.frame(
       file = f, test = tests[k], ggir = sg[[k]] %||% NA, gravcal = sv[[k]] %||% NA,
-      part1_calls = paste(v$calls, collapse = "/"), ggir_s = round(g$secs), gravcal_s = round(v$secs),
+      part1_calls = paste(v$calls, collapse = "/"), ggir_s = round(g$secs),
+      gravcal_s = round(v$secs),
       why_ggir = why(g), why_gravcal = why(v))
     if (identical(unname(sg[[k]]), "passes") && !identical(unname(sv[[k]]), "passes")) {
       m <- v$res$message[match(tests[k], v$res$test)]
@@ -169,8 +171,9 @@ md <- c(
   "",
   "| file | test | GGIR's part 1 | gravcal's part 1 | part1_calls | GGIR (s) | gravcal (s) |",
   "|---|---|---|---|---|---:|---:|",
-  sprintf("| %s | %s | %s | %s | %s | %s | %s |", tab$file, gsub("|", "\\|", tab$test, fixed = TRUE),
-          tab$ggir, tab$gravcal, tab$part1_calls, tab$ggir_s, tab$gravcal_s),
+  sprintf("| %s | %s | %s | %s | %s | %s | %s |", tab$file,
+          gsub("|", "\\|", tab$test, fixed = TRUE), tab$ggir, tab$gravcal, tab$part1_calls,
+          tab$ggir_s, tab$gravcal_s),
   "",
   "Why the tests that fail fail (the first failure's message, cut):",
   "",
