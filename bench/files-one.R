@@ -79,6 +79,21 @@ run <- switch(contender,
     saveRDS(list(M$metashort, M$metalong), f, compress = FALSE)
     list(coef = nrow(M$metashort), status = unname(tools::md5sum(f)))
   },
+  # GGIR part 1 as g.part1() runs it on a folder holding the file (its
+  # calibration applied, the meta file written); `coef`: the epochs, and
+  # the md5 of the meta file's metashort and metalong
+  "gravcal::g.part1" = function() {
+    d <- tempfile("part1-in-")
+    md <- tempfile("part1-out-")
+    dir.create(d)
+    file.symlink(normalizePath(file), file.path(d, basename(file)))
+    quiet(gravcal::g.part1(datadir = d, metadatadir = md, f1 = 1, verbose = FALSE))
+    e <- new.env()
+    load(dir(file.path(md, "meta", "basic"), full.names = TRUE)[1], envir = e)
+    f <- tempfile()
+    saveRDS(list(e$M$metashort, e$M$metalong), f, compress = FALSE)
+    list(coef = nrow(e$M$metashort), status = unname(tools::md5sum(f)))
+  },
   "calibrate(method = \"ggir\")" = function() {
     f <- if (length(rmc)) {
       quiet(gravcal::calibrate(file, method = "ggir", rmc = rmc))

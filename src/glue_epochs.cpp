@@ -261,7 +261,8 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       c.meantemp = Rcpp::as<double>(cal["meantemp"]);
       for (int a = 0; a < 3; ++a) c.inv_tempoffset[a] = ito[a];
     }
-    p1::apply_calibration(c, cx, cy, cz, temp_at, t != nullptr, un);
+    auto spans = [t](std::size_t n, auto&& f) { t->spans(n, f); };
+    p1::apply_calibration(c, cx, cy, cz, spans, t != nullptr, un);
   }
   std::vector<std::string> names(metrics.size());
   for (R_xlen_t k = 0; k < metrics.size(); ++k) names[static_cast<std::size_t>(k)] = Rcpp::as<std::string>(metrics[k]);

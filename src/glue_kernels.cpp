@@ -77,6 +77,17 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
                                 Rcpp::_["upto"] = static_cast<double>(upto));
     });
   }
+  if (name == "offset_divide") {
+    const Rcpp::NumericVector p = a["p"];
+    const double o = Rcpp::as<double>(a["o"]), s = Rcpp::as<double>(a["s"]);
+    const double term = Rcpp::as<double>(a["term"]);
+    const bool add = Rcpp::as<bool>(a["add"]);
+    return each_variant(k::offset_divide_variants, [&](k::OffsetDivideFn f) {
+      std::vector<double> v(p.begin(), p.end());
+      f(v.data(), v.size(), o, s, term, add);
+      return Rcpp::List::create(Rcpp::_["p"] = Rcpp::NumericVector(v.begin(), v.end()));
+    });
+  }
   const double* x = col(a, "x");
   const double* y = col(a, "y");
   const double* z = col(a, "z");

@@ -368,6 +368,34 @@ test_that("sorted_counts: the running median's places, as the reference counts t
   expect_identical(kernel_diffs("sorted_counts", cases), character(0))
 })
 
+test_that("offset_divide: GGIR's calibration of an axis span, as the reference and R compute it", {
+  # spans of 0 to 33 values (every loop's tail), ordinary and tricky
+  # values, offsets, scales and temperature terms; with and without the
+  # term (without it, -0 stays -0)
+  set.seed(9)
+  cases <- list()
+  for (n in 0:33) {
+    for (kind in c("ordinary", "tricky", "wide", "midpoint")) {
+      for (add in c(TRUE, FALSE)) {
+        cases[[paste(kind, n, add)]] <- list(
+          p = kernel_values(n, kind), o = sample(c(0.01, -0.02, 0, -0, sample(tricky, 1)), 1),
+          s = sample(c(1 / 1.01, 1 / 0.98, 1, sample(tricky, 1)), 1),
+          term = sample(c(0.0013, -0.002, 0, -0, sample(tricky, 1)), 1), add = add)
+      }
+    }
+  }
+  # the reference is R's arithmetic: (p + o) / s, then + term
+  for (cs in cases[c("ordinary 33 TRUE", "ordinary 17 FALSE", "wide 9 TRUE", "midpoint 12 FALSE")]) {
+    out <- gc_kernel_check("offset_divide", cs)$scalar$p
+    want <- (cs$p + cs$o) / cs$s
+    if (cs$add) want <- want + cs$term
+    expect_identical(out, want)
+  }
+  expect_identical(gc_kernel_check("offset_divide", list(p = c(-0, 0.5), o = 0, s = 1, term = 0,
+                                                         add = FALSE))$scalar$p, c(-0, 0.5))
+  expect_identical(kernel_diffs("offset_divide", cases), character(0))
+})
+
 test_that(".cwa kernels: checksum, packed samples, sample times and resampling", {
   set.seed(7)
   sums <- lapply(0:16, function(k) list(bytes = as.raw(sample(0:255, 32 * k, replace = TRUE))))
@@ -430,8 +458,8 @@ test_that("the kernel table holds one variant per kernel, chosen once", {
   k <- gc_kernels()
   expect_true(all(k %in% c("scalar", "sse2", "avx2")))
   expect_setequal(names(k), c("run_end", "stream_window", "r_scan", "r_var_means3",
-                              "first_zero", "sorted_counts", "word_sum", "scale_packed", "span_times",
-                              "cwa_interp", "hex_counts"))
+                              "first_zero", "sorted_counts", "offset_divide", "word_sum",
+                              "scale_packed", "span_times", "cwa_interp", "hex_counts"))
   # GRAVCAL_KERNELS forces a kernel to its scalar reference in a new process
   skip_if_no_avx2()
   out <- system2(file.path(R.home("bin"), "Rscript"),

@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "gravcal/decoders/decode.hpp"
+#include "gravcal/kernels/kernels.hpp"
 
 namespace gravcal {
 namespace ggir_part1 {
@@ -96,13 +97,17 @@ class RunColumn {
     if (plain_) {
       v_.insert(v_.end(), p, p + k);
     } else {
-      for (std::size_t i = 0; i < k; ++i) {
+      // a run at a time (the kernel run_end finds where it stops)
+      const kernels::RunEndFn run_end = kernels::active().run_end;
+      for (std::size_t i = 0; i < k;) {
+        const std::size_t j = run_end(p, i, k);
         if (!end_.empty() && same(v_.back(), p[i])) {
-          ++end_.back();
+          end_.back() = n_ + j;
         } else {
           v_.push_back(p[i]);
-          end_.push_back(n_ + i + 1);
+          end_.push_back(n_ + j);
         }
+        i = j;
       }
     }
     n_ += k;
@@ -123,6 +128,29 @@ class RunColumn {
     }
     hint_ = static_cast<std::size_t>(std::upper_bound(end_.begin(), end_.end(), i) - end_.begin());
     return v_[hint_];
+  }
+
+  // f(from, to, value) for the spans of rows [0, n) (n <= size()) whose
+  // values have the same bits, in increasing order: the runs, or a plain
+  // column's equal neighbours grouped.
+  template <class F>
+  void spans(std::size_t n, F&& f) const {
+    if (n > n_) throw std::out_of_range("spans beyond the column");
+    std::size_t a = 0;
+    if (plain_) {
+      while (a < n) {
+        std::size_t b = a + 1;
+        while (b < n && same(v_[b], v_[a])) ++b;
+        f(a, b, v_[a]);
+        a = b;
+      }
+      return;
+    }
+    for (std::size_t r = 0; r < end_.size() && a < n; ++r) {
+      const std::size_t b = std::min(end_[r], n);
+      if (b > a) f(a, b, v_[r]);
+      a = b;
+    }
   }
 
   // A reader of the column's rows for a pass in increasing order: the run

@@ -320,36 +320,26 @@ struct Calibration {
   double inv_tempoffset[3] = {1, 1, 1};
 };
 
-// `t(i)`: the temperature of row i (asked in increasing i, axis by axis),
-// `have_t` whether there is one.
-template <class T>
-void apply_calibration(const Calibration& c, double* x, double* y, double* z, T&& t,
+// `spans(n, f)` calls f(from, to, t) for spans of rows [0, n) of one
+// temperature t, in increasing order (RunColumn::spans()); `have_t`
+// whether there is a temperature. A temperature holds for a page: its term
+// is computed once per span, the same operands, the same bits. Each span
+// of an axis in one call of the kernel offset_divide (kernels/apply.hpp).
+template <class Spans>
+void apply_calibration(const Calibration& c, double* x, double* y, double* z, Spans&& spans,
                        bool have_t, std::size_t n) {
+  const kernels::OffsetDivideFn f = kernels::active().offset_divide;
   double* v[3] = {x, y, z};
-  for (int a = 0; a < 3; ++a) {
-    double* p = v[a];
-    const double o = c.offset[a], s = c.inv_scale[a];
-    for (std::size_t i = 0; i < n; ++i) p[i] = (p[i] + o) / s;
-    if (c.temp && have_t) {
-      const double m = c.meantemp, to = c.inv_tempoffset[a];
-      // a temperature holds for a page: its term is computed once per value
-      // (the same operands, the same bits)
-      std::uint64_t last = 0;
-      bool have = false;
-      double term = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double ti = t(i);
-        std::uint64_t bits;
-        std::memcpy(&bits, &ti, sizeof bits);
-        if (!have || bits != last) {
-          term = (ti - m) / to;
-          last = bits;
-          have = true;
-        }
-        p[i] = p[i] + term;
-      }
-    }
+  if (!(c.temp && have_t)) {
+    for (int a = 0; a < 3; ++a) f(v[a], n, c.offset[a], c.inv_scale[a], 0, false);
+    return;
   }
+  spans(n, [&](std::size_t from, std::size_t to, double t) {
+    for (int a = 0; a < 3; ++a) {
+      const double term = (t - c.meantemp) / c.inv_tempoffset[a];
+      f(v[a] + from, to - from, c.offset[a], c.inv_scale[a], term, true);
+    }
+  });
 }
 
 // sqrt(x^2 + y^2 + z^2) in R's order.

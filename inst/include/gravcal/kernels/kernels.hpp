@@ -1,14 +1,15 @@
 // gravcal: the kernel table, the one place where the instruction set is
 // chosen.
 //
-// The loops that have vector code (kernels/*.hpp: window statistics and
-// the device decoders) are called through one table of function
-// pointers, filled once, when first used: each kernel its best variant for
-// this processor (AVX2 where it has it, else SSE2 where compiled, else the
-// scalar reference). No kernel tests the processor itself. Every variant
-// gives its reference's bits, so the choice changes only the time; and a
-// variant stays only where it saves a measured share of a week's
-// calibration (5 % for floating-point ones: bench/results/ab-kernels.md).
+// The loops that have vector code (kernels/*.hpp: window statistics, the
+// device decoders, GGIR's calibration of a block) are called through one
+// table of function pointers, filled once, when first used: each kernel its
+// best variant for this processor (AVX2 where it has it, else SSE2 where
+// compiled, else the scalar reference). No kernel tests the processor
+// itself. Every variant gives its reference's bits, so the choice changes
+// only the time; and a variant stays only where it saves a measured share
+// of a week's calibration or part 1 (5 % for floating-point ones:
+// bench/results/ab-kernels.md).
 //
 // Environment, read when the table is filled:
 // - GRAVCAL_NO_AVX2 set to anything but "" or "0": no AVX2 variant.
@@ -28,6 +29,7 @@
 #include "gravcal/mcu/fp_contract.hpp"
 
 #include "gravcal/kernels/simd.hpp"
+#include "gravcal/kernels/apply.hpp"
 #include "gravcal/kernels/decode.hpp"
 #include "gravcal/kernels/r_mean.hpp"
 #include "gravcal/kernels/window.hpp"
@@ -49,6 +51,8 @@ struct Table {
   RVarMeans3Fn r_var_means3 = nullptr;
   FirstZeroFn first_zero = nullptr;
   SortedCountsFn sorted_counts = nullptr;  // the running median (ggir_epochs.hpp)
+  // GGIR's calibration of a block (kernels/apply.hpp)
+  OffsetDivideFn offset_divide = nullptr;
   // device decoders (kernels/decode.hpp)
   WordSumFn word_sum = nullptr;
   ScalePackedFn scale_packed = nullptr;
@@ -66,6 +70,7 @@ constexpr void each_kernel(T& t, Visit&& visit) {
   visit(t.r_var_means3, r_var_means3_variants, "r_var_means3");
   visit(t.first_zero, first_zero_variants, "first_zero");
   visit(t.sorted_counts, sorted_counts_variants, "sorted_counts");
+  visit(t.offset_divide, offset_divide_variants, "offset_divide");
   visit(t.word_sum, word_sum_variants, "word_sum");
   visit(t.scale_packed, scale_packed_variants, "scale_packed");
   visit(t.span_times, span_times_variants, "span_times");
