@@ -99,6 +99,19 @@ test_that("g.getmeta() gives the same M on one thread and on two; options(gravca
   # (all but bsc_qc, which has the time of the run, as in the comparisons with GGIR)
   for (k in setdiff(names(one), "bsc_qc")) expect_identical(two[[k]], one[[k]], label = k)
   expect_identical(meta(5)$metashort, one$metashort)  # (more counts as 2)
+  # without filters or MAD, the first thread makes the last part of z's
+  # medians and the second the rest (short_metrics()'s share): the same M
+  shared <- function(threads) {
+    old <- options(gravcal.threads = threads)
+    on.exit(options(old))
+    gravcal::g.getmeta(f, chunksize = 0.1, do.anglex = TRUE, do.roll_med_acc_z = TRUE,
+                       do.dev_roll_med_acc_x = TRUE, desiredtz = "UTC", verbose = FALSE)
+  }
+  s1 <- shared(1)
+  s2 <- shared(2)
+  expect_true(all(c("anglex", "anglez", "roll_med_acc_z", "dev_roll_med_acc_x") %in% names(s1$metashort)))
+  expect_identical(s1$metashort$anglez, one$metashort$anglez)
+  for (k in setdiff(names(s1), "bsc_qc")) expect_identical(s2[[k]], s1[[k]], label = k)
   old <- options(gravcal.threads = 0)
   on.exit(options(old), add = TRUE)
   expect_error(gravcal::g.getmeta(f, verbose = FALSE), "options\\(gravcal.threads\\)` must be a whole number >= 1")
