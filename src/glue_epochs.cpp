@@ -325,9 +325,7 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       auto column = [&](const p1::RunColumn* col) {
         longs.push_back(Sum{p1::EpochSums<Acc>(un, M, true),
                             [cur = p1::RunColumn::Cursor(*col)](std::size_t from, std::size_t to, const double*,
-                                                                double* o) mutable {
-                              for (std::size_t i = from; i < to; ++i) o[i - from] = cur(i);
-                            },
+                                                                double* o) mutable { cur.fill(from, to, o); },
                             false});
       };
       // (their places in `longs`: the norm's first, then those present)

@@ -221,6 +221,13 @@ test_that("a zone's offsets by calendar minute, as this R converts (R/zone.R)", 
   # a fixed offset: no table (the calendar read as UTC shifts every time alike)
   expect_null(gravcal:::zone_table("UTC"))
   expect_null(gravcal:::zone_table("Etc/GMT-1"))
+  # the quick test of a zone without changes (the instants' offsets) gives
+  # what converting every day's calendar time gives, with and without
+  # changes, the session's zone included
+  for (tz in c("", "UTC", "Etc/GMT-1", "Asia/Kolkata", "Europe/Amsterdam", "America/Sao_Paulo")) {
+    expect_identical(gravcal:::zone_table_make(tz), gravcal:::zone_table_make(tz, fast = FALSE),
+                     label = paste0("zone_table_make(\"", tz, "\")"))
+  }
   o <- gravcal:::zone_options("Europe/Amsterdam")
   expect_identical(o$tz_n, 129L)
   expect_identical(o$tz_amb_n, 64L)

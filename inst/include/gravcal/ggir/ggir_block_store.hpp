@@ -166,6 +166,20 @@ class RunColumn {
       seek(i);
       return val_;
     }
+    // rows [from, to) into o[0, to - from), a run at a time
+    void fill(std::size_t from, std::size_t to, double* o) {
+      if (c_->plain_) {
+        std::copy(c_->v_.begin() + static_cast<std::ptrdiff_t>(from),
+                  c_->v_.begin() + static_cast<std::ptrdiff_t>(to), o);
+        return;
+      }
+      for (std::size_t i = from; i < to;) {
+        if (i < lo_ || i >= hi_) seek(i);
+        const std::size_t stop = std::min(hi_, to);
+        std::fill(o + (i - from), o + (stop - from), val_);
+        i = stop;
+      }
+    }
 
    private:
     void seek(std::size_t i) {
