@@ -24,11 +24,23 @@ cohort_worker <- function(paths, ids, slots, method, args, settings, outcomes = 
 }
 
 # Run worker(i, progressor) for every i in todo, one future per recording
-# on the plan the user set (a plain loop without the future package).
+# on the plan the user set (a plain loop in this process where no plan is
+# set: the future package not loaded, nor a plan named in the options or
+# the environment; or without the future package).
 # Returns why the recordings without a result have none, by index. When a
 # worker dies, the recordings it was calibrating are reported; those that
 # could not even start on the dead worker are run again once on fresh
 # workers (the plan is set again, which restarts its workers).
+# Whether the session has no future plan of the user's: the future
+# package not loaded (plan() loads it) and no plan named by the option
+# future.plan or R_FUTURE_PLAN. Then the files run in this process: the
+# same as future's sequential plan, without its setup (0.1 s of a week's
+# part 1: bench/ab.sh).
+no_plan_set <- function() {
+  !isNamespaceLoaded("future") && is.null(getOption("future.plan")) &&
+    !nzchar(Sys.getenv("R_FUTURE_PLAN"))
+}
+
 run_cohort <- function(todo, worker, labels) {
   failures <- list()
   if (!length(todo)) return(failures)
@@ -49,7 +61,7 @@ run_cohort <- function(todo, worker, labels) {
   p <- if (requireNamespace("progressr", quietly = TRUE)) {
     progressr::progressor(steps = length(todo))
   }
-  if (!requireNamespace("future", quietly = TRUE)) {
+  if (no_plan_set() || !requireNamespace("future", quietly = TRUE)) {
     for (i in todo) tryCatch(worker(i, p), error = failed(i))
     return(failures)
   }

@@ -2,9 +2,11 @@
 #'
 #' Calibrates every file with [calibrate()], each read block by block, and
 #' returns one row per recording. The work is spread over whatever
-#' `future::plan()` the session has set (sequential by default;
-#' `plan(multisession)` on a laptop, `future.batchtools` on Slurm or SGE),
-#' one future per recording, when the future package is installed.
+#' `future::plan()` the session has set
+#' (`plan(multisession)` on a laptop, `future.batchtools` on Slurm or SGE),
+#' one future per recording, when the future package is installed; in this R
+#' process, one recording after the other, where no plan is set (the future
+#' package not loaded, no `future.plan` option or `R_FUTURE_PLAN`).
 #' Progress is reported through progressr (wrap the call in
 #' `progressr::with_progress()`, or set `progressr::handlers(global =
 #' TRUE)`).

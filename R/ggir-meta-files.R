@@ -68,9 +68,11 @@
 #' files, which GGIR would not have begun).
 #'
 #' The files run as [calibrate_files()] runs a cohort's: one future per
-#' file on the `future::plan()` the session has set (sequential by default;
-#' `plan(multisession)` on a laptop, `future.batchtools` on Slurm), with
-#' progress through progressr, when the future package is installed; a file
+#' file on the `future::plan()` the session has set
+#' (`plan(multisession)` on a laptop, `future.batchtools` on Slurm), with
+#' progress through progressr, when the future package is installed; in this
+#' R process, one after the other, where no plan is set (the future package
+#' not loaded, no `future.plan` option or `R_FUTURE_PLAN`); a file
 #' whose R process dies is reported as failed, and the files that worker had
 #' not begun are run again.
 #'

@@ -120,6 +120,22 @@ test_that("in parallel (multisession, 2 workers) the table is the same", {
                    seq_tab[setdiff(names(seq_tab), drop)])
 })
 
+test_that("without a plan of the user's the recordings run in this process, without futures", {
+  # a fresh process: the future package not loaded, no plan in the options
+  # or the environment; a worker's error is that recording's failure
+  skip_if_not_installed("future")
+  code <- paste(
+    "w <- function(i, p) if (i == 2) stop('bad file ', i) else invisible(NULL)",
+    "f <- gravcal:::run_cohort(1:3, w, c('a', 'b', 'c'))",
+    "cat(isNamespaceLoaded('future'), names(f), f[[1]], sep = '|')",
+    "options(future.plan = 'sequential')",
+    "f <- gravcal:::run_cohort(1:3, w, c('a', 'b', 'c'))",
+    "cat('|', isNamespaceLoaded('future'), names(f), f[[1]], sep = '|')", sep = "; ")
+  out <- system2(file.path(R.home("bin"), "Rscript"), c("-e", shQuote(code)), stdout = TRUE,
+                 stderr = FALSE, env = "R_FUTURE_PLAN=")
+  expect_identical(out, "FALSE|2|bad file 2||TRUE|2|bad file 2")
+})
+
 test_that("an interrupted run resumes without redoing finished recordings", {
   skip_if_quick()
   skip_on_os("windows")  # fork
