@@ -947,7 +947,8 @@ static void test_cwa_word_sum() {
 }
 
 // GGIR's running median (ggir_epochs.hpp's rolling_median(), zoo's
-// rollmedian with fill 0) against the plain rule: each window sorted
+// rollmedian with fill 0, and its parts, rolling_median_range()) against
+// the plain rule: each window sorted
 // stably (equal values, -0 and +0 among them, in their order in time),
 // its middle value, to the bit; NaN where the window holds one. Sensor-like
 // data with many ties, signed zeros, NaN runs, widths 1 to 51.
@@ -975,6 +976,18 @@ static void test_rolling_median() {
       if (out.size() != N) {
         ++bad;
         continue;
+      }
+      // the same centres made in three parts, the later ones first (as two
+      // threads may make them: short_metrics()'s share), to the bit
+      if (k <= N) {
+        std::size_t from = 0, to = 0;
+        gravcal::ggir_part1::median_centres(N, k, &from, &to);
+        const std::size_t a = from + (to - from) / 3, b = from + 2 * (to - from) / 3 + trial % 3;
+        std::vector<double> parts(N, 0.0);
+        gravcal::ggir_part1::rolling_median_range(v.data(), N, k, parts.data(), std::min(b, to), to);
+        gravcal::ggir_part1::rolling_median_range(v.data(), N, k, parts.data(), a, std::min(b, to));
+        gravcal::ggir_part1::rolling_median_range(v.data(), N, k, parts.data(), from, a);
+        if (std::memcmp(parts.data(), out.data(), N * sizeof(double)) != 0) ++bad;
       }
       const std::size_t m = k / 2;
       for (std::size_t i = 0; i < N; ++i) {

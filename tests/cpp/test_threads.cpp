@@ -160,6 +160,9 @@ int main() {
   const std::vector<std::string> all = {"angle_x", "angle_y", "angle_z", "roll_med_acc_x", "dev_roll_med_acc_y",
                                         "ENMO", "EN", "ENMOa", "MAD"};
   const std::vector<std::string> no_medians = {"ENMO", "EN", "MAD"};
+  // no filter, no MAD: the first thread makes part of z's medians
+  const std::vector<std::string> shared = {"angle_x", "angle_y", "angle_z", "roll_med_acc_z",
+                                           "dev_roll_med_acc_x", "ENMO", "EN", "ENMOa"};
   check("default, 6 h at 100 Hz", 6 * 3600 * 100, 100, false, dflt);
   check("every unfiltered metric, 2 h at 30 Hz", 2 * 3600 * 30, 30, false, all);
   check("every unfiltered metric, NaN rows", 3600 * 50, 50, true, all);
@@ -167,6 +170,28 @@ int main() {
   check("85.7 Hz (the medians at the full rate)", 3600 * 857 / 10, 85.7, false, all);
   check("shorter than the median's window", 30, 10, false, all);
   check("empty block", 0, 100, false, dflt);
+  check("medians shared, NaN rows", 3600 * 50, 50, true, shared);
+  check("medians shared, 85.7 Hz", 3600 * 857 / 10, 85.7, false, shared);
+  check("medians shared, shorter than the median's window", 30, 10, false, shared);
+  check("medians shared, a window and a bit", 520, 100, false, shared);
+  // an error of the first thread's while the second makes its medians:
+  // the second joined, the error raised
+  {
+    std::vector<double> w[3];
+    block(3600 * 100, 100, false, w);
+    std::string got;
+    try {
+      p1::short_metrics<long double>(w[0].data(), w[1].data(), w[2].data(), w[0].size(), 100, 5, dflt,
+                                     nullptr, {}, nullptr, 0, 2,
+                                     [] { throw std::runtime_error("beside failed"); });
+    } catch (const std::runtime_error& e) {
+      got = e.what();
+    }
+    if (got != "beside failed") {
+      std::printf("FAIL an error beside the medians: \"%s\"\n", got.c_str());
+      ++failures;
+    }
+  }
   std::vector<double> v[3];
   block(1000, 100, false, v);
   bool threw = false;
