@@ -61,6 +61,10 @@ gc_meta_store <- function(temperature, time, light, wear) {
     .Call(`_gravcal_gc_meta_store`, temperature, time, light, wear)
 }
 
+gc_meta_store_release <- function(ptr) {
+    invisible(.Call(`_gravcal_gc_meta_store_release`, ptr))
+}
+
 gc_meta_store_read <- function(ptr, decoder, units, capacity, want_time) {
     .Call(`_gravcal_gc_meta_store_read`, ptr, decoder, units, capacity, want_time)
 }
@@ -157,8 +161,8 @@ gc_source_blocks <- function(first, fetch) {
     .Call(`_gravcal_gc_source_blocks`, first, fetch)
 }
 
-gc_pump <- function(src, stage, opts, on_block = NULL) {
-    .Call(`_gravcal_gc_pump`, src, stage, opts, on_block)
+gc_pump <- function(src, stage, opts, on_block = NULL, beside = NULL) {
+    .Call(`_gravcal_gc_pump`, src, stage, opts, on_block, beside)
 }
 
 gc_ggir_fit_table <- function(table, temp_available, hours, opts) {

@@ -436,7 +436,13 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
   }
   Cdefault <- part1_default_cal()
   C <- Cdefault
-  if (do_cal && is.null(bcc) && !is.null(I$sf)) C <- calibrate()
+  if (do_cal && is.null(bcc) && !is.null(I$sf)) {
+    # g.getmeta()'s first block read beside the calibration's pass
+    # (R/meta-ahead.R); what g.getmeta() does not take is closed
+    on.exit(meta_ahead_close(), add = TRUE)
+    meta_ahead_open(datafile, pm, pr, pg, pc, I)
+    C <- calibrate()
+  }
   start <- C$cal.error.start
   if (!length(start)) start <- NA
   if (is.na(start) || !length(C$cal.error.end) || isTRUE(start < C$cal.error.end)) {

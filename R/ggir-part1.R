@@ -115,6 +115,24 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   myfun <- if (length(myfun)) meta_myfun_check(myfun, p$windowsizes[1])
   cal <- meta_calibration(offset, scale, tempoffset, meantempcal)
   check_fp_build("`g.getmeta()`")
+  # (g.part1() may have opened it already, its first block read beside
+  # g.calibrate()'s pass: R/meta-ahead.R)
+  src <- meta_ahead_take(datafile, p, inspectfileobject) %||%
+    meta_open(datafile, p, inspectfileobject)
+  on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
+  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  # text time in a zone whose offset changes: a block of GGIR's that starts
+  # at a time that exists twice or not at all there is refused, as by
+  # g.calibrate()
+  if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
+  M
+}
+
+# g.getmeta()'s source: `datafile` opened for GGIR's blocks (meta_source()),
+# checked against `inspectfileobject`, and refused where gravcal's
+# g.getmeta() does not read it or GGIR's gives no result to reproduce. The
+# caller closes it.
+meta_open <- function(datafile, p, inspectfileobject) {
   tz <- if (length(p$configtz)) p$configtz else p$desiredtz
   tz_arg <- if (length(p$configtz)) "configtz" else "desiredtz"
   read_opts <- list(interpolation = p$interpolationType, frequency_tol = p$frequency_tol,
@@ -136,25 +154,21 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
           "result for this file with the same parameters.")
   }
   if (!src$format %in% meta_formats() || is.null(src$native)) {
+    if (!is.null(src$native)) gc_decoder_close(src$native$ptr)
     abort("gravcal's g.getmeta() does not read ", format_entry(src$format)$label %||% src$format,
           " yet (it reads ", paste(vapply(meta_formats(), function(f) format_entry(f)$label, ""),
                                     collapse = " and "),
           "); use GGIR::g.getmeta() for \"", basename(datafile), "\".")
   }
-  on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
   stops <- format_entry(src$format)$ggir_stops
   why <- if (!is.null(stops)) stops(src)
   if (!is.null(why)) {
+    gc_decoder_close(src$native$ptr)
     abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's g.getmeta() ",
           "gives no result to reproduce there, so gravcal's refuses the file (calibrate() ",
           "reads the rest of it).")
   }
-  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
-  # text time in a zone whose offset changes: a block of GGIR's that starts
-  # at a time that exists twice or not at all there is refused, as by
-  # g.calibrate()
-  if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
-  M
+  src
 }
 
 # The formats g.getmeta() reads so far (the registry's `ggir_getmeta`).

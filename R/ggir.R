@@ -125,7 +125,9 @@ ggir_run <- function(src, compat = TRUE,
                                           stringsAsFactors = FALSE)
     NULL
   }
-  r <- gc_pump(src$pump(), "ggir", opts, record)
+  # (in g.part1(), g.getmeta()'s first block is read beside this pass:
+  # R/meta-ahead.R)
+  r <- gc_pump(src$pump(), "ggir", opts, record, meta_ahead_spec())
   check_source_read(src, r$samples)
   ggir_result(r, if (length(bsc)) do.call(rbind, bsc) else data.frame(),
               source_input(src, r$samples), verbose, printsummary)

@@ -122,8 +122,9 @@ meta_store <- function(src, time) {
   }
   store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]], cols[["wear"]])
   want_time <- !isFALSE(format_entry(src$format)$ggir_time)
+  chunk <- 2^20  # rows a read of the decoder's at most
   if (!is.null(src$native)) {
-    read <- function() gc_meta_store_read(store, src$native$ptr, src$units, 2^20, want_time)
+    read <- function() gc_meta_store_read(store, src$native$ptr, src$units, chunk, want_time)
   } else {
     s <- src$samples[!vapply(src$samples, is.null, TRUE)]
     if (!want_time) s$time <- NULL
@@ -136,7 +137,8 @@ meta_store <- function(src, time) {
     }
   }
   list(store = store, read = read, temperature = cols[["temperature"]],
-       light = cols[["light"]], wear = cols[["wear"]], keep_time = time, want_time = want_time)
+       light = cols[["light"]], wear = cols[["wear"]], keep_time = time, want_time = want_time,
+       chunk = chunk)
 }
 
 # Rows `i` of a block (a list of equal-length columns).
@@ -196,8 +198,11 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     "time_not_existing" %in% names(k) && k[["time_not_existing"]] > 0
   }
   last_read <- NA_real_  # the last time stamp of the block before
-  ms <- meta_store(src, time = FALSE)
+  # (the store g.part1() made, its first block read beside g.calibrate()'s
+  # pass: R/meta-ahead.R)
+  ms <- src$ahead_store %||% meta_store(src, time = FALSE)
   store <- ms$store
+  on.exit(gc_meta_store_release(store), add = TRUE)
   # GGIR's metashort and metalong (R/meta-sheet.R): the metrics (by
   # `asked`), a myfun's columns as text and the ENMO gradient's columns
   # (epoch_signals()); metalong's columns once the first block says which
@@ -484,6 +489,9 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     }
     i <- i + 1
   }
+  # the block's memory given back before M is made (on.exit() above gives
+  # it back on an error)
+  gc_meta_store_release(store)
   rep <- if (!is.null(src$report)) src$report() else list()
   # (a format whose reader's log is M$QClog keeps its damaged units as
   # GGIR's reader keeps them, and logs them there)

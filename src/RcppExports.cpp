@@ -175,6 +175,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_meta_store_release
+void gc_meta_store_release(SEXP ptr);
+RcppExport SEXP _gravcal_gc_meta_store_release(SEXP ptrSEXP) {
+BEGIN_RCPP
+    Rcpp::traits::input_parameter< SEXP >::type ptr(ptrSEXP);
+    gc_meta_store_release(ptr);
+    return R_NilValue;
+END_RCPP
+}
 // gc_meta_store_read
 Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capacity, bool want_time);
 RcppExport SEXP _gravcal_gc_meta_store_read(SEXP ptrSEXP, SEXP decoderSEXP, SEXP unitsSEXP, SEXP capacitySEXP, SEXP want_timeSEXP) {
@@ -488,15 +497,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // gc_pump
-Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts, Rcpp::Nullable<Rcpp::Function> on_block);
-RcppExport SEXP _gravcal_gc_pump(SEXP srcSEXP, SEXP stageSEXP, SEXP optsSEXP, SEXP on_blockSEXP) {
+Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts, Rcpp::Nullable<Rcpp::Function> on_block, Rcpp::Nullable<Rcpp::List> beside);
+RcppExport SEXP _gravcal_gc_pump(SEXP srcSEXP, SEXP stageSEXP, SEXP optsSEXP, SEXP on_blockSEXP, SEXP besideSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< SEXP >::type src(srcSEXP);
     Rcpp::traits::input_parameter< const std::string& >::type stage(stageSEXP);
     Rcpp::traits::input_parameter< const Rcpp::List& >::type opts(optsSEXP);
     Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::Function> >::type on_block(on_blockSEXP);
-    rcpp_result_gen = Rcpp::wrap(gc_pump(src, stage, opts, on_block));
+    Rcpp::traits::input_parameter< Rcpp::Nullable<Rcpp::List> >::type beside(besideSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_pump(src, stage, opts, on_block, beside));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -530,6 +540,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_decoder_drain", (DL_FUNC) &_gravcal_gc_decoder_drain, 1},
     {"_gravcal_gc_crc32", (DL_FUNC) &_gravcal_gc_crc32, 1},
     {"_gravcal_gc_meta_store", (DL_FUNC) &_gravcal_gc_meta_store, 4},
+    {"_gravcal_gc_meta_store_release", (DL_FUNC) &_gravcal_gc_meta_store_release, 1},
     {"_gravcal_gc_meta_store_read", (DL_FUNC) &_gravcal_gc_meta_store_read, 5},
     {"_gravcal_gc_meta_store_put", (DL_FUNC) &_gravcal_gc_meta_store_put, 3},
     {"_gravcal_gc_meta_store_rows", (DL_FUNC) &_gravcal_gc_meta_store_rows, 3},
@@ -554,7 +565,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_source_decoder", (DL_FUNC) &_gravcal_gc_source_decoder, 1},
     {"_gravcal_gc_source_columns", (DL_FUNC) &_gravcal_gc_source_columns, 4},
     {"_gravcal_gc_source_blocks", (DL_FUNC) &_gravcal_gc_source_blocks, 2},
-    {"_gravcal_gc_pump", (DL_FUNC) &_gravcal_gc_pump, 4},
+    {"_gravcal_gc_pump", (DL_FUNC) &_gravcal_gc_pump, 5},
     {"_gravcal_gc_ggir_fit_table", (DL_FUNC) &_gravcal_gc_ggir_fit_table, 4},
     {NULL, NULL, 0}
 };

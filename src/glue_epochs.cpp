@@ -7,17 +7,37 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "gravcal/ggir/ggir_block_store.hpp"
 #include "gravcal/ggir/ggir_epochs.hpp"
+#include "meta_ahead.h"
 #include "r_services.h"
 #include "sources_glue.h"
 
 namespace {
 
-using Store = gravcal::ggir_part1::BlockStore;
+// A read made beside the pump (meta_read_beside()), waiting for
+// gc_meta_store_read(): its arguments, the store's rows before it, and the
+// rows read or its error.
+struct ReadBeside {
+  bool ready = false;
+  const gravcal_glue::OpenFile* decoder = nullptr;
+  std::int64_t units = 0;
+  std::size_t chunk = 0;
+  bool want_time = false;
+  std::size_t before = 0, got = 0;
+  std::exception_ptr error;
+};
+
+// The block store (ggir_block_store.hpp), and a read made beside the pump.
+struct Store : gravcal::ggir_part1::BlockStore {
+  using BlockStore::BlockStore;
+  ReadBeside beside;
+};
 
 Rcpp::NumericVector as_r(const std::vector<double>& v) {
   return Rcpp::NumericVector(v.begin(), v.end());
@@ -84,6 +104,15 @@ SEXP gc_meta_store(bool temperature, bool time, bool light, bool wear) {
   return Rcpp::XPtr<Store>(new Store(temperature, time, light, wear), true);
 }
 
+// The store's memory given back now (a block and the epochs' work, a few
+// hundred MB), not when R's garbage collector finds the pointer; the store
+// is gone after this. Once more is nothing.
+// [[Rcpp::export(rng = false)]]
+void gc_meta_store_release(SEXP ptr) {
+  Rcpp::XPtr<Store> p(ptr);
+  if (p.get() != nullptr) p.release();
+}
+
 // One block from an open decoder (gc_decoder_open()'s ptr) appended to the
 // store: `units` units in reads of at most `capacity` samples. Returns
 // list(n = rows read, size, first_time = the first row read's time,
@@ -95,6 +124,23 @@ Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capac
   Store* s = store(ptr);
   gravcal_glue::OpenFile* f = gravcal_glue::open_file(decoder);
   if (!(capacity >= 1) || capacity > 1e9) Rcpp::stop("capacity must be in [1, 1e9]");
+  if (s->beside.ready) {
+    // the read was made beside the pump: the same one, taken
+    ReadBeside b = s->beside;
+    s->beside = ReadBeside();
+    if (b.decoder != f || b.units != static_cast<std::int64_t>(units) ||
+        b.chunk != static_cast<std::size_t>(capacity) || b.want_time != want_time) {
+      Rcpp::stop("the block read beside the calibration is not the one asked for");
+    }
+    if (b.error) {
+      try {
+        std::rethrow_exception(b.error);
+      } catch (const std::exception& e) {
+        Rcpp::stop(e.what());
+      }
+    }
+    return read_info(*s, b.before, b.got);
+  }
   const std::size_t before = s->size();
   std::size_t got = 0;
   try {
@@ -104,6 +150,31 @@ Rcpp::List gc_meta_store_read(SEXP ptr, SEXP decoder, double units, double capac
     Rcpp::stop(e.what());
   }
   return read_info(*s, before, got);
+}
+
+std::function<void()> gravcal_glue::meta_read_beside(const Rcpp::List& spec) {
+  Store* s = store(spec["store"]);
+  gravcal_glue::OpenFile* f = gravcal_glue::open_file(spec["decoder"]);
+  const double units = Rcpp::as<double>(spec["units"]);
+  const double chunk = Rcpp::as<double>(spec["chunk"]);
+  const bool want_time = Rcpp::as<bool>(spec["want_time"]);
+  if (!(chunk >= 1) || chunk > 1e9) Rcpp::stop("chunk must be in [1, 1e9]");
+  if (s->beside.ready) Rcpp::stop("the store holds a read not yet taken");
+  ReadBeside b;
+  b.decoder = f;
+  b.units = static_cast<std::int64_t>(units);
+  b.chunk = static_cast<std::size_t>(chunk);
+  b.want_time = want_time;
+  return [s, f, b]() mutable {
+    b.before = s->size();
+    try {
+      b.got = s->read(*f->decoder, b.units, b.chunk, b.want_time);
+    } catch (...) {
+      b.error = std::current_exception();
+    }
+    b.ready = true;
+    s->beside = b;
+  };
 }
 
 // Rows given from R (samples in memory) appended, or (`from` >= 0) put in

@@ -7,12 +7,16 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "gravcal/ggir/ggir_procedure.hpp"
 #include "gravcal/ggir/pipeline.hpp"
+#include "gravcal/host/threads.hpp"
+#include "meta_ahead.h"
 #include "r_services.h"
 #include "sources_glue.h"
 #include "windows_glue.h"
@@ -407,11 +411,27 @@ SEXP gc_source_blocks(const Rcpp::List& first, const Rcpp::Function& fetch) {
 
 // The one pump: runs `stage` ("windows", "ggir", "blocks" or "samples") over the
 // source with the options `opts`; on_block is the stage's callback (see
-// run_windows() and RHost::block_added()), or NULL.
+// run_windows() and RHost::block_added()), or NULL. `beside`: a block of
+// g.getmeta()'s read on a second thread meanwhile (meta_ahead.h), joined
+// before this returns or its error leaves; without a thread to be had,
+// not read (g.getmeta() reads it then).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List gc_pump(SEXP src, const std::string& stage, const Rcpp::List& opts,
-                   Rcpp::Nullable<Rcpp::Function> on_block = R_NilValue) {
+                   Rcpp::Nullable<Rcpp::Function> on_block = R_NilValue,
+                   Rcpp::Nullable<Rcpp::List> beside = R_NilValue) {
   SourceBox* b = source(src);
+#ifndef GRAVCAL_NO_THREADS
+  std::thread side;
+  const gravcal::JoinGuard join{side};
+  if (beside.isNotNull()) {
+    std::function<void()> read = gravcal_glue::meta_read_beside(Rcpp::List(beside.get()));
+    try {
+      side = std::thread(std::move(read));
+    } catch (const std::system_error&) {
+      // no thread: g.getmeta() reads the block itself
+    }
+  }
+#endif
   if (stage == "windows") return run_windows(*b->src, opts, on_block);
   if (stage == "ggir") return run_ggir(*b->src, opts, on_block);
   if (stage == "samples") return run_samples(*b->src, opts);

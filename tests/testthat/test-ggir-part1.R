@@ -167,6 +167,92 @@ test_that("g.part1() writes GGIR's meta files; GGIR's part 2 gives the same on t
   expect_equal(b$gravcal$again[["meta_p01.cwa.RData"]]$C$scale, obj$C$scale, tolerance = 1e-14)
 })
 
+# the first blocks read ahead and taken by g.getmeta() so far (R/meta-ahead.R)
+p1_taken <- function() {
+  v <- gravcal:::ahead_state$taken
+  if (is.null(v)) 0 else v
+}
+
+test_that("g.part1() reads g.getmeta()'s first block beside the calibration: the meta files of one thread", {
+  # R/meta-ahead.R: on two threads the first block is read while
+  # g.calibrate() makes its pass; on one (options(gravcal.threads = 1)) it
+  # is not. The .cwa of 60 hours has two of GGIR's blocks (36 hours each)
+  d <- tempfile("part1-ahead-")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  write_meta_recording(file.path(d, "a.cwa"), "cwa", 25, 60, 31, "2024-03-04 09:07:23")
+  write_meta_recording(file.path(d, "b.bin"), "bin", 30, 26, 32, "2024-03-05 10:01:07")
+  run <- function(threads) {
+    old <- options(gravcal.threads = threads)
+    on.exit(options(old))
+    out <- tempfile("part1-ahead-out-")
+    on.exit(unlink(out, recursive = TRUE), add = TRUE)
+    before <- p1_taken()
+    r <- p1_run(gravcal::g.part1, d, out, list())
+    list(obj = p1_objects(file.path(r$md, "meta", "basic")), tab = r$tab,
+         taken = p1_taken() - before)
+  }
+  two <- run(2)
+  one <- run(1)
+  expect_identical(two$taken, 2)  # both files read ahead
+  expect_identical(one$taken, 0)
+  expect_identical(two$tab$status, c("written", "written"))
+  expect_identical(names(two$obj), c("meta_a.cwa.RData", "meta_b.bin.RData"))
+  expect_same_objects(two$obj, one$obj, "read ahead")
+  # what the comparison saw: the .cwa's two blocks, a calibration
+  M <- two$obj[["meta_a.cwa.RData"]]$M
+  expect_gt(nrow(M$metalong), 36 * 4)
+  expect_false(identical(two$obj[["meta_a.cwa.RData"]]$C$scale, c(1, 1, 1)))
+  # nothing left open or pending after the files
+  expect_null(gravcal:::ahead_state$pending)
+})
+
+test_that("a block read ahead is taken only by the same read; what is not taken is closed", {
+  d <- tempfile("part1-ahead-")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE), add = TRUE)
+  f <- file.path(d, "a.cwa")
+  write_meta_recording(f, "cwa", 25, 26, 33, "2024-03-04 09:07:23")
+  on.exit(gravcal:::meta_ahead_close(), add = TRUE)
+  # opened, then g.calibrate()'s pump reads the first block beside its pass
+  expect_true(gravcal:::meta_ahead_open(f, c(), c(), c(), c(), NULL))
+  a <- gravcal:::ahead_state$pending
+  spec <- gravcal:::meta_ahead_spec()
+  expect_identical(spec$units, a$src$units)
+  expect_null(gravcal:::meta_ahead_spec())  # once
+  st <- gravcal:::ahead_state
+  st$pending$started <- FALSE
+  C <- p1_quiet(gravcal::g.calibrate(f, verbose = FALSE))
+  expect_true(gravcal:::ahead_state$pending$started)
+  # another read than the one made is an error, never a silent block
+  ms <- a$src$ahead_store
+  expect_error(gravcal:::gc_meta_store_read(ms$store, a$src$native$ptr, a$src$units + 1, ms$chunk,
+                                            ms$want_time),
+               "not the one asked for")
+  gravcal:::meta_ahead_close()
+  expect_null(gravcal:::ahead_state$pending)
+  expect_error(gravcal:::gc_decoder_epoch_gaps(a$src$native$ptr), "closed")
+  # g.getmeta() with other parameters than those opened for: not taken
+  # (closed), the file opened again; the same M as without any read ahead
+  expect_true(gravcal:::meta_ahead_open(f, c(), c(), c(), c(), NULL))
+  b <- gravcal:::ahead_state$pending
+  before <- p1_taken()
+  M1 <- gravcal::g.getmeta(f, verbose = FALSE, params_metrics = list(do.enmoa = TRUE))
+  expect_identical(p1_taken(), before)
+  expect_null(gravcal:::ahead_state$pending)
+  expect_error(gravcal:::gc_decoder_epoch_gaps(b$src$native$ptr), "closed")
+  M2 <- gravcal::g.getmeta(f, verbose = FALSE, params_metrics = list(do.enmoa = TRUE))
+  M1$bsc_qc <- M2$bsc_qc <- NULL
+  expect_identical(M1, M2)
+  expect_true("ENMOa" %in% names(M1$metashort))
+  # the same parameters: taken, and the same M
+  expect_true(gravcal:::meta_ahead_open(f, list(do.enmoa = TRUE), c(), c(), c(), NULL))
+  M3 <- gravcal::g.getmeta(f, verbose = FALSE, params_metrics = list(do.enmoa = TRUE))
+  expect_identical(p1_taken(), before + 1)
+  M3$bsc_qc <- NULL
+  expect_identical(M3, M1)
+})
+
 # g.part1() on the folder of one recording `name` at `sf` Hz against
 # GGIR's, then part 2 and part 1 again: the meta files and what part 2
 # makes of them the same. Returns gravcal's meta file's objects.

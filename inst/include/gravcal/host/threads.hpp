@@ -13,4 +13,21 @@
 #define GRAVCAL_NO_THREADS 1
 #endif
 
+#ifndef GRAVCAL_NO_THREADS
+#include <thread>
+
+namespace gravcal {
+
+// Joins the thread when the scope is left, whatever leaves it (declare what
+// the thread reads before the guard, so that it outlives the thread).
+struct JoinGuard {
+  std::thread& t;
+  ~JoinGuard() {
+    if (t.joinable()) t.join();
+  }
+};
+
+}  // namespace gravcal
+#endif
+
 #endif  // GRAVCAL_HOST_THREADS_HPP
