@@ -117,6 +117,10 @@ gc_ggir_duplicates <- function(table, rows, need) {
     .Call(`_gravcal_gc_ggir_duplicates`, table, rows, need)
 }
 
+gc_gzip <- function(bytes, level, threads) {
+    .Call(`_gravcal_gc_gzip`, bytes, level, threads)
+}
+
 gc_kernel_check <- function(name, args) {
     .Call(`_gravcal_gc_kernel_check`, name, args)
 }

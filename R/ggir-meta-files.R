@@ -498,10 +498,23 @@ part1_one <- function(i, fnames, fnamesfull, metadatadir, pm, pr, pc, pg, verbos
   env$desiredtz_part1 <- pg[["desiredtz"]]
   tmp <- tempfile(pattern = ".part1-", tmpdir = basic, fileext = ".RData")
   on.exit(unlink(tmp), add = TRUE)
-  save(list = c("M", "I", "C", "filename_dir", "filefoldername", "tail_expansion_log",
-                "GGIRversion", "desiredtz_part1"), envir = env, file = tmp)
+  part1_save(c("M", "I", "C", "filename_dir", "filefoldername", "tail_expansion_log",
+               "GGIRversion", "desiredtz_part1"), env, tmp)
   if (!file.rename(tmp, target)) abort("Could not write \"", target, "\".")
   if (length(C$QCmessage)) as.character(C$QCmessage)[1] else ""
+}
+
+# save()'s file of the objects `names` of `env`: the same bytes as save()
+# writes (R's serialization, then gzip at save()'s level 6), compressed on
+# two threads (gc_gzip(): two gzip members in a row, which load() reads as
+# one file). The serialization goes through a plain file in the session's
+# temporary folder (a raw connection grows in small steps).
+part1_save <- function(names, env, file) {
+  plain <- tempfile("part1-save-")
+  on.exit(unlink(plain))
+  save(list = names, envir = env, file = plain, compress = FALSE)
+  bytes <- readBin(plain, "raw", file.size(plain))
+  writeBin(gc_gzip(bytes, 6L, gravcal_threads()), file)
 }
 
 # recordingEndSleepHour: when the recording ends less than 24 h + dayborder

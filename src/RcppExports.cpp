@@ -366,6 +366,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_gzip
+Rcpp::RawVector gc_gzip(const Rcpp::RawVector& bytes, int level, int threads);
+RcppExport SEXP _gravcal_gc_gzip(SEXP bytesSEXP, SEXP levelSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type bytes(bytesSEXP);
+    Rcpp::traits::input_parameter< int >::type level(levelSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_gzip(bytes, level, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_kernel_check
 Rcpp::List gc_kernel_check(const std::string& name, const Rcpp::List& args);
 RcppExport SEXP _gravcal_gc_kernel_check(SEXP nameSEXP, SEXP argsSEXP) {
@@ -554,6 +566,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 8},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},
     {"_gravcal_gc_ggir_duplicates", (DL_FUNC) &_gravcal_gc_ggir_duplicates, 3},
+    {"_gravcal_gc_gzip", (DL_FUNC) &_gravcal_gc_gzip, 3},
     {"_gravcal_gc_kernel_check", (DL_FUNC) &_gravcal_gc_kernel_check, 2},
     {"_gravcal_gc_kernels", (DL_FUNC) &_gravcal_gc_kernels, 0},
     {"_gravcal_gc_set_avx2", (DL_FUNC) &_gravcal_gc_set_avx2, 1},

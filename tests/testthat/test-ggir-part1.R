@@ -253,6 +253,53 @@ test_that("a block read ahead is taken only by the same read; what is not taken 
   expect_identical(M3, M1)
 })
 
+test_that("the meta files are save()'s bytes, gzipped on two threads (members in a row)", {
+  gunzip <- function(z) {
+    f <- tempfile()
+    on.exit(unlink(f))
+    writeBin(z, f)
+    con <- gzfile(f, "rb")
+    on.exit(close(con), add = TRUE)
+    readBin(con, "raw", 4 * length(z) + 1e6)
+  }
+  set.seed(41)
+  # 3 MB of text-like bytes (two members on two threads), 1000 bytes
+  # (one), none
+  big <- as.raw(sample(c(48:57, 32, 10), 3e6, replace = TRUE, prob = c(rep(1, 10), 4, 1)))
+  for (b in list(big, big[1:1000], raw(0))) {
+    z1 <- gravcal:::gc_gzip(b, 6L, 1L)
+    z2 <- gravcal:::gc_gzip(b, 6L, 2L)
+    expect_identical(gunzip(z1), b)
+    expect_identical(gunzip(z2), b)
+    expect_identical(z2[1:3], as.raw(c(0x1f, 0x8b, 0x08)))  # gzip, deflate
+    if (length(b) >= 2^20) {
+      # the second member's header, where the first member ends
+      starts <- which(z2[-length(z2)] == as.raw(0x1f) & z2[-1] == as.raw(0x8b))
+      expect_true(length(starts) >= 2)
+      expect_false(identical(z1, z2))
+    } else {
+      expect_identical(z1, z2)
+    }
+  }
+  expect_error(gravcal:::gc_gzip(big, 0L, 1L), "level must be 1 to 9")
+  expect_error(gravcal:::gc_gzip(big, 6L, 0L), "threads must be at least 1")
+  # part1_save(): load() gives the objects back; the file's bytes, once
+  # gunzipped, are those of save() itself
+  e <- new.env()
+  e$M <- list(metashort = data.frame(timestamp = as.character(1:2e4), ENMO = stats::runif(2e4)))
+  e$tag <- "x"
+  f <- tempfile(fileext = ".RData")
+  g <- tempfile(fileext = ".RData")
+  on.exit(unlink(c(f, g)), add = TRUE)
+  gravcal:::part1_save(c("M", "tag"), e, f)
+  save(list = c("M", "tag"), envir = e, file = g)
+  back <- new.env()
+  load(f, envir = back)
+  expect_identical(mget(c("M", "tag"), envir = back), mget(c("M", "tag"), envir = e))
+  expect_identical(gunzip(readBin(f, "raw", file.size(f))),
+                   gunzip(readBin(g, "raw", file.size(g))))
+})
+
 # g.part1() on the folder of one recording `name` at `sf` Hz against
 # GGIR's, then part 2 and part 1 again: the meta files and what part 2
 # makes of them the same. Returns gravcal's meta file's objects.
