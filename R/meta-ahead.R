@@ -29,7 +29,11 @@ meta_ahead_open <- function(datafile, pm, pr, pg, pc, I) {
   got <- NULL
   said <- utils::capture.output(got <- tryCatch(withCallingHandlers({
     p <- meta_params(pm, pr, pg, pc, list())
-    list(p = p, src = meta_open(datafile, p, I))
+    # (a reader that imputes time gaps, or an ad hoc csv file, is known
+    # before the file is opened: not opened twice)
+    fmt <- if (is.null(p$.rmc)) file_format(datafile, "datafile")
+    gaps <- is.null(fmt) || (isTRUE(p$imputeTimegaps) && isTRUE(format_entry(fmt)$ggir_timegaps))
+    list(p = p, src = if (!gaps) meta_open(datafile, p, I))
   }, warning = function(w) {
     quiet <<- FALSE
     invokeRestart("muffleWarning")
@@ -37,7 +41,7 @@ meta_ahead_open <- function(datafile, pm, pr, pg, pc, I) {
     quiet <<- FALSE
     invokeRestart("muffleMessage")
   }), error = function(e) NULL))
-  if (is.null(got)) return(FALSE)
+  if (is.null(got$src)) return(FALSE)
   src <- got$src
   ms <- NULL
   if (quiet && !length(said) && is.null(got$p$.rmc) && !isTRUE(src$getmeta_timegaps) &&

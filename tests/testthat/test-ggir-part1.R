@@ -245,6 +245,11 @@ test_that("a block read ahead is taken only by the same read; what is not taken 
   M1$bsc_qc <- M2$bsc_qc <- NULL
   expect_identical(M1, M2)
   expect_true("ENMOa" %in% names(M1$metashort))
+  # a reader that imputes time gaps (.gt3x): not opened ahead
+  g <- file.path(d, "g.gt3x")
+  write_meta_recording(g, "gt3x", 30, 3, 34, "2024-03-06 11:00:00")
+  expect_false(gravcal:::meta_ahead_open(g, c(), c(), c(), c(), NULL))
+  expect_null(gravcal:::ahead_state$pending)
   # the same parameters: taken, and the same M
   expect_true(gravcal:::meta_ahead_open(f, list(do.enmoa = TRUE), c(), c(), c(), NULL))
   M3 <- gravcal::g.getmeta(f, verbose = FALSE, params_metrics = list(do.enmoa = TRUE))
