@@ -122,7 +122,12 @@ meta_store <- function(src, time) {
   }
   store <- gc_meta_store(cols[["temperature"]], time, cols[["light"]], cols[["wear"]])
   want_time <- !isFALSE(format_entry(src$format)$ggir_time)
-  chunk <- 2^20  # rows a read of the decoder's at most
+  # rows a read of the decoder's at most (the block is the same whatever
+  # it is): its temperature, light and time wait in buffers of this many
+  # rows before they join their columns, 512 KB each (at 2^20 rows, the two
+  # 8 MB buffers of a read beside the calibration stayed in that thread's
+  # heap: 16 MB more at the peak of every metric)
+  chunk <- 2^16
   if (!is.null(src$native)) {
     read <- function() gc_meta_store_read(store, src$native$ptr, src$units, chunk, want_time)
   } else {
