@@ -71,7 +71,7 @@ Rcpp::RawVector gc_gzip(const Rcpp::RawVector& bytes, int level, int threads) {
   const std::size_t cut = parts == 2 ? n / 2 : n;
   std::vector<unsigned char> z[2];
   std::string err[2];
-  bool second_done = false;
+  bool second_on_thread = false;
 #ifndef GRAVCAL_NO_THREADS
   std::thread side;
   {
@@ -85,7 +85,7 @@ Rcpp::RawVector gc_gzip(const Rcpp::RawVector& bytes, int level, int threads) {
             err[1] = e.what();  // (memory: nothing leaves a thread)
           }
         });
-        second_done = true;
+        second_on_thread = true;
       } catch (const std::system_error&) {
         // no thread: both parts on this one
       }
@@ -95,7 +95,7 @@ Rcpp::RawVector gc_gzip(const Rcpp::RawVector& bytes, int level, int threads) {
 #else
   z[0] = gzip_member(p, cut, level, &err[0]);
 #endif
-  if (parts == 2 && !second_done) z[1] = gzip_member(p + cut, n - cut, level, &err[1]);
+  if (parts == 2 && !second_on_thread) z[1] = gzip_member(p + cut, n - cut, level, &err[1]);
   for (const std::string& e : err) {
     if (!e.empty()) Rcpp::stop(e);
   }
