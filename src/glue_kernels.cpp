@@ -66,15 +66,16 @@ Rcpp::List window_kernel(const std::string& name, const Rcpp::List& a) {
       return Rcpp::List::create(Rcpp::_["end"] = static_cast<double>(f(v, i, n)));
     });
   }
-  if (name == "sorted_counts") {
+  if (name == "order_next") {
     const double* w = col(a, "w");
     const std::size_t n = len(a, "w");
-    const double o = Rcpp::as<double>(a["o"]), av = Rcpp::as<double>(a["a"]);
-    return each_variant(k::sorted_counts_variants, [&](k::SortedCountsFn f) {
-      std::size_t below = 0, upto = 0;
-      f(w, n, o, av, &below, &upto);
-      return Rcpp::List::create(Rcpp::_["below"] = static_cast<double>(below),
-                                Rcpp::_["upto"] = static_cast<double>(upto));
+    const double v = Rcpp::as<double>(a["v"]);
+    const bool down = Rcpp::as<bool>(a["down"]);
+    return each_variant(k::order_next_variants, [&](k::OrderNextFn f) {
+      double val = 0;
+      std::size_t count = 0;
+      f(w, n, v, down, &val, &count);
+      return Rcpp::List::create(Rcpp::_["val"] = val, Rcpp::_["count"] = static_cast<double>(count));
     });
   }
   if (name == "offset_divide") {

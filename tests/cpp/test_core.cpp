@@ -951,8 +951,9 @@ static void test_cwa_word_sum() {
 // the plain rule: each window sorted
 // stably (equal values, -0 and +0 among them, in their order in time),
 // its middle value, to the bit; NaN where the window holds one. Sensor-like
-// data with many ties, signed zeros, NaN runs, widths 1 to 51.
-static void test_rolling_median() {
+// data with many ties, signed zeros, infinities, NaN runs, widths 1 to 51;
+// with the kernel table at each level (the median's kernel order_next).
+static void test_rolling_median_at() {
   std::mt19937 rng(2024);
   std::uniform_int_distribution<int> level(-40, 40);
   std::uniform_real_distribution<double> u(0, 1);
@@ -964,6 +965,7 @@ static void test_rolling_median() {
       const double r = u(rng);
       if (r < 0.1) v[i] = 0.0;
       else if (r < 0.2) v[i] = -0.0;
+      else if (r < 0.21 && trial % 5 == 4) v[i] = r < 0.205 ? HUGE_VAL : -HUGE_VAL;
       else if (r < 0.6) v[i] = level(rng) / 256.0;  // ties, as a 8-bit sensor gives
       else v[i] = u(rng) - 0.5;
     }
@@ -1011,6 +1013,14 @@ static void test_rolling_median() {
     }
   }
   CHECK(bad == 0);
+}
+
+static void test_rolling_median() {
+  gravcal::kernels::refill(gravcal::kernels::scalar);
+  test_rolling_median_at();
+  gravcal::set_avx2(false);  // SSE2 where compiled
+  test_rolling_median_at();
+  if (gravcal::set_avx2(true)) test_rolling_median_at();
 }
 
 int main(int argc, char** argv) {

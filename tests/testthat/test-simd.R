@@ -339,33 +339,46 @@ test_that("first_zero: the first idle-sleep sample of the reference", {
   expect_identical(kernel_diffs("first_zero", cases), character(0))
 })
 
-test_that("sorted_counts: the running median's places, as the reference counts them", {
-  # sorted windows of 0 to 60 values (the median's is 51 at 10 Hz) with
-  # ties, signed zeros, infinities, subnormals; the values leaving and
-  # entering drawn from the window (ties with it), from tricky values
-  # (never NaN: the median keeps NaN out of its window) and between
+test_that("order_next: the running median's next value, as the reference finds it", {
+  # windows of 0 to 60 values (the median's is 51 at 10 Hz), in time order
+  # (not sorted), with ties, signed zeros, infinities, subnormals; the
+  # median's value drawn from the window (ties with it), from tricky values
+  # (never NaN: the median keeps NaN out of its window) and between; down
+  # and up
   set.seed(8)
   pool <- tricky[!is.na(tricky)]
   cases <- list()
   for (n in 0:60) {
     for (kind in c("ordinary", "ties", "tricky")) {
-      w <- sort(switch(kind,
+      w <- switch(kind,
         ordinary = 0.6 + 0.01 * stats::rnorm(n),
         ties = sample(c(-0, 0, 0.25, 0.5, 1), n, replace = TRUE),
-        tricky = sample(pool, n, replace = TRUE)))
+        tricky = sample(pool, n, replace = TRUE))
       from <- c(w, pool, 0.6 + 0.01 * stats::rnorm(3))
       for (r in 1:3) {
-        cases[[paste(kind, n, r)]] <- list(w = as.double(w), o = sample(from, 1), a = sample(from, 1))
+        for (down in c(TRUE, FALSE)) {
+          cases[[paste(kind, n, r, down)]] <- list(w = as.double(w), v = sample(from, 1), down = down)
+        }
       }
     }
   }
   # the reference is the rule itself (on every platform, vector code or not)
-  for (cs in cases[c("ties 60 1", "tricky 33 2", "ordinary 51 3", "ties 0 1")]) {
-    out <- gc_kernel_check("sorted_counts", cs)$scalar
-    expect_identical(out$below, as.double(sum(cs$w < cs$o)))
-    expect_identical(out$upto, as.double(sum(cs$w <= cs$a)))
+  rule <- function(cs) {
+    beyond <- if (cs$down) cs$w[cs$w < cs$v] else cs$w[cs$w > cs$v]
+    val <- if (length(beyond) == 0) (if (cs$down) -Inf else Inf) else
+      if (cs$down) max(beyond) else min(beyond)
+    list(val = if (val == 0) 0 else val, count = as.double(sum(cs$w == val)))
   }
-  expect_identical(kernel_diffs("sorted_counts", cases), character(0))
+  for (nm in c("ties 60 1 TRUE", "ties 60 1 FALSE", "tricky 33 2 TRUE", "tricky 33 2 FALSE",
+               "ordinary 51 3 TRUE", "ordinary 51 3 FALSE", "ties 0 1 TRUE")) {
+    out <- gc_kernel_check("order_next", cases[[nm]])$scalar
+    expect_identical(out, rule(cases[[nm]]), info = nm)
+  }
+  # a zero is +0, whichever zero the window holds
+  out <- gc_kernel_check("order_next", list(w = c(-0, 1, -0), v = 1, down = TRUE))$scalar
+  expect_identical(1 / out$val, Inf)
+  expect_identical(out$count, 2)
+  expect_identical(kernel_diffs("order_next", cases), character(0))
 })
 
 test_that("offset_divide: GGIR's calibration of an axis span, as the reference and R compute it", {
@@ -458,7 +471,7 @@ test_that("the kernel table holds one variant per kernel, chosen once", {
   k <- gc_kernels()
   expect_true(all(k %in% c("scalar", "sse2", "avx2")))
   expect_setequal(names(k), c("run_end", "stream_window", "r_scan", "r_var_means3",
-                              "first_zero", "sorted_counts", "offset_divide", "word_sum",
+                              "first_zero", "order_next", "offset_divide", "word_sum",
                               "scale_packed", "span_times", "cwa_interp", "hex_counts"))
   # GRAVCAL_KERNELS forces a kernel to its scalar reference in a new process
   skip_if_no_avx2()

@@ -354,62 +354,90 @@ inline double r_norm(double x, double y, double z) {
 // in [m, N - m); a window holding NaN gives NaN (zoo then uses median(),
 // whose result is NA). A window's median depends on its values only, so
 // that the centres may be made in parts, in any order, by any thread.
-// Sorted window, the value leaving and the one entering placed by counts.
 // The N values are v[0], v[stride], v[2 * stride], ... (a subsample read
 // in place).
+//
+// The window's K = 2m + 1 values sit in a ring, in time order. The median
+// is known by its value `med`, with `lo` values below it and `eq` equal
+// (lo <= m < lo + eq). A step changes lo and eq by the value leaving and
+// the one entering, by compares alone; only where m leaves [lo, lo + eq)
+// does the median move, one value down or up: to the window's largest
+// value below it or its smallest above (the kernel order_next, four or
+// two lanes at a time where the processor has them). On a week's
+// recording the median moves at about a quarter of the steps.
+//
+// The median's bits are those of the window sorted stably (equal values in
+// their order in time): for a median of zero, the zero of the sign found
+// at its place among the window's zeros in time order (-0 and +0 compare
+// equal; GGIR's angles keep the sign).
 inline void rolling_median_range(const double* v, std::size_t N, std::size_t k, double* out,
                                  std::size_t from, std::size_t to, std::size_t stride = 1) {
   const std::size_t m = k / 2;
   if (k == 0 || from >= to) return;
   if (from < m || to > N - m) throw std::out_of_range("running median centres out of range");
-  std::vector<double> win;
-  win.reserve(k);
-  std::size_t nans = 0;
-  const kernels::SortedCountsFn counts = kernels::active().sorted_counts;
-  auto add = [&](double a) {
-    if (std::isnan(a)) {
-      ++nans;
-      return;
-    }
-    win.insert(std::upper_bound(win.begin(), win.end(), a), a);
-  };
-  auto drop = [&](double a) {
-    if (std::isnan(a)) {
-      --nans;
-      return;
-    }
-    auto it = std::lower_bound(win.begin(), win.end(), a);
-    win.erase(it);
-  };
-  // the window slides: the value leaving is found (the first equal, as
-  // drop() finds it: at the count of values below it) and the one entering
-  // takes the place add() would give it (after its equals: at the count of
-  // the other values not above it), the values between moved by one. Both
-  // counts in one pass without branches (the kernel sorted_counts, four or
-  // two lanes at a time where the processor has them): a binary search's
-  // branches mispredict on sensor data (bench/ab.sh, a week's .cwa
-  // g.getmeta(): 0.96 of the CPU of lower_bound() and moves one by one).
-  auto slide = [&](double o, double a) {
-    if (std::isnan(o) || std::isnan(a)) {
-      drop(o);
-      add(a);
-      return;
-    }
-    double* w = win.data();
-    const std::size_t len = win.size();
-    std::size_t below_o = 0, upto_a = 0;
-    counts(w, len, o, a, &below_o, &upto_a);
-    const std::size_t pos = below_o;
-    const std::size_t to = upto_a - static_cast<std::size_t>(o <= a);  // o itself not counted
-    if (to > pos) std::memmove(w + pos, w + pos + 1, (to - pos) * sizeof(double));
-    else if (to < pos) std::memmove(w + to + 1, w + to, (pos - to) * sizeof(double));
-    w[to] = a;
-  };
-  for (std::size_t i = from - m; i <= from + m; ++i) add(v[i * stride]);
+  const std::size_t K = 2 * m + 1;
+  const kernels::OrderNextFn next = kernels::active().order_next;
+  std::vector<double> ring(K), sorted;
+  double* r = ring.data();
+  std::size_t head = 0, nans = 0;  // r[head]: the oldest value
+  for (std::size_t i = 0; i < K; ++i) {
+    r[i] = v[(from - m + i) * stride];
+    nans += std::isnan(r[i]) ? 1 : 0;
+  }
+  double med = 0;
+  std::size_t lo = 0, eq = 0;
+  bool known = false;  // med, lo and eq hold for the window
   for (std::size_t c = from;; ++c) {
-    out[c] = nans ? kNaN : win[m];
+    if (nans != 0) {
+      out[c] = kNaN;
+    } else {
+      if (!known) {  // the window's median found anew (at the start, after NaN)
+        sorted.assign(r, r + K);
+        std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(m), sorted.end());
+        med = sorted[m];
+        lo = eq = 0;
+        for (std::size_t i = 0; i < K; ++i) {
+          lo += r[i] < med ? 1 : 0;
+          eq += r[i] == med ? 1 : 0;
+        }
+        known = true;
+      }
+      double value = med;
+      if (med == 0) {  // the (m - lo)-th zero in time order
+        std::size_t seen = 0;
+        for (std::size_t j = 0, i = head; j < K; ++j, i = i + 1 == K ? 0 : i + 1) {
+          if (r[i] == 0 && seen++ == m - lo) {
+            value = r[i];
+            break;
+          }
+        }
+      }
+      out[c] = value;
+    }
     if (c + 1 >= to) break;
-    slide(v[(c - m) * stride], v[(c + m + 1) * stride]);
+    const double o = r[head], a = v[(c + m + 1) * stride];
+    r[head] = a;
+    head = head + 1 == K ? 0 : head + 1;
+    nans = nans + (std::isnan(a) ? 1 : 0) - (std::isnan(o) ? 1 : 0);
+    if (nans != 0 || !known) {  // (a known median had no NaN: o is a number)
+      known = false;
+      continue;
+    }
+    lo = lo + (a < med ? 1 : 0) - (o < med ? 1 : 0);
+    eq = eq + (a == med ? 1 : 0) - (o == med ? 1 : 0);
+    double nv = 0;
+    std::size_t n_eq = 0;
+    if (lo > m) {  // one value down: the largest below
+      next(r, K, med, true, &nv, &n_eq);
+      med = nv;
+      eq = n_eq;
+      lo -= n_eq;
+    } else if (lo + eq <= m) {  // one value up: the smallest above
+      next(r, K, med, false, &nv, &n_eq);
+      lo += eq;
+      med = nv;
+      eq = n_eq;
+    }
   }
 }
 
@@ -701,31 +729,62 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
                           std::fmod(M, stride) == 0;
   std::vector<double> lattice;
   std::vector<double> vals;
+  const double clip15 = cf.clipthres * 1.5;
   for (int a = 0; a < 3; ++a) {
     const double* v = xyz[a];
+    // first the clipping of every long epoch, then the non-wear (whose
+    // windows reach long epochs ahead). Clipping: values beyond clipthres
+    // in (1 + clipstart):clipend. On the lattice, M is whole and those are
+    // rows [(h - 1) M, h M): one pass over the axis counts them and copies
+    // the lattice's rows (every stride-th from the first) on the way.
+    const std::size_t st = on_lattice ? static_cast<std::size_t>(stride) : 0;
     if (on_lattice) {
-      const std::size_t st = static_cast<std::size_t>(stride);
       lattice.clear();
       lattice.reserve(nrow / st + 1);
-      for (std::size_t j = 0; j < nrow; j += st) lattice.push_back(v[j]);
     }
     for (std::int64_t h = 1; h <= N; ++h) {
       const Window w = window(h);
-      // clipping: values beyond clipthres in (1 + clipstart):clipend
       const RColon cc = r_colon(1 + w.clipstart, w.clipend);
       double count = 0;
       bool extreme = false;
-      at_r_indices(cc, nrow, [&](std::size_t j) {
-        const double av = std::fabs(v[j]);
-        if (av > cf.clipthres) {
-          count += 1;
-          if (av > cf.clipthres * 1.5) extreme = true;
+      if (on_lattice) {
+        // (from: a multiple of the stride, as M is)
+        const std::size_t from = static_cast<std::size_t>(h - 1) * static_cast<std::size_t>(M);
+        const std::size_t to = std::min(nrow, from + static_cast<std::size_t>(M));
+        std::size_t n_over = 0;
+        bool over15 = false;
+        for (std::size_t j = from; j < to; j += st) {
+          lattice.push_back(v[j]);
+          const std::size_t stop = std::min(to, j + st);
+          for (std::size_t i = j; i < stop; ++i) {  // (no branch)
+            const double av = std::fabs(v[i]);
+            n_over += av > cf.clipthres ? 1 : 0;
+            over15 = over15 | (av > clip15);
+          }
         }
-      });
+        count = static_cast<double>(n_over);  // (whole counts: exact)
+        extreme = over15;
+      } else {
+        at_r_indices(cc, nrow, [&](std::size_t j) {
+          const double av = std::fabs(v[j]);
+          if (av > cf.clipthres) {
+            count += 1;
+            if (av > clip15) extreme = true;
+          }
+        });
+      }
       if (count > 0 && extreme) count = M;
       // R's max(c(...)) of the three clipping fractions
       double& cm = r.clipping[static_cast<std::size_t>(h - 1)];
       cm = a == 0 ? count / M : std::max(cm, count / M);
+    }
+    if (on_lattice) {  // the rows after the last long epoch
+      for (std::size_t j = static_cast<std::size_t>(N) * static_cast<std::size_t>(M); j < nrow; j += st) {
+        lattice.push_back(v[j]);
+      }
+    }
+    for (std::int64_t h = 1; h <= N; ++h) {
+      const Window w = window(h);
       // non-wear: range, then sd, of the window's values
       vals.clear();
       if (!cf.approach_2023) {
@@ -821,7 +880,7 @@ std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
 
 // The share of z's running medians the calling thread of short_metrics()
 // makes when it has little else to do.
-constexpr double kShareOfZ = 2.0 / 3;
+constexpr double kShareOfZ = 0.2;
 
 // The short-epoch metrics of g.applymetrics() that need no filter, for a
 // block of calibrated samples: "roll_med_acc_x" (and y, z),
@@ -987,8 +1046,10 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
   // kShareOfZ of z's medians, so that the two threads end together: the
   // second makes x's and y's, then the rest of z's once this thread has
   // begun z (`z_begun`), then the sums that read them. A week's .cwa
-  // (bench/ab.sh): per block, the medians of an axis about 0.045 s, the
-  // sums without them and `beside` 0.115 s, those with them 0.04 s.
+  // (per-thread timers, stop 60): per block of 36 h, the medians of an axis
+  // about 0.017 s, the sums without them (0.07 s) and `beside` (0.045 s) on
+  // this thread, those with them 0.04 s; with kShareOfZ 0.2 or 0 the
+  // threads take 0.11-0.12 s (2/3: 0.12-0.13 s).
   // `z_begun` is set, with a value or this thread's error, before this
   // thread does anything else.
   const bool share = two && fms.empty() && mad_k.empty();

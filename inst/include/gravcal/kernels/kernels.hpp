@@ -50,7 +50,7 @@ struct Table {
   RScanFn r_scan = nullptr;
   RVarMeans3Fn r_var_means3 = nullptr;
   FirstZeroFn first_zero = nullptr;
-  SortedCountsFn sorted_counts = nullptr;  // the running median (ggir_epochs.hpp)
+  OrderNextFn order_next = nullptr;  // the running median (ggir_epochs.hpp)
   // GGIR's calibration of a block (kernels/apply.hpp)
   OffsetDivideFn offset_divide = nullptr;
   // device decoders (kernels/decode.hpp)
@@ -69,7 +69,7 @@ constexpr void each_kernel(T& t, Visit&& visit) {
   visit(t.r_scan, r_scan_variants, "r_scan");
   visit(t.r_var_means3, r_var_means3_variants, "r_var_means3");
   visit(t.first_zero, first_zero_variants, "first_zero");
-  visit(t.sorted_counts, sorted_counts_variants, "sorted_counts");
+  visit(t.order_next, order_next_variants, "order_next");
   visit(t.offset_divide, offset_divide_variants, "offset_divide");
   visit(t.word_sum, word_sum_variants, "word_sum");
   visit(t.scale_packed, scale_packed_variants, "scale_packed");

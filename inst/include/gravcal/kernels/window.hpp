@@ -645,66 +645,118 @@ constexpr Variants<FirstZeroFn> first_zero_variants = {
     first_zero_scalar, GRAVCAL_IF_SSE2(first_zero_sse2), GRAVCAL_IF_AVX2(first_zero_avx2)};
 
 // ---------------------------------------------------------------------------
-// sorted_counts(w, n, o, a, &below, &upto): over the n values of a running
-// median's sorted window (ggir_epochs.hpp rolling_median(); no NaN), how
-// many are below o and how many are not above a: where the value leaving
-// sits and where the one entering goes. Counts are exact in every variant.
+// order_next(w, n, v, down, &val, &count): over the n values of a running
+// median's window (ggir_epochs.hpp rolling_median_range(); no NaN, in any
+// order), the largest value below v (down) or the smallest above it (not
+// down), and how many of the values equal it: the median's next value when
+// it moves down or up. Where no value is below (above) v, val is -Inf
+// (+Inf) and count how many values are that infinity. A zero is returned as
+// +0 in every variant (the median finds a zero's sign itself, in time
+// order); counts are exact, so every variant gives the reference's bits.
 
-inline void sorted_counts_scalar(const double* w, std::size_t n, double o, double a,
-                                 std::size_t* below, std::size_t* upto) {
-  std::size_t b = 0, u = 0;
+inline void order_next_scalar(const double* w, std::size_t n, double v, bool down, double* val,
+                              std::size_t* count) {
+  double best = down ? -HUGE_VAL : HUGE_VAL;
+  std::size_t c = 0;
   for (std::size_t j = 0; j < n; ++j) {
-    b += static_cast<std::size_t>(w[j] < o);
-    u += static_cast<std::size_t>(w[j] <= a);
+    const double x = w[j];
+    if (down ? x < v : x > v) {
+      if (down ? x > best : x < best) {
+        best = x;
+        c = 1;
+      } else if (x == best) {
+        ++c;
+      }
+    }
   }
-  *below = b;
-  *upto = u;
+  *val = best == 0 ? 0.0 : best;
+  *count = c;
 }
 
 #if defined(GRAVCAL_SSE2)
-inline void sorted_counts_sse2(const double* w, std::size_t n, double o, double a,
-                               std::size_t* below, std::size_t* upto) {
-  // a true lane is all ones, -1 as an integer: subtracted, it counts one
-  const __m128d vo = _mm_set1_pd(o), va = _mm_set1_pd(a);
-  __m128i cb = _mm_setzero_si128(), cu = _mm_setzero_si128();
+// Up is down on the values negated (the sign bit flipped: exact): x > v is
+// -x < -v, and the smallest x above v is minus the largest -x below -v.
+// Each lane keeps its largest value below and its count; the lanes are
+// joined after (the largest, and the counts of the lanes that hold it).
+inline void order_next_join(const double* b, const std::int64_t* c, int lanes, const double* w,
+                            std::size_t j, std::size_t n, double v, bool down, double* val,
+                            std::size_t* count) {
+  double g = b[0];
+  for (int l = 1; l < lanes; ++l) g = b[l] > g ? b[l] : g;
+  std::size_t tot = 0;
+  for (int l = 0; l < lanes; ++l) tot += b[l] == g ? static_cast<std::size_t>(c[l]) : 0;
+  const double vs = down ? v : -v;
+  for (; j < n; ++j) {  // the rest
+    const double x = down ? w[j] : -w[j];
+    if (x < vs) {
+      if (x > g) {
+        g = x;
+        tot = 1;
+      } else if (x == g) {
+        ++tot;
+      }
+    }
+  }
+  const double r = down ? g : -g;
+  *val = r == 0 ? 0.0 : r;
+  *count = tot;
+}
+
+inline void order_next_sse2(const double* w, std::size_t n, double v, bool down, double* val,
+                            std::size_t* count) {
+  const __m128d sg = _mm_set1_pd(down ? 0.0 : -0.0);
+  const __m128d vs = _mm_xor_pd(_mm_set1_pd(v), sg);
+  const __m128i one = _mm_set1_epi64x(1);
+  __m128d best = _mm_set1_pd(-HUGE_VAL);
+  __m128i c = _mm_setzero_si128();
   std::size_t j = 0;
   for (; j + 2 <= n; j += 2) {
-    const __m128d v = _mm_loadu_pd(w + j);
-    cb = _mm_sub_epi64(cb, _mm_castpd_si128(_mm_cmplt_pd(v, vo)));
-    cu = _mm_sub_epi64(cu, _mm_castpd_si128(_mm_cmple_pd(v, va)));
+    const __m128d x = _mm_xor_pd(_mm_loadu_pd(w + j), sg);
+    const __m128d in = _mm_cmplt_pd(x, vs);
+    const __m128d gt = _mm_and_pd(in, _mm_cmpgt_pd(x, best));
+    const __m128d eq = _mm_and_pd(in, _mm_cmpeq_pd(x, best));
+    best = _mm_or_pd(_mm_and_pd(gt, x), _mm_andnot_pd(gt, best));
+    const __m128i gi = _mm_castpd_si128(gt);
+    c = _mm_sub_epi64(c, _mm_castpd_si128(eq));  // a true lane is -1
+    c = _mm_or_si128(_mm_and_si128(gi, one), _mm_andnot_si128(gi, c));
   }
-  std::int64_t lb[2], lu[2];
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(lb), cb);
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(lu), cu);
-  sorted_counts_scalar(w + j, n - j, o, a, below, upto);  // the rest
-  *below += static_cast<std::size_t>(lb[0] + lb[1]);
-  *upto += static_cast<std::size_t>(lu[0] + lu[1]);
+  double b[2];
+  std::int64_t cl[2];
+  _mm_storeu_pd(b, best);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(cl), c);
+  order_next_join(b, cl, 2, w, j, n, v, down, val, count);
 }
 #endif
 
 #if defined(GRAVCAL_AVX2)
-GRAVCAL_TARGET_AVX2 inline void sorted_counts_avx2(const double* w, std::size_t n, double o, double a,
-                                                   std::size_t* below, std::size_t* upto) {
-  const __m256d vo = _mm256_set1_pd(o), va = _mm256_set1_pd(a);
-  __m256i cb = _mm256_setzero_si256(), cu = _mm256_setzero_si256();
+GRAVCAL_TARGET_AVX2 inline void order_next_avx2(const double* w, std::size_t n, double v, bool down,
+                                                double* val, std::size_t* count) {
+  const __m256d sg = _mm256_set1_pd(down ? 0.0 : -0.0);
+  const __m256d vs = _mm256_xor_pd(_mm256_set1_pd(v), sg);
+  const __m256i one = _mm256_set1_epi64x(1);
+  __m256d best = _mm256_set1_pd(-HUGE_VAL);
+  __m256i c = _mm256_setzero_si256();
   std::size_t j = 0;
   for (; j + 4 <= n; j += 4) {
-    const __m256d v = _mm256_loadu_pd(w + j);
-    cb = _mm256_sub_epi64(cb, _mm256_castpd_si256(_mm256_cmp_pd(v, vo, _CMP_LT_OQ)));
-    cu = _mm256_sub_epi64(cu, _mm256_castpd_si256(_mm256_cmp_pd(v, va, _CMP_LE_OQ)));
+    const __m256d x = _mm256_xor_pd(_mm256_loadu_pd(w + j), sg);
+    const __m256d in = _mm256_cmp_pd(x, vs, _CMP_LT_OQ);
+    const __m256d gt = _mm256_and_pd(in, _mm256_cmp_pd(x, best, _CMP_GT_OQ));
+    const __m256d eq = _mm256_and_pd(in, _mm256_cmp_pd(x, best, _CMP_EQ_OQ));
+    best = _mm256_blendv_pd(best, x, gt);
+    c = _mm256_sub_epi64(c, _mm256_castpd_si256(eq));  // a true lane is -1
+    c = _mm256_blendv_epi8(c, one, _mm256_castpd_si256(gt));
   }
-  std::int64_t lb[4], lu[4];
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(lb), cb);
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(lu), cu);
-  sorted_counts_scalar(w + j, n - j, o, a, below, upto);  // the rest
-  *below += static_cast<std::size_t>(lb[0] + lb[1] + lb[2] + lb[3]);
-  *upto += static_cast<std::size_t>(lu[0] + lu[1] + lu[2] + lu[3]);
+  double b[4];
+  std::int64_t cl[4];
+  _mm256_storeu_pd(b, best);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(cl), c);
+  order_next_join(b, cl, 4, w, j, n, v, down, val, count);
 }
 #endif
 
-using SortedCountsFn = void (*)(const double*, std::size_t, double, double, std::size_t*, std::size_t*);
-constexpr Variants<SortedCountsFn> sorted_counts_variants = {
-    sorted_counts_scalar, GRAVCAL_IF_SSE2(sorted_counts_sse2), GRAVCAL_IF_AVX2(sorted_counts_avx2)};
+using OrderNextFn = void (*)(const double*, std::size_t, double, bool, double*, std::size_t*);
+constexpr Variants<OrderNextFn> order_next_variants = {
+    order_next_scalar, GRAVCAL_IF_SSE2(order_next_sse2), GRAVCAL_IF_AVX2(order_next_avx2)};
 
 }  // namespace kernels
 }  // namespace gravcal
