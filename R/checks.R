@@ -213,7 +213,8 @@ match_choice <- function(x, arg, choices = NULL) {
 # The threads g.getmeta() (and so g.part1() and epoch_signals()) uses
 # within a recording: the option `gravcal.threads`, 1 or 2 (more counts as
 # 2: a second thread makes the running medians of GGIR's angles beside
-# the other epoch signals), 2 where it is not set. The results do not
+# the other epoch signals, and the GGIR method's window sums beside its
+# decoder), 2 where it is not set. The results do not
 # depend on it. A cohort run on a plan with several workers sets 1 in them.
 gravcal_threads <- function() {
   o <- getOption("gravcal.threads")

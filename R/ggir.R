@@ -113,6 +113,9 @@ ggir_run <- function(src, compat = TRUE,
   # GGIR (GGIRread's resampling of repeated time stamps gives NaN); one in
   # a data frame (which GGIR does not take) is left out of its window
   opts$nonfinite_in_sums <- as.numeric(!identical(src$format, "data.frame"))
+  # the windows' sums on a second thread beside the decode (the same
+  # windows; options(gravcal.threads = 1): one thread)
+  opts$threads <- gravcal_threads()
   # the adaptive budget's rule, called by the core after a converged fit
   # that meets GGIR's error target (GgirHost::enough())
   if (!is.null(on_fit)) opts$on_fit <- on_fit

@@ -21,7 +21,10 @@
 #' the same results as one. `options(gravcal.threads = 1)` keeps them to
 #' one. Cohort runs on a plan with several workers keep each worker to one.
 #' The second thread also inflates a `.gt3x` file's data ahead of its
-#' decoder, wherever gravcal reads one (the same option turns it off).
+#' decoder, wherever gravcal reads one, and in the GGIR method's pass
+#' ([g.calibrate()], `calibrate(method = "ggir")`) takes the 10 s windows'
+#' sums of each hour while the decoder reads the next (the same option
+#' turns both off; the windows are the same).
 #' @keywords internal
 #' @useDynLib gravcal, .registration = TRUE
 #' @importFrom Rcpp evalCpp

@@ -282,6 +282,8 @@ GgirOptions parse_ggir_options(const Rcpp::List& o) {
   parse_block_rules(opt, c);
   c.lazy = opt.flag("lazy");
   c.nonfinite_in_sums = opt.num_or("nonfinite_in_sums", 0) != 0;
+  c.threads = static_cast<int>(opt.num_or("threads", 1));
+  if (c.threads < 1) Rcpp::stop("threads must be at least 1");
   c.r_long_double = gravcal_glue::r_long_double();
   c.min_rest = static_cast<int>(opt.num("min_rest"));
   c.error_digits = static_cast<int>(opt.num("error_digits"));

@@ -3,7 +3,10 @@
 // of the angles and the sums that read them on a second thread): the same
 // bits, for every mix of metrics and block shapes here. A byte source read
 // ahead (read_ahead.hpp): the inner source's bytes, end and failure, for
-// any sizes of buffer and read, and stopped before its end. Built also
+// any sizes of buffer and read, and stopped before its end. GGIR's block
+// rules with the segmenter's hours on a worker thread (ggir_blocks.hpp
+// async()): the same windows and blocks as on one thread, and a sink's
+// error raised on the caller's. Built also
 // with ThreadSanitizer (make test: test_threads_tsan), which fails the run
 // on a data race between the threads.
 #include <cmath>
@@ -16,6 +19,7 @@
 
 #include "gravcal/decoders/read_ahead.hpp"
 #include "gravcal/ggir/ggir_epochs.hpp"
+#include "gravcal/ggir/pipeline.hpp"
 
 namespace p1 = gravcal::ggir_part1;
 
@@ -154,8 +158,127 @@ static void check_read_ahead() {
   }
 }
 
+
+// Columns given by read() (as a decoder writes them), not lent.
+class WrittenSource : public gravcal::Source {
+ public:
+  WrittenSource(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& z,
+                const std::vector<double>& t)
+      : c_(x.data(), y.data(), z.data(), t.data(), x.size()) {}
+  std::int64_t read(gravcal::SampleBuffer& out, std::int64_t max_units) override {
+    // at most 5000 at a time, as a decoder's reads are cut
+    gravcal::SampleBuffer o = out;
+    o.capacity = std::min(out.capacity, out.n + 5000);
+    const std::int64_t u = c_.read(o, max_units);
+    out.n = o.n;
+    return u;
+  }
+  bool done() const override { return c_.done(); }
+  bool has_temperature() const override { return true; }
+
+ private:
+  gravcal::ColumnsSource c_;
+};
+
+// GGIR's block rules over a recording of `hours` at sf Hz (idle-sleep
+// zeros in runs, one at each block's end, a temperature), in blocks of
+// `units` samples, written through the pump: every window and every
+// block's numbers, with the segmenter on this thread or on a worker's.
+struct BlockRun {
+  std::vector<gravcal::WindowStats> windows;
+  std::vector<gravcal::GgirBlockInfo> blocks;
+};
+
+static BlockRun block_run(double sf, double hours, std::int64_t units, bool compat, bool async,
+                          std::int64_t throw_at = -1) {
+  const std::size_t n = static_cast<std::size_t>(sf * 3600 * hours);
+  std::vector<double> x(n), y(n), z(n), t(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = static_cast<double>(i) / sf;
+    const bool moving = std::fmod(u, 5400.0) < 1800.0;
+    x[i] = 0.1 * std::sin(u / 700) + (moving ? 0.2 * std::sin(u * 3.1) : 1e-4 * std::sin(u * 7.7));
+    y[i] = 0.98 - 0.05 * std::cos(u / 900);
+    z[i] = 0.15 + (moving ? 0.1 * std::cos(u * 2.3) : 0.0);
+    t[i] = 20 + std::floor(u / 600) * 0.0625;
+    const bool idle = std::fmod(u, 7000.0) < 300.0 ||
+                      (units > 0 && (i + 1) % static_cast<std::size_t>(units) == 0);
+    if (idle) x[i] = y[i] = z[i] = 0.0;
+  }
+  WrittenSource src(x, y, z, t);
+  gravcal::Segmenter seg(10 * sf, true);
+#ifndef GRAVCAL_NO_THREADS
+  gravcal::Worker worker;
+#endif
+  gravcal::GgirBlocks blocks(seg, 3600 * sf, compat, true);
+#ifndef GRAVCAL_NO_THREADS
+  if (async) blocks.async(&worker);
+#else
+  (void)async;  // (no threads: both runs on this one)
+#endif
+  gravcal::BlocksStage stage(blocks, true);
+  BlockRun out;
+  for (;;) {
+    auto sink = [&](const gravcal::WindowStats& w) {
+      if (throw_at >= 0 && static_cast<std::int64_t>(out.windows.size()) == throw_at) {
+        throw std::runtime_error("the sink's error");
+      }
+      out.windows.push_back(w);
+    };
+    const gravcal::GgirBlockRead r = gravcal::read_ggir_block(src, blocks, stage, units, sink, [] { return false; });
+    if (r.pump.units == 0 && r.pump.samples == 0) break;
+    out.blocks.push_back(r.info);
+    if (r.pump.done) break;
+  }
+  return out;
+}
+
+static void check_async_blocks() {
+  struct Case {
+    double sf, hours;
+    std::int64_t units;
+    bool compat;
+  } cases[] = {{10, 30, 250000, true}, {10, 30, 250000, false}, {10, 7, 36000 * 3, true},
+               {33.3, 6, 300000, true}, {2, 20, 40000, true}, {10, 0.5, 100000, true}};
+  for (const Case& c : cases) {
+    const BlockRun a = block_run(c.sf, c.hours, c.units, c.compat, false);
+    const BlockRun b = block_run(c.sf, c.hours, c.units, c.compat, true);
+    bool ok = a.windows.size() == b.windows.size() && a.blocks.size() == b.blocks.size() &&
+              !a.windows.empty() == (c.hours >= 1);
+    for (std::size_t i = 0; ok && i < a.windows.size(); ++i) {
+      ok = std::memcmp(&a.windows[i], &b.windows[i], sizeof(gravcal::WindowStats)) == 0;
+    }
+    for (std::size_t i = 0; ok && i < a.blocks.size(); ++i) {
+      const gravcal::GgirBlockInfo &p = a.blocks[i], &q = b.blocks[i];
+      ok = p.rows == q.rows && p.zeros == q.zeros && p.ld == q.ld && p.used == q.used &&
+           p.carried == q.carried && std::memcmp(&p.first_mean, &q.first_mean, sizeof(double)) == 0 &&
+           std::memcmp(&p.temp_sd, &q.temp_sd, sizeof(double)) == 0;
+    }
+    if (!ok) {
+      std::printf("FAIL async block rules: %g Hz, %g h, blocks of %lld, compat %d: %zu / %zu windows\n", c.sf,
+                  c.hours, static_cast<long long>(c.units), static_cast<int>(c.compat), a.windows.size(),
+                  b.windows.size());
+      ++failures;
+    }
+  }
+  // the sink's error on the worker: raised on this thread, by the read
+  for (bool async : {false, true}) {
+    std::string what;
+    try {
+      block_run(10, 5, 100000, true, async, 700);
+    } catch (const std::runtime_error& e) {
+      what = e.what();
+    }
+    if (what != "the sink's error") {
+      std::printf("FAIL async block rules: the sink's error (async %d): \"%s\"\n", static_cast<int>(async),
+                  what.c_str());
+      ++failures;
+    }
+  }
+}
+
 int main() {
   check_read_ahead();
+  check_async_blocks();
   const std::vector<std::string> dflt = {"ENMO", "angle_z"};
   const std::vector<std::string> all = {"angle_x", "angle_y", "angle_z", "roll_med_acc_x", "dev_roll_med_acc_y",
                                         "ENMO", "EN", "ENMOa", "MAD"};

@@ -587,3 +587,29 @@ test_that("write_coefs() takes a fit_icp() fit (no `$ggir` partial match)", {
   expect_equal(out$cal.error.start, fi$error_before)
   expect_equal(out$cal.error.end, fi$error_after)
 })
+
+test_that("g.calibrate() gives the same result on one thread and on two", {
+  # with two threads the segmenter takes each hour's 10 s windows on the
+  # second while the decoder reads the next hour (ggir_blocks.hpp async()):
+  # the same windows in the same order, so the same fit, to the bit. 30
+  # hours at 25 Hz in GGIR's blocks of 12 hours (carries, idle sleep)
+  rec <- simulate_recording(hours = 30, sf = 25, seed = 17, idle_sleep = 0.02,
+                            start = as.POSIXct("2024-05-06 07:00:00", tz = "UTC"))
+  f <- tempfile(fileext = ".cwa")
+  on.exit(unlink(f), add = TRUE)
+  gravcal:::write_cwa(as.matrix(rec[, c("x", "y", "z")]), f, sf = 25,
+                      start = as.numeric(rec$time[1]), temperature = rec$temperature)
+  cal <- function(threads) {
+    old <- options(gravcal.threads = threads)
+    on.exit(options(old))
+    list(ggir = gravcal::g.calibrate(f, verbose = FALSE),
+         own = coef(gravcal::calibrate(f, method = "ggir", ggir_compat = FALSE)))
+  }
+  one <- cal(1)
+  two <- cal(2)
+  expect_gt(one$ggir$npoints, 100)  # a fit on the recording's rest
+  expect_gt(one$ggir$nhoursused, 24)
+  # (all but bsc_qc, which has the time of the run)
+  for (k in setdiff(names(one$ggir), "bsc_qc")) expect_identical(two$ggir[[k]], one$ggir[[k]], label = k)
+  expect_identical(two$own, one$own)
+})

@@ -37,6 +37,14 @@
 // or so waits behind it, and moving the waiting samples to the front of the
 // buffer costs nothing.
 //
+// With a Worker (async()), the segmenter takes each hour on the worker's
+// thread while the caller writes the next hour behind it (a decoder's
+// samples: the decode beside the windows' sums). The segmenter gets the
+// same samples in the same order, so the windows are the same. The buffer
+// then holds three hours, so that the hour being taken is never moved or
+// written over: compact() waits for it only where it would be, as does
+// any change to the waiting samples at the block's ends.
+//
 // The temperature checks need R's mean and sd of the block's used
 // temperatures; they are kept run-length coded, in order, so that they cost
 // a few bytes per run of equal values (device files repeat one temperature
@@ -57,6 +65,7 @@
 
 #include "gravcal/host/r_arith.hpp"
 #include "gravcal/host/segmenter.hpp"
+#include "gravcal/host/threads.hpp"
 
 namespace gravcal {
 
@@ -112,9 +121,41 @@ class GgirBlocks {
     below_ = compat_ && per_hour < static_cast<double>(H_) && H_ >= 2;
   }
 
+  ~GgirBlocks() { settle(); }
+  GgirBlocks(const GgirBlocks&) = delete;
+  GgirBlocks& operator=(const GgirBlocks&) = delete;
+
+#ifndef GRAVCAL_NO_THREADS
+  // The segmenter's hours on `w`'s thread (null: on the caller's). The
+  // worker must outlive this object and the sinks given to it; the caller
+  // calls settle() before a sink goes when it leaves by an exception
+  // (read_ggir_block() does).
+  void async(Worker* w) {
+    settle();
+    async_ = w;
+  }
+#endif
+  // Waits for the hour the segmenter is taking, if any, and raises its
+  // error (wait()), or forgets it (settle(): leaving by an exception).
+  void wait() {
+#ifndef GRAVCAL_NO_THREADS
+    if (async_ != nullptr && job_from_ != kNoJob) {
+      job_from_ = kNoJob;
+      async_->wait();
+    }
+#endif
+  }
+  void settle() noexcept {
+#ifndef GRAVCAL_NO_THREADS
+    if (async_ != nullptr) async_->settle();
+#endif
+    job_from_ = kNoJob;
+  }
+
   // A new block from the reader: the carry goes in front. Each
   // begin_block() is followed by end_block() before the next.
   void begin_block() {
+    wait();
     info_ = GgirBlockInfo();
     pushed_ = 0;
     started_ = false;
@@ -216,6 +257,7 @@ class GgirBlocks {
   // The block ends: the whole hours go on, the rest is carried.
   template <class Sink>
   GgirBlockInfo end_block(Sink&& sink) {
+    wait();
     const std::int64_t use = (info_.ld / H_) * H_;
     info_.used = use;
     // GGIR's use = floor(LD / (3600 sf)) * (3600 sf) in double: below a
@@ -239,6 +281,7 @@ class GgirBlocks {
     }
     if (use > 0) {
       flush(static_cast<std::size_t>(use - pushed_), sink);
+      wait();
       if (shifted) {
         shift_carry(use_d, use);
       } else if (compat_ && use == info_.ld) {
@@ -288,8 +331,14 @@ class GgirBlocks {
   // each step copies the samples and touches fresh memory.
   void grow(std::size_t k) {
     if (cap_ >= k) return;
-    const std::size_t most = std::max(k, static_cast<std::size_t>(H_) + 1);
-    cap_ = std::min(std::max({k, 2 * cap_, std::size_t(1) << 19}), most);
+    wait();  // (the columns move)
+    const std::size_t hour = static_cast<std::size_t>(H_) + 1;
+    if (async_ != nullptr) {
+      cap_ = std::max(k, 3 * hour);  // at once: three hours (see the top)
+    } else {
+      const std::size_t most = std::max(k, hour);
+      cap_ = std::min(std::max({k, 2 * cap_, std::size_t(1) << 19}), most);
+    }
     for (int c = 0; c < columns(); ++c) hold_[c].resize(cap_);
   }
 
@@ -297,6 +346,9 @@ class GgirBlocks {
   void compact() {
     if (head_ == 0) return;
     const std::size_t k = tail_ - head_;
+    // the waiting samples and the next hour behind them, [0, k + H + 1),
+    // must not reach the hour the segmenter is taking
+    if (job_from_ != kNoJob && job_from_ < k + static_cast<std::size_t>(H_) + 1) wait();
     for (int c = 0; c < columns(); ++c) {
       std::memmove(hold_[c].data(), hold_[c].data() + head_, k * sizeof(double));
     }
@@ -372,8 +424,25 @@ class GgirBlocks {
       seg_.new_block();  // GGIR restarts its sums with each block it reads
       started_ = true;
     }
-    seg_.push(hold_[0].data() + head_, hold_[1].data() + head_, hold_[2].data() + head_,
-              temp_ ? hold_[3].data() + head_ : nullptr, k, sink);
+    const double* x = hold_[0].data() + head_;
+    const double* y = hold_[1].data() + head_;
+    const double* z = hold_[2].data() + head_;
+    const double* t = temp_ ? hold_[3].data() + head_ : nullptr;
+#ifndef GRAVCAL_NO_THREADS
+    if (async_ != nullptr) {
+      Segmenter& seg = seg_;
+      wait();  // (the hour before: the segmenter takes them in order)
+      if (async_->run([&seg, &sink, x, y, z, t, k] { seg.push(x, y, z, t, k, sink); })) {
+        job_from_ = head_;
+      } else {
+        seg_.push(x, y, z, t, k, sink);  // no thread to be had
+      }
+    } else {
+      seg_.push(x, y, z, t, k, sink);
+    }
+#else
+    seg_.push(x, y, z, t, k, sink);
+#endif
     for (int c = 0; c < columns(); ++c) {
       before2_[c] = k >= 2 ? hold_[c][head_ + k - 2] : before_[c];
       before_[c] = hold_[c][head_ + k - 1];
@@ -447,6 +516,13 @@ class GgirBlocks {
   // R's `:` takes floor(to - from + 1 + FLT_EPSILON) values
   static constexpr double kRColonFuzz = 1.1920928955078125e-07;
 
+  static constexpr std::size_t kNoJob = static_cast<std::size_t>(-1);
+#ifndef GRAVCAL_NO_THREADS
+  Worker* async_ = nullptr;
+#else
+  void* async_ = nullptr;
+#endif
+  std::size_t job_from_ = kNoJob;  // where the hour the segmenter is taking starts
   Segmenter& seg_;
   double Hd_;                  // 3600 sf, in double
   std::int64_t H_;             // whole samples an hour, as R's `1:use` takes them

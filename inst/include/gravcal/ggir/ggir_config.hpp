@@ -25,6 +25,8 @@ struct GgirConfig {
                                    // readers' samples: its NaN empties the
                                    // rest of its block); else left out of
                                    // its window (samples in memory)
+  int threads = 1;             // 2: the segmenter's windows on a second
+                               // thread beside the decode (GgirBlocks::async())
   bool r_long_double = true;   // R's accumulator (its LDOUBLE) is long
                                // double; false: double (an R without long
                                // double, capabilities("long.double") FALSE)

@@ -164,7 +164,13 @@ class GgirProcedure {
   void blocks(Source& src, GgirOutcome& o) {
     const double per_hour = 3600.0 * cfg_.sf;
     const bool temp = cfg_.temperature && src.has_temperature();
+#ifndef GRAVCAL_NO_THREADS
+    Worker worker;  // (before the blocks: outlives them)
+#endif
     GgirBlocks blocks(seg_, per_hour, cfg_.compat, temp, cfg_.temp_min_sd, cfg_.r_long_double);
+#ifndef GRAVCAL_NO_THREADS
+    if (cfg_.threads >= 2) blocks.async(&worker);  // the windows beside the decode
+#endif
     BlocksStage stage(blocks, temp);
     const std::int64_t units = static_cast<std::int64_t>(cfg_.block_units);
     for (int i = 1;; ++i) {

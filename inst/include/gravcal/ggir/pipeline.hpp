@@ -337,8 +337,13 @@ GgirBlockRead read_ggir_block(Source& src, GgirBlocks& blocks, BlocksStage& stag
                               std::int64_t units, Sink&& sink, Tick&& tick) {
   GgirBlockRead r;
   blocks.begin_block();
-  r.pump = pump(src, stage, units, sink, tick);
-  r.info = blocks.end_block(sink);
+  try {
+    r.pump = pump(src, stage, units, sink, tick);
+    r.info = blocks.end_block(sink);
+  } catch (...) {
+    blocks.settle();  // the segmenter done with `sink` before it goes
+    throw;
+  }
   return r;
 }
 
