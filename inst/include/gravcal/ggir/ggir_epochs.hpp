@@ -743,8 +743,6 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
       lattice.reserve(nrow / st + 1);
     }
     for (std::int64_t h = 1; h <= N; ++h) {
-      const Window w = window(h);
-      const RColon cc = r_colon(1 + w.clipstart, w.clipend);
       double count = 0;
       bool extreme = false;
       if (on_lattice) {
@@ -765,7 +763,8 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
         count = static_cast<double>(n_over);  // (whole counts: exact)
         extreme = over15;
       } else {
-        at_r_indices(cc, nrow, [&](std::size_t j) {
+        const Window w = window(h);
+        at_r_indices(r_colon(1 + w.clipstart, w.clipend), nrow, [&](std::size_t j) {
           const double av = std::fabs(v[j]);
           if (av > cf.clipthres) {
             count += 1;

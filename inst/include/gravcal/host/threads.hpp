@@ -76,10 +76,6 @@ class Worker {
     cv_.wait(lock, [this] { return !busy_; });
     error_ = nullptr;
   }
-  bool busy() {
-    const std::lock_guard<std::mutex> lock(m_);
-    return busy_;
-  }
 
  private:
   void loop() {
