@@ -65,7 +65,12 @@ folders <- vapply(names(files), function(fmt) {
   d
 }, "")
 
-# One contender in a process of its own: elapsed seconds and peak RSS (MB).
+# One contender in a process of its own: elapsed seconds, peak RSS (MB),
+# user and system CPU seconds and minor page faults (GNU time). The last
+# two say what the machine charges for fresh memory: on a virtual machine
+# whose page faults are dear (stop 61's: about 3 us a 4 KB page, and freed
+# memory handed back to the host), a process that allocates much pays in
+# elapsed time what elsewhere it would not.
 run <- function(code, file, folder) {
   script <- tempfile(fileext = ".R")
   out <- tempfile("part1-out-")
@@ -78,11 +83,12 @@ run <- function(code, file, folder) {
   for (i in 1:2) invisible(readBin(file, "raw", 1))  # in the page cache
   tm <- tempfile()
   t0 <- Sys.time()
-  status <- system2("/usr/bin/time", c("-f", "%M", "-o", tm, "Rscript", script),
+  status <- system2("/usr/bin/time", c("-f", "%M %U %S %R", "-o", tm, "Rscript", script),
                     stdout = FALSE, stderr = FALSE)
   el <- as.numeric(difftime(Sys.time(), t0, units = "secs"))
   if (status != 0) stop("contender failed: ", paste(code, collapse = "; "))
-  c(seconds = el, rss_mb = as.numeric(readLines(tm)[1]) / 1024)
+  g <- as.numeric(strsplit(utils::tail(readLines(tm), 1), " ", fixed = TRUE)[[1]])
+  c(seconds = el, rss_mb = g[1] / 1024, user = g[2], sys = g[3], faults = g[4])
 }
 quiet <- "q <- function(e) { o <- NULL; utils::capture.output(o <- suppressWarnings(e)); o }"
 contenders <- list(
@@ -110,7 +116,8 @@ for (fmt in names(files)) {
     say(fmt, nm)
     r <- run(contenders[[nm]], files[[fmt]], folders[[fmt]])
     rows[[length(rows) + 1]] <- data.frame(format = fmt, contender = nm, seconds = r[["seconds"]],
-                                           rss_mb = r[["rss_mb"]])
+                                           rss_mb = r[["rss_mb"]], user_s = r[["user"]],
+                                           sys_s = r[["sys"]], minor_faults = r[["faults"]])
   }
 }
 res <- do.call(rbind, rows)
@@ -131,9 +138,12 @@ md <- c("# GGIR part 1's epoch signals: GGIR against gravcal (bench/part1.R)", "
         sprintf("%g days at %g Hz (simulate_recording()'s day, nights at rest, repeated), %s, R %s, GGIR %s, GGIRread %s; %s.",
                 days, sf, R.version$platform, getRversion(), utils::packageVersion("GGIR"),
                 utils::packageVersion("GGIRread"), format(Sys.Date())),
-        "Each contender in a cold R process of its own; elapsed seconds and peak resident memory.", "",
-        "| format | contender | seconds | peak MB |", "|---|---|---:|---:|",
-        sprintf("| %s | %s | %.1f | %.0f |", res$format, res$contender, res$seconds, res$rss_mb), "",
+        paste("Each contender in a cold R process of its own; elapsed seconds, peak resident memory,",
+              "user and system CPU seconds, minor page faults (thousands)."), "",
+        "| format | contender | seconds | peak MB | user s | system s | faults (k) |",
+        "|---|---|---:|---:|---:|---:|---:|",
+        sprintf("| %s | %s | %.1f | %.0f | %.1f | %.1f | %.0f |", res$format, res$contender,
+                res$seconds, res$rss_mb, res$user_s, res$sys_s, res$minor_faults / 1000), "",
         paste("| format | g.getmeta: GGIR / gravcal | g.part1: GGIR / gravcal |",
               "g.part1, every metric | M identical (all but bsc_qc) |"),
         "|---|---:|---:|---:|---|",

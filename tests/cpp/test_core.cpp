@@ -8,6 +8,7 @@
 // unit (the test data's generators included), whatever the flags.
 #include "gravcal/mcu/fp_contract.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,7 @@
 #include "gravcal/gravcal.hpp"
 #include "gravcal/host/segmenter.hpp"
 #include "gravcal/ggir/icp.hpp"
+#include "gravcal/host/big_array.hpp"
 
 static int failures = 0;
 #define CHECK(cond)                                                   \
@@ -953,6 +955,77 @@ static void test_cwa_word_sum() {
 // its middle value, to the bit; NaN where the window holds one. Sensor-like
 // data with many ties, signed zeros, infinities, NaN runs, widths 1 to 51;
 // with the kernel table at each level (the median's kernel order_next).
+// big_array() and BigVector (host/big_array.hpp): memory that holds what is
+// written; from kHugeFrom bytes on Linux aligned to 2 MB and advised as
+// huge-page memory (the mapping's VmFlags carry "hg" in /proc/self/smaps
+// wherever the kernel has transparent huge pages, whatever their mode).
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+static bool huge_advised(const void* p) {
+  std::FILE* f = std::fopen("/proc/self/smaps", "r");
+  if (f == nullptr) return false;
+  const auto a = reinterpret_cast<std::uintptr_t>(p);
+  char line[512];
+  bool inside = false, found = false;
+  while (std::fgets(line, sizeof line, f) != nullptr) {
+    unsigned long lo = 0, hi = 0;
+    if (std::sscanf(line, "%lx-%lx ", &lo, &hi) == 2 && std::strchr(line, '-') != nullptr &&
+        std::isxdigit(static_cast<unsigned char>(line[0]))) {
+      inside = a >= lo && a < hi;
+      continue;
+    }
+    if (inside && std::strncmp(line, "VmFlags:", 8) == 0) {
+      found = std::strstr(line, " hg") != nullptr;
+      break;
+    }
+  }
+  std::fclose(f);
+  return found;
+}
+#endif
+
+static void test_big_array() {
+  for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000},
+                        gravcal::kHugeFrom / sizeof(double) + 3}) {
+    gravcal::BigArray a = gravcal::big_array(n);
+    CHECK(a != nullptr);
+    for (std::size_t i = 0; i < n; ++i) a[i] = static_cast<double>(i) * 0.5;
+    bool same = true;
+    for (std::size_t i = 0; i < n; ++i) same = same && a[i] == static_cast<double>(i) * 0.5;
+    CHECK(same);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (n * sizeof(double) >= gravcal::kHugeFrom) {
+      CHECK(reinterpret_cast<std::uintptr_t>(a.get()) % (std::size_t{2} << 20) == 0);
+      std::FILE* thp = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+      if (thp != nullptr) {
+        std::fclose(thp);
+        CHECK(huge_advised(a.get()));
+      }
+    }
+#endif
+  }
+  // a vector of them: the same values as std::vector's through assign,
+  // growth, copy and swap
+  std::vector<double> ref;
+  gravcal::BigVector v;
+  const std::size_t big = gravcal::kHugeFrom / sizeof(double) * 2;
+  ref.assign(big, 0.25);
+  v.assign(big, 0.25);
+  for (std::size_t i = 0; i < big; i += 4097) {
+    ref[i] = static_cast<double>(i);
+    v[i] = static_cast<double>(i);
+  }
+  ref.resize(big + 10, -1.0);
+  v.resize(big + 10, -1.0);
+  gravcal::BigVector w(v);
+  gravcal::BigVector().swap(v);
+  CHECK(v.empty());
+  CHECK(w.size() == ref.size() && std::equal(w.begin(), w.end(), ref.begin()));
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  CHECK(reinterpret_cast<std::uintptr_t>(w.data()) % (std::size_t{2} << 20) == 0);
+#endif
+  std::printf("big_array: ok\n");
+}
+
 static void test_rolling_median_at() {
   std::mt19937 rng(2024);
   std::uniform_int_distribution<int> level(-40, 40);
@@ -1044,6 +1117,7 @@ int main(int argc, char** argv) {
   test_segmenter();
   test_bins();
   test_rolling_median();
+  test_big_array();
   test_gradient<double>(1e-4);
   test_gradient<float>(5e-3);
   std::printf("core: %s\n", failures ? "FAILED" : "all checks passed");

@@ -37,6 +37,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "gravcal/host/big_array.hpp"
 #include "gravcal/decoders/decode.hpp"
 #include "gravcal/kernels/kernels.hpp"
 
@@ -360,7 +361,7 @@ class BlockStore {
       }
     }
     // (not zeroed: the pages a part does not use are never touched)
-    std::vector<std::unique_ptr<double[]>> parts[kCols];
+    std::vector<BigArray> parts[kCols];
     std::vector<std::size_t> used;  // rows in each part
     std::vector<double> t_buf(ask_t ? chunk : 0), light_buf(ask_light ? chunk : 0),
         wear_buf(ask_wear ? chunk : 0), time_buf(ask_time && !col_time ? chunk : 0);
@@ -375,7 +376,7 @@ class BlockStore {
       } else {
         if (used.empty() || part_rows - used.back() < chunk) {
           for (int c = 0; c < kCols; ++c) {
-            if (c <= kZ || (c == kTime && has_[kTime])) parts[c].emplace_back(new double[part_rows]);
+            if (c <= kZ || (c == kTime && has_[kTime])) parts[c].push_back(big_array(part_rows));
           }
           used.push_back(0);
         }
@@ -524,7 +525,7 @@ class BlockStore {
   void grow(std::size_t rows) {
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c] || is_run(c)) continue;
-      std::unique_ptr<double[]> v(new double[std::max<std::size_t>(rows, 1)]);
+      BigArray v = big_array(rows);
       if (n_ > 0) std::copy(cols_[c].get(), cols_[c].get() + n_, v.get());
       cols_[c] = std::move(v);
     }
@@ -534,13 +535,13 @@ class BlockStore {
   // the columns' n_ rows, then the first used[k] rows of each part k, in
   // arrays of exactly that length and `room` rows more; one column at a
   // time, each part freed once copied
-  void assemble(std::vector<std::unique_ptr<double[]>> parts[kCols],
+  void assemble(std::vector<BigArray> parts[kCols],
                 const std::vector<std::size_t>& used, std::size_t room) {
     std::size_t total = n_;
     for (std::size_t k = 0; k < used.size(); ++k) total += used[k];
     for (int c = 0; c < kCols; ++c) {
       if (!has_[c] || is_run(c)) continue;
-      std::unique_ptr<double[]> v(new double[total + room]);
+      BigArray v = big_array(total + room);
       if (n_ > 0) std::copy(cols_[c].get(), cols_[c].get() + n_, v.get());
       cols_[c].reset();
       std::size_t at = n_;
@@ -568,7 +569,7 @@ class BlockStore {
   }
 
   bool has_[kCols] = {};
-  std::unique_ptr<double[]> cols_[kCols];  // x, y, z, time (temperature, light, wear: runs_)
+  BigArray cols_[kCols];  // x, y, z, time (temperature, light, wear: runs_)
   RunColumn runs_[3];                      // temperature, light, wear
   std::size_t n_ = 0, cap_ = 0;
   double first_time_ = nan();

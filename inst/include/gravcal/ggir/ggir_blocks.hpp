@@ -63,6 +63,7 @@
 #include <limits>
 #include <vector>
 
+#include "gravcal/host/big_array.hpp"
 #include "gravcal/host/r_arith.hpp"
 #include "gravcal/host/segmenter.hpp"
 #include "gravcal/host/threads.hpp"
@@ -541,7 +542,7 @@ class GgirBlocks {
   double before2_[4] = {0.0, 0.0, 0.0, 0.0};  // and of the one before it
   bool below_ = false;         // compatible mode, 3600 sf just below H_
   bool carry_in_hold_ = true;  // the carry is the waiting samples (else carry_)
-  std::vector<double> hold_[4];   // x, y, z, temperature
+  BigVector hold_[4];        // x, y, z, temperature
   std::vector<double> carry_[4];  // compatible mode: the carry in front of
                                   // the block, kept for the next block
   std::vector<double> first_;     // the block's first 10 temperatures

@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "gravcal/host/threads.hpp"
+#include "gravcal/host/big_array.hpp"
 #ifndef GRAVCAL_NO_THREADS
 #include <future>
 #include <thread>
@@ -466,7 +467,7 @@ inline void rolling_median(const std::vector<double>& v, std::size_t k, std::vec
 // (when LN exceeds the block), the raw axis itself. Held at the
 // subsample's rate: a tenth of the block, or none.
 struct RollMed {
-  std::vector<double> xm;
+  BigVector xm;
   const double* raw = nullptr;  // the fallback: the raw axis
   std::size_t step = 1, LN = 0;
   double tail = kNaN;
@@ -513,7 +514,7 @@ inline void rollmed_part(RollMed& r, const RollMedWork& w, std::size_t from, std
 
 inline void rollmed_end(RollMed& r, RollMedWork& w, const double* x, std::size_t LX, double sf) {
   const std::size_t step = w.step;
-  std::vector<double>& xm = r.xm;
+  BigVector& xm = r.xm;
   const std::size_t LN0 = xm.size();
   // the head: zeros among the first S2check values take the first value
   // there that is not zero (NA when there is none)
@@ -557,7 +558,7 @@ inline void rollmed_end(RollMed& r, RollMedWork& w, const double* x, std::size_t
   }
   const std::size_t LN = LN0 * step;
   if (LN > LX) {
-    std::vector<double>().swap(xm);
+    BigVector().swap(xm);
     r.raw = x;  // GGIR's fallback: the raw axis
     return;
   }
