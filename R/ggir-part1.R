@@ -82,7 +82,8 @@
 #' "character" (GGIR stops without it).
 #' Anything else GGIR's g.getmeta() would compute (another format) is an
 #' error naming it, never a result without it. Not reproduced: `bsc_qc` (GGIR's
-#' wall-clock times and memory); GGIR shrinks its blocks when its own R
+#' wall-clock times and memory: gravcal's gives the time and the process's
+#' resident memory in MB, without GGIR's full garbage collection); GGIR shrinks its blocks when its own R
 #' session holds over 4000 MB, which gravcal's reading never makes it do.
 #'
 #' @param datafile Path of the recording.
@@ -412,7 +413,8 @@ meta_result <- function(short, long, asked, metnames, metricnames_long, starttim
                         wdayname, filetooshort, filecorrupt, p, ws3, ws2, QClog,
                         myfun = NULL) {
   via_text <- text_round_trip
-  bsc_qc <- data.frame(time = format(Sys.time()), size = gc()[2, 2], stringsAsFactors = FALSE)
+  bsc_qc <- data.frame(time = format(Sys.time()), size = memory_in_use_mb(),
+                       stringsAsFactors = FALSE)
   if (filecorrupt || filetooshort) {
     return(invisible(list(filecorrupt = filecorrupt, filetooshort = TRUE,
                           NFilePagesSkipped = 0, metalong = c(), metashort = c(),

@@ -770,6 +770,20 @@ struct DecodedGa {
   std::vector<std::string> notes;
 };
 
+// A buffer over the five columns (x, y, z, temperature, time), as long as x.
+static gravcal::SampleBuffer ga_buffer(std::vector<double>& x, std::vector<double>& y,
+                                       std::vector<double>& z, std::vector<double>& t,
+                                       std::vector<double>& tm) {
+  gravcal::SampleBuffer out;
+  out.x = x.data();
+  out.y = y.data();
+  out.z = z.data();
+  out.t = t.data();
+  out.time = tm.data();
+  out.capacity = x.size();
+  return out;
+}
+
 static DecodedGa decode_geneactiv(const std::string& file, bool compat) {
   gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(file.data()), file.size());
   gravcal::Options opts;
@@ -780,13 +794,7 @@ static DecodedGa decode_geneactiv(const std::string& file, bool compat) {
   const std::size_t cap = 1000;
   std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap);
   while (!dec.done()) {
-    gravcal::SampleBuffer out;
-    out.x = x.data();
-    out.y = y.data();
-    out.z = z.data();
-    out.t = t.data();
-    out.time = tm.data();
-    out.capacity = cap;
+    gravcal::SampleBuffer out = ga_buffer(x, y, z, t, tm);
     const std::int64_t u = dec.read(out, 3);
     for (std::size_t i = 0; i < out.n; ++i) {
       d.v.insert(d.v.end(), {x[i], y[i], z[i], t[i], tm[i]});
@@ -827,6 +835,57 @@ static void test_avx2_geneactiv() {
   gravcal::set_avx2(true);
   CHECK(differ == 0);
   CHECK(skipped_pages > 1000);  // the damaged pages were met, and skipped
+}
+
+// SampleBuffer::time_ends_only (g.getmeta()'s block store): the GENEActiv
+// decoder times a buffer's first row and its last two only, and those as
+// it times every row without the flag; every other column the same. Random
+// pages (damaged, short, long ones among them), both modes, buffers of 1
+// to 1000 rows, reads of 3 pages or of as many as fit.
+static std::vector<double> ga_read_ends(const std::string& file, bool compat, std::size_t cap,
+                                        std::int64_t units, bool ends) {
+  gravcal::MemorySource src(reinterpret_cast<const unsigned char*>(file.data()), file.size());
+  gravcal::Options opts;
+  opts.set("compat", compat ? 1.0 : 0.0);
+  gravcal::GeneactivDecoder dec(src, opts);
+  std::vector<double> got;
+  if (!dec.open()) return got;
+  std::vector<double> x(cap), y(cap), z(cap), t(cap), tm(cap, -1.0);
+  while (!dec.done()) {
+    gravcal::SampleBuffer out = ga_buffer(x, y, z, t, tm);
+    out.time_ends_only = ends;
+    const std::int64_t u = dec.read(out, units);
+    for (std::size_t i = 0; i < out.n; ++i) got.insert(got.end(), {x[i], y[i], z[i], t[i]});
+    if (out.n > 0) got.insert(got.end(), {tm[0], out.n >= 2 ? tm[out.n - 2] : 0.0, tm[out.n - 1]});
+    got.push_back(static_cast<double>(out.n));
+    if (out.n == 0 && u == 0) break;
+  }
+  return got;
+}
+
+static void test_geneactiv_time_ends() {
+  std::mt19937 rng(61);
+  int differ = 0, cases = 0;
+  for (int rep = 0; rep < 20; ++rep) {
+    const std::string f = random_geneactiv(rng, 12);
+    for (int compat = 0; compat < 2; ++compat) {
+      for (std::size_t cap : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{301},
+                              std::size_t{1000}}) {
+        for (std::int64_t units : {std::int64_t{3}, std::int64_t{-1}}) {
+          const std::vector<double> a = ga_read_ends(f, compat != 0, cap, units, false);
+          const std::vector<double> b = ga_read_ends(f, compat != 0, cap, units, true);
+          ++cases;
+          if (a.size() != b.size() || a.empty() ||
+              std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) != 0) {
+            ++differ;
+          }
+        }
+      }
+    }
+  }
+  CHECK(cases == 400);
+  CHECK(differ == 0);
+  std::printf("GENEActiv time_ends_only: %d cases, the same ends\n", cases);
 }
 
 // A digest of the windows of a fixed stream and of ICP fits, printed so that
@@ -1110,6 +1169,7 @@ int main(int argc, char** argv) {
   test_hex16();
   test_cwa_word_sum();
   test_avx2_geneactiv();
+  test_geneactiv_time_ends();
   test_add_repeated();
   test_lazy_sd();
   test_lazy_sd_edges();

@@ -275,6 +275,12 @@ struct SampleBuffer {
   double* wear = nullptr;
   std::size_t capacity = 0;
   std::size_t n = 0;
+  // The caller reads the times of the buffer's first row and of its last
+  // two (the rows it holds when the read returns), no others: a decoder may
+  // leave the other rows' times unwritten (GENEActiv's, whose per-sample
+  // times cost a tenth of its decoding; g.getmeta()'s block store reads a
+  // block's first and last times only).
+  bool time_ends_only = false;
   bool full() const { return n >= capacity; }
   std::size_t room() const { return capacity - n; }
   // A buffer over consecutive columns of `cap` values at `base`: x, y, z,

@@ -800,7 +800,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   }
   if (out.light != nullptr) emit_light(p, emitted_, k, out.light + n);
   if (out.time != nullptr) {
-    for (std::size_t j = 0; j < k; ++j) {
+    auto time_of = [&](std::size_t j) {
       const double i = static_cast<double>(emitted_ + j);
       if (rules_.compat) {
         // Unix ms as the reference: truncated to an integer, then / 1000
@@ -809,6 +809,15 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
       } else {
         out.time[n + j] = p.time_s + i / p.freq;
       }
+    };
+    if (!out.time_ends_only) {
+      for (std::size_t j = 0; j < k; ++j) time_of(j);
+    } else {
+      // the buffer's first row, and this call's last two (the buffer's
+      // last two when it is the read's last call, or its last and the
+      // call before's last)
+      if (n == 0 && k > 0) time_of(0);
+      for (std::size_t j = k >= 2 ? k - 2 : 0; j < k; ++j) time_of(j);
     }
   }
   out.n += k;
@@ -862,7 +871,15 @@ inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
     start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
              block_rate_;
   }
-  for (std::size_t i = n0; i < out.n; ++i) out.time[i] = out.time[i] + start;
+  if (!out.time_ends_only) {
+    for (std::size_t i = n0; i < out.n; ++i) out.time[i] = out.time[i] + start;
+    return;
+  }
+  // the rows emit() timed: the first, the last two (each once)
+  const std::size_t last = out.n - 1;
+  const std::size_t from = std::max(n0, out.n >= 2 ? out.n - 2 : 0);
+  if (n0 == 0 && from > 0) out.time[0] = out.time[0] + start;
+  for (std::size_t i = from; i <= last; ++i) out.time[i] = out.time[i] + start;
 }
 
 inline void GeneactivDecoder::finish_input() {

@@ -391,6 +391,7 @@ class BlockStore {
       if (ask_light) out.light = light_buf.data();
       if (ask_wear) out.wear = wear_buf.data();
       if (ask_time) out.time = col_time ? dst[kTime] : time_buf.data();
+      out.time_ends_only = ask_time && !col_time;  // (only note_tail()'s and the first read)
       out.capacity = chunk;
       const std::int64_t u = d.read(out, left);
       const std::size_t got = out.n;
