@@ -24,6 +24,17 @@ GGIR_CACHE := $(abspath tests/ggir-cache)
 VERSION := $(shell sed -n 's/^Version: *//p' DESCRIPTION)
 TARBALL := gravcal_$(VERSION).tar.gz
 
+# The tests' R processes ask glibc's malloc (>= 2.35; older ones ignore it)
+# to advise transparent huge pages for the memory it maps. R gives a large
+# vector's memory back to the kernel when it frees it, so the next one is
+# fresh memory, and on a virtual machine that returns freed memory to its
+# host the first write costs about 3 us for each 4 KB page: with 2 MB pages
+# the suite ran 1.5 times faster on such a machine (bench/speed-notes.md,
+# "Fresh memory"). It changes where memory comes from, never a result. Set
+# for make test's steps and the test targets only: bench/'s contenders run
+# as users run them.
+TEST_TUNABLES := glibc.malloc.hugetlb=1
+
 # R CMD check on a machine without general network access: skip the parts
 # that must reach servers other than CRAN (current-time lookup) and CRAN's
 # incoming checks that need its database. NOT_CRAN=true: testthat runs
@@ -31,7 +42,9 @@ TARBALL := gravcal_$(VERSION).tar.gz
 # and printed fit are part of the suite.
 CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE \
              _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
-             GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true
+             GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+             GLIBC_TUNABLES=$(TEST_TUNABLES)
+
 
 # (test-slurm: a single-node Slurm, see below)
 .PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-ggir-own test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
@@ -60,30 +73,48 @@ demo: install
 	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/demo.R
 
 # make test: the tarball, then two lanes side by side, one a core:
-# - lane A, in the background: the sanitizer run (the whole suite under ASan
-#   and UBSan), installed from the tarball (so built in a directory of its
-#   own, not in src/, where lane B builds), then the fuzzers (tests/fuzz);
-#   its output: $(BUILD)/lane-a.log;
-# - lane B: R CMD check, then the other steps one after another.
+# - lane A, in the background: the sanitizer run (SANITIZE_TESTS under ASan
+#   and UBSan, quick tier), installed from the tarball (so built in a
+#   directory of its own, not in src/, where lane B builds), then the
+#   fuzzers (tests/fuzz), the Windows and libc++ builds (cross-check) and the
+#   aggressive flags' builds (flags-check, also from the tarball); its
+#   output: $(BUILD)/lane-a.log;
+# - lane B: R CMD check (the whole suite), then the other steps one after
+#   another.
 # It fails when either lane does. Each step's wall time is printed and kept
 # in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the identity tests
 # comes from tests/ggir-cache where the same input, parameters, GGIR version
 # and platform were run before (tests/testthat/helper-ggir-cache.R; the
-# check recomputes a sixteenth of the entries and compares them).
-TEST_LANE_A := fuzz-short
-TEST_LANE_B := core cross-check flags-check valgrind test-slurm site
+# check recomputes a sixteenth of the entries and compares them). Every
+# step's R runs with TEST_TUNABLES.
+#
+# SANITIZE_TESTS: the test files whose tests drive the C++ core and its glue
+# on device files, damaged files and bad input (the decoders, the
+# segmenter, the fits, the windows, the epoch signals, GGIR part 1's store
+# and meta files, interrupts), run at the quick tier. Left to make sanitize
+# (the whole suite under the sanitizers, about 75 minutes on 2 cores where
+# fresh memory is dear: a check before resolving an issue): the identity
+# tests against GGIR on long recordings and many parameters, whose compiled
+# paths these files already take, and the R-side tests (cohorts, formats of
+# coefficients, plots, plausibility).
+SANITIZE_TESTS := apply|bad-input|bad-input-cases|budget|calibrate|damaged|decode-csv|decode-cwa|decode-geneactiv|decode-gt3x|decode-movisens|decode-parmay|epochs|fit-ellipsoid|fit-gradient|fit-icp|ggir-part1|ggir-segments|headers|interrupt|meta-store|near-rest|points|pool|read|rest-quality|segments|selection|simd|uncertainty|windows|write-recording
+TEST_LANE_A := fuzz-short cross-check
+TEST_LANE_B := core valgrind test-slurm site
 test: setup-test
 	@rm -f $(BUILD)/times.txt; start=$$(date +%s); \
+	  export GLIBC_TUNABLES="$${GLIBC_TUNABLES:+$$GLIBC_TUNABLES:}$(TEST_TUNABLES)"; \
 	  bash tools/timed.sh tarball $(MAKE) tarball || exit 1; \
-	  ( bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) || exit 1; \
-	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ) \
+	  ( bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) \
+	      SANITIZE_FILTER='^($(SANITIZE_TESTS))$$' SANITIZE_TIER=quick || exit 1; \
+	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done; \
+	    bash tools/timed.sh flags-check $(MAKE) flags-check FLAGS_SRC=$(BUILD)/$(TARBALL) || exit 1 ) \
 	    > $(BUILD)/lane-a.log 2>&1 & lane_a=$$!; \
-	  echo "test: lane A (sanitize, then $(TEST_LANE_A)) runs in the background (log: $(BUILD)/lane-a.log)"; \
+	  echo "test: lane A (sanitize, then $(TEST_LANE_A) flags-check) runs in the background (log: $(BUILD)/lane-a.log)"; \
 	  ( bash tools/timed.sh check $(MAKE) check-run || exit 1; \
 	    for t in $(TEST_LANE_B); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ); b=$$?; \
 	  wait $$lane_a; a=$$?; \
 	  if [ $$a -ne 0 ]; then tail -80 $(BUILD)/lane-a.log; echo "test: lane A failed"; \
-	  else grep -E "ASan/UBSan clean|expectations|^fuzz_" $(BUILD)/lane-a.log; fi; \
+	  else grep -E "ASan/UBSan clean|expectations|^fuzz_|agree|passed under wine" $(BUILD)/lane-a.log; fi; \
 	  echo "test: steps' wall times:"; cat $(BUILD)/times.txt; \
 	  echo "test: $$(( $$(date +%s) - start )) s in all"; \
 	  test $$a -eq 0 && test $$b -eq 0
@@ -93,7 +124,7 @@ test: setup-test
 # a few minutes
 quick: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
 	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/run-tests.R
 
 # every cached GGIR result recomputed and compared with the cache (and the
@@ -102,7 +133,7 @@ quick: install setup-test
 # Not part of make test; run it before resolving and after a GGIR upgrade.
 test-ggir-cache: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
 	  GRAVCAL_GGIR_CACHE_MODE=verify $(RSCRIPT) ../../tools/run-tests.R
 
 # the time (wall and CPU) of each test file and of the slowest tests, into
@@ -111,13 +142,13 @@ test-ggir-cache: install setup-test
 PROFILE_OUT ?= bench/results/test-profile.md
 profile-tests: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
 	  $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_OUT))
 
 PROFILE_QUICK_OUT ?= bench/results/test-profile-quick.md
 profile-quick: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
 	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_QUICK_OUT))
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
@@ -160,20 +191,23 @@ cross-check: setup-test
 # sees it and the GGIR-compatible entries refuse. About 5 minutes.
 FLAGS_NATIVE := -O3 -march=native -ffp-contract=fast
 FLAGS_CLANG := -O1 -march=native -ffp-contract=fast
+# FLAGS_SRC: what is installed (default: this tree, built in src/; make test
+# gives it the tarball, built in a directory of its own)
+FLAGS_SRC ?= .
 flags-check: setup-test
 	mkdir -p $(BUILD)/lib-native $(BUILD)/lib-clang-fast
 	printf 'CXX17FLAGS = $(FLAGS_NATIVE)\nCXXFLAGS = $(FLAGS_NATIVE)\n' > $(BUILD)/native.mk
 	printf 'CXX17 = clang++\nCXX17FLAGS = $(FLAGS_CLANG)\nCXXFLAGS = $(FLAGS_CLANG)\n' > $(BUILD)/clang-fast.mk
 	GRAVCAL_KEEP_SYMBOLS=1 R_MAKEVARS_USER=$(abspath $(BUILD)/native.mk) $(R) CMD INSTALL --preclean --no-multiarch \
-	  -l $(BUILD)/lib-native . > $(BUILD)/native-install.log 2>&1 || (tail -40 $(BUILD)/native-install.log; exit 1)
+	  -l $(BUILD)/lib-native $(FLAGS_SRC) > $(BUILD)/native-install.log 2>&1 || (tail -40 $(BUILD)/native-install.log; exit 1)
 	sh tools/fma-count.sh $(BUILD)/lib-native/gravcal/libs/gravcal.so
 	R_LIBS="$(abspath $(BUILD)/lib-native)$${R_LIBS:+:$$R_LIBS}" GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) \
 	  $(RSCRIPT) tools/flags-check.R bits
 	$(MAKE) -C tests/cpp digest-flags DIGEST_FLAGS="$(FLAGS_NATIVE)"
 	R_MAKEVARS_USER=$(abspath $(BUILD)/clang-fast.mk) $(R) CMD INSTALL --preclean --no-multiarch \
-	  -l $(BUILD)/lib-clang-fast . > $(BUILD)/clang-install.log 2>&1 || (tail -40 $(BUILD)/clang-install.log; exit 1)
+	  -l $(BUILD)/lib-clang-fast $(FLAGS_SRC) > $(BUILD)/clang-install.log 2>&1 || (tail -40 $(BUILD)/clang-install.log; exit 1)
 	R_LIBS="$(abspath $(BUILD)/lib-clang-fast)$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/flags-check.R refuse
-	rm -f src/*.o src/*.so
+	if [ "$(FLAGS_SRC)" = "." ]; then rm -f src/*.o src/*.so; fi
 
 # the whole test suite against the package built with AddressSanitizer and
 # UndefinedBehaviorSanitizer (as CRAN's gcc-ASAN check); R itself is not
@@ -182,6 +216,12 @@ flags-check: setup-test
 # test gives it the checked tarball, built in a directory of its own).
 ASAN_RT = $(shell gcc -print-file-name=libasan.so) $(shell gcc -print-file-name=libubsan.so)
 SANITIZE_SRC ?= .
+# SANITIZE_FILTER, SANITIZE_TIER: which test files (a regular expression on
+# their names, as GRAVCAL_TEST_FILTER) and which tier (as GRAVCAL_TEST_TIER);
+# empty, as for make sanitize: the whole suite, full tier. make test passes
+# SANITIZE_TESTS at the quick tier (see there).
+SANITIZE_FILTER ?=
+SANITIZE_TIER ?=
 sanitize: setup-test
 	$(MAKE) sanitize-run
 sanitize-run:
@@ -192,6 +232,7 @@ sanitize-run:
 	cd tests/testthat && LD_PRELOAD="$(ASAN_RT)" \
 	  ASAN_OPTIONS=detect_leaks=0:detect_stack_use_after_return=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1 R_LIBS="$(abspath $(BUILD)/asan)" GRAVCAL_GGIR_CACHE_MODE=trust \
+	  GRAVCAL_TEST_FILTER='$(SANITIZE_FILTER)' GRAVCAL_TEST_TIER='$(SANITIZE_TIER)' \
 	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true $(RSCRIPT) ../../tools/run-tests.R \
 	  > ../../$(BUILD)/sanitize.log 2>&1 || (tail -60 ../../$(BUILD)/sanitize.log; exit 1)
 	@if grep -qE "ERROR: AddressSanitizer|runtime error:" $(BUILD)/sanitize.log; then \
