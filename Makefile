@@ -3,9 +3,13 @@
 #               compiler, zlib, Rcpp, RcppEigen), install, calibrate the
 #               bundled example recording
 #   make test   set up the test tools too (tools/setup-test.sh), R CMD
-#               build + R CMD check --as-cran (all tests), then the standalone C++ core tests, the Windows
-#               (mingw-w64, run under wine) and clang/libc++ builds (cross-check) and the build with a
+#               build + R CMD check --as-cran (all tests), the C++-driving
+#               test files under ASan and UBSan, the fuzzers, the standalone
+#               C++ core tests, the Windows (mingw-w64, run under wine) and
+#               clang/libc++ builds (cross-check) and the build with a
 #               user's aggressive compiler flags (flags-check)
+#   make sanitize  (not part of make test) the whole suite under ASan and
+#               UBSan, run before resolving
 #   make site   the pkgdown documentation site (_build/site), checked in
 #               headless Chromium
 #   make test-noLD  (not part of make test) the tests that compare with
