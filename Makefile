@@ -33,8 +33,10 @@ TARBALL := gravcal_$(VERSION).tar.gz
 # vector's memory back to the kernel when it frees it, so the next one is
 # fresh memory, and on a virtual machine that returns freed memory to its
 # host the first write costs about 3 us for each 4 KB page: with 2 MB pages
-# the suite ran 1.5 times faster on such a machine (bench/speed-notes.md,
-# "Fresh memory"). It changes where memory comes from, never a result. Set
+# test-ggir.R and test-ggir-part1.R ran 1.55 times faster alone on such a
+# machine, the check's whole suite beside the other lane 1.06 times
+# (bench/speed-notes.md, "Fresh memory"). It changes where memory comes
+# from, never a result. Set
 # for make test's steps and the test targets only: bench/'s contenders run
 # as users run them.
 TEST_TUNABLES := glibc.malloc.hugetlb=1
