@@ -164,9 +164,13 @@ file_last_line <- function(file) {
 # (lubridate::force_tz(); fread's date-times only when a zone is given): a
 # fixed offset moves every stamp of the recording by the same whole
 # seconds, which leaves the resampling, and so GGIR's result, to the bit as
-# it is (times of 2004 to 2038 share one floating-point exponent), but an
-# offset that changes during the recording moves some stamps and not
-# others: refused. Other text is read by as.POSIXct() in the zone, as the
+# it is (times of 2004 to 2038 share one floating-point exponent). Across
+# a change of offset during the recording the decoder forces each stamp as
+# force_tz() does (the offset at its clock time; a clock time that exists
+# twice takes the later offset), so that GGIR's resampling interpolates
+# across the hour the stamps jump as GGIR's does; a recording through the
+# hour the clocks skip (NA stamps in GGIR, NaN samples after them) is
+# refused. Other text is read by as.POSIXct() in the zone, as the
 # csv decoder reads it (its offset, or R/zone.R's table of them where it
 # changes; a block of GGIR's reading that starts at a time that exists
 # twice or not at all there is refused after the read,
@@ -191,21 +195,64 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     off <- civil_offset(floor(time$first), zone)
     return(if (is.na(off)) list() else list(time_utc_offset = off))
   }
-  # a zone whose offset changes: the recording's span (from its first and
-  # last stamps, a day either side) must see one offset
+  # a zone whose offset changes: across a change in the recording's span
+  # the stamps follow force_tz()'s table of the zone (zone_force_options()),
+  # moved by the offset at each stamp's clock time
+  o <- axivity_csv_force_table(file, time, zone)
+  if (isTRUE(o$no_offset)) {
+    abort(zone_name, ": R gives no UTC offset in that zone for some of the times of the ",
+          "Axivity csv export \"", basename(file), "\".")
+  }
+  if (is.null(o)) {
+    # (one offset over the span: as for a zone of one offset above)
+    if (time$kind == "unix") return(list())
+    return(list(time_utc_offset = civil_offset(floor(time$first), zone)))
+  }
+  if (isTRUE(o$skips)) {
+    abort(zone_name, ": the Axivity csv export \"", basename(file), "\" runs through an hour ",
+          "that zone's clocks skip (daylight saving). GGIR forces its ",
+          if (time$kind == "unix") "UNIX" else "ISO 8601", " time stamps into the zone, which ",
+          "makes those of that hour NA, and GGIRread's resampling then gives NaN for every ",
+          "sample from there to the end of GGIR's block; gravcal does not reproduce that. Give ",
+          "a zone without a change there (\"UTC\", or a fixed offset such as \"Etc/GMT-1\").")
+  }
+  o$skips <- NULL
+  c(list(time_utc_offset = 0), o)
+}
+
+# Whether GGIR's reader forces the export's stamps across a change of UTC
+# offset in `zone` (UNIX seconds or fread's date-times, a change within
+# the recording's span, from its first and last stamps a day either side):
+# force_tz()'s table of the zone then (zone_force_options(), with `skips`
+# TRUE where the span meets clock times the zone skips; `no_offset` TRUE
+# where R gives no offset), else NULL.
+axivity_csv_force_table <- function(file, time, zone) {
+  if (time$kind == "text" || is.null(zone_table(zone))) return(NULL)
   last <- file_last_line(file)
   t1 <- axivity_stamp_seconds(trimws(strsplit(last, ",", fixed = TRUE)[[1]][1]), time)
   span <- range(c(time$first, t1), na.rm = TRUE)
   at <- floor(seq(span[1] - 86400, span[2] + 86400, by = 1800))
   off <- civil_offset(at, zone)
-  if (anyNA(off) || any(off != off[1])) {
-    abort(zone_name, ": the Axivity csv export \"", basename(file), "\" spans a change of UTC ",
-          "offset in that zone (daylight saving), into which GGIR forces its ",
-          if (time$kind == "unix") "UNIX" else "ISO 8601", " time stamps, moving those after ",
-          "it; gravcal does not reproduce that. Give a zone without a change there (\"UTC\", ",
-          "or a fixed offset such as \"Etc/GMT-1\").")
-  }
-  if (time$kind == "unix") list() else list(time_utc_offset = off[1])
+  if (anyNA(off)) return(list(no_offset = TRUE))
+  if (all(off == off[1])) return(NULL)
+  o <- zone_force_options(zone, span[1], span[2])
+  if (is.null(o)) return(NULL)
+  o$skips <- any(vapply(seq_len(o$tz_na_n), function(j) {
+    o[[paste0("tz_na_lo_", j - 1L)]] <= span[2] && o[[paste0("tz_na_hi_", j - 1L)]] > span[1]
+  }, TRUE))
+  o
+}
+
+# Whether GGIR's reader takes the export's clock per sample after reading
+# (UNIX seconds forced into the zone by one offset, which the decoder leaves
+# to g.getmeta(): "sample"), or not (NULL: text and fread's date-times the
+# decoder reads in the zone, and stamps across a change of offset, which the
+# decoder forces itself).
+axivity_csv_clock <- function(file, zone) {
+  time <- axivity_csv_time(file, as.numeric(axivity_csv_header(file)))
+  if (!identical(time$kind, "unix")) return(NULL)
+  o <- tryCatch(axivity_csv_force_table(file, time, zone %||% ""), error = function(e) NULL)
+  if (is.null(o) || isTRUE(o$no_offset)) "sample"
 }
 
 # A stamp of the kind `time` in seconds (UTC), for the recording's span.

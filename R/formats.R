@@ -17,7 +17,8 @@
 #   in configtz (else desiredtz) and the native decoder gives them as UTC
 #   (g.getmeta() moves them: meta_zone_shift()): "block" (GGIRread converts
 #   a block's first time) or "sample" (lubridate::force_tz() on each); or
-#   a function of the file giving one of them or NULL (format_local_clock());
+#   a function of the file and the zone giving one of them or NULL
+#   (format_local_clock());
 # * ggir_getmeta: TRUE where g.getmeta() (GGIR part 1) reads the format;
 # * ggir_monitor: GGIR's monitor (its MONITOR code's name, lower case), for
 #   the rules GGIR keys on it (g.getmeta(): ActiGraph serial numbers'
@@ -146,11 +147,10 @@ recording_formats <- list(
     ggir_getmeta = TRUE,
     ggir_monitor = "axivity", ggir_timegaps = TRUE,
     # GGIR forces UNIX stamps into the zone after reading them (a clock per
-    # sample); text and ISO 8601 stamps the decoder reads in the zone itself
-    # (axivity_csv_zone())
-    local_clock = function(file) {
-      if (identical(axivity_csv_time(file, as.numeric(axivity_csv_header(file)))$kind, "unix")) "sample"
-    },
+    # sample); text and ISO 8601 stamps the decoder reads in the zone itself,
+    # and stamps across a change of the zone's offset it forces itself
+    # (axivity_csv_zone(), axivity_csv_clock())
+    local_clock = function(file, zone) axivity_csv_clock(file, zone),
     ggir_codes = "4 2", ggir_decimal = TRUE, ggir_zone_ambiguous = TRUE,
     ggir_read_opts = "interpolation", resample_fused = TRUE, fread_rule = TRUE,
     # the time stamps' layout and GGIR's rate (R/axivity-csv.R); in GGIR's
@@ -443,12 +443,13 @@ format_entry <- function(format) {
   if (format %in% names(recording_formats)) recording_formats[[format]]
 }
 
-# The format's local_clock (see the top of this file) for `file`: where
-# GGIR's reader takes the file's clock times as times in the zone and the
-# decoder gives them as UTC ("block", "sample"), or NULL.
-format_local_clock <- function(format, file) {
+# The format's local_clock (see the top of this file) for `file` read in
+# `zone` (configtz, else desiredtz): where GGIR's reader takes the file's
+# clock times as times in the zone and the decoder gives them as UTC
+# ("block", "sample"), or NULL.
+format_local_clock <- function(format, file, zone) {
   lc <- format_entry(format)$local_clock
-  if (is.function(lc)) lc(file) else lc
+  if (is.function(lc)) lc(file, zone) else lc
 }
 
 # Every extension, once, in the registry's order.

@@ -77,7 +77,7 @@
 #' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Movisens (its temperature); Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa` (the zone of its block times) | honoured, across changes of UTC offset (daylight saving) too, by the zone rules of the R it runs in; an error naming it only where a block of GGIR's reading starts or ends at a calendar time that exists twice or not at all in that zone, and with `reader = "reference"` where the offset changes |
-#' | `desiredtz`, `configtz` | Axivity csv (the zone GGIR reads or forces its time stamps in) | honoured: text that is not ISO 8601 as `as.POSIXct()` reads it in the zone, across changes of offset too; UNIX and ISO 8601 stamps, which GGIR forces into the zone, an error naming it where the recording spans a change of UTC offset there |
+#' | `desiredtz`, `configtz` | Axivity csv (the zone GGIR reads or forces its time stamps in) | honoured: text that is not ISO 8601 as `as.POSIXct()` reads it in the zone, across changes of offset too; UNIX and ISO 8601 stamps forced into the zone as GGIR forces them (`lubridate::force_tz()`), across a change of offset too; an error naming it where the recording runs through the hour the clocks skip (GGIR's samples NaN from there to its block's end) |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
 #' | other `rmc.*` | ad hoc csv | see "Ad hoc csv files" |
 #'

@@ -32,8 +32,11 @@
 #' does on R 4.3 or later, which reads the gap's time of day in the session's
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
 #' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
-#' GGIR resamples it; a `desiredtz` whose UTC offset changes during the
-#' recording refused, as for gravcal's g.calibrate()), Parmay Matrix
+#' GGIR resamples it; across a change of `desiredtz`'s UTC offset UNIX and
+#' ISO 8601 stamps forced into the zone as GGIR forces them, the hour they
+#' jump in autumn filled as GGIR's resampling fills it, and a recording
+#' through the hour the clocks skip in spring refused, where GGIR's samples
+#' are NaN to the block's end), Parmay Matrix
 #' `.bin`/`.BIN` (the whole file one block, as GGIRread's reader gives it,
 #' a packet with a bad checksum kept as it keeps it; the dynamic range from
 #' the file's header, whatever `dynrange` says; `configtz` changes nothing,

@@ -32,7 +32,7 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
   if (is.numeric(start) && length(start) == 1 && is.finite(start)) {
     ro$local_zone <- meta_local_zone(start)
   }
-  per_sample <- identical(format_local_clock(src$format, datafile), "sample")
+  per_sample <- identical(format_local_clock(src$format, datafile, zone), "sample")
   tab <- if (per_sample && !isFALSE(fe$ggir_time) &&
              is.numeric(start) && length(start) == 1 && is.finite(start)) {
     meta_clock_table(zone, start)
@@ -231,7 +231,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   metricnames_long <- NULL
   short_rows <- src$short_rows %||% 0
   zone <- if (length(p$configtz)) p$configtz else p$desiredtz
-  clock <- format_local_clock(src$format, src$path)
+  clock <- format_local_clock(src$format, src$path, zone)
   threads <- gravcal_threads()
   i <- 1
   LD <- 2

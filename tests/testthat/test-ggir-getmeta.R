@@ -417,6 +417,22 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
       expect_identical(substr(b$gravcal$metashort$timestamp[1], 1, 19), at)
     }
   }
+  # UNIX and ISO 8601 stamps across Europe/Amsterdam's autumn change
+  # (2024-10-27, 01:00 UTC): GGIR forces them into the zone, the clock
+  # times after 02:00 (which exist twice) at the later offset, so that its
+  # stamps jump an hour ahead there and its resampling fills that hour; the
+  # decoder forces each stamp by the zone's table (gravcal refused these)
+  for (st in c("unix", "text")) {
+    gravcal:::write_axivity_csv(short, f, true_sf = 10.03, stamps = st,
+                                start = "2024-10-27 00:00:00")
+    b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
+    expect_same_meta(b)
+    expect_identical(b$gravcal$metashort$timestamp[1], "2024-10-27T00:00:00+0200")
+    # the hour GGIR's resampling fills: the lines span 4.99 hours (5 hours
+    # of samples at 10.03 Hz), the grid 5.99, whose whole long epochs are
+    # 5.75 hours of short ones (4.75 without the hour)
+    expect_identical(nrow(b$gravcal$metashort), 23L * 180L)
+  }
   # GGIR's own test file: too short for GGIR, and for gravcal
   csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
   b <- meta_both(csv)

@@ -97,10 +97,13 @@ class CsvTimeStamps {
   // from the text). False when the field is not a time.
   bool time_of(const csv_text::Field& f, double& t, int& frac_digits) {
     if (adhoc_ && time_iso_) {
-      // as fread reads it, less a fixed offset (a zone GGIR forces it into)
+      // as fread reads it, less the offset of the zone GGIR forces it into
+      // (force_tz()'s table where that offset changes: NaN where the clock
+      // time does not exist; else a fixed offset)
       frac_digits = 9;
       if (!iso_.parse(f.b, f.e, number_rule_, t)) return false;
-      if (time_utc_offset_ != 0) t = t - time_utc_offset_;
+      if (!zone_.empty()) t = t - zone_.offset(t);
+      else if (time_utc_offset_ != 0) t = t - time_utc_offset_;
       return true;
     }
     if (adhoc_ && !time_fmt_.empty()) {
