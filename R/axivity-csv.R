@@ -168,9 +168,11 @@ file_last_line <- function(file) {
 # a change of offset during the recording the decoder forces each stamp as
 # force_tz() does (the offset at its clock time; a clock time that exists
 # twice takes the later offset), so that GGIR's resampling interpolates
-# across the hour the stamps jump as GGIR's does; a recording through the
-# hour the clocks skip (NA stamps in GGIR, NaN samples after them) is
-# refused. Other text is read by as.POSIXct() in the zone, as the
+# across the hour the stamps jump in autumn as GGIR's does; in spring the
+# stamps of the hour the clocks skip are NA, and the resampler reads them
+# as GGIRread::resample() does (every later sample of the block NA; a
+# block that starts or ends with one stops, as GGIR's seq() does:
+# ggir_check_nan_edge()). Other text is read by as.POSIXct() in the zone, as the
 # csv decoder reads it (its offset, or R/zone.R's table of them where it
 # changes; a block of GGIR's reading that starts at a time that exists
 # twice or not at all there is refused after the read,
@@ -197,7 +199,8 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
   }
   # a zone whose offset changes: across a change in the recording's span
   # the stamps follow force_tz()'s table of the zone (zone_force_options()),
-  # moved by the offset at each stamp's clock time
+  # moved by the offset at each stamp's clock time, NaN where it does not
+  # exist
   o <- axivity_csv_force_table(file, time, zone)
   if (isTRUE(o$no_offset)) {
     abort(zone_name, ": R gives no UTC offset in that zone for some of the times of the ",
@@ -208,24 +211,14 @@ axivity_csv_zone <- function(file, time, zone, zone_arg) {
     if (time$kind == "unix") return(list())
     return(list(time_utc_offset = civil_offset(floor(time$first), zone)))
   }
-  if (isTRUE(o$skips)) {
-    abort(zone_name, ": the Axivity csv export \"", basename(file), "\" runs through an hour ",
-          "that zone's clocks skip (daylight saving). GGIR forces its ",
-          if (time$kind == "unix") "UNIX" else "ISO 8601", " time stamps into the zone, which ",
-          "makes those of that hour NA, and GGIRread's resampling then gives NaN for every ",
-          "sample from there to the end of GGIR's block; gravcal does not reproduce that. Give ",
-          "a zone without a change there (\"UTC\", or a fixed offset such as \"Etc/GMT-1\").")
-  }
-  o$skips <- NULL
   c(list(time_utc_offset = 0), o)
 }
 
 # Whether GGIR's reader forces the export's stamps across a change of UTC
 # offset in `zone` (UNIX seconds or fread's date-times, a change within
 # the recording's span, from its first and last stamps a day either side):
-# force_tz()'s table of the zone then (zone_force_options(), with `skips`
-# TRUE where the span meets clock times the zone skips; `no_offset` TRUE
-# where R gives no offset), else NULL.
+# force_tz()'s table of the zone then (zone_force_options(); `no_offset`
+# TRUE where R gives no offset), else NULL.
 axivity_csv_force_table <- function(file, time, zone) {
   if (time$kind == "text" || is.null(zone_table(zone))) return(NULL)
   last <- file_last_line(file)
@@ -235,12 +228,7 @@ axivity_csv_force_table <- function(file, time, zone) {
   off <- civil_offset(at, zone)
   if (anyNA(off)) return(list(no_offset = TRUE))
   if (all(off == off[1])) return(NULL)
-  o <- zone_force_options(zone, span[1], span[2])
-  if (is.null(o)) return(NULL)
-  o$skips <- any(vapply(seq_len(o$tz_na_n), function(j) {
-    o[[paste0("tz_na_lo_", j - 1L)]] <= span[2] && o[[paste0("tz_na_hi_", j - 1L)]] > span[1]
-  }, TRUE))
-  o
+  zone_force_options(zone, span[1], span[2])
 }
 
 # Whether GGIR's reader takes the export's clock per sample after reading

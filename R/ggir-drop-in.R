@@ -77,7 +77,7 @@
 #' | `interpolationType` (1 linear, 2 nearest neighbour) | `.cwa`; GENEActiv `.bin` at a rate that is not whole; Parmay Matrix `.bin`; Movisens (its temperature); Axivity csv; ad hoc csv with `rmc.doresample` | honoured (an error with `reader = "reference"` unless 1) |
 #' | `frequency_tol` | `.cwa` | honoured (an error with `reader = "reference"` unless 0.1) |
 #' | `desiredtz`, `configtz` | `.cwa` (the zone of its block times) | honoured, across changes of UTC offset (daylight saving) too, by the zone rules of the R it runs in; an error naming it only where a block of GGIR's reading starts or ends at a calendar time that exists twice or not at all in that zone, and with `reader = "reference"` where the offset changes |
-#' | `desiredtz`, `configtz` | Axivity csv (the zone GGIR reads or forces its time stamps in) | honoured: text that is not ISO 8601 as `as.POSIXct()` reads it in the zone, across changes of offset too; UNIX and ISO 8601 stamps forced into the zone as GGIR forces them (`lubridate::force_tz()`), across a change of offset too; an error naming it where the recording runs through the hour the clocks skip (GGIR's samples NaN from there to its block's end) |
+#' | `desiredtz`, `configtz` | Axivity csv (the zone GGIR reads or forces its time stamps in) | honoured: text that is not ISO 8601 as `as.POSIXct()` reads it in the zone, across changes of offset too; UNIX and ISO 8601 stamps forced into the zone as GGIR forces them (`lubridate::force_tz()`), across changes of offset too (in spring GGIR's samples are NA from the skipped hour to its block's end, and so are gravcal's); an error naming it where one of GGIR's blocks starts or ends in that hour, as GGIR stops there |
 #' | `rmc.noise`, `rmc.sf` | ad hoc csv | honoured (also for data frames) |
 #' | other `rmc.*` | ad hoc csv | see "Ad hoc csv files" |
 #'
@@ -199,6 +199,7 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
     rmc_check_wear(src)
   } else {
     ggir_check_zone_read(src, tz %||% "", tz_arg)
+    ggir_check_nan_edge(src, tz %||% "", tz_arg)
   }
   attr(out, "gravcal") <- NULL
   invisible(out)
@@ -299,17 +300,36 @@ ggir_params <- function(params_rawdata, params_general, dots) {
 # that depends on R's conversions before it, which gravcal does not know:
 # an error naming the parameter.
 ggir_check_zone_read <- function(src, tz, arg) {
-  if (!isTRUE(format_entry(src$format)$ggir_zone_ambiguous) || is.null(src$report)) {
-    return(invisible())
-  }
-  n <- src$report()$counters["zone_ambiguous"]
+  if (!isTRUE(format_entry(src$format)$ggir_zone_ambiguous)) return(invisible())
+  zone_block_stop(src, "zone_ambiguous", tz, arg,
+                  "at a time that exists twice or not at all in that zone (a change of UTC offset), ",
+                  "where GGIR's time depends on R's conversions before it; gravcal does not ",
+                  "reproduce that")
+}
+
+# After a read of an Axivity csv export through an hour its zone's clocks
+# skip (GGIR forces the stamps into the zone: NA there): where one of
+# GGIR's blocks starts or ends with such a stamp, GGIR's seq() of the
+# block's grid stops ("'from' must be a finite number"); so does gravcal,
+# naming the parameter.
+ggir_check_nan_edge <- function(src, tz, arg) {
+  zone_block_stop(src, "resample_nan_edge", tz, arg,
+                  "in the hour that zone's clocks skip (daylight saving), where GGIR's time ",
+                  "stamps are NA (lubridate::force_tz()) and its resampling of the block stops; ",
+                  "gravcal's stops too")
+}
+
+# The error of the two checks above, where the source's report counts
+# `counter`: the zone parameter `arg` = `tz`, "a block of GGIR's reading
+# of this file starts or ends " and `...`, and what to do.
+zone_block_stop <- function(src, counter, tz, arg, ...) {
+  if (is.null(src$report)) return(invisible())
+  n <- src$report()$counters[counter]
   if (isTRUE(n > 0)) {
     abort("`", arg, "` = \"", tz, "\"", if (!nzchar(tz)) " (the session's time zone)",
-          ": a block of GGIR's reading of this file starts or ends at a time ",
-          "that exists twice or not at all in that zone (a change of UTC offset), ",
-          "where GGIR's time depends on R's conversions before it; gravcal does ",
-          "not reproduce that. Give a zone without a change there (\"UTC\", or a ",
-          "fixed offset such as \"Etc/GMT-1\"), or another `chunksize`.")
+          ": a block of GGIR's reading of this file starts or ends ", ..., ". Give a zone ",
+          "without a change there (\"UTC\", or a fixed offset such as \"Etc/GMT-1\"), or ",
+          "another `chunksize`.")
   }
   invisible()
 }

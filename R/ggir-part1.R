@@ -33,10 +33,11 @@
 #' time zone; on R 4.2.1 to 4.2.3 GGIR stops there, gravcal gives what it
 #' gives on R 4.3), Movisens, Axivity csv exports (each block resampled as
 #' GGIR resamples it; across a change of `desiredtz`'s UTC offset UNIX and
-#' ISO 8601 stamps forced into the zone as GGIR forces them, the hour they
-#' jump in autumn filled as GGIR's resampling fills it, and a recording
-#' through the hour the clocks skip in spring refused, where GGIR's samples
-#' are NaN to the block's end), Parmay Matrix
+#' ISO 8601 stamps forced into the zone as GGIR forces them: the hour they
+#' jump in autumn filled as GGIR's resampling fills it, the hour the clocks
+#' skip in spring NA stamps, after which GGIR's samples are NA to the
+#' block's end, as gravcal's are; a block that starts or ends in that hour
+#' an error, as GGIR stops there), Parmay Matrix
 #' `.bin`/`.BIN` (the whole file one block, as GGIRread's reader gives it,
 #' a packet with a bad checksum kept as it keeps it; the dynamic range from
 #' the file's header, whatever `dynrange` says; `configtz` changes nothing,
@@ -129,6 +130,10 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   # at a time that exists twice or not at all there is refused, as by
   # g.calibrate()
   if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
+  # (an Axivity csv export's block that starts or ends in an hour the
+  # zone's clocks skip: GGIR stops)
+  ggir_check_nan_edge(src, if (length(p$configtz)) p$configtz else p$desiredtz,
+                      if (length(p$configtz)) "configtz" else "desiredtz")
   M
 }
 

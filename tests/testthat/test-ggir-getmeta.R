@@ -417,21 +417,31 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
       expect_identical(substr(b$gravcal$metashort$timestamp[1], 1, 19), at)
     }
   }
-  # UNIX and ISO 8601 stamps across Europe/Amsterdam's autumn change
-  # (2024-10-27, 01:00 UTC): GGIR forces them into the zone, the clock
-  # times after 02:00 (which exist twice) at the later offset, so that its
-  # stamps jump an hour ahead there and its resampling fills that hour; the
-  # decoder forces each stamp by the zone's table (gravcal refused these)
+  # UNIX and ISO 8601 stamps across Europe/Amsterdam's changes, which GGIR
+  # forces into the zone (gravcal refused these). Autumn (2024-10-27, 01:00
+  # UTC): the clock times after 02:00, which exist twice, at the later
+  # offset, so that the stamps jump an hour ahead there and GGIR's
+  # resampling fills that hour: the lines span 4.99 hours (5 hours of
+  # samples at 10.03 Hz), the grid 5.99, whose whole long epochs are 5.75
+  # hours of short ones (4.75 without the hour). Spring (2024-03-31): the
+  # stamps of 02:00 to 03:00 NA, where GGIRread::resample()'s search stops,
+  # so that every sample after them in the block is NA, and so are the
+  # epochs' ENMO and EN
   for (st in c("unix", "text")) {
     gravcal:::write_axivity_csv(short, f, true_sf = 10.03, stamps = st,
                                 start = "2024-10-27 00:00:00")
     b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
     expect_same_meta(b)
     expect_identical(b$gravcal$metashort$timestamp[1], "2024-10-27T00:00:00+0200")
-    # the hour GGIR's resampling fills: the lines span 4.99 hours (5 hours
-    # of samples at 10.03 Hz), the grid 5.99, whose whole long epochs are
-    # 5.75 hours of short ones (4.75 without the hour)
     expect_identical(nrow(b$gravcal$metashort), 23L * 180L)
+    gravcal:::write_axivity_csv(short, f, true_sf = 10.03, stamps = st,
+                                start = "2024-03-31 00:00:00")
+    b <- meta_both(f, list(params_general = list(desiredtz = "Europe/Amsterdam")))
+    expect_same_meta(b)
+    na <- is.na(b$gravcal$metashort$ENMO)
+    expect_true(any(na) && !all(na), label = paste(st, "some ENMO NA"))
+    en <- b$gravcal$metalong$EN
+    expect_true(!anyNA(en[1:7]) && all(is.na(en[-(1:8)])), label = paste(st, "EN NA after 02:00"))
   }
   # GGIR's own test file: too short for GGIR, and for gravcal
   csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")

@@ -51,7 +51,10 @@
 // 100 Hz, where GGIR would need gigabytes) is not filled but counted and
 // noted ("resample_gaps_not_filled"), and a time stamp that is not a finite
 // number, or lies more than 2^51 grid steps from 1970, is left out with its
-// sample ("resample_bad_time").
+// sample ("resample_bad_time"); but for Axivity csv exports (nan_stuck) a
+// NaN time stamp (GGIR's NA, where force_tz() puts a stamp in an hour the
+// zone's clocks skip) is read as GGIRread::resample() reads it: every grid
+// point after the stamp before it NA, to the end of the block.
 //
 // What it forwards to the decoder it wraps (opening it, its report, its
 // units) is ForwardingDecoder's (decode_forwarding.hpp), shared with the
@@ -85,10 +88,14 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
   // grid_rate: the output rate (0: the inner decoder's); interpolation: 1
   // linear, 2 nearest neighbour (GGIR's interpolationType); fused: GGIRread's
   // multiply-add rounded once
+  // nan_stuck: a time stamp that is NaN read as GGIRread::resample() reads
+  // it (below: every grid point after the time stamp before it NaN, to the
+  // call's end)
   explicit GgirResamplerOf(std::unique_ptr<Inner> inner, double grid_rate = 0,
                            int interpolation = 1, bool keep_last = false,
-                           bool fused = false)
-      : Base(std::move(inner)), grid_rate_(grid_rate), keep_last_(keep_last) {
+                           bool fused = false, bool nan_stuck = false)
+      : Base(std::move(inner)), grid_rate_(grid_rate), keep_last_(keep_last),
+        nan_stuck_(nan_stuck) {
     walk_.interp.nearest = interpolation == 2;
     walk_.interp.fused = fused;
   }
@@ -164,6 +171,8 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
     have_prev_ = false;
     have_interval_ = false;
     gen_active_ = false;
+    stuck_ = false;
+    last_nan_ = false;
     k_ = 0;
     pending_.clear();
   }
@@ -187,6 +196,19 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
   void take(std::size_t i) {
     for (std::size_t c = 0; c < kRawCols; ++c) cur_[c] = raw_[c * kRawChunk + i];
     if (!raw_light_) cur_[kLight] = std::numeric_limits<double>::quiet_NaN();
+    // GGIRread::resample() on a NaN time stamp (nan_stuck): its search for
+    // the interval of a grid point stops there (NaN compares false) and
+    // stays, so every grid point past the time stamp before it is NA (the
+    // stamp's NA carried), in every column, to the end of the call; a call
+    // whose first or last time stamp is NaN is one GGIR's seq() of the grid
+    // stops on (counted)
+    last_nan_ = false;
+    if (nan_stuck_ && std::isnan(cur_[4])) {
+      if (!have_prev_) ++nan_edges_;
+      stuck_ = true;
+      last_nan_ = true;
+      return;
+    }
     // a time stamp so far from 1970 that one grid step is below its
     // resolution (beyond 2^51 steps: more than 700,000 years at 100 Hz)
     // has no grid around it: left out as a non-finite one is (the grid's
@@ -243,9 +265,17 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
   Point point_at(std::int64_t k, double g, const double* lo, const double* hi) const {
     Point p;
     p.k = k;
+    p.v[4] = g;
+    if (stuck_) {
+      // (R's NA: the NA time stamp's payload, carried through GGIRread's
+      // arithmetic)
+      const double nan = r_na_real();
+      for (int c = 0; c < 4; ++c) p.v[c] = nan;
+      p.v[kLight] = want_light_ ? nan : 0.0;
+      return p;
+    }
     const double u = walk_.weight(g, lo[4], hi[4]);
     for (int c = 0; c < 4; ++c) p.v[c] = walk_.value(u, lo[c], hi[c]);
-    p.v[4] = g;
     p.v[kLight] = want_light_ ? walk_.value(u, lo[kLight], hi[kLight]) : 0.0;
     return p;
   }
@@ -274,6 +304,11 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
   void add_own(Report& r) const {
     if (bad_time_ > 0) r.count("resample_bad_time", bad_time_);
     if (gaps_not_filled_ > 0) r.count("resample_gaps_not_filled", gaps_not_filled_);
+    if (nan_edges_ > 0) {
+      r.count("resample_nan_edge", nan_edges_);
+      r.note("a block of GGIR's reading starts or ends with a time stamp that is NA, on which "
+             "GGIR's resampling stops");
+    }
     for (const auto& n : gap_notes_) r.note(n);
   }
 
@@ -284,6 +319,7 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
   // it is interpolated there, from the block's last interval.
   void end_call() {
     in_call_ = false;
+    if (last_nan_) ++nan_edges_;
     if (have_prev_) {
       const double n = std::floor((last_ - walk_.grid.origin) / walk_.grid.by + 1e-10);
       std::size_t m = 0;
@@ -316,6 +352,10 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
 
   double grid_rate_ = 0.0;
   bool keep_last_ = false;
+  bool nan_stuck_ = false;
+  bool stuck_ = false;     // a NaN time stamp seen in this call (nan_stuck_)
+  bool last_nan_ = false;  // the call's last raw sample so far had a NaN time
+  std::int64_t nan_edges_ = 0;
   bool active_ = false;
   bool want_light_ = false;  // light asked for (and the inner decoder has it)
   bool raw_light_ = false;   // the raw samples in raw_ have light

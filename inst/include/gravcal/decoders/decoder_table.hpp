@@ -79,8 +79,11 @@ inline DecoderPtr make_axivity_csv(ByteSource& bytes, const Options& opts,
   std::unique_ptr<CsvDecoder> d(new CsvDecoder(bytes, opts, name));
   const ReadRules r = ReadRules::of(opts);
   if (!r.compat) return d;
+  // (a NaN time stamp, force_tz()'s in an hour the zone's clocks skip, read
+  // as GGIRread::resample() reads it)
   return DecoderPtr(new GgirResamplerOf<CsvDecoder>(
-      std::move(d), opts.num("grid_sf", opts.num("sf", 0)), r.interpolation, false, r.fused));
+      std::move(d), opts.num("grid_sf", opts.num("sf", 0)), r.interpolation, false, r.fused,
+      true));
 }
 
 // GGIR's ad hoc csv: the csv decoder with the rmc.* layout; with
