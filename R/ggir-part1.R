@@ -37,7 +37,9 @@
 #' jump in autumn filled as GGIR's resampling fills it, the hour the clocks
 #' skip in spring NA stamps, after which GGIR's samples are NA to the
 #' block's end, as gravcal's are; a block that starts or ends in that hour
-#' an error, as GGIR stops there), Parmay Matrix
+#' an error, as GGIR stops there; text stamps in a zone whose offset
+#' changes refused where a block of GGIR's starts at a time that exists
+#' twice or not at all there, as by g.calibrate()), Parmay Matrix
 #' `.bin`/`.BIN` (the whole file one block, as GGIRread's reader gives it,
 #' a packet with a bad checksum kept as it keeps it; the dynamic range from
 #' the file's header, whatever `dynrange` says; `configtz` changes nothing,
@@ -126,14 +128,19 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
     meta_open(datafile, p, inspectfileobject)
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
   M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
-  # text time in a zone whose offset changes: a block of GGIR's that starts
-  # at a time that exists twice or not at all there is refused, as by
-  # g.calibrate()
-  if (!is.null(p$.rmc)) ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
-  # (an Axivity csv export's block that starts or ends in an hour the
-  # zone's clocks skip: GGIR stops)
-  ggir_check_nan_edge(src, if (length(p$configtz)) p$configtz else p$desiredtz,
-                      if (length(p$configtz)) "configtz" else "desiredtz")
+  # text time in a zone whose offset changes (ad hoc and Axivity csv), and
+  # .cwa blocks there: a block of GGIR's that starts at a time that exists
+  # twice or not at all there is refused, as by g.calibrate(); an Axivity
+  # csv export's block that starts or ends in an hour the zone's clocks
+  # skip stops, as GGIR does
+  tz <- if (length(p$configtz)) p$configtz else p$desiredtz
+  tz_arg <- if (length(p$configtz)) "configtz" else "desiredtz"
+  if (!is.null(p$.rmc)) {
+    ggir_check_zone_read(src, attr(p$.rmc, "tz"), attr(p$.rmc, "tz_arg"))
+  } else {
+    ggir_check_zone_read(src, tz, tz_arg)
+  }
+  ggir_check_nan_edge(src, tz, tz_arg)
   M
 }
 

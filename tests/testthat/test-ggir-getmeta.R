@@ -443,6 +443,17 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
     en <- b$gravcal$metalong$EN
     expect_true(!anyNA(en[1:7]) && all(is.na(en[-(1:8)])), label = paste(st, "EN NA after 02:00"))
   }
+  # text stamps read in the zone, a block of GGIR's (chunksize 0.1: 87,000
+  # lines, 2.4 hours) starting at 02:34 on 2024-10-27, a time that exists
+  # twice in Europe/Amsterdam: refused as g.calibrate() refuses it (GGIR's
+  # time there depends on R's conversions before it; gravcal's g.getmeta()
+  # gave an M that was not GGIR's, silently)
+  gravcal:::write_axivity_csv(short, f, true_sf = 10.03, stamps = "text",
+                              time_format = "%Y/%m/%d %H:%M:%S", start = "2024-10-27 00:10:00")
+  expect_error(meta_quiet(gravcal::g.getmeta(f, params_general = list(desiredtz = "Europe/Amsterdam"),
+                                             params_rawdata = list(chunksize = 0.1), verbose = FALSE)),
+               "`desiredtz` = \"Europe/Amsterdam\": a block of GGIR's reading of this file starts or ends at a time that exists twice",
+               fixed = TRUE)
   # GGIR's own test file: too short for GGIR, and for gravcal
   csv <- system.file("testfiles", "ax3_testfile_unix_timestamps.csv", package = "GGIR")
   b <- meta_both(csv)
