@@ -138,6 +138,20 @@ test_that("a .cwa recording across the spring and autumn changes: M is GGIR's, Q
   expect_true(all(b$ggir$QClog$imputed))
   expect_same_meta(b)
   unlink(f)
+  # 10 hours from 2024-10-26 23:17:13 UTC read in GGIR's blocks of
+  # chunksize 0.1: a block starts at a calendar time that exists twice in
+  # the zone, where readAxivity's block time depends on R's conversions
+  # before it: refused, as g.calibrate() refuses such a block (gravcal's
+  # g.getmeta() gave an M that was not GGIR's here, metashort and metalong,
+  # without a word)
+  f <- tempfile(fileext = ".cwa")
+  write_meta_recording(f, "cwa", 25, 10, 5, "2024-10-26 23:17:13")
+  expect_error(meta_quiet(gravcal::g.getmeta(f, params_general = args$params_general,
+                                             params_rawdata = list(chunksize = 0.1),
+                                             verbose = FALSE)),
+               "a block of GGIR's reading of this file starts or ends at a time that exists twice",
+               fixed = TRUE)
+  unlink(f)
 })
 
 test_that("a damaged .cwa recording: M is GGIR's, readAxivity's log of the damage (QClog) too", {
