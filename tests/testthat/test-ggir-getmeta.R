@@ -457,6 +457,23 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
     en <- b$gravcal$metalong$EN
     expect_true(!anyNA(en[1:7]) && all(is.na(en[-(1:8)])), label = paste(st, "EN NA after 02:00"))
   }
+  # 8 hours of UNIX stamps from 22:47:13 UTC, chunksize 0.1: a non-wear
+  # window of the block after the skipped hour holds one value that is not
+  # NA, whose sd() is NA, on which GGIR's if() stops; gravcal's g.getmeta()
+  # gave an M (found by probing 24 exports: three kinds of stamp, two
+  # zones, both changes, chunksize 0.1 and 0.25)
+  eight <- simulate_recording(hours = 8, sf = 10, seed = 31, temperature = FALSE)
+  gravcal:::write_axivity_csv(eight, f, true_sf = 10.03, stamps = "unix",
+                              start = "2024-03-30 22:47:13")
+  pg <- utils::modifyList(GGIR::load_params()$params_general, list(desiredtz = "Europe/Amsterdam"))
+  pr <- utils::modifyList(GGIR::load_params()$params_rawdata, list(chunksize = 0.1))
+  I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+  expect_error(keep_warn(meta_quiet(GGIR::g.getmeta(f, params_rawdata = pr, params_general = pg,
+                                                    inspectfileobject = I, verbose = FALSE))),
+               "missing value where TRUE/FALSE needed")
+  expect_error(meta_quiet(gravcal::g.getmeta(f, params_rawdata = pr, params_general = pg,
+                                             verbose = FALSE)),
+               "holds one value that is not NA: GGIR's g.getmeta() stops there too", fixed = TRUE)
   # text stamps read in the zone, a block of GGIR's (chunksize 0.1: 87,000
   # lines, 2.4 hours) starting at 02:34 on 2024-10-27, a time that exists
   # twice in Europe/Amsterdam: refused as g.calibrate() refuses it (GGIR's

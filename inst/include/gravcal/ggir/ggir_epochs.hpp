@@ -815,10 +815,23 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
         if (e < mn) mn = e;
       }
       const double absrange = std::fabs(mx - mn);
+      // GGIR tests the range and then the sd with if(), which stops on NA:
+      // a range that is NaN (values all +Inf or all -Inf), or an sd of a
+      // window with one value that is not NA (sd() gives NA; in an Axivity
+      // csv export after an hour its zone's clocks skip the samples are NA)
+      if (std::isnan(absrange)) {
+        throw std::runtime_error("a non-wear window of a block holds infinite values only: GGIR's "
+                                 "g.getmeta() stops there too (detect_nonwear_clipping(): its range is NaN)");
+      }
       if (absrange < cf.racriter) {
         const RMeanSd ms = r_mean_sd<Acc>([&](auto&& f) {
           for (double e : vals) f(e);
         });
+        if (std::isnan(ms.sd)) {
+          throw std::runtime_error("a non-wear window of a block (long epoch " + std::to_string(h) +
+                                   ") holds one value that is not NA: GGIR's g.getmeta() stops there "
+                                   "too (detect_nonwear_clipping(): the sd of one value is NA)");
+        }
         if (ms.sd < cf.sdcriter) {
           for (std::int64_t g = w.flag_from; g <= w.flag_to; ++g) {
             nwlog[static_cast<std::size_t>(g - 1) * 3 + static_cast<std::size_t>(a)] = 1;
