@@ -459,3 +459,32 @@ test_that("lines parsed in place give what the general parser gives, damage incl
     }
   }
 })
+
+test_that("an Axivity csv export through spring's skipped hour: GGIR's NA samples, no undefined arithmetic", {
+  skip_if(is.null(gravcal:::zone_table("Europe/Amsterdam")),
+          "this R has no daylight saving rules for Europe/Amsterdam")
+  # UNIX stamps forced into Europe/Amsterdam (as GGIR forces them): those
+  # of 02:00 to 03:00 on 2024-03-31 do not exist there (NA), and the
+  # resampler reads them as GGIRread::resample() does, every later sample
+  # of the block NA (test-ggir-getmeta.R and test-axivity-csv.R compare
+  # with GGIR; this runs the path in the sanitizer lane, GGIR not needed)
+  rec <- simulate_recording(hours = 4, sf = 10, seed = 33, temperature = FALSE)
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, stamps = "unix",
+                              start = "2024-03-31 00:00:00")
+  pg <- list(desiredtz = "Europe/Amsterdam")
+  M <- suppressWarnings(gravcal::g.getmeta(f, params_general = pg, verbose = FALSE))
+  enmo <- M$metashort$ENMO
+  # 2 hours (forced: 01:00 to 03:00 local) of epochs before the hour, NA
+  # after it to the end of the block (the whole file here)
+  expect_false(anyNA(enmo[1:(2 * 720 - 1)]))
+  expect_true(all(is.na(enmo[(2 * 720 + 1):length(enmo)])))
+  expect_gt(length(enmo), 2 * 720 + 100)
+  C <- suppressWarnings(gravcal::g.calibrate(f, params_general = pg, verbose = FALSE))
+  expect_true(all(is.finite(C$offset)))
+  # the same export read in UTC: no NA
+  M0 <- suppressWarnings(gravcal::g.getmeta(f, params_general = list(desiredtz = "UTC"),
+                                             verbose = FALSE))
+  expect_false(anyNA(M0$metashort$ENMO))
+})
