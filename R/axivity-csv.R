@@ -172,8 +172,8 @@ file_last_line <- function(file) {
 # stamps of the hour the clocks skip are NA, and the resampler reads them
 # as GGIRread::resample() does (every later sample of the block NA; a
 # block that starts or ends with one stops, as GGIR's seq() does:
-# ggir_check_nan_edge()). Other text is read by as.POSIXct() in the zone, as the
-# csv decoder reads it (its offset, or R/zone.R's table of them where it
+# ggir_check_nan_edge()). Other text is read by as.POSIXct() in the zone,
+# as the csv decoder reads it (its offset, or R/zone.R's table of them where it
 # changes; a block of GGIR's reading that starts at a time that exists
 # twice or not at all there is refused after the read,
 # ggir_check_zone_read()).

@@ -310,8 +310,8 @@ ggir_check_zone_read <- function(src, tz, arg) {
 # After a read of an Axivity csv export through an hour its zone's clocks
 # skip (GGIR forces the stamps into the zone: NA there): where one of
 # GGIR's blocks starts or ends with such a stamp, GGIR's seq() of the
-# block's grid stops ("'from' must be a finite number"); so does gravcal,
-# naming the parameter.
+# block's grid stops ("'from' (or 'to') must be a finite number"); so
+# does gravcal, naming the parameter.
 ggir_check_nan_edge <- function(src, tz, arg) {
   zone_block_stop(src, "resample_nan_edge", tz, arg,
                   "in the hour that zone's clocks skip (daylight saving), where GGIR's time ",
