@@ -393,17 +393,27 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
                             std::copy(en, en + (to - from), o);
                           },
                           true});
-      auto column = [&](const p1::RunColumn* col) {
+      // a column (the temperature, the light) whose running sums are exact
+      // (a .cwa file's) is summed a run at a time (run_sums_exact()), the
+      // others in the pass; `at`: its place in `longs` (the norm's first),
+      // or -1 - its place in `by_runs`
+      std::vector<p1::EpochSums<Acc>> by_runs;
+      by_runs.reserve(2);
+      auto column = [&](const p1::RunColumn* col) -> std::ptrdiff_t {
+        if (p1::run_sums_exact<Acc>([&](auto&& f) { col->spans(un, f); })) {
+          by_runs.emplace_back(un, M, true);
+          p1::EpochSums<Acc>& e = by_runs.back();
+          col->spans(un, [&e](std::size_t from, std::size_t to, double v) { e.add_run_exact(v, to - from); });
+          return -1 - static_cast<std::ptrdiff_t>(by_runs.size() - 1);
+        }
         longs.push_back(Sum{p1::EpochSums<Acc>(un, M, true),
                             [cur = p1::RunColumn::Cursor(*col)](std::size_t from, std::size_t to, const double*,
                                                                 double* o) mutable { cur.fill(from, to, o); },
                             false});
+        return static_cast<std::ptrdiff_t>(longs.size() - 1);
       };
-      // (their places in `longs`: the norm's first, then those present)
-      const std::size_t t_at = longs.size();
-      if (t) column(t);
-      const std::size_t li_at = longs.size();
-      if (li) column(li);
+      const std::ptrdiff_t t_at = t ? column(t) : 0;
+      const std::ptrdiff_t li_at = li ? column(li) : 0;
       std::vector<Sum*> lp;
       for (Sum& l : longs) lp.push_back(&l);
       // non-wear, clipping and the light's peaks beside the metrics (on
@@ -413,15 +423,21 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       std::vector<double> peaks;
       const std::function<void()> beside = [&]() {
         r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
-        if (li) peaks = p1::light_peaks(light_at, un, M);
+        if (li) {
+          peaks = p1::light_peaks(light_at, un, M, [li](std::size_t from, std::size_t to, auto&& f) {
+            li->values_in(from, to, f);
+          });
+        }
       };
       const std::vector<std::vector<double>> sm =
           p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
                                  have_f ? &fc : nullptr, arith, lp.data(), lp.size(), threads, beside);
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
-      auto finished = [&](bool have, std::size_t at) {
-        return have ? Rcpp::RObject(as_r(longs[at].sums.finish())) : Rcpp::RObject();
+      auto finished = [&](bool have, std::ptrdiff_t at) {
+        if (!have) return Rcpp::RObject();
+        return Rcpp::RObject(as_r(at >= 0 ? longs[static_cast<std::size_t>(at)].sums.finish()
+                                          : by_runs[static_cast<std::size_t>(-1 - at)].finish()));
       };
       const Rcpp::RObject en = as_r(longs[0].sums.finish());
       const Rcpp::RObject temperature = finished(t != nullptr, t_at);

@@ -124,3 +124,54 @@ test_that("a block read from a decoder is the samples the decoder gives, in GGIR
   expect_named(r, c("x", "y", "z", "temperature", "light"))
   for (k in names(r)) same_bits(r[[k]], ref[[k]][seq_len(info$n)])
 })
+
+test_that("the long epochs' temperature and light: R's cumulative sums, a run at a time only where exact", {
+  # gc_meta_store_epochs() sums a column a run at a time (a run's value
+  # times its length) only where every running sum is exact in R's
+  # accumulator (ggir_epochs.hpp run_sums_exact()): a .cwa file's
+  # temperature (multiples of 2^-8) and light (whole numbers). Elsewhere
+  # row by row, as R's cumsum(). Both against R's own arithmetic: GGIR's
+  # long-epoch mean, diff(cumsum(c(0, v))[round(seq(1, n + 1, by = M))]) / M,
+  # and its lightpeak, max(light[((li - 1) * M):(li * M)]).
+  sf <- 10
+  ws <- c(5, 60, 120)
+  M <- ws[2] * sf
+  n <- 12000
+  per_page <- function(v) rep(v, length.out = ceiling(n / 120))[ceiling(seq_len(n) / 120)]
+  set.seed(4)
+  runs <- list(
+    # a .cwa file's: raw * 75 / 256 - 50 (run by run)
+    cwa = per_page(sample(0:1023, 60, replace = TRUE) * 75 / 256 - 50),
+    # decimals (GENEActiv's text): row by row
+    decimal = per_page(round(stats::runif(60, 18, 32), 1)),
+    # whole multiples of 2^-38 whose running sums pass 2^33: each addition
+    # of 1 + 2^-31 - 2^-38 rounds down by almost half a unit of R's long
+    # double accumulator (2^-30 there), thousands of times, where a product
+    # per run would round once a run: most epochs' means differ in double.
+    # Row by row
+    fine = per_page(c(2^27, rep(1 + 2^-31 - 2^-38, 99))),
+    # with NaN and infinite runs: row by row
+    nonfinite = per_page(c(20, NaN, 21, Inf, 22))
+  )
+  light <- list(whole = per_page(as.numeric(sample(0:1023, 50, replace = TRUE))),
+                nan = per_page(c(5, 7, NaN, 9, 11, 13)))
+  rmean <- function(v) diff(cumsum(c(0, v))[round(seq(1, n + 1, by = M))]) / M
+  rpeak <- function(v) {
+    vapply(seq_len(n / M), function(li) max(v[((li - 1) * M):(li * M)]), 0)
+  }
+  nw <- list(clipthres = 7.5, sdcriter = 0.013, racriter = 0.05, approach = "2023")
+  cal <- list(offset = c(0, 0, 0), inv_scale = c(1, 1, 1))
+  for (k in seq_along(runs)) {
+    li <- light[[1 + (k %% 2)]]
+    d <- list(x = stats::rnorm(n, 0, 0.01), y = stats::rnorm(n, 0, 0.01), z = 1 + stats::rnorm(n, 0, 0.01),
+              temperature = runs[[k]], light = li)
+    st <- gravcal:::gc_meta_store(TRUE, FALSE, TRUE, FALSE)
+    gravcal:::gc_meta_store_put(st, d, -1)
+    out <- gravcal:::gc_meta_store_epochs(st, cal, NULL, TRUE, sf, ws, "ENMO", nw, NULL, FALSE, FALSE,
+                                          n, 1L)
+    gravcal:::gc_meta_store_release(st)
+    same_bits(out$temperature, rmean(runs[[k]]))
+    same_bits(out$lightmean, rmean(li))
+    same_bits(out$lightpeak, rpeak(li))
+  }
+})

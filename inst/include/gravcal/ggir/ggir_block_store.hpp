@@ -154,6 +154,22 @@ class RunColumn {
     }
   }
 
+  // f(v) for the values of rows [from, to) (to <= size()): once per run,
+  // or once per row of a plain column.
+  template <class F>
+  void values_in(std::size_t from, std::size_t to, F&& f) const {
+    if (to > n_) throw std::out_of_range("rows beyond the column");
+    if (plain_) {
+      for (std::size_t i = from; i < to; ++i) f(v_[i]);
+      return;
+    }
+    std::size_t r = static_cast<std::size_t>(std::upper_bound(end_.begin(), end_.end(), from) - end_.begin());
+    for (std::size_t a = from; a < to && r < end_.size(); ++r) {
+      f(v_[r]);
+      a = end_[r];
+    }
+  }
+
   // A reader of the column's rows for a pass in increasing order: the run
   // last read is held in the reader (not in the column), so that a row of
   // the same run costs two comparisons; any other row is found by the next

@@ -85,27 +85,44 @@ inline RColon r_colon(double from, double to) {
 // R's seq(from, to, by = by) for finite doubles with from <= to, by > 0,
 // from and to not both integer-typed (the double branch of seq.default):
 // n = as.integer((to - from) / by + 1e-10); from + k by, capped at to. A
-// single `from` when (to - from) / max(|to|, |from|) < 100 eps.
-inline std::vector<double> r_seq_by(double from, double to, double by) {
-  const double del = to - from;
-  std::vector<double> out;
-  if (del == 0 && to == 0) {
-    out.push_back(to);
-    return out;
+// single `from` when (to - from) / max(|to|, |from|) < 100 eps. RSeqBy is
+// the sequence without its values (at(k) gives value k); r_seq_by() the
+// values.
+struct RSeqBy {
+  double from = 0, to = 0, by = 0;
+  std::size_t n = 0;  // how many values
+  double at(std::size_t k) const {
+    if (k == 0) return from;
+    return std::min(from + static_cast<double>(k) * by, to);
   }
+};
+
+inline RSeqBy r_seq_by_spec(double from, double to, double by) {
+  RSeqBy s;
+  s.to = to;
+  s.by = by;
+  const double del = to - from;
+  if (del == 0 && to == 0) {
+    s.from = to;
+    s.n = 1;
+    return s;
+  }
+  s.from = from;
   const double n = del / by;
   if (!std::isfinite(n) || n < 0) throw std::runtime_error("seq(): invalid (to - from) / by");
   if (n > 2147483647.0) throw std::runtime_error("seq(): 'by' is much too small");
   if (std::fabs(del) / std::max(std::fabs(to), std::fabs(from)) < 100 * DBL_EPSILON) {
-    out.push_back(from);
-    return out;
+    s.n = 1;
+    return s;
   }
-  const std::int64_t k = static_cast<std::int64_t>(n + 1e-10);
-  out.resize(static_cast<std::size_t>(k) + 1);
-  for (std::int64_t i = 0; i <= k; ++i) {
-    const double v = from + static_cast<double>(i) * by;
-    out[static_cast<std::size_t>(i)] = std::min(v, to);
-  }
+  s.n = static_cast<std::size_t>(static_cast<std::int64_t>(n + 1e-10)) + 1;
+  return s;
+}
+
+inline std::vector<double> r_seq_by(double from, double to, double by) {
+  const RSeqBy s = r_seq_by_spec(from, to, by);
+  std::vector<double> out(s.n);
+  for (std::size_t i = 0; i < s.n; ++i) out[i] = s.at(i);
   return out;
 }
 
@@ -134,21 +151,11 @@ class EpochSums {
   // f(i).
   template <class F>
   void feed(std::size_t count, F&& f) {
-    const std::size_t end = at_ + count;
-    while (at_ < end && k_ < bound_.size()) {
-      const std::size_t to = static_cast<std::size_t>(bound_[k_]) - 1;  // values before the bound
-      if (at_ == to) {
-        record();
-        continue;
-      }
-      const std::size_t stop = std::min(end, to);
+    advance(count, [this, &f](std::size_t from, std::size_t to) {
       Acc s = s_;
-      for (std::size_t i = at_; i < stop; ++i) s += f(i);
+      for (std::size_t i = from; i < to; ++i) s += f(i);
       s_ = s;
-      at_ = stop;
-    }
-    at_ = end;
-    reached();
+    });
   }
   // The next `count` values from v[0].
   void add(const double* v, std::size_t count) {
@@ -173,6 +180,15 @@ class EpochSums {
         default: e[q]->add(v[q], count); break;
       }
     }
+  }
+  // `count` copies of v, added as one product: only for values whose
+  // running sums are all exact in Acc (run_sums_exact()), where v times a
+  // count, and every addition, are exact, so that the sum at each bound is
+  // that of the count additions one at a time.
+  void add_run_exact(double v, std::size_t count) {
+    advance(count, [this, v](std::size_t from, std::size_t to) {
+      s_ += static_cast<Acc>(v) * static_cast<Acc>(to - from);
+    });
   }
   // The epochs' values; every value up to the last bound must have been
   // given.
@@ -228,6 +244,25 @@ class EpochSums {
     }
     for (int q = 0; q < K; ++q) e[q]->at_ = end;
   }
+  // The next `count` values: add(from, to) adds those of [from, to) to s_,
+  // called for the spans between the bounds (each bound's sum recorded as
+  // it is reached); values past the last bound are not added.
+  template <class Add>
+  void advance(std::size_t count, Add&& add) {
+    const std::size_t end = at_ + count;
+    while (at_ < end && k_ < bound_.size()) {
+      const std::size_t to = static_cast<std::size_t>(bound_[k_]) - 1;  // values before the bound
+      if (at_ == to) {
+        record();
+        continue;
+      }
+      const std::size_t stop = std::min(end, to);
+      add(at_, stop);
+      at_ = stop;
+    }
+    at_ = end;
+    reached();
+  }
   // the running sum is cumsum(c(0, v))[bound] for every bound at the values
   // given so far
   void reached() {
@@ -264,6 +299,43 @@ std::vector<double> per_epoch_of(std::size_t n, double by, bool mean, F&& f) {
 template <class Acc>
 std::vector<double> per_epoch(const double* x, std::size_t n, double by, bool mean) {
   return per_epoch_of<Acc>(n, by, mean, [x](std::size_t i) { return x[i]; });
+}
+
+// Whether every running sum, in Acc, of the values that `spans(f)` gives
+// (f(from, to, v): rows [from, to) of value v) is exact: the values
+// finite, each a whole multiple of 2^q (q the least exponent of their
+// lowest set bits), the sum of their magnitudes under 2^(q + digits - 2).
+// Then each running sum, and each value times a count of rows, is a
+// multiple of 2^q under 2^(q + digits): Acc holds it, no addition rounds,
+// and a run of one value can be added as one product
+// (EpochSums::add_run_exact()), the same bits as row by row. A .cwa
+// file's temperature (multiples of 2^-8) and light (whole numbers) are
+// such values.
+template <class Acc, class Spans>
+bool run_sums_exact(Spans&& spans) {
+  bool ok = true;
+  int q = std::numeric_limits<int>::max();
+  double total = 0;  // (rounded: the bound has a factor of 2 to spare)
+  spans([&](std::size_t from, std::size_t to, double v) {
+    if (!ok || v == 0) return;
+    if (!std::isfinite(v)) {
+      ok = false;
+      return;
+    }
+    int e = 0;
+    const double f = std::frexp(std::fabs(v), &e);  // |v| = f 2^e, f in [0.5, 1)
+    std::uint64_t m = static_cast<std::uint64_t>(std::ldexp(f, 53));  // (whole: 53 bits)
+    int low = e - 53;
+    while ((m & 1u) == 0) {
+      m >>= 1;
+      ++low;
+    }
+    q = std::min(q, low);
+    total += std::fabs(v) * static_cast<double>(to - from);
+  });
+  if (!ok) return false;
+  if (q == std::numeric_limits<int>::max()) return true;  // zeros only
+  return total < std::ldexp(1.0, q + std::numeric_limits<Acc>::digits - 2);
 }
 
 // One sum of a pass over a block's rows (run_pass()): its epochs, and how
@@ -790,19 +862,19 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
       if (!cf.approach_2023) {
         at_r_indices(r_colon(1 + w.nwstart, w.nwend), nrow, [&](std::size_t j) { vals.push_back(v[j]); });
       } else {
-        const std::vector<double> s = r_seq_by(1 + w.nwstart, w.nwend, stride);
-        const double from = s.empty() ? 0 : s[0];
+        const RSeqBy s = r_seq_by_spec(1 + w.nwstart, w.nwend, stride);
+        const double from = s.at(0);
         if (on_lattice && from >= 1 && from == std::floor(from) && std::fmod(from - 1, stride) == 0) {
           // the rows from, from + stride, ... within 1..nrow: the copy's
           const std::size_t j0 = static_cast<std::size_t>((from - 1) / stride);
-          const std::size_t stop = std::min(lattice.size(), j0 + s.size());
+          const std::size_t stop = std::min(lattice.size(), j0 + s.n);
           if (j0 < stop) {
             vals.insert(vals.end(), lattice.begin() + static_cast<std::ptrdiff_t>(j0),
                         lattice.begin() + static_cast<std::ptrdiff_t>(stop));
           }
         } else {
-          for (double d : s) {
-            const std::int64_t j = static_cast<std::int64_t>(d);
+          for (std::size_t k = 0; k < s.n; ++k) {
+            const std::int64_t j = static_cast<std::int64_t>(s.at(k));
             if (j >= 1 && j <= static_cast<std::int64_t>(nrow)) vals.push_back(v[static_cast<std::size_t>(j - 1)]);
           }
         }
@@ -868,8 +940,11 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
 
 // GGIR's lightpeak: for li in 1:(n / M), max(light[((li - 1) M):(li M)])
 // (index 0 dropped, so the first epoch has M values and the others M + 1).
-template <class L>
-std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
+// `light(i)`: row i's value; `range(from, to, f)`, when given, calls f(v)
+// for the values of rows [from, to) (a value once per run of it is
+// enough: a maximum), for the usual epochs of whole rows.
+template <class L, class Range>
+std::vector<double> light_peaks(L&& light, std::size_t n, double M, Range&& range) {
   std::vector<double> out;
   const RColon loop = r_colon(1, static_cast<double>(n) / M);
   if (static_cast<double>(n) / M < 1) return out;
@@ -878,17 +953,32 @@ std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
     const double li = loop.at(k);
     double mx = -std::numeric_limits<double>::infinity();
     bool na = false;
-    at_r_indices(r_colon((li - 1) * M, li * M), n, [&](std::size_t j) {
-      const double v = light(j);
+    const RColon c = r_colon((li - 1) * M, li * M);
+    auto take = [&](double v) {
       if (std::isnan(v)) na = true;
       else if (v > mx) mx = v;
-    });
+    };
+    if (!c.down && c.from >= 0 && c.from == std::floor(c.from) && c.from < 9007199254740992.0) {
+      // whole indices from, from + 1, ...: rows [max(from, 1) - 1, min(last, n))
+      const std::int64_t first = std::max<std::int64_t>(static_cast<std::int64_t>(c.from), 1);
+      const std::int64_t last = std::min<std::int64_t>(static_cast<std::int64_t>(c.from) + c.n - 1,
+                                                       static_cast<std::int64_t>(n));
+      if (first <= last) range(static_cast<std::size_t>(first - 1), static_cast<std::size_t>(last), take);
+    } else {
+      at_r_indices(c, n, [&](std::size_t j) { take(light(j)); });
+    }
     // indices beyond the end are NA in R, and max() without na.rm is NA
-    const RColon c = r_colon((li - 1) * M, li * M);
     if (static_cast<std::int64_t>(c.at(c.n - 1)) > static_cast<std::int64_t>(n)) na = true;
     out[static_cast<std::size_t>(k)] = na ? kNaN : mx;
   }
   return out;
+}
+
+template <class L>
+std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
+  return light_peaks(light, n, M, [&light](std::size_t from, std::size_t to, auto&& f) {
+    for (std::size_t i = from; i < to; ++i) f(light(i));
+  });
 }
 
 // The share of z's running medians the calling thread of short_metrics()
