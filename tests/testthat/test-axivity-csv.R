@@ -294,6 +294,25 @@ test_that("desiredtz across daylight saving: GGIR's, forced stamps and GGIR's NA
     expect_s3_class(b$gravcal, "error")
     expect_match(conditionMessage(b$gravcal),
                  "`desiredtz` = \"Europe/Amsterdam\": a block of GGIR's reading .* starts or ends in the hour")
+    # a recording that starts in the hour: its first block's first stamp is
+    # NA, where GGIR's seq() of the grid stops (g.calibrate() and
+    # g.getmeta()), and so does gravcal
+    gravcal:::write_axivity_csv(rec, f, true_sf = 10.03, start = "2024-03-31 02:30:00", stamps = st)
+    b <- both()
+    expect_s3_class(b$ggir, "error")
+    expect_match(conditionMessage(b$ggir), "must be a finite number")
+    expect_s3_class(b$gravcal, "error")
+    expect_match(conditionMessage(b$gravcal), "starts or ends in the hour that zone's clocks skip")
+    args <- list(params_rawdata = pl$params_rawdata, params_general = pg,
+                 params_metrics = pl$params_metrics, params_cleaning = pl$params_cleaning)
+    gm <- tryCatch({
+      I <- quiet(GGIR::g.inspectfile(f, params_rawdata = pl$params_rawdata, params_general = pg))
+      quiet(do.call(GGIR::g.getmeta, c(list(f), args, list(inspectfileobject = I, verbose = FALSE))))
+    }, error = function(e) e)
+    expect_s3_class(gm, "error")
+    expect_match(conditionMessage(gm), "must be a finite number")
+    expect_error(quiet(do.call(gravcal::g.getmeta, c(list(f), args, list(verbose = FALSE)))),
+                 "starts or ends in the hour that zone's clocks skip")
   }
   # across the autumn change (2024-10-27, 01:00 UTC) forced stamps jump an
   # hour ahead (clock times that exist twice take the later offset), and
