@@ -421,8 +421,13 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       const double* xyz[3] = {cx, cy, cz};
       p1::NonwearResult r;
       std::vector<double> peaks;
+      // the clipping counts and the non-wear's lattice read in the pass of
+      // the sums (the rows read once)
+      p1::ClipLattice lattice(un, nw);
+      const std::function<void(std::size_t, std::size_t)> on_rows =
+          [&](std::size_t from, std::size_t to) { lattice.feed(xyz, from, to); };
       const std::function<void()> beside = [&]() {
-        r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr);
+        r = p1::nonwear_clipping<Acc>(xyz, un, nw, we ? &wear_at : nullptr, &lattice);
         if (li) {
           peaks = p1::light_peaks(light_at, un, M, [li](std::size_t from, std::size_t to, auto&& f) {
             li->values_in(from, to, f);
@@ -431,7 +436,8 @@ Rcpp::List gc_meta_store_epochs(SEXP ptr, const Rcpp::List& cal,
       };
       const std::vector<std::vector<double>> sm =
           p1::short_metrics<Acc>(cx, cy, cz, un, sf, windowsizes[0], names,
-                                 have_f ? &fc : nullptr, arith, lp.data(), lp.size(), threads, beside);
+                                 have_f ? &fc : nullptr, arith, lp.data(), lp.size(), threads, beside,
+                                 lattice.usable ? on_rows : std::function<void(std::size_t, std::size_t)>());
       for (std::size_t k = 0; k < sm.size(); ++k) shorts[static_cast<R_xlen_t>(k)] = as_r(sm[k]);
       shorts.names() = metrics;
       auto finished = [&](bool have, std::ptrdiff_t at) {

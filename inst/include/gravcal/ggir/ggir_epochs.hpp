@@ -358,10 +358,13 @@ inline double r_norm(double x, double y, double z);
 // six sums side by side (EpochSums::add_many()). Each sum's bits are
 // those of its own pass (the same values added in the same order); the
 // pass reads the block once where separate passes read it once per sum.
+// `on_rows`, when given, is called with each chunk's rows [from, to) while
+// they are in cache (ClipLattice::feed()), in increasing order, every row.
 template <class Acc>
 void run_pass(PassSum<Acc>* const* ps, std::size_t k, const double* x, const double* y,
-              const double* z, std::size_t n) {
-  if (k == 0) return;
+              const double* z, std::size_t n,
+              const std::function<void(std::size_t, std::size_t)>& on_rows = {}) {
+  if (k == 0 && !on_rows) return;
   constexpr std::size_t C = 1024;  // rows per chunk: the buffers fit the first-level cache
   bool norm = false;
   for (std::size_t q = 0; q < k; ++q) norm = norm || ps[q]->needs_norm;
@@ -379,7 +382,8 @@ void run_pass(PassSum<Acc>* const* ps, std::size_t k, const double* x, const dou
       for (std::size_t i = from; i < to; ++i) nb[i - from] = r_norm(x[i], y[i], z[i]);
     }
     for (std::size_t q = 0; q < k; ++q) ps[q]->fill(from, to, ps[q]->needs_norm ? nb : nullptr, buf.data() + q * C);
-    EpochSums<Acc>::add_many(e.data(), v.data(), k, to - from);
+    if (k > 0) EpochSums<Acc>::add_many(e.data(), v.data(), k, to - from);
+    if (on_rows) on_rows(from, to);
   }
 }
 
@@ -737,6 +741,69 @@ inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
   }
 }
 
+// The part of nonwear_clipping() that reads every row, for approach
+// "2023" on its lattice (whole stride and long epoch, the epoch a multiple
+// of the stride): each axis's count of values beyond clipthres (and
+// whether any is beyond 1.5 times it) per long epoch, and its rows on the
+// lattice (every stride-th from the first). Fed rows in increasing order,
+// a chunk at a time (feed()), so that it can read them in the pass that
+// reads them for the sums (run_pass()'s `on_rows`) rather than in one of
+// its own; nonwear_clipping() then reads only the lattice. `usable`: the
+// block is on such a lattice (otherwise nonwear_clipping() reads the rows
+// itself).
+struct ClipLattice {
+  bool usable = false;
+  std::size_t nrow = 0, st = 0, M = 0, N = 0;
+  double clipthres = 0, clip15 = 0;
+  std::vector<double> lattice[3];
+  std::vector<std::size_t> over[3];  // per long epoch
+  std::vector<unsigned char> over15[3];
+  std::size_t fed = 0;
+
+  ClipLattice(std::size_t n, const NonwearConfig& cf) : nrow(n) {
+    const double Md = cf.ws2 * cf.sf;
+    const double stride = std::ceil(cf.sf / 5);
+    usable = cf.approach_2023 && stride >= 1 && stride < 1e9 && Md == std::floor(Md) && Md >= 1 &&
+             std::fmod(Md, stride) == 0;
+    if (!usable) return;
+    st = static_cast<std::size_t>(stride);
+    M = static_cast<std::size_t>(Md);
+    N = nrow / M;
+    clipthres = cf.clipthres;
+    clip15 = cf.clipthres * 1.5;
+    for (int a = 0; a < 3; ++a) {
+      lattice[a].reserve(nrow / st + 1);
+      over[a].assign(N, 0);
+      over15[a].assign(N, 0);
+    }
+  }
+  // rows [from, to) of the three axes (from: the rows fed so far)
+  void feed(const double* const xyz[3], std::size_t from, std::size_t to) {
+    if (!usable) return;
+    if (from != fed) throw std::logic_error("ClipLattice: rows out of order");
+    fed = to;
+    for (int a = 0; a < 3; ++a) {
+      const double* v = xyz[a];
+      for (std::size_t j = (from + st - 1) / st * st; j < to; j += st) lattice[a].push_back(v[j]);
+      // the long epochs' counts (rows after the last whole epoch: none)
+      for (std::size_t i = from; i < std::min(to, N * M);) {
+        const std::size_t e = i / M;
+        const std::size_t stop = std::min(std::min(to, N * M), (e + 1) * M);
+        std::size_t n_over = 0;
+        bool big = false;
+        for (std::size_t k = i; k < stop; ++k) {  // (no branch)
+          const double av = std::fabs(v[k]);
+          n_over += av > clipthres ? 1 : 0;
+          big = big | (av > clip15);
+        }
+        over[a][e] += n_over;
+        over15[a][e] = static_cast<unsigned char>(over15[a][e] | big);
+        i = stop;
+      }
+    }
+  }
+};
+
 // With `wear` (an ad hoc csv file's wear flags, row i's as wear(i): 1, 0
 // or NaN), a window's non-wear score is its flags' most frequent value
 // times 3 (GGIR's rule: over (1 + nwstart):nwend, NA left out, a tie goes
@@ -744,7 +811,8 @@ inline void at_r_indices(const RColon& c, std::size_t n, F&& f) {
 // stops there: its table of flags is empty).
 template <class Acc>
 NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, const NonwearConfig& cf,
-                               const std::function<double(std::size_t)>* wear = nullptr) {
+                               const std::function<double(std::size_t)>* wear = nullptr,
+                               const ClipLattice* read = nullptr) {
   NonwearResult r;
   const double M = cf.ws2 * cf.sf;  // MediumEpochSize
   const double L = cf.ws * cf.sf;   // LongEpochSize
@@ -795,46 +863,35 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
   // approach "2023" reads every stride-th row of windows that overlap
   // (ws / ws2 of them hold each row): where the windows start on one
   // lattice of rows (whole stride and long epoch, the epoch a multiple of
-  // the stride), the axis's rows on it are copied once, in order, and the
+  // the stride), each axis's rows on it are copied once, in order, and the
   // windows read the copy (the same values, the axis read once rather than
-  // once per window a row out of every few cache lines)
-  const bool on_lattice = cf.approach_2023 && stride >= 1 && stride < 1e9 && M == std::floor(M) &&
-                          std::fmod(M, stride) == 0;
-  std::vector<double> lattice;
+  // once per window a row out of every few cache lines); the clipping
+  // counts are made in the same read (ClipLattice: `read`, when given, has
+  // read the rows already)
+  std::unique_ptr<ClipLattice> own;
+  const ClipLattice* cl = read;
+  if (cl == nullptr) {
+    own.reset(new ClipLattice(nrow, cf));
+    own->feed(xyz, 0, nrow);
+    cl = own.get();
+  }
+  if (cl->usable && (cl->nrow != nrow || cl->fed != nrow)) throw std::logic_error("ClipLattice: not the block's rows");
+  const bool on_lattice = cl->usable;
   std::vector<double> vals;
   const double clip15 = cf.clipthres * 1.5;
   for (int a = 0; a < 3; ++a) {
     const double* v = xyz[a];
     // first the clipping of every long epoch, then the non-wear (whose
     // windows reach long epochs ahead). Clipping: values beyond clipthres
-    // in (1 + clipstart):clipend. On the lattice, M is whole and those are
-    // rows [(h - 1) M, h M): one pass over the axis counts them and copies
-    // the lattice's rows (every stride-th from the first) on the way.
-    const std::size_t st = on_lattice ? static_cast<std::size_t>(stride) : 0;
-    if (on_lattice) {
-      lattice.clear();
-      lattice.reserve(nrow / st + 1);
-    }
+    // in (1 + clipstart):clipend; on the lattice, M is whole and those are
+    // rows [(h - 1) M, h M), counted by ClipLattice.
+    const std::vector<double>& lattice = cl->lattice[a];
     for (std::int64_t h = 1; h <= N; ++h) {
       double count = 0;
       bool extreme = false;
       if (on_lattice) {
-        // (from: a multiple of the stride, as M is)
-        const std::size_t from = static_cast<std::size_t>(h - 1) * static_cast<std::size_t>(M);
-        const std::size_t to = std::min(nrow, from + static_cast<std::size_t>(M));
-        std::size_t n_over = 0;
-        bool over15 = false;
-        for (std::size_t j = from; j < to; j += st) {
-          lattice.push_back(v[j]);
-          const std::size_t stop = std::min(to, j + st);
-          for (std::size_t i = j; i < stop; ++i) {  // (no branch)
-            const double av = std::fabs(v[i]);
-            n_over += av > cf.clipthres ? 1 : 0;
-            over15 = over15 | (av > clip15);
-          }
-        }
-        count = static_cast<double>(n_over);  // (whole counts: exact)
-        extreme = over15;
+        count = static_cast<double>(cl->over[a][static_cast<std::size_t>(h - 1)]);  // (whole counts: exact)
+        extreme = cl->over15[a][static_cast<std::size_t>(h - 1)] != 0;
       } else {
         const Window w = window(h);
         at_r_indices(r_colon(1 + w.clipstart, w.clipend), nrow, [&](std::size_t j) {
@@ -849,11 +906,6 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
       // R's max(c(...)) of the three clipping fractions
       double& cm = r.clipping[static_cast<std::size_t>(h - 1)];
       cm = a == 0 ? count / M : std::max(cm, count / M);
-    }
-    if (on_lattice) {  // the rows after the last long epoch
-      for (std::size_t j = static_cast<std::size_t>(N) * static_cast<std::size_t>(M); j < nrow; j += st) {
-        lattice.push_back(v[j]);
-      }
     }
     for (std::int64_t h = 1; h <= N; ++h) {
       const Window w = window(h);
@@ -995,7 +1047,8 @@ constexpr double kShareOfZ = 0.2;
 // caller's own sums of the block (`extra`: the long epochs' means) are
 // made in the same pass as the metrics' (run_pass()); the caller finishes
 // them. `beside`, when given, is the caller's other work on the block (it
-// reads x, y, z and writes none of what is here).
+// reads x, y, z and writes none of what is here), made after the pass;
+// `on_rows`, when given, reads the rows in the pass (run_pass()).
 //
 // With `threads` 2, the running medians of GGIR's angles (a fifth of a
 // block's time) and the sums that read them are made on a second thread,
@@ -1012,7 +1065,8 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
                                                RFilterArith arith = {},
                                                PassSum<Acc>* const* extra = nullptr,
                                                std::size_t n_extra = 0, int threads = 1,
-                                               const std::function<void()>& beside = {}) {
+                                               const std::function<void()>& beside = {},
+                                               const std::function<void(std::size_t, std::size_t)>& on_rows = {}) {
   const double by = sf * ws3;
   std::vector<std::vector<double>> out(names.size());
   // the sums of the metrics computed sample by sample, made in one pass
@@ -1261,7 +1315,7 @@ std::vector<std::vector<double>> short_metrics(const double* x, const double* y,
       return std::fabs(en(i % n) - means[(i % m) / each]);
     });
   }
-  run_pass<Acc>(near.data(), near.size(), x, y, z, n);
+  run_pass<Acc>(near.data(), near.size(), x, y, z, n, on_rows);
   if (beside) beside();
 #ifndef GRAVCAL_NO_THREADS
   if (two) {
