@@ -30,8 +30,10 @@ kill_run <- function(job) {
   gone <- function() {
     st <- file.path("/proc", job$pid, "stat")
     if (!dir.exists("/proc/self") || !file.exists(st)) return(TRUE)
-    grepl("\\) [ZX]", paste(tryCatch(readLines(st, n = 1L, warn = FALSE),
-                                      error = function(e) ""), collapse = ""))
+    # (reaped between the two looks: file() warns, then errs)
+    line <- tryCatch(readLines(st, n = 1L, warn = FALSE), error = function(e) NULL,
+                     warning = function(w) NULL)
+    is.null(line) || grepl("\\) [ZX]", paste(line, collapse = ""))
   }
   t0 <- Sys.time()
   while (!gone() && difftime(Sys.time(), t0, units = "secs") < 60) Sys.sleep(0.05)
