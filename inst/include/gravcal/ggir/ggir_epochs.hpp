@@ -992,9 +992,9 @@ NonwearResult nonwear_clipping(const double* const xyz[3], std::size_t nrow, con
 
 // GGIR's lightpeak: for li in 1:(n / M), max(light[((li - 1) M):(li M)])
 // (index 0 dropped, so the first epoch has M values and the others M + 1).
-// `light(i)`: row i's value; `range(from, to, f)`, when given, calls f(v)
-// for the values of rows [from, to) (a value once per run of it is
-// enough: a maximum), for the usual epochs of whole rows.
+// `light(i)`: row i's value; `range(from, to, f)` calls f(v) for the
+// values of rows [from, to) (a value once per run of it is enough: a
+// maximum), for the usual epochs of whole rows.
 template <class L, class Range>
 std::vector<double> light_peaks(L&& light, std::size_t n, double M, Range&& range) {
   std::vector<double> out;
@@ -1024,13 +1024,6 @@ std::vector<double> light_peaks(L&& light, std::size_t n, double M, Range&& rang
     out[static_cast<std::size_t>(k)] = na ? kNaN : mx;
   }
   return out;
-}
-
-template <class L>
-std::vector<double> light_peaks(L&& light, std::size_t n, double M) {
-  return light_peaks(light, n, M, [&light](std::size_t from, std::size_t to, auto&& f) {
-    for (std::size_t i = from; i < to; ++i) f(light(i));
-  });
 }
 
 // The share of z's running medians the calling thread of short_metrics()
