@@ -75,18 +75,47 @@ axivity_csv_header <- function(file) {
 # rounded down to a multiple of 5.
 axivity_csv_sf <- function(file) {
   t <- utils::read.csv(file, nrows = 1e5)[[1]]
+  n <- length(t)
   if (!is.numeric(t)) {
-    t <- tryCatch(as.numeric(as.POSIXct(t, origin = "1970-01-01")), error = function(e) NULL)
+    t <- tryCatch(r_posixct_ends(t), error = function(e) NULL)
     if (is.null(t)) {
       abort("The time stamps of the Axivity csv export \"", file, "\" are in no format R's ",
             "as.POSIXct() reads (GGIR's g.inspectfile() stops on them too).")
     }
+  } else if (n > 0) {
+    t <- t[c(1, n)]
   }
-  sf <- floor((length(t) / (t[length(t)] - t[1])) / 5) * 5
+  sf <- floor((n / (t[length(t)] - t[1])) / 5) * 5
   if (!isTRUE(sf > 0 && is.finite(sf))) {
     abort("The sampling frequency of the Axivity csv export \"", file, "\" is unknown: give `sf`.")
   }
   sf
+}
+
+# The first and last values of as.numeric(as.POSIXct(x)) for text `x` (in
+# the session's zone), without converting the values between: R's
+# as.POSIXlt() takes the first of its formats that reads every value that
+# is not NA, and stops when none does. A format that does not read the
+# first of them cannot read them all, so it is passed over after one value
+# (R reads all of them with it); the one taken is checked on all, as R
+# checks it; each value's time depends on its own text alone, so the two
+# ends are converted alone. Other types (a factor, all NA) go through R's
+# own conversion.
+r_posixct_ends <- function(x) {
+  n <- length(x)
+  if (!is.character(x) || n == 0) {
+    v <- as.numeric(as.POSIXct(x, origin = "1970-01-01"))
+    return(if (n) v[c(1, n)] else v)
+  }
+  xx <- x[!is.na(x)]
+  if (!length(xx)) return(as.numeric(as.POSIXct(x[c(1, n)])))
+  for (f in r_time_formats) {
+    if (is.na(strptime(xx[1], f, tz = ""))) next
+    if (all(!is.na(strptime(xx, f, tz = "")))) {
+      return(as.numeric(as.POSIXct(strptime(x[c(1, n)], f, tz = ""), tz = "")))
+    }
+  }
+  stop("character string is not in a standard unambiguous format")
 }
 
 # The formats R's as.POSIXct() tries on text, in its order.

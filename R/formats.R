@@ -156,8 +156,11 @@ recording_formats <- list(
     # the time stamps' layout and GGIR's rate (R/axivity-csv.R); in GGIR's
     # blocks of lines when streamed
     decoder_options = function(file, opts, sf, read) {
+      # (found_sf: the rate an earlier opening of the file found, in place
+      # of reading its first 100,000 stamps again)
       lay <- if (read$whole) axivity_csv_layout(file, sf) else {
-        axivity_csv_layout(file, sf, compat = isTRUE(read$compat), zone = read$zone %||% "",
+        axivity_csv_layout(file, sf %||% read$found_sf, compat = isTRUE(read$compat),
+                           zone = read$zone %||% "",
                            zone_arg = read$zone_arg %||% "desiredtz")
       }
       sf <- lay$sf

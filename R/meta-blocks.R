@@ -23,6 +23,9 @@ meta_source <- function(datafile, p, sf, arg, read_opts) {
   if (is.null(src$native) || !isTRUE(p$imputeTimegaps) || !isTRUE(fe$ggir_timegaps)) {
     return(src)
   }
+  # (the rate the first opening found from the file's data, where `sf` did
+  # not give it, taken as found: formats that find it so skip that read)
+  if (is.null(sf)) read_opts$found_sf <- src$sf
   ro <- c(read_opts, list(getmeta_timegaps = 1,
                           getmeta_gap_limit = max(c(((p$windowsizes[2] / 60) * 6), 90)),
                           getmeta_epoch_gaps = 1, short_epoch = p$windowsizes[1],

@@ -212,12 +212,14 @@ source_native <- function(file, format, sf, chunksize, compat, arg,
                           read_opts = list(), extra = NULL, part = "calibrate") {
   opts <- c(list(compat = as.numeric(isTRUE(compat))), read_opts)
   opts$zone_arg <- NULL
+  opts$found_sf <- NULL
   if (!is.null(sf)) opts$sf <- as.numeric(sf)
   opts[names(extra)] <- extra
   set <- format_decoder_options(format, file, opts, sf,
                                 list(whole = FALSE, compat = compat, chunksize = chunksize,
                                      part = part, zone = read_opts$zone,
-                                     zone_arg = read_opts$zone_arg))
+                                     zone_arg = read_opts$zone_arg,
+                                     found_sf = read_opts$found_sf))
   opts <- set$opts
   sf <- set$sf
   h <- decoder_open(file, format, opts)

@@ -45,6 +45,46 @@ test_that("g.calibrate() on an Axivity csv export is GGIR's, both readers", {
                "`interpolationType` = 2 is taken by gravcal's own decoders only")
 })
 
+test_that("the rate's two time stamps are R's as.POSIXct() of the whole column, every format and zone", {
+  # axivity_csv_sf() converts only the first and last of GGIR's 100,000
+  # stamps (r_posixct_ends()); the reference is R's own conversion of all
+  # of them (as g.inspectfile() converts them), in the session's zone
+  whole <- function(x) {
+    v <- tryCatch(as.numeric(as.POSIXct(x, origin = "1970-01-01")), error = function(e) "error")
+    if (is.character(v)) v else v[c(1, length(v))]
+  }
+  ends <- function(x) tryCatch(gravcal:::r_posixct_ends(x), error = function(e) "error")
+  t0 <- as.POSIXct("2024-03-31 00:30:00", tz = "UTC") + (0:35999) / 10.03  # Amsterdam's spring change
+  txt <- function(f, t = t0) format(t, f, tz = "UTC")
+  cases <- list(
+    iso = txt("%Y-%m-%d %H:%M:%OS3"),
+    slash = txt("%Y/%m/%d %H:%M:%OS2"),
+    minutes = txt("%Y-%m-%d %H:%M"),
+    slash_minutes = txt("%Y/%m/%d %H:%M"),
+    days = txt("%Y-%m-%d"),
+    # one stamp without seconds: R takes "%Y-%m-%d %H:%M" for all (the
+    # seconds of the others dropped)
+    one_short = replace(txt("%Y-%m-%d %H:%M:%S"), 20000, "2024-03-31 06:00"),
+    # the first stamps in one format, the last in another: none reads all
+    mixed = c(txt("%Y/%m/%d %H:%M:%S")[1:100], txt("%Y-%m-%d %H:%M:%S")[-(1:100)]),
+    na_inside = replace(txt("%Y-%m-%d %H:%M:%S"), c(5, 900), NA),
+    na_first = replace(txt("%Y-%m-%d %H:%M:%S"), 1, NA),
+    all_na = rep(NA_character_, 10),
+    garbage = c("not a time", txt("%Y-%m-%d %H:%M:%S")[-1]),
+    one = txt("%Y-%m-%d %H:%M:%S")[1],
+    factor = factor(txt("%Y-%m-%d %H:%M:%S")[1:50]))
+  old <- Sys.getenv("TZ", unset = NA)
+  on.exit(if (is.na(old)) Sys.unsetenv("TZ") else Sys.setenv(TZ = old), add = TRUE)
+  for (tz in c("UTC", "Europe/Amsterdam", "America/New_York")) {
+    Sys.setenv(TZ = tz)
+    for (nm in names(cases)) {
+      expect_identical(ends(cases[[nm]]), whole(cases[[nm]]), label = paste(tz, nm))
+    }
+  }
+  expect_identical(ends(cases$mixed), "error")
+  expect_true(is.numeric(ends(cases$one_short)))
+})
+
 test_that("an Axivity csv export read whole keeps its samples and times; other csv files are not one", {
   rec <- simulate_recording(hours = 0.1, sf = 10, seed = 22, temperature = FALSE)
   f <- tempfile(fileext = ".csv")
