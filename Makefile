@@ -91,7 +91,8 @@ demo: install
 # in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the identity tests
 # comes from tests/ggir-cache where the same input, parameters, GGIR version
 # and platform were run before (tests/testthat/helper-ggir-cache.R; the
-# check recomputes a sixteenth of the entries and compares them). Every
+# check recomputes a sixteenth of the entries, those whose GGIR call took
+# at most 20 s of CPU, and compares them; make test-ggir-cache all). Every
 # step's R runs with TEST_TUNABLES.
 #
 # SANITIZE_TESTS: the test files whose tests drive the C++ core and its glue
