@@ -141,7 +141,9 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
   if (length(dots) && (is.null(names(dots)) || any(names(dots) == ""))) {
     abort("All arguments in `...` must be named.")
   }
-  pr <- ggir_params(params_rawdata, params_general, dots)
+  pr <- ggir_params(params_rawdata, params_general, dots,
+                    checked = ggir_extracts(dots, params_rawdata, params_general,
+                                            params_cleaning))
   check_flag(verbose, "verbose")
   check_fp_build("`g.calibrate()`")
   sf <- dots$sf
@@ -273,7 +275,7 @@ ggir_check_inspect <- function(I, datafile, adhoc) {
 # the legacy arguments in `dots`, which win; other parameters GGIR takes
 # (the table's rows, params_cleaning's) are accepted, anything else in
 # `dots` warned about.
-ggir_params <- function(params_rawdata, params_general, dots) {
+ggir_params <- function(params_rawdata, params_general, dots, checked = FALSE) {
   for (a in c("params_rawdata", "params_general")) {
     v <- get(a)
     if (length(v) && !is.list(v)) {
@@ -299,8 +301,10 @@ ggir_params <- function(params_rawdata, params_general, dots) {
     warning("g.calibrate(): ignored argument", if (length(extra) > 1) "s",
             " ", paste0("`", extra, "`", collapse = ", "), call. = FALSE)
   }
-  ggir_param_values("ggir", list(from(params_rawdata, "rawdata"),
-                                 from(params_general, "general"), dots))
+  out <- ggir_param_values("ggir", list(from(params_rawdata, "rawdata"),
+                                        from(params_general, "general"), dots))
+  if (checked) out <- ggir_check_values(out, "rawdata")
+  out
 }
 
 # After a GGIR-compatible .cwa or ad hoc csv read in a zone whose offset

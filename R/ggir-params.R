@@ -250,3 +250,66 @@ ggir_param_known <- function() {
   rows <- Filter(function(p) !is.na(p$ggir), ggir_param_table())
   vapply(rows, `[[`, "", "ggir")
 }
+
+# Whether GGIR 3.3-9's g.calibrate() and g.getmeta() pass their parameters
+# through extract_params() and so check_params(): when an argument comes
+# in `...` or one of the parameter lists they take is not given (empty).
+# g.part1() always does (it calls GGIR's own).
+ggir_extracts <- function(dots, ...) {
+  length(dots) > 0 || any(vapply(list(...), length, 0L) == 0)
+}
+
+# What GGIR 3.3-9's check_params() changes, of the values g.calibrate() and
+# g.getmeta() read, in the lists it checks (`lists`: "rawdata", "general",
+# "metrics"), on the parameters `p` (one list by name):
+# * `chunksize` below 0.1 is taken as 0.1;
+# * `windowsizes`: a long epoch that is not whole minutes is rounded up to
+#   them; then a short epoch that does not divide the long one is taken as
+#   the nearest of 1, 5, 10, 15, 20, 30 and 60 seconds; then a non-wear
+#   window that is not a whole number of long epochs is rounded up to one
+#   (each with a warning, as GGIR warns);
+# * a `dataFormat` of epoch data (Actiwatch, PHB, UK Biobank) turns off the
+#   metrics of raw data, on which GGIR's g.getmeta() computes nothing: an
+#   error naming it.
+ggir_check_values <- function(p, lists) {
+  if ("rawdata" %in% lists) {
+    cs <- p$chunksize
+    if (is.numeric(cs) && length(cs) == 1 && !is.na(cs) && cs < 0.1) p$chunksize <- 0.1
+  }
+  ws <- p$windowsizes
+  if ("general" %in% lists && is.numeric(ws) && length(ws) == 3 && !anyNA(ws) && all(ws > 0)) {
+    said <- function(what, to) {
+      warning("`windowsizes`: ", what, ", so GGIR's parameter check makes it ", to,
+              " seconds (and so does gravcal's g.getmeta()).", call. = FALSE)
+    }
+    if (ws[2] / 60 != round(ws[2] / 60)) {
+      ws[2] <- 60 * ceiling(ws[2] / 60)
+      said("the long epoch is not a whole number of minutes", ws[2])
+    }
+    if (ws[2] / ws[1] != round(ws[2] / ws[1])) {
+      steps <- c(1, 5, 10, 15, 20, 30, 60)
+      d <- abs(steps - ws[1])
+      near <- steps[d == min(d)]
+      if (length(near) != 1) {
+        abort("`windowsizes`: the short epoch of ", ws[1], " seconds does not divide the long ",
+              "epoch, and GGIR's parameter check would replace it by two values at once (",
+              paste(near, collapse = " and "), ": its windowsizes then has four); give a short ",
+              "epoch that divides the long one.")
+      }
+      ws[1] <- near
+      said("the short epoch does not divide the long one", ws[1])
+    }
+    if (ws[3] / ws[2] != round(ws[3] / ws[2])) {
+      ws[3] <- ws[2] * ceiling(ws[3] / ws[2])
+      said("the non-wear window is not a whole number of long epochs", ws[3])
+    }
+    p$windowsizes <- ws
+  }
+  epoch_data <- c("actiwatch_awd", "actiwatch_csv", "phb_xlsx", "ukbiobank")
+  if (all(c("metrics", "general") %in% lists) && isTRUE(p$dataFormat %in% epoch_data)) {
+    abort("`dataFormat` = \"", p$dataFormat, "\": epoch data, not raw samples; GGIR's parameter ",
+          "check then turns off the metrics of raw data, and g.getmeta() has nothing to compute ",
+          "(GGIR's GGIR() reads such files without part 1's g.getmeta()).")
+  }
+  p
+}

@@ -114,6 +114,10 @@
 #'   `rmc.*` parameters give).
 #' @param verbose Print the blocks read, as GGIR does.
 #' @param ... GGIR's legacy arguments: any parameter of the lists by name.
+#'   Where GGIR's g.getmeta() runs its parameter check (an argument here,
+#'   or a list not given), what that check changes is changed here too:
+#'   `chunksize` below 0.1 is 0.1, `windowsizes` are made multiples of
+#'   each other (with a warning), a `dataFormat` of epoch data is refused.
 #' @return GGIR's list `M`: `filecorrupt`, `filetooshort`,
 #'   `NFilePagesSkipped`, `metalong`, `metashort`, `wday`, `wdayname`,
 #'   `windowsizes`, `bsc_qc`, `QClog`.
@@ -124,8 +128,10 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
                       offset = c(0, 0, 0), scale = c(1, 1, 1), tempoffset = c(0, 0, 0),
                       meantempcal = c(), myfun = c(), inspectfileobject = c(),
                       verbose = TRUE, ...) {
-  p <- meta_params(params_metrics, params_rawdata, params_general, params_cleaning,
-                   list(...))
+  dots <- list(...)
+  p <- meta_params(params_metrics, params_rawdata, params_general, params_cleaning, dots,
+                   checked = ggir_extracts(dots, params_metrics, params_rawdata,
+                                           params_general, params_cleaning))
   check_flag(verbose, "verbose")
   myfun <- if (length(myfun)) meta_myfun_check(myfun, p$windowsizes[1])
   cal <- meta_calibration(offset, scale, tempoffset, meantempcal)
@@ -236,7 +242,7 @@ meta_defaults <- function() {
 # GGIR's defaults), then the legacy arguments in `dots` by name. The ones
 # that change M and are not honoured are an error naming them.
 meta_params <- function(params_metrics, params_rawdata, params_general, params_cleaning,
-                        dots) {
+                        dots, checked = FALSE) {
   if (length(dots) && (is.null(names(dots)) || any(names(dots) == ""))) {
     abort("All arguments in `...` must be named.")
   }
@@ -254,6 +260,9 @@ meta_params <- function(params_metrics, params_rawdata, params_general, params_c
     for (nm in names(v)) p[nm] <- list(v[[nm]])
   }
   for (nm in names(dots)) p[nm] <- list(dots[[nm]])
+  # (GGIR's g.getmeta() checks them when a list is not given or an argument
+  # comes in `...`: what that check changes, changed here)
+  if (checked) p <- ggir_check_values(p, c("metrics", "rawdata", "general"))
   # nonwear_approach as a number (GGIR's config.csv read back gives 2023):
   # GGIR's %in% and == read it as its text
   na <- p$nonwear_approach

@@ -1389,3 +1389,71 @@ test_that("M's text round trip, taken once per distinct value, is R's element by
   # the text does not give back every value: the round trip is not the identity
   expect_false(identical(text_round_trip(1 / 3), 1 / 3))
 })
+
+test_that("GGIR's parameter check, where GGIR's g.getmeta() and g.calibrate() run it: chunksize, windowsizes, dataFormat", {
+  skip_if_quick()
+  skip_if_not_installed("GGIR")
+  # GGIR 3.3-9's g.getmeta() and g.calibrate() pass their parameters through
+  # extract_params() and check_params() when an argument comes in `...` or
+  # a list is not given: chunksize below 0.1 becomes 0.1, windowsizes are
+  # made multiples of each other (with warnings); given every list, they
+  # are taken as they are. gravcal gave the values as given either way
+  # (found by probing: file too short at chunksize 0.05, other epochs).
+  f <- meta_recording("cwa", 25, 6, seed = 3)
+  I <- meta_quiet(GGIR::g.inspectfile(f))
+  both <- function(label, ...) {
+    args <- list(...)
+    warned <- function(expr) {
+      w <- character()
+      v <- withCallingHandlers(meta_quiet_keep_warnings(expr), warning = function(x) {
+        w <<- c(w, conditionMessage(x))
+        invokeRestart("muffleWarning")
+      })
+      list(v = v, w = w)
+    }
+    R <- ggir_cached("g.getmeta", f, c(list(check = label), args), {
+      meta_quiet(do.call(GGIR::g.getmeta, c(list(datafile = f, inspectfileobject = I,
+                                                  verbose = FALSE), args)))
+    })
+    G <- warned(do.call(gravcal::g.getmeta, c(list(datafile = f, inspectfileobject = I,
+                                                   verbose = FALSE), args)))
+    list(ggir = R, gravcal = G$v, warnings = G$w)
+  }
+  b <- both("chunksize", chunksize = 0.05)
+  expect_same_meta(b)
+  expect_false(b$gravcal$filetooshort)
+  pr <- GGIR::load_params()$params_rawdata
+  pr$chunksize <- 0.05
+  expect_same_meta(both("list", params_rawdata = pr))
+  for (ws in list(c(5, 930, 3600), c(7, 900, 3600), c(5, 900, 4000))) {
+    b <- both("windowsizes", windowsizes = ws)
+    expect_same_meta(b)
+    expect_false(identical(b$gravcal$windowsizes, ws))
+    expect_match(b$warnings, "GGIR's parameter check makes it", all = FALSE)
+  }
+  # every list given: no check, the values as given (GGIR's too)
+  L <- GGIR::load_params()
+  L$params_general$windowsizes <- c(5, 930, 3600)
+  b <- both("all lists", params_metrics = L$params_metrics, params_rawdata = L$params_rawdata,
+            params_general = L$params_general, params_cleaning = L$params_cleaning)
+  expect_same_meta(b)
+  expect_identical(b$gravcal$windowsizes, c(5, 930, 3600))
+  # a short epoch halfway between two of GGIR's: its check gives both
+  expect_error(meta_quiet(gravcal::g.getmeta(f, inspectfileobject = I, verbose = FALSE,
+                                             windowsizes = c(17.5, 900, 3600))),
+               "would replace it by two values at once")
+  # epoch data: GGIR turns the metrics of raw data off (its g.getmeta()
+  # then stops on some files, "subscript out of bounds"): refused, naming it
+  pg <- L$params_general
+  pg$dataFormat <- "ukbiobank"
+  expect_error(meta_quiet(gravcal::g.getmeta(f, inspectfileobject = I, verbose = FALSE,
+                                             params_general = pg)),
+               "`dataFormat` = \"ukbiobank\": epoch data")
+  # g.calibrate(): chunksize 0.05 in `...` is GGIR's 0.1
+  C <- ggir_cached("g.calibrate", f, list(check = "chunksize", chunksize = 0.05), {
+    meta_quiet(GGIR::g.calibrate(f, inspectfileobject = I, verbose = FALSE, chunksize = 0.05))
+  })
+  G <- meta_quiet(gravcal::g.calibrate(f, inspectfileobject = I, verbose = FALSE,
+                                       chunksize = 0.05))
+  for (nm in setdiff(names(C), "bsc_qc")) expect_identical(G[[nm]], C[[nm]], label = nm)
+})
