@@ -141,7 +141,7 @@ ggir_cached <- function(label, files, args, compute) {
 # test-ggir-cache).
 ggir_cache_spot_check <- function(dir, key) {
   if (!startsWith(key, "0")) return(FALSE)
-  limit <- as.numeric(Sys.getenv("GRAVCAL_GGIR_VERIFY_SECONDS", "20"))
+  limit <- suppressWarnings(as.numeric(Sys.getenv("GRAVCAL_GGIR_VERIFY_SECONDS", "20")))
   if (is.na(limit)) {
     stop("GRAVCAL_GGIR_VERIFY_SECONDS must be a number of seconds, not \"",
          Sys.getenv("GRAVCAL_GGIR_VERIFY_SECONDS"), "\"", call. = FALSE)
