@@ -39,6 +39,12 @@
 #   (a data frame, or NULL when none);
 # * ggir_stops(src): why GGIR's reader stops on the file (g.getmeta() then
 #   refuses it, saying so), or NULL;
+# * ggir_read_stops(src, part): the same from what the native decoder has
+#   read so far, asked after each of g.getmeta()'s blocks (`part`
+#   "getmeta") and after g.calibrate() ("calibrate"): where GGIR's reader
+#   stops, or reads what gravcal's decoder does not follow;
+# * ggir_damage_warning(src): g.getmeta()'s warning of the damage its
+#   native decoder read as GGIR's reader reads it;
 # * own_rate: TRUE for a device format whose file records its sampling
 #   rate (that rate is used; an `sf` that disagrees is an error);
 # * label: the format in messages ("as an Axivity .cwa file");
@@ -330,6 +336,11 @@ recording_formats <- list(
     # for the last one; after its resampling of a rate that rounds down
     # (12.5 Hz to 12) every block has fewer, so GGIR stops after the first
     ggir_short_rows = function(units) units * 300,
+    # damaged pages: read as GGIRread reads them (decode_geneactiv.hpp),
+    # but where it stops or goes where the decoder does not follow
+    ggir_stops = function(src) geneactiv_ggir_stops(src, "getmeta"),
+    ggir_read_stops = function(src, part) geneactiv_ggir_stops(src, part),
+    ggir_damage_warning = function(src) geneactiv_damage_warning(src),
     r_options = function(file, options, zone) {
       lo <- geneactiv_light_header(file)
       lo <- lo[setdiff(names(lo), names(options))]

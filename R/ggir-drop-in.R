@@ -196,6 +196,15 @@ g.calibrate <- function(datafile, params_rawdata = c(), params_general = c(),
                         minloadcrit = pr$minloadcrit,
                         sdcriter = sdcriter, verbose = verbose,
                         printsummary = pr$printsummary)
+  # where GGIR's reader stops, or reads what the decoder does not follow
+  # (GENEActiv: damaged pages)
+  stops <- format_entry(src$format)$ggir_read_stops
+  why <- if (!is.null(stops) && !is.null(src$native)) stops(src, "calibrate")
+  if (!is.null(why)) {
+    abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's g.calibrate() ",
+          "gives no result there that gravcal reproduces, so gravcal's refuses the file ",
+          "(calibrate() reads it).")
+  }
   if (identical(src$format, rmc_format()) && !is.null(rmc)) {
     ggir_check_zone_read(src, attr(rmc, "tz") %||% "", attr(rmc, "tz_arg"))
     rmc_check_wear(src)

@@ -25,6 +25,14 @@
 #' worker to one.
 #'
 #' @section What this version covers:
+#' Damaged files: where GGIR's reader skips or imputes as gravcal's decoder
+#' does (`.cwa`, Parmay Matrix), M is GGIR's, `QClog` included; a damaged
+#' GENEActiv page (garbled digits, a hex line cut short or too long, a
+#' garbled temperature or rate, a line missing, a last page cut short) is
+#' read as GGIRread reads it, so M is GGIR's there too (a warning says what
+#' was read so); where GGIR stops on such a file, or its time stamps are
+#' not defined where it reads them, gravcal's stops too, saying why.
+#'
 #' Formats: Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x` and csv
 #' exports (their time gaps and idle-sleep zeros filled as GGIR fills them; a
 #' gap over GGIR's limit, 90 minutes or 6 long epochs, filled up to the next

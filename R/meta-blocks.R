@@ -297,6 +297,16 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
       }
     }
     last_read <- times[3]
+    # where GGIR's reader stops, or reads what the decoder does not follow
+    # (GENEActiv: damaged pages), from what has been read so far
+    if (!is.null(fe$ggir_read_stops) && !is.null(src$native)) {
+      why <- fe$ggir_read_stops(src, "getmeta")
+      if (!is.null(why)) {
+        abort("\"", basename(src$filename), "\" (`datafile`) has ", why, ": GGIR's ",
+              "g.getmeta() gives no result there that gravcal reproduces, so gravcal's refuses ",
+              "the file (calibrate() reads it).")
+      }
+    }
     isLastBlock <- FALSE
     have <- TRUE
     if (nr == 0) {
@@ -346,6 +356,14 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         metricnames_long <- c("timestamp", "nonwearscore", "clippingscore",
                               if (light.available) c("lightmean", "lightpeak"),
                               if (use.temp) "temperaturemean", "EN")
+      }
+      # a time stamp the decoder leaves NaN where GGIR's reader does not
+      # define it (GENEActiv: a page read at 0 Hz), read by GGIR here
+      if (meta_undefined_time(src, if (i == 1) times[1] else if (carry > 0) c(times[1], carry_time))) {
+        abort("\"", basename(src$filename), "\" (`datafile`) has a page read at 0 Hz (its ",
+              "\"Measurement Frequency:\" damaged or cut), after which GGIR's reader's time ",
+              "stamps are not defined (they depend on the platform), and GGIR's g.getmeta() ",
+              "reads them at a block's edge; gravcal's refuses the file (calibrate() reads it).")
       }
       if (carry > 0 && !is.na(times[1]) && !is.na(carry_time)) {
         gap <- as.numeric(times[1] - carry_time)
@@ -507,9 +525,8 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   imputed <- counter("imputed_spans")
   if (is.null(fe$ggir_qclog) && is.null(fe$ggir_block_qclog) &&
       (imputed > 0 || isTRUE(rep$skipped > 0))) {
-    # (GGIRread's GENEActiv reader, for one, keeps what it can decode of a
-    # damaged page, garbled digits read as far as they go, and closes up
-    # its time count after it: gravcal's decoder skips the page whole)
+    # (csv lines and .gt3x records the decoder skips; GENEActiv pages are
+    # read as GGIR's reader reads them, none skipped: ggir_damage_warning)
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
             unit_name(src$format, rep$skipped), " skipped, ", imputed, " span",
             if (imputed != 1) "s", " imputed (damage, or time stamps that jump); GGIR's reader ",
@@ -523,6 +540,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
             unit_name(src$format, rep$skipped), " skipped, as GGIR's reader skips them ",
             "(M$QClog logs them).", call. = FALSE)
   }
+  if (!is.null(fe$ggir_damage_warning)) fe$ggir_damage_warning(src)
   if (!is.null(fe$ggir_block_qclog) && counter("qclog_not_reproduced") > 0) {
     warning("\"", basename(src$filename), "\": ", counter("qclog_not_reproduced"),
             " place", if (counter("qclog_not_reproduced") != 1) "s", " where GGIR's reader stops ",
@@ -537,6 +555,16 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
     if (!is.null(M$enmo_gradient)) colnames(M$enmo_gradient) <- grad_names
   }
   invisible(M)
+}
+
+# Whether `times` (what GGIR's g.getmeta() reads of a block) hold one that
+# the native decoder left NaN because GGIR's reader does not define it (its
+# count "ggir_time_undefined": GENEActiv).
+meta_undefined_time <- function(src, times) {
+  # (NaN, or NA once the zone's shift has been applied)
+  if (!anyNA(times) || is.null(src$native) || is.null(src$report)) return(FALSE)
+  k <- src$report()$counters
+  "ggir_time_undefined" %in% names(k) && k[["ggir_time_undefined"]] > 0
 }
 
 # A block's time stamps, from a decoder that reads the file's clock as UTC,
@@ -560,7 +588,11 @@ meta_zone_shift <- function(time, zone, per_sample = FALSE) {
     }
     local - t1
   }
-  d <- shift(time[1])
+  # (a time that is not finite, GENEActiv's after a page read at 0 Hz,
+  # stays as it is)
+  ok <- is.finite(time)
+  if (!any(ok)) return(time)
+  d <- shift(time[ok][1])
   if (per_sample && shift(time[length(time)]) != d) d <- shift(time)
   time + d
 }

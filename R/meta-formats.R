@@ -1,8 +1,10 @@
 # What g.getmeta() takes from a format's own header or log, as GGIR's
-# readers take it (the registry's ggir_start, ggir_qclog and ggir_stops in
-# R/formats.R point here): the start of an ActiGraph csv export and of a
-# Movisens recording, a Parmay Matrix file's packet log and the files
-# GGIR's Parmay reader fails on.
+# readers take it (the registry's ggir_start, ggir_qclog, ggir_stops,
+# ggir_read_stops and ggir_damage_warning in R/formats.R point here): the
+# start of an ActiGraph csv export and of a Movisens recording, a Parmay
+# Matrix file's packet log and the files GGIR's Parmay reader fails on,
+# and the damaged GENEActiv files GGIR's reader stops on or reads where
+# gravcal's decoder does not follow.
 
 # The start of an ActiGraph csv export, as GGIR's g.getstarttime() reads
 # it: "Start Time" and "Start Date" from the header lines below the first,
@@ -165,4 +167,63 @@ parmay_ggir_stops <- function(src) {
                   "nothing, and GGIR's g.getmeta() fails)"))
   }
   NULL
+}
+
+# Where GGIR's reading of a damaged GENEActiv .bin file (GGIRread's
+# readGENEActiv(), whose reading of damaged pages the native decoder follows
+# in GGIR's mode: decode_geneactiv.hpp) stops, or goes where the decoder
+# does not follow, from the decoder's counts so far: why, or NULL.
+# `part`: "getmeta" (its start is read; a block's first and last time
+# stamps are checked in meta_run()) or "calibrate" (time stamps matter only
+# where GGIR resamples the blocks by them: a rate that is not whole).
+geneactiv_ggir_stops <- function(src, part) {
+  k <- src$report()$counters
+  n <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+  if (n("ggir_not_reproduced") > 0) {
+    return(paste0("a page line longer than 8192 characters that GGIR's reader reads on ",
+                  "(gravcal's decoder keeps lines to that length)"))
+  }
+  if (n("ggir_rate_mismatch") > 0) {
+    return(paste0("a page whose \"Measurement Frequency:\" reads as another rate than ",
+                  "the file's where GGIR takes the file's rate from it, or decides by it ",
+                  "whether to resample a block (or stops: \"sampling rate inconsistency\")"))
+  }
+  if (n("ggir_start_unread") > 0 && (part == "getmeta" || n("ggir_resampled_time_undefined") > 0)) {
+    return(paste0("a first page whose \"Page Time:\" GGIR's reader does not read as a time ",
+                  "(its time stamps are then NA, and GGIR stops on them)"))
+  }
+  if (n("ggir_resampled_time_undefined") > 0) {
+    return(paste0("a page read at 0 Hz, whose time stamps GGIR's reader does not define ",
+                  "(what they hold depends on the platform), in a recording GGIR resamples ",
+                  "by its time stamps"))
+  }
+  NULL
+}
+
+# g.getmeta()'s warning of a GENEActiv file's damage, which the native
+# decoder read as GGIR's reader reads it (so M is GGIR's): damaged pages
+# (a hex line that is not 3600 hex digits: what decodes of it kept, garbled
+# digits read as far as they go; a page header line not as the format has
+# it), lines missing or extra (GGIR reads ten lines a page regardless), a
+# last page cut short.
+geneactiv_damage_warning <- function(src) {
+  rep <- src$report()
+  k <- rep$counters
+  n <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+  damaged <- n("damaged_hex") + n("damaged_page_header")
+  what <- c(
+    if (damaged > 0) {
+      paste0(damaged, " damaged page", if (damaged != 1) "s", " (what GGIR's reader decodes ",
+             "of each kept, garbled digits read as far as they go)")
+    },
+    if (n("misaligned_page") > 0) {
+      paste0(n("misaligned_page"), " page", if (n("misaligned_page") != 1) "s",
+             " after lines missing or extra, read ten lines a page as GGIR's reader reads them")
+    },
+    if (n("truncated_page") > 0) "a last page cut short")
+  if (!length(what)) return(invisible())
+  warning("\"", basename(src$filename), "\": ", paste(what, collapse = ", "),
+          "; read as GGIR's reader (GGIRread) reads them, so M is GGIR's ",
+          "(M$QClog is NULL, as GGIR's).", call. = FALSE)
+  invisible()
 }

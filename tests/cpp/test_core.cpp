@@ -17,6 +17,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -817,7 +818,7 @@ static void test_avx2_geneactiv() {
     return;
   }
   std::mt19937 rng(2026);
-  int differ = 0, skipped_pages = 0;
+  int differ = 0, skipped_pages = 0, read_damaged = 0;
   for (int rep = 0; rep < 100; ++rep) {
     const std::string f = random_geneactiv(rng, 30);
     for (int compat = 0; compat < 2; ++compat) {
@@ -829,12 +830,74 @@ static void test_avx2_geneactiv() {
                         (a.v.empty() || std::memcmp(a.v.data(), b.v.data(),
                                                     a.v.size() * sizeof(double)) == 0);
       if (!same) ++differ;
-      if (!a.counts.empty()) skipped_pages += static_cast<int>(a.counts[2]);
+      if (a.counts.empty()) continue;
+      if (compat == 0) {
+        skipped_pages += static_cast<int>(a.counts[2]);
+      } else {
+        // (the counters' names lead the notes, in the counters' order)
+        for (std::size_t c = 5; c < a.counts.size(); ++c) {
+          if (a.notes[c - 5] == "damaged_hex") read_damaged += static_cast<int>(a.counts[c]);
+        }
+      }
     }
   }
   gravcal::set_avx2(true);
   CHECK(differ == 0);
-  CHECK(skipped_pages > 1000);  // the damaged pages were met, and skipped
+  CHECK(skipped_pages > 1000);  // the damaged pages were met: skipped (compat 0)
+  CHECK(read_damaged > 1000);   // and read as GGIRread reads them (compat 1)
+}
+
+// GGIRread's rules for a damaged GENEActiv page (geneactiv_ggir.hpp) against
+// the standard library they follow, GCC's (GGIRread's reader is built with
+// the R it runs in: libstdc++ on Linux and Windows): a value line as
+// std::stringstream's ignore(':') and >> double read it (random lines of
+// number-like characters; kept where the extraction leaves the value), and
+// every group of up to 3 characters as std::stoll(group, nullptr, 16) reads
+// it (or throws).
+static void test_geneactiv_ggir_rules() {
+#if defined(__GLIBCXX__)
+  using gravcal::geneactiv::FieldRead;
+  const std::string alpha = "0123456789.eE+- :xXafAFG\r\t";
+  std::mt19937 rng(7);
+  int differ = 0;
+  for (int it = 0; it < 300000; ++it) {
+    std::string s = (rng() % 2) ? "Temperature:" : "";
+    for (int i = 0, n = static_cast<int>(rng() % 9); i < n; ++i) s += alpha[rng() % alpha.size()];
+    double v = std::numeric_limits<double>::quiet_NaN();
+    std::stringstream ss(s);
+    ss.ignore(std::numeric_limits<std::streamsize>::max(), ':');
+    ss >> v;
+    const FieldRead r = gravcal::geneactiv::read_field(s.data(), s.size(), true);
+    const bool same = std::isnan(v) ? r.kind == FieldRead::keep
+                                    : r.kind == FieldRead::value && r.v == v &&
+                                          std::signbit(r.v) == std::signbit(v);
+    if (!same) ++differ;
+  }
+  const std::string ga = "0123456789aAfFgG+- \r\txX:\v";
+  for (int len = 0; len <= 3; ++len) {
+    long total = 1;
+    for (int i = 0; i < len; ++i) total *= static_cast<long>(ga.size());
+    for (long c = 0; c < total; ++c) {
+      std::string s;
+      for (long k = c, i = 0; i < len; ++i, k /= static_cast<long>(ga.size())) {
+        s += ga[static_cast<std::size_t>(k % static_cast<long>(ga.size()))];
+      }
+      bool ok = true;
+      long long ref = 0;
+      try {
+        ref = std::stoll(s, nullptr, 16);
+      } catch (...) {
+        ok = false;
+      }
+      int v = 0;
+      const bool mine = gravcal::geneactiv::read_group(s.data(), s.size(), v);
+      if (mine != ok || (ok && v != ref)) ++differ;
+    }
+  }
+  CHECK(differ == 0);
+#else
+  std::printf("note: not GCC's standard library: GGIRread's rules not compared with it\n");
+#endif
 }
 
 // SampleBuffer::time_ends_only (g.getmeta()'s block store): the GENEActiv
@@ -1170,6 +1233,7 @@ int main(int argc, char** argv) {
   test_cwa_word_sum();
   test_avx2_geneactiv();
   test_geneactiv_time_ends();
+  test_geneactiv_ggir_rules();
   test_add_repeated();
   test_lazy_sd();
   test_lazy_sd_edges();

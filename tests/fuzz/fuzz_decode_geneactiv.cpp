@@ -62,9 +62,16 @@ static std::uint64_t decode_all(const std::vector<unsigned char>& bytes, std::ui
     const std::int64_t u = dec.read(out, max_units);
     CHECK(!(out.n > cap || u < 0 || (max_units >= 0 && u > max_units)));
     CHECK(!(u == 0 && out.n == 0 && !dec.done()));  // no progress
+    // compat 1: a time that is not finite only where a page's rate or the
+    // start is one the reference's times are not defined by (NaN: 0 Hz, a
+    // start not read) or infinite for (a block ending at 0 Hz)
+    const gravcal::Report& now = dec.report();
+    const bool odd_times = (mode & 2) == 0 &&
+                           (now.get("ggir_time_undefined") > 0 || now.get("ggir_start_unread") > 0 ||
+                            now.get("rate_changes") > 0 || now.get("ggir_rate_mismatch") > 0);
     for (std::size_t i = 0; i < out.n; ++i) {
       CHECK(std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(z[i]) &&
-            std::isfinite(t[i]) && std::isfinite(tm[i]));
+            std::isfinite(t[i]) && (std::isfinite(tm[i]) || odd_times));
       const double v[5] = {x[i], y[i], z[i], t[i], tm[i]};
       mix(v, sizeof v);
     }
@@ -76,7 +83,10 @@ static std::uint64_t decode_all(const std::vector<unsigned char>& bytes, std::ui
   const gravcal::Report& r = dec.report();
   CHECK(!(r.samples != samples));
   CHECK(!(r.units + r.skipped != units));
-  CHECK(!(r.samples > r.units * static_cast<std::int64_t>(gravcal::geneactiv::kSamplesPerPage)));
+  // (compat 1: a damaged page may give more, as the reference reads it)
+  const std::size_t per_page = (mode & 2) ? gravcal::geneactiv::kSamplesPerPage
+                                          : gravcal::geneactiv::kMaxPageSamples;
+  CHECK(!(r.samples > r.units * static_cast<std::int64_t>(per_page)));
   CHECK(!(r.gaps < 0 || !(r.gap_seconds >= 0) || !std::isfinite(r.gap_seconds)));
   CHECK(!(r.notes.size() > gravcal::Report::max_notes));
   for (const auto& c : r.counters) mix(&c.second, sizeof c.second);

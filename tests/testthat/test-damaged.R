@@ -79,3 +79,71 @@ test_that("a damaged GENEActiv .bin keeps its other pages and reports the bad on
   expect_identical(b$status, a$status)
   expect_true(any(grepl("1 unreadable page skipped", utils::capture.output(print(b)))))
 })
+
+test_that("g.calibrate() is GGIR's on a GENEActiv .bin with damaged pages, or cut short", {
+  skip_if_not_installed("GGIR")
+  skip_if_not_installed("GGIRread")
+  dir <- tempfile("damaged")
+  dir.create(dir)
+  on.exit(unlink(dir, recursive = TRUE))
+  # 26 hours at 10 Hz, CRLF line ends: GGIR's blocks of 1451 pages (12 h)
+  rec <- simulate_recording(hours = 26, sf = 10, seed = 62)
+  clean <- file.path(dir, "clean.bin")
+  gravcal:::write_geneactiv_bin(rec, clean, sf = 10, eol = "\r\n")
+  bytes <- readBin(clean, raw(), file.size(clean))
+  txt <- strsplit(rawToChar(bytes), "\r\n", fixed = TRUE)[[1]]
+  rd <- which(txt == "Recorded Data")
+  put <- function(l, name) {
+    f <- file.path(dir, name)
+    writeBin(charToRaw(paste0(paste(l, collapse = "\r\n"), "\r\n")), f)
+    f
+  }
+  cut <- function(n, name) {
+    f <- file.path(dir, name)
+    writeBin(bytes[seq_len(n)], f)
+    f
+  }
+  # a non-hex character at a sample's start in page 100: GGIRread keeps the
+  # page's first 100 samples, and GGIR takes its first block, 200 samples
+  # short, for the last
+  l <- txt
+  substr(l[rd[100] + 9], 1201, 1201) <- "G"
+  b <- run_both(put(l, "nonhex.bin"))
+  expect_same_as_ggir(b)
+  expect_lt(b$gravcal$nhoursused, 12.1)
+  # one inside a group (read as far as it goes), in the second block
+  l <- txt
+  substr(l[rd[2000] + 9], 602, 602) <- "Q"
+  expect_same_as_ggir(run_both(put(l, "garbled.bin")))
+  # a line missing in page 2000: every page after it misaligned (none of
+  # them decoded)
+  expect_same_as_ggir(run_both(put(txt[-(rd[2000] + 4)], "missing.bin")))
+  # page 1's time garbled: GGIR's times are NA, which g.calibrate() does
+  # not read at a whole rate
+  l <- txt
+  l[rd[1] + 3] <- "Page Tine:2024-01-01 00:00:00:000"
+  expect_same_as_ggir(run_both(put(l, "time.bin")))
+  # cut in the last page's header lines (GGIRread gives the page before
+  # again) and inside its hex line
+  last <- tail(gregexpr("Recorded Data", rawToChar(bytes), fixed = TRUE)[[1]], 1)
+  expect_same_as_ggir(run_both(cut(last + 120, "cut-header.bin")))
+  expect_same_as_ggir(run_both(cut(length(bytes) - 1000, "cut-hex.bin")))
+  # where GGIR's result is not reproduced, g.calibrate() stops, saying why:
+  # a hex line longer than the decoder keeps, all of it decodable (GGIRread
+  # reads 900 samples from it)
+  l <- txt
+  l[rd[10] + 9] <- strrep(l[rd[10] + 9], 3)
+  expect_error(gravcal::g.calibrate(put(l, "long.bin"), verbose = FALSE),
+               "\"long.bin\" \\(`datafile`\\) has a page line longer than 8192 characters")
+  # the real test file (85.7 Hz, which GGIR resamples) with its last page's
+  # rate garbled to 0: GGIR takes that block at 0 Hz, whole, and does not
+  # resample it
+  r <- system.file("testfiles", "GENEActiv_testfile.bin", package = "GGIRread")
+  rb <- readBin(r, raw(), file.size(r))
+  at <- tail(grepRaw("Measurement Frequency:85.7", rb, fixed = TRUE, all = TRUE), 1)
+  rb[at + 22:25] <- charToRaw("abc.")
+  g <- file.path(dir, "rate.bin")
+  writeBin(rb, g)
+  expect_error(suppressWarnings(gravcal::g.calibrate(g, verbose = FALSE)),
+               "reads as another rate than the file's")
+})

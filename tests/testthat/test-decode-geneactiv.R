@@ -79,8 +79,42 @@ expect_same <- function(a, b, what = cols) {
   for (v in what) expect_identical(a[[v]], b[[v]], label = v)
 }
 
+# The columns of `what` in which a and b differ (many cases, one
+# expectation: testthat's cost per expectation is the loops' cost).
+# `undefined`: a's NaN times are not compared (the decoder's where the
+# reference's are not defined).
+differ <- function(a, b, what = cols, undefined = FALSE) {
+  if (undefined) {
+    und <- is.nan(a$time)
+    if (length(und) == length(b$time)) b$time[und] <- NaN
+  }
+  if (!identical(nrow(a), nrow(b))) return("rows")
+  what[!vapply(what, function(v) identical(a[[v]], b[[v]]), TRUE)]
+}
+
+# As expect_blocks(), the blocks of B pages that differ ("from page s: x").
+blocks_differ <- function(file, B, capacity = B * 700) {
+  h <- gravcal:::native_open(file, "geneactiv", list(resample = 0))
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  out <- character(0)
+  s <- 1
+  repeat {
+    ref <- ga_ref(file, s, s + B - 1)
+    b <- gravcal:::native_block(h, B, capacity, TRUE, TRUE)
+    got <- as.data.frame(lapply(b$cols[cols], function(v) v[seq_len(b$to)]))
+    bad <- differ(got, ref, undefined = TRUE)
+    if (length(bad)) out <- c(out, paste0("from page ", s, ": ", paste(bad, collapse = ", ")))
+    if (nrow(ref) == 0 && b$to == 0) break
+    s <- s + B
+  }
+  out
+}
+
 # Reads `file` in blocks of B pages as GGIR does (readGENEActiv(start = s,
 # end = s + B - 1)) and natively (read(out, B)); expects identical blocks.
+# A time the decoder leaves NaN where the reference's is not defined (a
+# page read at 0 Hz: the platform's conversion of NaN to an integer) is
+# not compared.
 expect_blocks <- function(file, B, capacity = B * 300) {
   h <- gravcal:::native_open(file, "geneactiv", list(resample = 0))
   on.exit(gravcal:::gc_decoder_close(h$ptr))
@@ -90,6 +124,11 @@ expect_blocks <- function(file, B, capacity = B * 300) {
     b <- gravcal:::native_block(h, B, capacity, TRUE, TRUE)
     got <- lapply(b$cols[cols], function(v) v[seq_len(b$to)])
     expect_identical(as.integer(b$to), nrow(ref))
+    und <- is.nan(got$time)
+    if (any(und) && length(und) == nrow(ref)) {
+      expect_gt(gravcal:::native_report(h)$counters[["ggir_time_undefined"]], 0)
+      ref$time[und] <- NaN
+    }
     for (v in cols) expect_identical(got[[v]], ref[[v]], label = paste(v, "from page", s))
     if (nrow(ref) == 0) break
     s <- s + B
@@ -213,10 +252,56 @@ test_that("other .bin files and non-files are refused with a clear error", {
   expect_error(ga_read(tempfile()), "cannot open")
 })
 
-test_that("a damaged page is skipped and counted, every other sample kept", {
+# The ways a page gets damaged, on page `p` (5 unless given) of a file's
+# lines: list(label, lines after the damage).
+ga_damages <- function(lines, p = 5) {
+  hex <- lines[ga_line(lines, p, 10)]
+  at <- function(i, ch) {
+    l <- lines
+    substr(l[ga_line(l, p, 10)], i, i) <- ch
+    l
+  }
+  line <- function(k, value) {
+    l <- lines
+    if (is.null(value)) l[-ga_line(l, p, k)] else {
+      l[ga_line(l, p, k)] <- value
+      l
+    }
+  }
+  longer <- function(k) line(10, paste0(hex, substr(strrep(hex, 2), 1, k)))
+  list(
+    # a character that is not a hex digit: at a group's start (the page ends
+    # there: its samples before are kept), inside a group (read as far as it
+    # goes), in a light group, as a sign or a blank (read on)
+    list("G at a sample's start", at(1201, "G")), list("G in x", at(1202, "G")),
+    list("G in z's last digit", at(1209, "G")), list("G in light", at(1210, "G")),
+    list("G first", at(1, "G")), list("G last", at(3600, "G")),
+    list("'-' at a group's start", at(1204, "-")), list("' ' in a group", at(1205, " ")),
+    list("'x' after a 0", at(1202, "x")),
+    # a line cut short (a digit lost: every group after it shifted), too
+    # long (more samples), empty
+    list("a digit lost", line(10, substr(hex, 2, 3600))),
+    list("cut to 3590", line(10, substr(hex, 1, 3590))),
+    list("cut to 1234", line(10, substr(hex, 1, 1234))),
+    list("one digit more", longer(1)), list("10 more", longer(10)),
+    list("12 more", longer(12)), list("4000 more", longer(4000)),
+    list("empty", line(10, "")),
+    # page header lines: temperature and rate read as a stream reads them
+    list("Temperature:2x.5", line(6, "Temperature:2x.5")),
+    list("Temperature:abc", line(6, "Temperature:abc")),
+    list("Temperature (no ':')", line(6, "Temperature")),
+    list("Measurement Frequency: (no value)", line(9, "Measurement Frequency:")),
+    list("Measurement Frequency:50", line(9, "Measurement Frequency:50")),
+    list("Measurement Frequency:1x0", line(9, "Measurement Frequency:1x0")),
+    list("Page Tine (garbled key)", line(4, "Page Tine:2024-01-01 00:00:12:000")),
+    # a line missing or extra: ten lines a page from there on, misaligned
+    list("Unassigned: missing", line(5, NULL)),
+    list("a line extra", append(lines, "extra", ga_line(lines, p, 5))))
+}
+
+test_that("gravcal's own reading (compat 0) skips a damaged page whole and counts it", {
   skip_if_not_installed("GGIRread")
   f <- ga_write(12)
-  clean <- ga_read(f)
   clean0 <- ga_read(f, compat = 0)
   lines <- ga_lines(f)
   damage <- function(p, k, value) {
@@ -236,16 +321,13 @@ test_that("a damaged page is skipped and counted, every other sample kept", {
     list(3, 4, "Page Tine:2024-01-01 00:00:06:000", "bad_page_header")  # garbled key
   )
   for (cs in cases) {
-    g <- damage(cs[[1]], cs[[2]], cs[[3]])
-    for (compat in 1:0) {
-      d <- ga_read(g, compat = compat)
-      expect_same(d, drop_pages(if (compat) clean else clean0, cs[[1]]))
-      rep <- attr(d, "report")
-      expect_identical(rep$counters[[cs[[4]]]], 1, label = cs[[4]])
-      expect_identical(c(rep$units, rep$skipped, rep$gaps), c(11, 1, 0))
-      expect_false(rep$truncated)
-      expect_match(rep$notes[1], paste0("page ", cs[[1]], ", byte "))
-    }
+    d <- ga_read(damage(cs[[1]], cs[[2]], cs[[3]]), compat = 0)
+    expect_same(d, drop_pages(clean0, cs[[1]]))
+    rep <- attr(d, "report")
+    expect_identical(rep$counters[[cs[[4]]]], 1, label = cs[[4]])
+    expect_identical(c(rep$units, rep$skipped, rep$gaps), c(11, 1, 0))
+    expect_false(rep$truncated)
+    expect_match(rep$notes[1], paste0("page ", cs[[1]], ", byte "))
   }
   # the same on the real file (NULs in its header: edit bytes): page 3's hex
   # with a non-hex digit
@@ -255,9 +337,108 @@ test_that("a damaged page is skipped and counted, every other sample kept", {
   rb[at[4] - 2 - 3600 + 100] <- charToRaw("Z")
   g <- tempfile(fileext = ".bin")
   writeBin(rb, g)
-  d <- ga_read(g)
-  expect_same(d, drop_pages(ga_read(r), 3))
+  d <- ga_read(g, compat = 0)
+  expect_same(d, drop_pages(ga_read(r, compat = 0), 3))
   expect_identical(attr(d, "report")$counters[["bad_hex"]], 1)
+})
+
+test_that("GGIR's mode reads a damaged page as readGENEActiv reads it, whole and in GGIR's blocks", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(12)
+  clean <- ga_read(f)
+  bad <- character(0)
+  for (eol in c("\r\n", "\n")) {
+    lines <- ga_lines(ga_write(12, eol = eol), eol)
+    for (cs in ga_damages(lines)) {
+      g <- ga_put(cs[[2]], eol)
+      d <- ga_read(g)
+      lab <- paste0(cs[[1]], " (", nchar(eol), "-byte line ends)")
+      bad <- c(bad, paste(lab, differ(d, ga_ref(g))))
+      # a block from a damaged page on, up to it, one page: the reference's
+      # strings and time count start again with each call
+      if (eol == "\r\n") {
+        for (B in c(5, 4, 1)) bad <- c(bad, paste(lab, "B", B, blocks_differ(g, B)))
+      }
+      rep <- attr(d, "report")
+      said <- c("damaged_hex", "damaged_page_header", "misaligned_page", "rate_changes")
+      if (rep$skipped != 0 || sum(c(rep$counters[said], 0), na.rm = TRUE) == 0) {
+        bad <- c(bad, paste(lab, "not said"))
+      }
+      unlink(g)
+    }
+  }
+  expect_identical(bad[!grepl("\\)( B [0-9]+)? ?$", bad)], character(0))
+  lines <- ga_lines(f)
+  dm <- stats::setNames(lapply(ga_damages(lines), function(cs) ga_read(ga_put(cs[[2]]))),
+                        vapply(ga_damages(lines), `[[`, "", 1))
+  # what was kept, and the time count closed up after it: 100 samples of
+  # page 5 from a damaged group's start, every one where a group reads as
+  # far as it goes; page 6 then starts 1 s after page 5, not 3
+  expect_identical(nrow(dm[["G at a sample's start"]]), 3600L - 200L)
+  expect_same(dm[["G at a sample's start"]], clean[-(1301:1500), ], c("x", "y", "z", "light"))
+  t6 <- dm[["G at a sample's start"]]$time[1301]
+  expect_identical(t6 - clean$time[1201], 1)
+  expect_identical(nrow(dm[["G in x"]]), 3600L)
+  expect_false(identical(dm[["G in x"]]$x[1301], clean$x[1301]))
+  expect_same(dm[["G in x"]], clean, c("y", "z", "light", "time"))
+  expect_identical(nrow(dm[["G first"]]), 3300L)   # page 5 gives nothing
+  expect_identical(nrow(dm[["12 more"]]), 3601L)   # a 301st sample
+  expect_identical(nrow(dm[["a digit lost"]]), 3600L)  # its groups shifted
+  expect_identical(unique(dm[["Temperature:2x.5"]]$temperature[1201:1500]), 2)
+  expect_identical(unique(dm[["Temperature:abc"]]$temperature[1201:1500]), 0)
+  # page 4's temperature kept for page 5
+  expect_identical(unique(dm[["Temperature (no ':')"]]$temperature[1201:1500]), clean$temperature[1200])
+  expect_same(dm[["Temperature (no ':')"]], clean, setdiff(cols, "temperature"))
+  expect_same(dm[["Page Tine (garbled key)"]], clean)
+  # a line missing: every page after it misaligned, none of them decoded
+  expect_identical(nrow(dm[["Unassigned: missing"]]), 1200L)
+  expect_identical(attr(dm[["Unassigned: missing"]], "report")$counters[["misaligned_page"]], 7)
+  # the real file (85.7 Hz, NULs in its header: bytes edited), page 3 with
+  # a non-hex digit; and through GGIR's resampling onto 86 Hz
+  r <- ga_real()
+  rb <- readBin(r, "raw", file.size(r))
+  at <- grepRaw("Recorded Data", rb, fixed = TRUE, all = TRUE)
+  rb[at[4] - 2 - 3600 + 100] <- charToRaw("Z")
+  g <- tempfile(fileext = ".bin")
+  writeBin(rb, g)
+  d <- ga_read(g)
+  expect_same(d, ga_ref(g))
+  # (a y group's second digit: read as far as it goes, the page kept)
+  expect_identical(nrow(d), 5031L)
+  expect_false(identical(d$y[609], ga_read(r)$y[609]))
+  expect_blocks(g, 2)
+  expect_identical(attr(d, "report")$counters[["damaged_hex"]], 1)
+})
+
+test_that("a page read at 0 Hz: its times left NaN where the reference's are not defined", {
+  skip_if_not_installed("GGIRread")
+  f <- ga_write(12)
+  lines <- ga_lines(f)
+  lines[ga_line(lines, 5, 9)] <- "Measurement Frequency:abc"  # reads as 0
+  g <- ga_put(lines)
+  d <- ga_read(g)
+  ref <- ga_ref(g)
+  # (the reference converts NaN and infinite times to integers: what it
+  # gives is the platform's) every other value the reference's
+  expect_same(d, ref, setdiff(cols, "time"))
+  expect_identical(d$time[1:1200], ref$time[1:1200])
+  expect_true(all(is.nan(d$time[-(1:1200)])))
+  rep <- attr(d, "report")
+  expect_identical(rep$counters[["ggir_time_undefined"]], 8)
+  # in blocks of 4 pages: the second block's times undefined, the third's
+  # the reference's
+  h <- gravcal:::native_open(g, "geneactiv", list(resample = 0))
+  on.exit(gravcal:::gc_decoder_close(h$ptr))
+  for (s in c(1, 5, 9)) {
+    b <- gravcal:::native_block(h, 4, 1200, TRUE, TRUE)
+    ref <- ga_ref(g, s, s + 3)
+    if (s == 5) {
+      expect_true(all(is.nan(b$cols$time)))
+    } else {
+      expect_identical(b$cols$time, ref$time)
+    }
+    expect_identical(b$cols$x, ref$x)
+  }
 })
 
 test_that("sequence numbers and page times are checked; gaps are reported", {
@@ -320,16 +501,19 @@ test_that("a file cut short keeps every whole sample and says so", {
   }
   # 1-based position of page 10's first hex digit (its CRLF ends it)
   line10 <- starts[11] - 2 - 3600
-  # inside page 10's header lines: page 10 lost
+  # inside page 10's header lines: the reference gives page 9's samples
+  # again as page 10 (std::getline at the end of the input leaves its
+  # string as it was), and so does GGIR's mode; gravcal's own drops it
   g <- cut(starts[10] + 180)
   d <- ga_read(g)
-  expect_same(d, clean[1:2700, ])
-  # (the reference gives page 9's samples again as page 10: std::getline
-  # at the end of the input leaves its string as it was)
   ref <- ga_ref(g)
+  expect_same(d, ref)
   expect_identical(ref$x[2701:3000], ref$x[2401:2700])
   expect_true(attr(d, "report")$truncated)
-  expect_identical(attr(d, "report")$skipped, 1)
+  expect_identical(attr(d, "report")$counters[["truncated_page"]], 1)
+  d0 <- ga_read(g, compat = 0)
+  expect_same(d0, ga_read(f, compat = 0)[1:2700, ])
+  expect_identical(attr(d0, "report")$skipped, 1)
   # inside page 10's hex line after r digits: whole samples kept, and a tail
   # of 10 or 11 digits (x, y, z whole) as the reference keeps it
   # (10 or 11 digits: the light of that sample from its 1 or 2 light digits)
@@ -355,6 +539,48 @@ test_that("a file cut short keeps every whole sample and says so", {
   expect_identical(nrow(d0), 2700L + 100L)
 })
 
+test_that("a file cut anywhere in its last page is read as readGENEActiv reads it", {
+  skip_if_not_installed("GGIRread")
+  # every byte from the end of page 3 to 30 digits into page 4's hex line:
+  # where the cut falls in page 4's header lines, the reference gives page
+  # 3's samples again, with what its strings then read as temperature and
+  # rate (a cut line's number: "Temperature:2" gives 2, "Sequence
+  # Number:3" gives 3 for both; in "Recorded Data", page 3's rate for
+  # both), none where page 4 starts a call of its own. A rate of 0 ("Device
+  # Status:Rec", a serial number cut to "0"): times not defined (NaN), the
+  # rest the reference's
+  for (eol in c("\r\n", "\n")) {
+    f <- ga_write(4, eol = eol)
+    bytes <- readBin(f, "raw", file.size(f))
+    starts <- gregexpr("Recorded Data", rawToChar(bytes), fixed = TRUE)[[1]]
+    undefined <- 0
+    bad <- character(0)
+    for (n in (starts[4] - 2):(length(bytes) - 3600 - nchar(eol) + 30)) {
+      g <- tempfile(fileext = ".bin")
+      writeBin(bytes[seq_len(n)], g)
+      d <- ga_read(g)
+      und <- is.nan(d$time)
+      if (any(und)) {
+        undefined <- undefined + 1
+        if (!identical(which(und), 901:1200) ||
+            !isTRUE(attr(d, "report")$counters[["ggir_time_undefined"]] > 0)) {
+          bad <- c(bad, paste("undefined times not as said, cut at", n))
+        }
+      }
+      cut <- paste0("cut at byte ", n, ": ")
+      bad <- c(bad, paste0(cut, differ(d, ga_ref(g), undefined = TRUE)))
+      if (attr(d, "report")$skipped != 0) bad <- c(bad, paste0(cut, "skipped"))
+      # GGIR's blocks: the last page alone, and with the page before
+      if (eol == "\r\n" && n %% 4 == 0) {
+        for (B in 1:2) bad <- c(bad, paste0(cut, "B ", B, " ", blocks_differ(g, B)))
+      }
+      unlink(g)
+    }
+    expect_identical(bad[!grepl(": (B [0-9] )?$", bad)], character(0))
+    expect_gt(undefined, 10)
+  }
+})
+
 test_that("trailing garbage and stray lines are skipped and counted", {
   skip_if_not_installed("GGIRread")
   f <- ga_write(4)
@@ -365,11 +591,22 @@ test_that("trailing garbage and stray lines are skipped and counted", {
   writeBin(c(charToRaw("garbage\r\n"), as.raw(c(1, 2, 0, 255, 10)),
              charToRaw(strrep("F", 20000))), con)
   close(con)
-  d <- ga_read(g)
-  expect_same(d, clean)
+  d <- ga_read(g, compat = 0)
+  expect_same(d, ga_read(f, compat = 0))
   rep <- attr(d, "report")
   expect_identical(rep$counters[["stray_lines"]], 3)
   expect_identical(rep$skipped, 0)
+  # GGIR's mode: the reference takes the garbage for a page, whose hex line
+  # it never reaches (the input ends in its third line): page 4 again. The
+  # 20000-character line is longer than the decoder keeps: its value (had
+  # it a ':' further on) is not known, and that is counted
+  # (readGENEActiv with end = 0 stops at the header's page count; GGIR
+  # gives an end)
+  d <- ga_read(g)
+  expect_same(d, ga_ref(g, 1, 100))
+  expect_identical(nrow(d), 1500L)
+  expect_identical(attr(d, "report")$counters[["ggir_not_reproduced"]], 1)
+  expect_same(d[1:1200, ], clean)
 })
 
 # A block of whole pages whose last page does not fit the glue's fixed
@@ -514,6 +751,13 @@ test_that("at a rate that is not whole, light is resampled as GGIR resamples it"
   cut <- tempfile(fileext = ".bin")
   writeBin(bytes[seq_len(starts[11] - 2 - 3600 - 1 + 1211)], cut)
   for (B in c(4, 3)) expect_ggir_blocks(cut, B)
+  # damaged pages (readGENEActiv's reading of them) resampled as GGIR
+  # resamples them: page 5 cut short, page 9 with a garbled digit
+  lines <- ga_lines(g)
+  lines[ga_line(lines, 5, 10)] <- substr(lines[ga_line(lines, 5, 10)], 1, 2000)
+  substr(lines[ga_line(lines, 9, 10)], 602, 602) <- "Q"
+  dmg <- ga_put(lines)
+  for (B in c(4, 3)) expect_ggir_blocks(dmg, B)
   d <- gravcal:::native_read_all(g, "geneactiv", list(compat = 1))
   expect_false(anyNA(d$light))
   expect_gt(stats::sd(d$light), 100)

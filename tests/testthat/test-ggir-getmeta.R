@@ -194,22 +194,145 @@ test_that("a damaged .cwa recording: M is GGIR's, readAxivity's log of the damag
   unlink(c(f, g))
 })
 
-test_that("a GENEActiv page with garbled digits: skipped whole, and the warning says M can differ", {
-  # GGIRread's reader keeps the samples before the first group std::stoll
-  # cannot read (garbled digits read as far as they go) and closes up its
-  # time count; gravcal's decoder skips the page whole
-  # (decode_geneactiv.hpp), so M differs from GGIR's after it: the warning
-  # says so rather than only that QClog is not reproduced
-  f <- meta_recording("geneactiv", 30, 3, seed = 5)
-  txt <- readLines(f)
-  hex <- grep("^Recorded Data", txt)[100] + 9
-  substr(txt[hex], 21, 24) <- "ZZZZ"
+# A GENEActiv recording's lines (meta_recording(): `hours` at 30 Hz), and
+# a .bin file of them with CRLF line ends, as the device writes them.
+ga_meta_lines <- function(hours = 3) {
+  f <- meta_recording("geneactiv", 30, hours, seed = 5)
+  on.exit(unlink(f))
+  readLines(f)
+}
+ga_meta_put <- function(lines) {
   g <- tempfile(fileext = ".bin")
-  writeLines(txt, g)
-  expect_warning(M <- meta_quiet_keep_warnings(gravcal::g.getmeta(g, verbose = FALSE)),
-                 "1 damaged page skipped, 0 spans imputed .*M can differ from GGIR's from there on")
-  expect_gt(nrow(M$metashort), 1000)
-  unlink(c(f, g))
+  writeBin(charToRaw(paste0(paste(lines, collapse = "\r\n"), "\r\n")), g)
+  g
+}
+ga_meta_cut <- function(file, n) {
+  g <- tempfile(fileext = ".bin")
+  writeBin(readBin(file, "raw", file.size(file))[seq_len(n)], g)
+  g
+}
+
+test_that("g.getmeta() is GGIR's on GENEActiv files with damaged pages, or cut short", {
+  # GGIRread's reader keeps what it decodes of a damaged page (garbled
+  # digits read as far as they go, the page ending at a group without one)
+  # and closes up its time count after it; a block then short of samples
+  # is GGIR's last. gravcal's decoder reads damaged pages so
+  # (decode_geneactiv.hpp). GGIR's blocks of 871 pages (chunksize 0.1), the
+  # damage in the first of two (page 300) or at the file's end
+  args <- list(params_rawdata = list(chunksize = 0.1))
+  lines <- ga_meta_lines()
+  rd <- which(lines == "Recorded Data")
+  hex <- rd[300] + 9
+  damaged <- function(f) {
+    l <- lines
+    l <- f(l)
+    ga_meta_put(l)
+  }
+  files <- list(
+    "a non-hex character at a sample's start" = damaged(function(l) {
+      substr(l[hex], 1201, 1201) <- "G"
+      l
+    }),
+    "one inside a group" = damaged(function(l) {
+      substr(l[hex], 1202, 1202) <- "G"
+      l
+    }),
+    "a hex line cut short" = damaged(function(l) {
+      l[hex] <- substr(l[hex], 1, 3000)
+      l
+    }),
+    "a hex line too long" = damaged(function(l) {
+      l[hex] <- paste0(l[hex], substr(l[hex], 1, 24))
+      l
+    }),
+    "a garbled temperature" = damaged(function(l) {
+      l[rd[300] + 5] <- "Temperature:2x.5"
+      l
+    }),
+    "a line missing" = damaged(function(l) l[-(rd[300] + 4)]))
+  clean <- ga_meta_put(lines)
+  bytes <- file.size(clean)
+  last <- tail(gregexpr("Recorded Data", rawToChar(readBin(clean, "raw", bytes)), fixed = TRUE)[[1]], 1)
+  files[["cut inside the last hex line"]] <- ga_meta_cut(clean, bytes - 1000)
+  files[["cut after the last page's \"Recorded Data\""]] <- ga_meta_cut(clean, last + 14)
+  files[["cut inside its serial number's key"]] <- ga_meta_cut(clean, last + 30)
+  for (nm in names(files)) {
+    b <- meta_both(files[[nm]], args)
+    expect_same_meta(b)
+    # (a line missing: every page after it gives nothing, the first block
+    # is too short)
+    if (nm == "a line missing") {
+      expect_true(b$gravcal$filetooshort)
+    } else {
+      expect_gt(nrow(b$gravcal$metashort), 500)
+    }
+  }
+  # a block's last page read at another whole rate (29 Hz): GGIR times the
+  # block by it (its start moves 300 s on, and the gap to the block before
+  # is filled), and so does gravcal, though its first part was read before
+  l4 <- ga_meta_lines(4)
+  r4 <- which(l4 == "Recorded Data")
+  l4[tail(r4, 1) + 8] <- "Measurement Frequency:29"
+  b <- meta_both(ga_meta_put(l4), args)
+  expect_same_meta(b)
+  # what was read so is said
+  expect_warning(meta_quiet_keep_warnings(gravcal::g.getmeta(files[[1]], verbose = FALSE)),
+                 "1 damaged page .*read as GGIR's reader \\(GGIRread\\) reads them, so M is GGIR's")
+  expect_warning(meta_quiet_keep_warnings(gravcal::g.getmeta(files[["a line missing"]],
+                                                               verbose = FALSE)),
+                 "780 pages after lines missing or extra")
+  unlink(c(unlist(files), clean))
+})
+
+test_that("where GGIR's g.getmeta() stops on a damaged GENEActiv file, gravcal's stops too", {
+  skip_if_not_installed("GGIR")
+  lines <- ga_meta_lines()
+  rd <- which(lines == "Recorded Data")
+  pr <- utils::modifyList(GGIR::load_params()$params_rawdata, list(chunksize = 0.1))
+  ggir_stops <- function(f, pattern) {
+    # (GGIR's side, a run of GGIR each, never cached: the slow tier)
+    if (identical(Sys.getenv("GRAVCAL_TEST_TIER"), "quick")) return(invisible())
+    I <- keep_warn(meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr)))
+    # (GGIRread's "data error" lines on stderr dropped)
+    utils::capture.output(type = "message", expect_error(keep_warn(meta_quiet(
+      GGIR::g.getmeta(f, params_rawdata = pr, inspectfileobject = I, verbose = FALSE))), pattern))
+  }
+  ours <- function(f) gravcal::g.getmeta(f, params_rawdata = pr, verbose = FALSE)
+  # the last page cut in its temperature's number: GGIRread's rate of that
+  # page (and of the second block) is 2 Hz, which moves the block's start
+  # by hours: GGIR stops on the gap
+  clean <- ga_meta_put(lines)
+  at <- tail(grepRaw("Temperature:", readBin(clean, "raw", file.size(clean)), fixed = TRUE,
+                     all = TRUE), 1)
+  f <- ga_meta_cut(clean, at + 12)
+  ggir_stops(f, "Time gap observed of more than 1 hour")
+  expect_error(meta_quiet(ours(f)), "Time gap observed of more than 1 hour between data chunks")
+  # cut in "Device Status:Rec...": rate 0, the block's times infinite
+  at <- tail(grepRaw("Status:Rec", readBin(clean, "raw", file.size(clean)), fixed = TRUE,
+                     all = TRUE), 1)
+  f <- ga_meta_cut(clean, at + 9)
+  ggir_stops(f, "Time gap observed of more than 1 hour")
+  expect_error(meta_quiet(ours(f)), "Time gap observed of more than 1 hour between data chunks")
+  # page 1's time garbled: GGIR's start NA
+  l <- lines
+  l[rd[1] + 3] <- "Page Tine:2024-03-04 09:07:23:000"
+  f <- ga_meta_put(l)
+  ggir_stops(f, "missing value where TRUE/FALSE needed")
+  expect_error(meta_quiet(ours(f)), "first page whose \"Page Time:\" GGIR's reader does not read",
+               fixed = TRUE)
+  # a rate garbled to 0 in the first block: the reference's times after it
+  # undefined (the platform's conversion of NaN: on x86-64 GGIR stops on
+  # the gap they make)
+  l <- lines
+  l[rd[300] + 8] <- "Measurement Frequency:abc"
+  f <- ga_meta_put(l)
+  if (identical(R.version$arch, "x86_64")) ggir_stops(f, "Time gap observed of more than 1 hour")
+  expect_error(meta_quiet(ours(f)), "has a page read at 0 Hz")
+  # the file's header cut short: GGIR's g.inspectfile() finds no rate
+  f <- ga_meta_put(lines[1:40])
+  ggir_stops(f, "invalid 'nrow' value")
+  expect_error(meta_quiet(ours(f)), "header truncated at byte")
+  unlink(clean)
 })
 
 test_that("g.getmeta() is GGIR's with every metric, non-wear 2013 and shorter blocks", {

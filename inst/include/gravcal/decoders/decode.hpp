@@ -457,6 +457,19 @@ class Decoder {
     double remaining;
   };
   virtual std::vector<EpochGap> take_epoch_gaps() { return {}; }
+  // The times of the first and of the last two samples of the latest read
+  // of a number of units (one of GGIR's blocks, in one read() or several),
+  // as they stand once that read has ended, for a decoder whose times of a
+  // block depend on what comes at its end and so were given before they
+  // were known (GENEActiv in GGIR's mode: readGENEActiv times a call by the
+  // rate of its last page). False: the times as given stand.
+  struct CallEndTimes {
+    double first = std::numeric_limits<double>::quiet_NaN();
+    double last[2] = {std::numeric_limits<double>::quiet_NaN(),
+                      std::numeric_limits<double>::quiet_NaN()};  // the last, the one before
+    int n_last = 0;  // how many of those two the read gave
+  };
+  virtual bool call_end_times(CallEndTimes&) const { return false; }
   // The file's units as they are stored, for a format whose reference
   // reader logs them (GGIRread's readParmayMatrix(): its QClog, a row per
   // packet): named columns of numbers, one value a unit, in the file's

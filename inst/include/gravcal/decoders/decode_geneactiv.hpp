@@ -34,18 +34,37 @@
 //   plus i / rate.
 // - End: the reference with end = 0 stops at the header's "Number of Pages"
 //   (GGIR passes an explicit end, so it reads every page); we read every page.
-// - Damage: the reference assumes a 59-line header and 10-line pages (a
-//   missing line shifts every later page), decodes the hex digits before a
-//   bad character (std::stoll stops there), keeps the samples before the
-//   first undecodable group, and its time count closes up what was lost. We
-//   resynchronise on "Recorded Data", skip and count a damaged page whole,
-//   and time later pages as if it had been there (its 300 samples' worth).
-//   A final hex line cut short keeps its samples whose x, y, z digits are
-//   complete (compat 1: those with at least 10 digits, as the reference;
-//   compat 0: whole 12-digit samples only).
-//   A page header cut by the end of the input: the reference gives the
-//   previous page's samples again (std::getline leaves its string as it
-//   was); we drop the page.
+// - Damage: compat 1 reads a page as the reference does (parse_page_ggir(),
+//   the rules in geneactiv_ggir.hpp): ten lines a page whatever they hold
+//   (a line missing or extra shifts every page after it, as there), the
+//   temperature and rate from their lines as a stringstream reads them (a
+//   garbled value as far as it reads, 0 where it does not, the call's value
+//   kept where the line has no ':' or nothing after it), the hex line cut
+//   into groups of 3 read by std::stoll (garbled digits read as far as they
+//   go; the page ends at the first group with none: what came before it is
+//   kept; a line too long gives more samples), and the time count closes up
+//   after a page short of samples (each page starts where its samples
+//   before end). Where the input ends inside a page's header lines, the
+//   reference's strings keep what they held (std::getline leaves them): the
+//   page gives the page before's samples again (none at a call's first
+//   page), with what its cut line reads as temperature and rate. Nothing
+//   is skipped; damaged_hex, damaged_page_header, misaligned_page and
+//   truncated_page count what was read so, with notes. Where the reference
+//   gives what gravcal does not reproduce, it is counted for R to refuse
+//   (R/meta-formats.R): a rate of 0 Hz, whose times C++ does not define
+//   (ggir_time_undefined: those times NaN; ggir_resampled_time_undefined
+//   where the rate is not whole and GGIR resamples by them), a block whose
+//   last page's rate changes GGIR's resampling or its file rate
+//   (ggir_rate_mismatch), a first page time R does not read
+//   (ggir_start_unread), a line longer than the reader keeps whose rest the
+//   reference would read (ggir_not_reproduced). A call whose last page's
+//   rate differs from its pages' before has its ends retimed
+//   (call_end_times()).
+//   compat 0 resynchronises on "Recorded Data", skips and counts a damaged
+//   page whole (bad_hex, bad_page_header), and times later pages as if it
+//   had been there (each page by its own Page Time); a final hex line cut
+//   short keeps its whole 12-digit samples; a page header cut by the end of
+//   the input drops the page.
 // - Page times and sequence numbers are checked (the reference does not):
 //   expected is the last good page + (units since) * 300 / rate. A jump in
 //   both is a gap (gaps, gap_seconds); a lone page whose time is off while
@@ -56,8 +75,9 @@
 //
 // Light (when asked: SampleBuffer::light; the same in both modes) is what
 // readGENEActiv gives: the sample's last 3 hex digits over 4 (10 bits, the 2
-// status bits dropped; a final sample cut to 10 or 11 digits: the 1 or 2 it
-// has, over 4, as std::stoll reads them), for a "Device Model" other than
+// status bits dropped; compat 1, a damaged or cut hex line: its fourth
+// group as std::stoll reads it, over 4, -63..1023, a value below 0 not
+// mapped), for a "Device Model" other than
 // one ending in "1.1" mapped as GGIRread maps it (256..511: (l - 128) * 2,
 // 512..767: (l - 320) * 4, 768..1023: (l - 656) * 16), then times Lux /
 // Volts, the header's "Lux:" and "Volts:" values: lux. As readGENEActiv
@@ -69,18 +89,22 @@
 // numbers of real headers; options "light_lux", "light_volts" and
 // "light_model11" (R/decode.R gives R's own reading) replace what the
 // decoder found. Light is decoded only when asked, from a copy of the page's
-// hex line (3600 bytes) made while the reads ask for light: from open() to
+// hex line (3600 bytes; compat 1, a damaged line: its values as read) made
+// while the reads ask for light: from open() to
 // the first read() without light, and again from a read() with it. A page
 // read before a caller starts asking has no copy: its light is NaN.
 //
 // max_units counts pages ("Recorded Data" units, damaged ones included, as
-// the reference's page numbers do). GGIR's block k, readGENEActiv(start = s,
-// end = s + B - 1) with s = (k - 1) * B + 1, is the k-th read(out, B) into a
-// buffer of at least B * 300 samples.
+// the reference's page numbers do; compat 1: its pages of ten lines). GGIR's
+// block k, readGENEActiv(start = s, end = s + B - 1) with s = (k - 1) * B +
+// 1, is the k-th read(out, B) into a buffer of at least B * 300 samples
+// (more where a damaged page gives more: up to kMaxPageSamples).
 //
-// Report counters: bad_hex, bad_page_header, truncated_page (skipped pages),
-// stray_lines (lines outside any page), bad_sequence, bad_page_time,
-// time_backwards, rate_changes; notes give the page number and byte offset.
+// Report counters: bad_hex, bad_page_header, truncated_page (skipped pages;
+// compat 1: the pages read as the reference reads them, see Damage),
+// stray_lines (lines outside any page, compat 0), bad_sequence,
+// bad_page_time, time_backwards (pages with a readable sequence number
+// and time), rate_changes; notes give the page number and byte offset.
 #ifndef GRAVCAL_DECODE_GENEACTIV_HPP
 #define GRAVCAL_DECODE_GENEACTIV_HPP
 
@@ -96,6 +120,7 @@
 #include <string>
 
 #include "gravcal/decoders/decode.hpp"
+#include "gravcal/decoders/geneactiv_ggir.hpp"
 #include "gravcal/kernels/kernels.hpp"
 #include "gravcal/decoders/line_reader.hpp"
 
@@ -107,9 +132,13 @@ constexpr std::size_t kSamplesPerPage = 300;
 constexpr std::size_t kDigitsPerSample = 12;  // x, y, z: 3 each; light+status: 3
 constexpr std::size_t kDigitsPerPage = kSamplesPerPage * kDigitsPerSample;
 constexpr std::size_t kDigitsXyz = 9;
-constexpr std::size_t kDigitsXyzCompat = 10;  // the reference needs 1 light digit
 constexpr int kPageHeaderLines = 8;           // between "Recorded Data" and hex
+constexpr int kTemperatureLine = 5;           // the page's lines GGIRread reads a value from
+constexpr int kFrequencyLine = 8;
 constexpr std::size_t kMaxLine = 8192;        // longer lines are cut (and counted)
+// samples a page can give (compat: GGIRread reads a hex line as long as it
+// is; the reader's lines are cut at kMaxLine): a longer one is not read
+constexpr std::size_t kMaxPageSamples = kMaxLine / kDigitsPerSample + 1;
 constexpr std::size_t kBufferBytes = 1u << 16;  // the line reader's buffer
 constexpr int kMaxHeaderLines = 256;          // real headers have 59
 constexpr double kMinRate = 0.1;              // Hz; real devices: 10..100
@@ -122,6 +151,7 @@ constexpr int kCountSigned = 2048;
 constexpr double kCountScale = 100.0;         // g = (count * 100 - offset) / gain
 constexpr double kMaxTimeZoneHours = 14.0;
 constexpr int kLightHeaderLines = 69;          // readGENEActiv's readLines(filename, 69)
+constexpr const char* kPageTimeKey = "Page Time:";
 constexpr int kLightRange = 1024;              // 10-bit light
 
 constexpr const char* kFirstLine = "Device Identity";
@@ -284,22 +314,42 @@ class GeneactivDecoder : public Decoder {
   bool open() override;
   std::int64_t read(SampleBuffer& out, std::int64_t max_units) override;
   bool done() const override { return done_; }
+  // what a page holds; a damaged page read as GGIRread reads it (compat)
+  // may give more, up to kMaxPageSamples (a block store grows for them)
   std::size_t max_samples_per_unit() const override { return geneactiv::kSamplesPerPage; }
+  bool call_end_times(CallEndTimes& t) const override;
 
  private:
   enum class Unit { none, good, skipped };
   struct Page {
-    std::uint16_t raw[geneactiv::kSamplesPerPage][3];
+    std::uint16_t raw[geneactiv::kMaxPageSamples][3];
     std::size_t count = 0;  // samples decoded
     double temperature = 0, freq = 0;
     double time_s = 0;      // compat 0: first sample, s since 1970 UTC
     std::int64_t base_ms = 0;  // compat 1: the reference's ms count at sample 0
+    bool times_defined = true;  // compat 1: so are the reference's times of its samples
     std::int64_t seq = 0, stamp_ms = 0;
     geneactiv::Stamp stamp;
+    bool stamped = false;  // compat 1: its sequence number and time read (for check_time())
     std::int64_t offset = 0;
     char hex[geneactiv::kDigitsPerPage];  // the hex line, for light
     std::size_t hex_n = 0;
     bool has_hex = false;  // hex holds the line (keep_hex_ when parsed)
+    // compat 1, a hex line read by GGIRread's rules (geneactiv_ggir.hpp):
+    // each sample's light value (-63..1023) in light_read
+    std::int16_t light_read[geneactiv::kMaxPageSamples];
+    bool has_light_read = false;
+    // compat 1: the values its temperature and frequency lines read, before
+    // the reference call they fall in resolves them (a value kept from
+    // before is the call's); from_before: none of its header lines was
+    // read (the input ended in its first line), so both read the lines'
+    // string as the page before left it, whose reading is before_read;
+    // repeat: its hex line was not read, so it holds the page before's
+    geneactiv::FieldRead temp_read, freq_read, before_read;
+    bool from_before = false, repeat = false;
+    // compat 1: a line longer than the reader keeps whose rest GGIRread
+    // would read (counted when the page is taken: ggir_not_reproduced)
+    const char* overlong = nullptr;
   };
 
   bool fail(const std::string& why) {
@@ -311,15 +361,31 @@ class GeneactivDecoder : public Decoder {
   bool check_header();
   bool recognise();
   Unit parse_page();
+  Unit parse_page_ggir();
+  bool ggir_line();
+  void settle_line();
+  void ggir_hex_line(Page& pg);
+  void start_line_seen();
+  void start_from_page_time();
+  void first_page_rate();
   Unit skip(const char* counter, const char* what, bool truncated);
   bool page_field(int k, const char* p, std::size_t n);
   bool decode_hex(const char* p, std::size_t n, bool complete);
   void accept(Unit u);
+  void accept_ggir();
   void check_time();
-  void advance_chain(double freq, std::size_t count);
+  bool advance_chain(double freq, std::size_t count);
+  void start_call();
+  void check_call_rate();
+  double call_start() const;
+  double timed(double raw, double start) const;
+  void not_reproduced(const char* counter, const std::string& why);
+  // GGIR resamples the blocks (by their times): a rate that is not whole
+  bool resampled() const { return header_rate_ != std::nearbyint(header_rate_); }
   void emit(SampleBuffer& out);
   void emit_light(const Page& p, std::size_t from, std::size_t k, double* light) const;
   void light_table();
+  double light_per() const;
   void finish_block(SampleBuffer& out, std::size_t n0);
   void finish_input();
   void note_at(const char* what, std::int64_t offset);
@@ -369,6 +435,7 @@ class GeneactivDecoder : public Decoder {
   std::int64_t seq_candidate_ = 0;
   // compat 1: the reference's per-call time count
   std::int64_t chain_ms_ = 0;
+  bool chain_defined_ = true;  // the count is a defined integer
   bool continue_call_ = false;
   std::int64_t block_first_ = 0;  // pages before this reference call
   double block_rate_ = 0;
@@ -376,6 +443,27 @@ class GeneactivDecoder : public Decoder {
   double anchor_ = 0;           // first page's time, s (local time zone)
   double last_good_rate_ = 0;
   bool block_open_ = false;
+  // compat 1: GGIRread's reading of the lines (geneactiv_ggir.hpp): whether
+  // its stream has ended (a getline then leaves its string as it was), the
+  // reading of the page header string as the last page left it, the
+  // reference call's temperature and rate (a value kept from before is
+  // theirs; 0 at the call's start), its pages read; the first of the first
+  // 69 lines with "Page Time" (readGENEActiv's start), and whether it was
+  // looked for
+  bool stream_ended_ = false;
+  geneactiv::FieldRead last_header_read_;
+  double call_temp_ = 0, call_freq_ = 0;
+  std::int64_t call_pages_ = 0;
+  bool call_checked_ = false;  // check_call_rate() done
+  std::string start_line_;
+  bool have_start_line_ = false;
+  // compat 1: the reference call's rows' times before its start is added
+  // (NaN: not defined): its first row and its last two, for
+  // call_end_times()
+  std::int64_t call_rows_ = 0;
+  double call_first_raw_ = 0;
+  double call_tail_raw_[2] = {0, 0};
+  bool call_timed_ = false;
 };
 
 // ---------------------------------------------------------------------------
@@ -528,6 +616,7 @@ inline bool GeneactivDecoder::open() {
                   std::to_string(geneactiv::kMaxHeaderLines) + " lines");
     }
     light_header_.line(line_.p, line_.n);
+    start_line_seen();
     if (!header_line(line_.p, line_.n)) return false;
   }
   if (!check_header()) return false;
@@ -537,10 +626,27 @@ inline bool GeneactivDecoder::open() {
   info_.has_light = true;
   next_unit_ = parse_page();
   have_next_ = true;
-  if (next_unit_ == Unit::good) {
-    info_.start_time = rules_.compat ? anchor_time(next_->stamp) : next_->time_s;
+  if (rules_.compat) {
+    start_from_page_time();
+    first_page_rate();
+  } else if (next_unit_ == Unit::good) {
+    info_.start_time = next_->time_s;
   }
   return true;
+}
+
+// compat 1: GGIR takes the file's rate from its first page as
+// readGENEActiv(start = 0, end = 1) reads it (g.inspectfile(): that page's
+// rate, rounded); where that rounds to another than the header's rate,
+// which gravcal takes, it is counted (ggir_rate_mismatch).
+inline void GeneactivDecoder::first_page_rate() {
+  const Page& p = *next_;
+  const bool own = next_unit_ == Unit::good && !p.from_before;
+  const double v = own && p.freq_read.kind == geneactiv::FieldRead::value ? p.freq_read.v : 0.0;
+  if (std::nearbyint(v) == std::nearbyint(header_rate_)) return;
+  report_.count("ggir_rate_mismatch");
+  report_.note("the first page reads a rate of " + std::to_string(v) + " Hz, not the header's " +
+               std::to_string(header_rate_) + " Hz: GGIR takes the file's rate from it");
 }
 
 // ---------------------------------------------------------------------------
@@ -581,29 +687,17 @@ inline bool GeneactivDecoder::page_field(int k, const char* p, std::size_t n) {
   }
 }
 
-// The hex line into next_->raw; false when it is malformed. A line the input
-// cut short (complete false) keeps its samples whose x, y, z are whole.
+// The hex line into next_->raw (compat 0); false when it is malformed. A
+// line the input cut short keeps its whole samples (12 digits each).
 inline bool GeneactivDecoder::decode_hex(const char* p, std::size_t n, bool complete) {
   using namespace geneactiv;
-  const unsigned char* h = hex_table().v;
   const unsigned char* s = reinterpret_cast<const unsigned char*>(p);
   if (complete ? n != kDigitsPerPage : n > kDigitsPerPage) return false;
   const std::size_t whole = n / kDigitsPerSample;
-  unsigned bad = kernels::active().hex_counts(s, whole, n, next_->raw, kSamplesPerPage);
-  s += whole * kDigitsPerSample;
-  std::size_t count = whole;
-  const std::size_t rest = n - whole * kDigitsPerSample;
-  if (rest >= (rules_.compat ? kDigitsXyzCompat : kDigitsPerSample)) {
-    for (int a = 0; a < 3; ++a) {
-      const unsigned d0 = h[s[3 * a]], d1 = h[s[3 * a + 1]], d2 = h[s[3 * a + 2]];
-      bad |= d0 | d1 | d2;
-      next_->raw[count][a] = static_cast<std::uint16_t>((d0 << 8) | (d1 << 4) | d2);
-    }
-    for (std::size_t j = kDigitsXyz; j < rest; ++j) bad |= h[s[j]];
-    ++count;
-  }
-  next_->count = count;
+  const unsigned bad = kernels::active().hex_counts(s, whole, n, next_->raw, kSamplesPerPage);
+  next_->count = whole;
   next_->has_hex = keep_hex_;
+  next_->has_light_read = false;
   if (keep_hex_) {
     std::memcpy(next_->hex, p, n);
     next_->hex_n = n;
@@ -623,6 +717,7 @@ inline GeneactivDecoder::Unit GeneactivDecoder::skip(const char* counter, const 
 // Reads the next unit into next_. none: the input has ended.
 inline GeneactivDecoder::Unit GeneactivDecoder::parse_page() {
   using namespace geneactiv;
+  if (rules_.compat) return parse_page_ggir();
   for (;;) {  // to the next "Recorded Data"
     if (!lines_.next(line_)) return Unit::none;
     if (is_line(line_.p, line_.n, kPageStart)) break;
@@ -665,6 +760,197 @@ inline GeneactivDecoder::Unit GeneactivDecoder::parse_page() {
 }
 
 // ---------------------------------------------------------------------------
+// Pages as GGIRread reads them (compat 1; its rules: geneactiv_ggir.hpp)
+
+// Its std::getline of the next line into line_: false when nothing comes
+// (the input ended at a line's end, or the stream ended before: a getline
+// then fails; the first that fails at the input's end empties its string,
+// the later ones leave it as it was).
+inline bool GeneactivDecoder::ggir_line() {
+  if (stream_ended_) return false;
+  if (!lines_.next(line_)) {
+    stream_ended_ = true;
+    return false;
+  }
+  start_line_seen();
+  return true;
+}
+
+// After line_ is read: an overlong line skipped to its end, and the stream
+// ended where the input ended inside the line.
+inline void GeneactivDecoder::settle_line() {
+  const bool ended = line_.too_long ? lines_.finish_overlong() : line_.has_end;
+  if (!ended) stream_ended_ = true;
+}
+
+// The first of the file's first 69 lines that contains "Page Time" (as R's
+// readLines() gives them: cut at a NUL), where readGENEActiv finds the
+// recording's start.
+inline void GeneactivDecoder::start_line_seen() {
+  if (have_start_line_ || line_.number > geneactiv::kLightHeaderLines) return;
+  std::size_t n = line_.n;
+  const void* nul = std::memchr(line_.p, '\0', n);
+  if (nul != nullptr) n = static_cast<std::size_t>(static_cast<const char*>(nul) - line_.p);
+  const std::string s(line_.p, n);
+  if (s.find("Page Time") == std::string::npos) return;
+  have_start_line_ = true;
+  start_line_ = s;
+}
+
+// readGENEActiv's start: that line with every "Page Time:" taken out, read
+// as a time (see parse_stamp()); a start it cannot read is counted
+// (ggir_start_unread: GGIR's times are then NA).
+inline void GeneactivDecoder::start_from_page_time() {
+  using namespace geneactiv;
+  std::string v = start_line_;
+  const std::size_t k = std::strlen(kPageTimeKey);
+  for (std::size_t at = v.find(kPageTimeKey); at != std::string::npos; at = v.find(kPageTimeKey, at)) {
+    v.erase(at, k);
+  }
+  Stamp st;
+  have_anchor_ = true;
+  if (have_start_line_ && parse_stamp(v.data(), v.data() + v.size(), st)) {
+    anchor_ = anchor_time(st);
+    info_.start_time = anchor_;
+    return;
+  }
+  anchor_ = std::numeric_limits<double>::quiet_NaN();
+  if (resampled()) report_.count("ggir_resampled_time_undefined");
+  not_reproduced("ggir_start_unread",
+                 have_start_line_ ? "the first page's time \"" + start_line_ +
+                                        "\" does not read as a time: GGIR's times are NA"
+                                  : "no \"Page Time\" in the file's first 69 lines: GGIR's times are NA");
+}
+
+inline void GeneactivDecoder::not_reproduced(const char* counter, const std::string& why) {
+  if (report_.get(counter) == 0) note_at(why.c_str(), next_->offset);
+  report_.count(counter);
+}
+
+// The hex line in line_ into pg: a line of 3600 hex digits by the decode
+// kernel, any other by GGIRread's rules.
+inline void GeneactivDecoder::ggir_hex_line(Page& pg) {
+  using namespace geneactiv;
+  const bool whole = !line_.too_long;
+  const std::size_t size = line_.n + (line_.cr ? 1 : 0);  // std::getline keeps the '\r'
+  pg.has_hex = false;
+  pg.has_light_read = false;
+  if (whole && line_.n == kDigitsPerPage) {
+    const unsigned char* s = reinterpret_cast<const unsigned char*>(line_.p);
+    const unsigned bad = kernels::active().hex_counts(s, kSamplesPerPage, line_.n, pg.raw, kMaxPageSamples);
+    if ((bad & 0x10u) == 0) {
+      pg.count = kSamplesPerPage;
+      pg.has_hex = keep_hex_;
+      if (keep_hex_) {
+        std::memcpy(pg.hex, line_.p, line_.n);
+        pg.hex_n = line_.n;
+      }
+      return;
+    }
+  }
+  const HexRead r = read_hex_line(line_.p, size, size, whole, kMaxPageSamples, pg.raw, pg.light_read);
+  pg.count = r.count;
+  pg.has_light_read = true;
+  if (r.unknown || r.full) {
+    pg.overlong = "a hex line longer than the decoder reads, which GGIRread would read on";
+    return;
+  }
+  if (!line_.has_end && line_.n < kDigitsPerPage) {
+    report_.truncated = true;
+    report_.count("truncated_page");
+    note_at(("input ends inside the hex line: " + std::to_string(r.count) +
+             " of 300 samples kept").c_str(), pg.offset);
+    return;
+  }
+  report_.count("damaged_hex");
+  if (!line_.has_end) report_.truncated = true;
+  note_at(("hex line of " + std::to_string(line_.n) + " characters, not 3600 hex digits: " +
+           std::to_string(r.count) + " samples read from it as GGIRread reads it" +
+           (r.all_read ? "" : " (the rest lost at a group without a hex digit)")).c_str(),
+          pg.offset);
+}
+
+// The next page as GGIRread reads it: its ten lines, whatever they hold.
+// Only the temperature and frequency lines' values and the hex line count;
+// the others are checked for the report (damaged_page_header,
+// misaligned_page) and the sequence number and time read for
+// check_time(). A page the input ends in keeps what GGIRread's strings
+// hold then (see Page: from_before, repeat).
+inline GeneactivDecoder::Unit GeneactivDecoder::parse_page_ggir() {
+  using namespace geneactiv;
+  Page& pg = *next_;
+  if (!ggir_line()) return Unit::none;  // its loop's getline fails
+  pg.offset = line_.offset;
+  pg.count = 0;
+  pg.has_hex = pg.has_light_read = false;
+  pg.stamped = false;
+  pg.repeat = false;
+  pg.overlong = nullptr;
+  const bool aligned = !line_.has_end || is_line(line_.p, line_.n, kPageStart);
+  settle_line();
+  // the eight header lines; `hdr`: the reading of the string std::getline
+  // leaves, as it stands (the last line read, "" once the input has ended)
+  FieldRead hdr = last_header_read_;
+  bool own = false, damaged = false, seq_ok = false, time_ok = false;
+  for (int k = 1; k <= kPageHeaderLines; ++k) {
+    if (!stream_ended_) {
+      own = true;
+      if (!ggir_line()) {
+        hdr = FieldRead::kept();
+      } else {
+        const bool whole = !line_.too_long;
+        if (k == kTemperatureLine || k == kFrequencyLine || !line_.has_end || !whole) {
+          hdr = read_field(line_.p, line_.n + (line_.cr ? 1 : 0), whole);
+        }
+        const bool field = whole && page_field(k - 1, line_.p, line_.n);
+        if (k - 1 == kSequence) seq_ok = field;
+        if (k - 1 == kTime) time_ok = field;
+        if (!field && line_.has_end) damaged = true;
+        settle_line();
+      }
+    }
+    if (k == kTemperatureLine) pg.temp_read = hdr;
+    if (k == kFrequencyLine) pg.freq_read = hdr;
+    if ((k == kTemperatureLine || k == kFrequencyLine) && hdr.kind == FieldRead::unknown) {
+      pg.overlong = "a page header line longer than the decoder reads, whose value GGIRread reads on";
+    }
+  }
+  pg.from_before = !own;
+  pg.before_read = last_header_read_;
+  last_header_read_ = hdr;
+  pg.stamped = seq_ok && time_ok;
+  // the hex line
+  const char* cut = nullptr;
+  if (stream_ended_) {
+    pg.repeat = true;  // std::getline leaves the string as it was
+    cut = "input ends inside the page's header lines: the page before's samples given again "
+          "(none at a block's first page), as GGIRread gives them";
+  } else if (ggir_line()) {
+    ggir_hex_line(pg);
+    settle_line();
+  } else {
+    cut = "input ends before the page's hex line: no samples";  // the string emptied
+  }
+  if (cut != nullptr) {
+    report_.truncated = true;
+    report_.count("truncated_page");
+    note_at(cut, pg.offset);
+  }
+  if (!aligned) {
+    report_.count("misaligned_page");
+    if (report_.get("misaligned_page") == 1) {
+      note_at("page does not start with \"Recorded Data\": lines missing or extra before it, "
+              "read ten lines a page as GGIRread reads them", pg.offset);
+    }
+  }
+  if (damaged) {
+    report_.count("damaged_page_header");
+    note_at("page header line not as the format has it: read as GGIRread reads it", pg.offset);
+  }
+  return Unit::good;
+}
+
+// ---------------------------------------------------------------------------
 // Time
 
 // A Page Time as R's as.POSIXlt(tz = "") then as.numeric() reads it: the
@@ -686,13 +972,31 @@ inline double GeneactivDecoder::anchor_time(const geneactiv::Stamp& s) const {
   return static_cast<double>(t) + (v - std::floor(v));
 }
 
+// Whether a double converts to a 64-bit integer (C++ defines no other
+// conversion: GGIRread's times of a rate of 0 Hz are NaN or infinite, and
+// what its long then holds is the platform's).
+inline bool fits_int64(double v) {
+  return v >= -9223372036854775808.0 && v < 9223372036854775808.0;
+}
+
 // The reference's ms count after a page of `count` samples at `freq`: the
-// last sample's time plus one period, truncated.
-inline void GeneactivDecoder::advance_chain(double freq, std::size_t count) {
-  if (count == 0) return;
-  const double last = ms_after(static_cast<double>(chain_ms_),
-                               static_cast<double>(count - 1) * (1.0 / freq));
-  chain_ms_ = static_cast<std::int64_t>(ms_after(last, 1.0 / freq));
+// last sample's time plus one period, truncated. False where the page's
+// times are not defined (then neither is the count after it, for the rest
+// of the call).
+inline bool GeneactivDecoder::advance_chain(double freq, std::size_t count) {
+  if (count == 0) return chain_defined_;
+  if (!chain_defined_) return false;
+  const double inv = 1.0 / freq;
+  const double base = static_cast<double>(chain_ms_);
+  const double last = ms_after(base, static_cast<double>(count - 1) * inv);
+  const double next = ms_after(last, inv);
+  const bool defined = fits_int64(ms_after(base, 0.0 * inv)) && fits_int64(last);
+  if (!defined || !fits_int64(next)) {
+    chain_defined_ = false;
+  } else {
+    chain_ms_ = static_cast<std::int64_t>(next);
+  }
+  return defined;
 }
 
 // Checks next_'s Page Time and Sequence Number against the last good page
@@ -752,9 +1056,9 @@ inline void GeneactivDecoder::check_time() {
 
 // Consumes the unit in next_.
 inline void GeneactivDecoder::accept(Unit u) {
+  if (rules_.compat) return accept_ggir();
   if (u == Unit::skipped) {
     ++report_.skipped;
-    if (rules_.compat) advance_chain(last_good_rate_, geneactiv::kSamplesPerPage);
     ++pages_seen_;
     return;
   }
@@ -764,22 +1068,136 @@ inline void GeneactivDecoder::accept(Unit u) {
     if (report_.get("rate_changes") == 0) note_at("measurement frequency changes", p.offset);
     report_.count("rate_changes");
   }
-  if (!have_anchor_) {
-    have_anchor_ = true;
-    anchor_ = anchor_time(p.stamp);
-    if (pages_seen_ > 0) {
-      anchor_ -= static_cast<double>(pages_seen_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) / p.freq;
-    }
-  }
   last_good_rate_ = p.freq;
-  block_rate_ = p.freq;
-  p.base_ms = chain_ms_;
-  if (rules_.compat) advance_chain(p.freq, p.count);
   ++report_.units;
   ++pages_seen_;
   std::swap(next_, cur_);
   emitted_ = 0;
   pending_ = true;
+}
+
+// Consumes the page in next_ as the reference call it falls in reads it
+// (compat 1): its temperature and rate where its lines keep the call's,
+// the page before's samples where it repeats them (none at the call's
+// first page: GGIRread's strings start empty), its place in the call's
+// time count.
+inline void GeneactivDecoder::accept_ggir() {
+  using geneactiv::FieldRead;
+  Page& p = *next_;
+  const bool first = call_pages_ == 0;
+  auto resolve = [&](const FieldRead& own, double& held) {
+    const FieldRead& r = !p.from_before ? own : first ? FieldRead::kept() : p.before_read;
+    if (r.kind == FieldRead::value) held = r.v;
+    return held;
+  };
+  p.temperature = static_cast<double>(static_cast<float>(resolve(p.temp_read, call_temp_)));
+  p.freq = resolve(p.freq_read, call_freq_);
+  if (p.repeat) {
+    p.count = first ? 0 : cur_->count;
+    if (p.count > 0) {
+      std::memcpy(p.raw, cur_->raw, p.count * sizeof p.raw[0]);
+      p.has_hex = cur_->has_hex;
+      p.hex_n = cur_->hex_n;
+      if (p.has_hex) std::memcpy(p.hex, cur_->hex, cur_->hex_n);
+      p.has_light_read = cur_->has_light_read;
+      if (p.has_light_read) std::memcpy(p.light_read, cur_->light_read, p.count * sizeof p.light_read[0]);
+    }
+  }
+  if (p.overlong != nullptr) not_reproduced("ggir_not_reproduced", p.overlong);
+  if (p.stamped) check_time();
+  if (p.freq != last_good_rate_ && report_.units > 0) {
+    if (report_.get("rate_changes") == 0) note_at("measurement frequency changes", p.offset);
+    report_.count("rate_changes");
+  }
+  last_good_rate_ = p.freq;
+  block_rate_ = p.freq;
+  p.base_ms = chain_ms_;
+  p.times_defined = advance_chain(p.freq, p.count);
+  if (!p.times_defined) {
+    if (report_.get("ggir_time_undefined") == 0) {
+      note_at(("page read at " + std::to_string(p.freq) + " Hz: GGIRread's times of its samples "
+               "(and of its call's after them) are not defined").c_str(), p.offset);
+    }
+    report_.count("ggir_time_undefined");
+    // (where GGIR resamples the blocks by them: a rate that is not whole)
+    if (resampled()) report_.count("ggir_resampled_time_undefined");
+  }
+  ++call_pages_;
+  ++report_.units;
+  ++pages_seen_;
+  std::swap(next_, cur_);
+  emitted_ = 0;
+  pending_ = true;
+}
+
+// A new reference call (compat 1) from page pages_seen_ + 1: the call
+// before's rate checked, the time count and GGIRread's values restarted.
+inline void GeneactivDecoder::start_call() {
+  check_call_rate();
+  block_open_ = true;
+  chain_ms_ = 0;
+  chain_defined_ = true;
+  block_first_ = pages_seen_;
+  block_rate_ = last_good_rate_;
+  call_temp_ = call_freq_ = 0;
+  call_pages_ = 0;
+  call_checked_ = false;
+  call_rows_ = 0;
+  call_timed_ = false;
+}
+
+// GGIR takes a call's rate (its last page's: readGENEActiv's SampleRate)
+// to decide whether to resample the block, and stops where that rate,
+// not whole, rounds to another than the file's: where the rate of a call
+// that read pages differs from the file's so that GGIR would resample it
+// otherwise than gravcal (which decides by the file's rate), or stop, it
+// is counted (ggir_rate_mismatch). A whole rate that differs from a whole
+// file rate changes only the call's times (call_end_times()).
+inline void GeneactivDecoder::check_call_rate() {
+  if (!rules_.compat || !block_open_ || call_pages_ == 0 || call_checked_) return;
+  call_checked_ = true;
+  const double s = block_rate_, h = header_rate_;
+  const bool s_whole = s == std::nearbyint(s), h_whole = h == std::nearbyint(h);
+  if (h_whole ? s_whole : s == h) return;
+  report_.count("ggir_rate_mismatch");
+  if (report_.get("ggir_rate_mismatch") == 1) {
+    report_.note("the block of pages " + std::to_string(block_first_ + 1) + " to " +
+                 std::to_string(block_first_ + call_pages_) + " ends on a page read at " +
+                 std::to_string(s) + " Hz, not the file's " + std::to_string(h) +
+                 " Hz: GGIR resamples such a block otherwise, or stops");
+  }
+}
+
+// readGENEActiv's start of the current call: the recording's start plus
+// ((s - 1) * 300) / rate for a call from page s, at the rate of the call's
+// last page read so far.
+inline double GeneactivDecoder::call_start() const {
+  double start = anchor_;
+  if (block_first_ > 0) {
+    start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
+             block_rate_;
+  }
+  return start;
+}
+
+// A row's time from its ms count (raw, s; NaN: not defined) and the call's
+// start: their sum, as readGENEActiv adds them; a start that is not finite
+// (NA, or infinite: a call ending at 0 Hz) is every row's time whatever its
+// count; and no row's time is defined where the call's first one is not
+// (readGENEActiv adds it to every row).
+inline double GeneactivDecoder::timed(double raw, double start) const {
+  if (!std::isfinite(start)) return start;
+  if (call_rows_ > 0 && std::isnan(call_first_raw_)) return call_first_raw_;
+  return raw + start;
+}
+
+inline bool GeneactivDecoder::call_end_times(CallEndTimes& t) const {
+  if (!rules_.compat || !call_timed_ || call_rows_ == 0) return false;
+  const double start = call_start();
+  t.first = timed(call_first_raw_, start);
+  t.n_last = call_rows_ >= 2 ? 2 : 1;
+  for (int i = 0; i < t.n_last; ++i) t.last[i] = timed(call_tail_raw_[i], start);
+  return true;
 }
 
 // Gives cur_'s samples until out is full.
@@ -802,14 +1220,28 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
   if (out.time != nullptr) {
     auto time_of = [&](std::size_t j) {
       const double i = static_cast<double>(emitted_ + j);
-      if (rules_.compat) {
+      double v;
+      if (!rules_.compat) {
+        v = p.time_s + i / p.freq;
+      } else if (!p.times_defined) {
+        v = std::numeric_limits<double>::quiet_NaN();
+      } else {
         // Unix ms as the reference: truncated to an integer, then / 1000
         const double t = ms_after(static_cast<double>(p.base_ms), i * inv);
-        out.time[n + j] = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
-      } else {
-        out.time[n + j] = p.time_s + i / p.freq;
+        v = static_cast<double>(static_cast<std::int64_t>(t)) / 1000;
       }
+      out.time[n + j] = v;
+      return v;
     };
+    if (rules_.compat && k > 0) {
+      // the reference call's first row and last two, for call_end_times()
+      if (call_rows_ == 0) call_first_raw_ = time_of(0);
+      for (std::size_t j = k >= 2 ? k - 2 : 0; j < k; ++j) {
+        call_tail_raw_[1] = call_tail_raw_[0];
+        call_tail_raw_[0] = time_of(j);
+      }
+      call_timed_ = true;
+    }
     if (!out.time_ends_only) {
       for (std::size_t j = 0; j < k; ++j) time_of(j);
     } else {
@@ -820,6 +1252,7 @@ inline void GeneactivDecoder::emit(SampleBuffer& out) {
       for (std::size_t j = k >= 2 ? k - 2 : 0; j < k; ++j) time_of(j);
     }
   }
+  if (rules_.compat) call_rows_ += static_cast<std::int64_t>(k);
   out.n += k;
   emitted_ += k;
   report_.samples += static_cast<std::int64_t>(k);
@@ -831,6 +1264,14 @@ inline void GeneactivDecoder::emit_light(const Page& p, std::size_t from, std::s
                                          double* light) const {
   using namespace geneactiv;
   const unsigned char* h = hex_table().v;
+  if (p.has_light_read) {  // compat 1: GGIRread's values of a damaged line
+    const double per = light_per();
+    for (std::size_t j = 0; j < k; ++j) {
+      const int l = p.light_read[from + j];
+      light[j] = l < 0 ? static_cast<double>(l) * per : light_lut_[l];
+    }
+    return;
+  }
   if (!p.has_hex) {
     std::fill(light, light + k, std::numeric_limits<double>::quiet_NaN());
     return;
@@ -844,13 +1285,19 @@ inline void GeneactivDecoder::emit_light(const Page& p, std::size_t from, std::s
   }
 }
 
-// Each 10-bit value's light, as readGENEActiv computes it from the header's
-// values (or those the options give).
-inline void GeneactivDecoder::light_table() {
+// Lux / Volts, from the header (or the options).
+inline double GeneactivDecoder::light_per() const {
   const double lux = light_given_[0] ? light_opt_[0] : light_header_.lux;
   const double volts = light_given_[1] ? light_opt_[1] : light_header_.volts;
+  return lux / volts;
+}
+
+// Each 10-bit value's light, as readGENEActiv computes it from the header's
+// values (or those the options give); a value below 0 (compat 1: a damaged
+// line's) is not mapped, only scaled.
+inline void GeneactivDecoder::light_table() {
   const bool model11 = light_given_[2] ? light_opt_[2] != 0 : light_header_.model11;
-  const double per = lux / volts;
+  const double per = light_per();
   for (int u = 0; u < geneactiv::kLightRange; ++u) {
     const double l = u;
     const double m = model11 ? l
@@ -863,28 +1310,28 @@ inline void GeneactivDecoder::light_table() {
 }
 
 // compat 1: the reference adds the first page's time and ((s - 1) * 300) /
-// rate (rate of the call's last page) to its ms count / 1000.
+// rate (rate of the call's last page) to its ms count / 1000 (timed()).
+// A call read in several reads has its rows timed by the rate of the last
+// page read so far; call_end_times() gives its ends as they stand at its
+// end.
 inline void GeneactivDecoder::finish_block(SampleBuffer& out, std::size_t n0) {
   if (!rules_.compat || out.time == nullptr || out.n == n0) return;
-  double start = anchor_;
-  if (block_first_ > 0) {
-    start += static_cast<double>(block_first_ * static_cast<std::int64_t>(geneactiv::kSamplesPerPage)) /
-             block_rate_;
-  }
+  const double start = call_start();
   if (!out.time_ends_only) {
-    for (std::size_t i = n0; i < out.n; ++i) out.time[i] = out.time[i] + start;
+    for (std::size_t i = n0; i < out.n; ++i) out.time[i] = timed(out.time[i], start);
     return;
   }
   // the rows emit() timed: the first, the last two (each once)
   const std::size_t last = out.n - 1;
   const std::size_t from = std::max(n0, out.n >= 2 ? out.n - 2 : 0);
-  if (n0 == 0 && from > 0) out.time[0] = out.time[0] + start;
-  for (std::size_t i = from; i <= last; ++i) out.time[i] = out.time[i] + start;
+  if (n0 == 0 && from > 0) out.time[0] = timed(out.time[0], start);
+  for (std::size_t i = from; i <= last; ++i) out.time[i] = timed(out.time[i], start);
 }
 
 inline void GeneactivDecoder::finish_input() {
   if (done_) return;
   done_ = true;
+  check_call_rate();
   if (lines_.read_failed()) {
     report_.read_error = true;
     report_.note("read error after byte " + std::to_string(line_.offset) + ": data end there");
@@ -900,11 +1347,7 @@ inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_u
   keep_hex_ = out.light != nullptr;
   std::int64_t units = 0;
   if (rules_.compat && !pending_ && !continue_call_ && (max_units >= 0 || !block_open_)) {
-    // a new reference call from page pages_seen_ + 1
-    block_open_ = true;
-    chain_ms_ = 0;
-    block_first_ = pages_seen_;
-    block_rate_ = last_good_rate_;
+    start_call();  // a new reference call from page pages_seen_ + 1
   }
   for (;;) {
     if (pending_) {
@@ -922,6 +1365,8 @@ inline std::int64_t GeneactivDecoder::read(SampleBuffer& out, std::int64_t max_u
     ++units;
   }
   finish_block(out, n0);
+  // the reference call's pages are all read: its rate is known
+  if (rules_.compat && max_units >= 0 && units >= max_units) check_call_rate();
   if (!pending_) {
     if (!have_next_) {
       next_unit_ = parse_page();

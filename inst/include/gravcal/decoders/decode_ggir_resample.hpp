@@ -151,6 +151,10 @@ class GgirResamplerOf : public ForwardingDecoder<Inner, GgirResamplerOf<Inner>> 
     return inner_->done() && !in_call_ && !gen_active_ && head_ == ready_.size() &&
            raw_at_ >= raw_n_;
   }
+  // passing through (a whole rate): the inner decoder's times are these
+  bool call_end_times(Decoder::CallEndTimes& t) const override {
+    return !active_ && inner_->call_end_times(t);
+  }
 
  private:
   static constexpr std::size_t kRawChunk = 4096;

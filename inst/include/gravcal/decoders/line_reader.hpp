@@ -22,6 +22,7 @@ struct Line {
   std::int64_t offset = 0;   // byte offset of its first byte
   bool has_end = true;       // ended by '\n' (else: the input ended)
   bool too_long = false;     // longer than the limit; p, n hold its start
+  bool cr = false;           // a '\r' at its end was dropped (it is still at p[n])
 };
 
 // Lines from a ByteSource through one fixed buffer. A line ends at '\n'
@@ -66,6 +67,24 @@ class LineReader {
   // next() gives the line it gave last once more (its bytes are still
   // where they were: nothing is read in between).
   void unread() { again_ = true; }
+  // After next() gave a line too_long: skips the rest of it now rather
+  // than with the next line, and says how it ended: true at its '\n',
+  // false when the input ended inside it (then next() gives nothing more).
+  // The line's bytes (p, n) may move: read them first.
+  bool finish_overlong() {
+    while (skipping_) {
+      const char* b = buf_.data() + beg_;
+      const void* nl = std::memchr(b, '\n', end_ - beg_);
+      if (nl != nullptr) {
+        skipping_ = false;
+        advance(static_cast<std::size_t>(static_cast<const char*>(nl) - b) + 1, false);
+        return true;
+      }
+      advance(end_ - beg_, false);
+      if (!fill()) return false;
+    }
+    return true;
+  }
   // No more lines (the input ended and every byte was given).
   bool exhausted() {
     for (;;) {
@@ -177,7 +196,10 @@ class LineReader {
     ln.number = line_ + 1;
     ln.offset = offset_;
     ln.has_end = has_end;
-    if (ln.n > 0 && ln.p[ln.n - 1] == '\r') --ln.n;  // CRLF
+    if (ln.n > 0 && ln.p[ln.n - 1] == '\r') {  // CRLF
+      --ln.n;
+      ln.cr = true;
+    }
     return ln;
   }
   bool give(Line& ln, std::size_t len, bool has_end) {

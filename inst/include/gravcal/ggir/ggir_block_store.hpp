@@ -433,6 +433,13 @@ class BlockStore {
       if (d.done()) break;
     }
     if (!used.empty()) assemble(parts, used, 2 * chunk);
+    // a decoder that times a block by what comes at its end (GENEActiv in
+    // GGIR's mode) gives its ends' times as they stand now
+    Decoder::CallEndTimes ends;
+    if (ask_time && !col_time && got_all > 0 && d.call_end_times(ends)) {
+      first_time_ = ends.first;
+      for (int i = 0; i < ends.n_last; ++i) tail_time_[i] = ends.last[i];
+    }
     return got_all;
   }
 
