@@ -104,8 +104,14 @@ test_that("GENEActiv .bin: decoding is the same bits with and without AVX2", {
       expect_identical(r$avx2, r$baseline, label = paste(basename(f), "compat", compat))
     }
   }
+  # the damaged page was met: read as GGIRread reads it in GGIR's mode,
+  # skipped whole in gravcal's own
   rep <- decode_all(f2, "geneactiv", 1, 1e6)$report
+  expect_equal(rep$skipped, 0)
+  expect_equal(rep$counters[["damaged_hex"]], 1)
+  rep <- decode_all(f2, "geneactiv", 0, 1e6)$report
   expect_equal(rep$skipped, 1)
+  expect_equal(rep$counters[["bad_hex"]], 1)
 })
 
 test_that("windows and fits are the same bits with and without AVX2", {
