@@ -2,7 +2,7 @@
 # Installs what gravcal's tests need (make test and the targets it calls),
 # when it is missing: first what it needs to be built and run
 # (tools/setup.sh), then the Suggests, the tools of the test targets
-# (Chromium, pandoc, qpdf, tidy, valgrind, clang with libFuzzer and libc++,
+# (Chromium, pandoc, pngquant for the vignettes' figures, qpdf, tidy, valgrind, clang with libFuzzer and libc++,
 # the Cortex-M and mingw-w64 cross compilers, wine64 to run the Windows
 # build of the core tests, qemu, 32-bit multilib) and
 # GGIR. Debian's prebuilt r-cran-* packages when we are root on Debian
@@ -16,7 +16,7 @@ cran="${GRAVCAL_CRAN:-https://cloud.r-project.org}"
 
 deb_pkgs="r-cran-testthat r-cran-knitr
 r-cran-rmarkdown r-cran-data.table r-cran-future r-cran-future.apply
-r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc qpdf tidy valgrind gcc-arm-none-eabi
+r-cran-progressr r-cran-deoptim r-cran-batchtools r-cran-future.batchtools r-cran-pkgdown r-cran-png chromium pandoc pngquant qpdf tidy valgrind gcc-arm-none-eabi
 libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib qemu-system-arm clang libclang-rt-14-dev
 libc++-dev libc++abi-dev g++-multilib g++-mingw-w64-x86-64 libz-mingw-w64-dev wine64"
 
