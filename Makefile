@@ -5,9 +5,12 @@
 #   make test   set up the test tools too (tools/setup-test.sh), R CMD
 #               build + R CMD check --as-cran (all tests), the C++-driving
 #               test files under ASan and UBSan, the fuzzers, the standalone
-#               C++ core tests, the Windows (mingw-w64, run under wine) and
-#               clang/libc++ builds (cross-check) and the build with a
-#               user's aggressive compiler flags (flags-check)
+#               C++ core tests (also under valgrind), the Slurm run and the
+#               site: CI's command
+#   make platform-check  (not part of make test; run before resolving)
+#               the Windows (mingw-w64, run under wine) and clang/libc++
+#               builds (cross-check) and the build with a user's aggressive
+#               compiler flags (flags-check)
 #   make sanitize  (not part of make test) the whole suite under ASan and
 #               UBSan, run before resolving
 #   make site   the pkgdown documentation site (_build/site), checked in
@@ -53,7 +56,7 @@ CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE
 
 
 # (test-slurm: a single-node Slurm, see below)
-.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-ggir-own test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
+.PHONY: quick test-ggir-cache profile-tests profile-quick test-noLD test-Rnext test-arm64 test-part2to5 test-ggir-own test-slurm setup setup-test install demo test tarball check-run sanitize-run check core cross-check flags-check platform-check sanitize valgrind fuzz fuzz-short site document bench bench-speed bench-memory bench-files bench-formats refresh-vignettes clean
 
 # what building and running gravcal needs, nothing more
 setup:
@@ -81,12 +84,17 @@ demo: install
 # make test: the tarball, then two lanes side by side, one a core:
 # - lane A, in the background: the sanitizer run (SANITIZE_TESTS under ASan
 #   and UBSan, quick tier), installed from the tarball (so built in a
-#   directory of its own, not in src/, where lane B builds), then the
-#   fuzzers (tests/fuzz), the Windows and libc++ builds (cross-check) and the
-#   aggressive flags' builds (flags-check, also from the tarball); its
-#   output: $(BUILD)/lane-a.log;
-# - lane B: R CMD check (the whole suite), then the other steps one after
-#   another.
+#   directory of its own), then the fuzzers for 10 s each (tests/fuzz, their
+#   regressions replayed), the core's tests (core, valgrind), the Slurm run
+#   and the site: every step that installs the package into $(LIB) from
+#   src/ is in this lane, so no two builds share src/; its output:
+#   $(BUILD)/lane-a.log;
+# - lane B: R CMD check (the whole suite) of the tarball, in its own
+#   directory.
+# The two lanes take about the same time (CI's limit is 90 minutes; make
+# test about 35 on 2 cores). The Windows, libc++ and aggressive flags'
+# builds are make platform-check's, run before resolving with the other
+# slow platform checks (CONTRIBUTING.md).
 # It fails when either lane does. Each step's wall time is printed and kept
 # in $(BUILD)/times.txt (tools/timed.sh). GGIR's side of the identity tests
 # comes from tests/ggir-cache where the same input, parameters, GGIR version
@@ -105,20 +113,17 @@ demo: install
 # paths these files already take, and the R-side tests (cohorts, formats of
 # coefficients, plots, plausibility).
 SANITIZE_TESTS := apply|bad-input|bad-input-cases|budget|calibrate|damaged|decode-csv|decode-cwa|decode-geneactiv|decode-gt3x|decode-movisens|decode-parmay|epochs|fit-ellipsoid|fit-gradient|fit-icp|ggir-part1|ggir-segments|headers|interrupt|meta-store|near-rest|points|pool|read|rest-quality|segments|selection|simd|uncertainty|windows|write-recording
-TEST_LANE_A := fuzz-short cross-check
-TEST_LANE_B := core valgrind test-slurm site
+TEST_LANE_A := fuzz-short core valgrind test-slurm site
 test: setup-test
 	@rm -f $(BUILD)/times.txt; start=$$(date +%s); \
 	  export GLIBC_TUNABLES="$${GLIBC_TUNABLES:+$$GLIBC_TUNABLES:}$(TEST_TUNABLES)"; \
 	  bash tools/timed.sh tarball $(MAKE) tarball || exit 1; \
 	  ( bash tools/timed.sh sanitize $(MAKE) sanitize-run SANITIZE_SRC=$(BUILD)/$(TARBALL) \
 	      SANITIZE_FILTER='^($(SANITIZE_TESTS))$$' SANITIZE_TIER=quick || exit 1; \
-	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done; \
-	    bash tools/timed.sh flags-check $(MAKE) flags-check FLAGS_SRC=$(BUILD)/$(TARBALL) || exit 1 ) \
+	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ) \
 	    > $(BUILD)/lane-a.log 2>&1 & lane_a=$$!; \
-	  echo "test: lane A (sanitize, then $(TEST_LANE_A) flags-check) runs in the background (log: $(BUILD)/lane-a.log)"; \
-	  ( bash tools/timed.sh check $(MAKE) check-run || exit 1; \
-	    for t in $(TEST_LANE_B); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ); b=$$?; \
+	  echo "test: lane A (sanitize, then $(TEST_LANE_A)) runs in the background (log: $(BUILD)/lane-a.log)"; \
+	  bash tools/timed.sh check $(MAKE) check-run; b=$$?; \
 	  wait $$lane_a; a=$$?; \
 	  if [ $$a -ne 0 ]; then tail -80 $(BUILD)/lane-a.log; echo "test: lane A failed"; \
 	  else grep -E "ASan/UBSan clean|expectations|^fuzz_|agree|passed under wine" $(BUILD)/lane-a.log; fi; \
@@ -255,7 +260,11 @@ fuzz: setup-test
 	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=$${FUZZ_SECONDS:-600}
 
 fuzz-short: setup-test
-	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=30
+	$(MAKE) -C tests/fuzz fuzz FUZZ_SECONDS=10
+
+# the Windows, libc++ and aggressive flags' builds (see cross-check and
+# flags-check): a slow platform check, before resolving; about 10 minutes
+platform-check: cross-check flags-check
 
 check: setup-test
 	$(MAKE) tarball
