@@ -135,6 +135,18 @@ ggir_cached <- function(label, files, args, compute) {
   value
 }
 
+# The message of GGIR's error for a call a test expects to fail, or NA when
+# the call returned. GGIR's failing the same way on the same input is a
+# reference result like any other, so it is cached (and spot-checked) as
+# the others are; an error of the caching itself is not caught.
+ggir_error <- function(label, files, args, compute) {
+  ggir_cached(paste(label, "(its error)"), files, args,
+              tryCatch({
+                compute
+                NA_character_
+              }, error = conditionMessage))
+}
+
 # Whether a run in "use" mode recomputes the stored entry `key`: one in 16
 # by the key, unless its GGIR call is known to take more than
 # GRAVCAL_GGIR_VERIFY_SECONDS of CPU (those are left to make

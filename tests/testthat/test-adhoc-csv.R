@@ -147,9 +147,10 @@ test_that("a wear column (rmc.col.wear): g.calibrate() is GGIR's, and stops wher
     I <- keep_warn(suppressWarnings(GGIR::g.inspectfile(f, params_rawdata = pg)))
     # (keep_warn(): GGIR's g.calibrate() turns warnings off while it reads,
     # and leaves them off when its reader stops)
-    expect_error(keep_warn(utils::capture.output(GGIR::g.calibrate(f, params_rawdata = pg,
-                                                                   inspectfileobject = I,
-                                                                   verbose = FALSE))),
+    expect_match(ggir_error("g.calibrate", f, list(pg),
+                            keep_warn(utils::capture.output(GGIR::g.calibrate(f, params_rawdata = pg,
+                                                                              inspectfileobject = I,
+                                                                              verbose = FALSE)))),
                  "Corrupt file. The wear column")
     expect_error(gravcal::g.calibrate(f, params_rawdata = p, verbose = FALSE), msg)
   }

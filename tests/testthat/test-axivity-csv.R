@@ -223,8 +223,10 @@ test_that("an Axivity csv export with OMGUI's header line: GGIR stops, so g.cali
   # GGIR stops with the session's warnings switched off (options(warn =
   # -1)); keep_warn() restores them, so later snapshots record warnings
   warn <- getOption("warn")
-  expect_error(keep_warn(suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr, inspectfileobject = I,
-                                                            verbose = FALSE))),
+  expect_match(ggir_error("g.calibrate", f, list(pr),
+                          keep_warn(suppressWarnings(GGIR::g.calibrate(f, params_rawdata = pr,
+                                                                       inspectfileobject = I,
+                                                                       verbose = FALSE)))),
                "standard unambiguous format")
   expect_identical(getOption("warn"), warn)
   expect_error(gravcal::g.calibrate(f, verbose = FALSE),

@@ -2,8 +2,23 @@
 # parallel, a corrupt file, resumption after a killed run; calibrate_cli().
 # The faults a cohort run must survive are in test-cohort-faults.R.
 
+# A folder of the five recordings, each call a fresh copy (the tests change
+# and add files in it) of one made once per run of this file: writing the
+# csv files is most of a cohort test's time.
 cohort_dir <- function() {
+  template <- file.path(tempdir(), "gravcal-cohort-template")
+  if (!file.exists(file.path(template, "p05_corrupt.csv"))) {
+    unlink(template, recursive = TRUE)
+    make_cohort_dir(template)
+  }
   dir <- tempfile("cohort")
+  dir.create(dir)
+  ok <- file.copy(list.files(template, full.names = TRUE), dir)
+  stopifnot(all(ok))
+  dir
+}
+
+make_cohort_dir <- function(dir) {
   dir.create(dir)
   p <- c(k_xx = 1.02, k_yy = 0.98, k_zz = 1.01, k_xy = 0, k_xz = 0, k_yz = 0,
          o_x = 0.03, o_y = -0.02, o_z = 0.015)
@@ -16,6 +31,7 @@ cohort_dir <- function() {
   gravcal:::write_actigraph_csv(rec, file.path(dir, "p03_actigraph.csv"), sf = 10)
   saveRDS(simulate_recording(hours = 26, sf = 10, seed = 104, params = p),
           file.path(dir, "p04.rds"))
+  # (written last: its presence says the folder is whole)
   writeLines(c("x,y,z", "a,b,c", "1,2"), file.path(dir, "p05_corrupt.csv"))
   dir
 }

@@ -213,8 +213,10 @@ test_that("damaged Movisens recordings: a cut acc.bin, no temp.bin, a bad unisen
   file.copy(file.path(src, "temp.bin"), d)
   tb <- file.path(d, "temp.bin")
   writeBin(readBin(tb, raw(), 26 * 3600 * 2), tb)
-  expect_error(keep_warn(suppressWarnings(GGIR::g.calibrate(f, inspectfileobject = GGIR::g.inspectfile(f),
-                                                            verbose = FALSE))))
+  expect_match(ggir_error("g.calibrate", d, list(),
+                          keep_warn(suppressWarnings(GGIR::g.calibrate(f, inspectfileobject = GGIR::g.inspectfile(f),
+                                                                       verbose = FALSE)))),
+               "subscript out of bounds", fixed = TRUE)
   expect_error(gravcal::g.calibrate(f, verbose = FALSE),
                "temp.bin does not cover samples 5529601 to 6911999")
   r <- read_recording(d)

@@ -290,12 +290,14 @@ test_that("where GGIR's g.getmeta() stops on a damaged GENEActiv file, gravcal's
   rd <- which(lines == "Recorded Data")
   pr <- utils::modifyList(GGIR::load_params()$params_rawdata, list(chunksize = 0.1))
   ggir_stops <- function(f, pattern) {
-    # (GGIR's side, a run of GGIR each, never cached: the slow tier)
+    # (GGIR's side: its error, cached; the slow tier)
     if (identical(Sys.getenv("GRAVCAL_TEST_TIER"), "quick")) return(invisible())
-    I <- keep_warn(meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr)))
     # (GGIRread's "data error" lines on stderr dropped)
-    utils::capture.output(type = "message", expect_error(keep_warn(meta_quiet(
-      GGIR::g.getmeta(f, params_rawdata = pr, inspectfileobject = I, verbose = FALSE))), pattern))
+    utils::capture.output(type = "message", expect_match(ggir_error("g.getmeta", f, list(pr), {
+      I <- keep_warn(meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr)))
+      keep_warn(meta_quiet(GGIR::g.getmeta(f, params_rawdata = pr, inspectfileobject = I,
+                                           verbose = FALSE)))
+    }), pattern))
   }
   ours <- function(f) gravcal::g.getmeta(f, params_rawdata = pr, verbose = FALSE)
   # the last page cut in its temperature's number: GGIRread's rate of that
@@ -590,10 +592,11 @@ test_that("g.getmeta() on an Axivity csv export is GGIR's (each block resampled)
                               start = "2024-03-30 22:47:13")
   pg <- utils::modifyList(GGIR::load_params()$params_general, list(desiredtz = "Europe/Amsterdam"))
   pr <- utils::modifyList(GGIR::load_params()$params_rawdata, list(chunksize = 0.1))
-  I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
-  expect_error(keep_warn(meta_quiet(GGIR::g.getmeta(f, params_rawdata = pr, params_general = pg,
-                                                    inspectfileobject = I, verbose = FALSE))),
-               "missing value where TRUE/FALSE needed")
+  expect_match(ggir_error("g.getmeta", f, list(pr, pg), {
+    I <- meta_quiet(GGIR::g.inspectfile(f, params_rawdata = pr, params_general = pg))
+    keep_warn(meta_quiet(GGIR::g.getmeta(f, params_rawdata = pr, params_general = pg,
+                                         inspectfileobject = I, verbose = FALSE)))
+  }), "missing value where TRUE/FALSE needed", fixed = TRUE)
   expect_error(meta_quiet(gravcal::g.getmeta(f, params_rawdata = pr, params_general = pg,
                                              verbose = FALSE)),
                "holds one value that is not NA: GGIR's g.getmeta() stops there too", fixed = TRUE)
@@ -1359,9 +1362,12 @@ test_that("g.getmeta() takes non-wear from a wear column (rmc.col.wear) as GGIR 
     s <- meta_adhoc(time = "UNIXsec", hours = 2.5, wear = wear)
     pr <- utils::modifyList(GGIR::load_params()$params_rawdata, s$pr)
     # (keep_warn(): GGIR's functions that stop may leave warnings off)
-    I <- keep_warn(meta_quiet(GGIR::g.inspectfile(s$file, params_rawdata = pr)))
-    expect_error(keep_warn(meta_quiet(GGIR::g.getmeta(s$file, params_rawdata = pr, inspectfileobject = I,
-                                                      verbose = FALSE))))
+    ggir_msg <- ggir_error("g.getmeta", s$file, list(pr), {
+      I <- keep_warn(meta_quiet(GGIR::g.inspectfile(s$file, params_rawdata = pr)))
+      keep_warn(meta_quiet(GGIR::g.getmeta(s$file, params_rawdata = pr, inspectfileobject = I,
+                                           verbose = FALSE)))
+    })
+    expect_false(is.na(ggir_msg), label = "GGIR's g.getmeta() stopped")
     expect_error(meta_quiet(gravcal::g.getmeta(s$file, params_rawdata = pr, verbose = FALSE)), msg)
     unlink(s$file)
   }
