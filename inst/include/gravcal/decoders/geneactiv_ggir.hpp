@@ -129,9 +129,25 @@ inline bool read_group(const char* s, std::size_t len, int& v) {
   while (i < len && c_space(s[i])) ++i;
   bool negative = false;
   if (i < len && (s[i] == '+' || s[i] == '-')) negative = s[i++] == '-';
-  if (i + 2 < len && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X') &&
-      hex_digit(s[i + 2]) >= 0) {
-    i += 2;
+  if (i + 1 < len && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
+    if (i + 2 < len && hex_digit(s[i + 2]) >= 0) {
+      i += 2;
+    } else {
+      // "0x" with no hex digit after it: C libraries differ. glibc's
+      // strtoll reads the 0 and stops at the x; Microsoft's C runtime (as
+      // Wine's, where the Windows build's tests run) reads nothing, so that
+      // GGIRread's std::stoll throws there. GGIRread's reader is built with
+      // the toolchain R's packages are built with, as gravcal is: ask the
+      // same strtoll (only here: it is rare, and a call per group would
+      // cost seconds a week).
+      char buf[4] = {0, 0, 0, 0};
+      std::memcpy(buf, s, len);
+      char* stop = nullptr;
+      static_cast<void>(std::strtoll(buf, &stop, 16));
+      if (stop == buf) return false;
+      v = 0;  // the 0 before the x, signed or not
+      return true;
+    }
   }
   int value = 0;
   std::size_t digits = 0;
