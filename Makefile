@@ -85,12 +85,12 @@ demo: install
 # - lane A, in the background: the sanitizer run (SANITIZE_TESTS under ASan
 #   and UBSan, quick tier), installed from the tarball (so built in a
 #   directory of its own), then the fuzzers for 10 s each (tests/fuzz, their
-#   regressions replayed), the core's tests (core, valgrind), the Slurm run
-#   and the site: every step that installs the package into $(LIB) from
-#   src/ is in this lane, so no two builds share src/; its output:
-#   $(BUILD)/lane-a.log;
+#   regressions replayed) and the core's tests (core, valgrind): the only
+#   step that installs the package into $(LIB) from src/ is in this lane;
+#   its output: $(BUILD)/lane-a.log;
 # - lane B: R CMD check (the whole suite) of the tarball, in its own
-#   directory.
+#   directory, then the Slurm run and the site, from the check's own
+#   installation (RUN_LIB).
 # The two lanes take about the same time (CI's limit is 90 minutes; make
 # test about 35 on 2 cores). The Windows, libc++ and aggressive flags'
 # builds are make platform-check's, run before resolving with the other
@@ -113,7 +113,8 @@ demo: install
 # paths these files already take, and the R-side tests (cohorts, formats of
 # coefficients, plots, plausibility).
 SANITIZE_TESTS := apply|bad-input|bad-input-cases|budget|calibrate|damaged|decode-csv|decode-cwa|decode-geneactiv|decode-gt3x|decode-movisens|decode-parmay|epochs|fit-ellipsoid|fit-gradient|fit-icp|ggir-part1|ggir-segments|headers|interrupt|meta-store|near-rest|points|pool|read|rest-quality|segments|selection|simd|uncertainty|windows|write-recording
-TEST_LANE_A := fuzz-short core valgrind test-slurm site
+TEST_LANE_A := fuzz-short core valgrind
+TEST_LANE_B := test-slurm site
 test: setup-test
 	@rm -f $(BUILD)/times.txt; start=$$(date +%s); \
 	  export GLIBC_TUNABLES="$${GLIBC_TUNABLES:+$$GLIBC_TUNABLES:}$(TEST_TUNABLES)"; \
@@ -122,8 +123,9 @@ test: setup-test
 	      SANITIZE_FILTER='^($(SANITIZE_TESTS))$$' SANITIZE_TIER=quick || exit 1; \
 	    for t in $(TEST_LANE_A); do bash tools/timed.sh $$t $(MAKE) $$t || exit 1; done ) \
 	    > $(BUILD)/lane-a.log 2>&1 & lane_a=$$!; \
-	  echo "test: lane A (sanitize, then $(TEST_LANE_A)) runs in the background (log: $(BUILD)/lane-a.log)"; \
-	  bash tools/timed.sh check $(MAKE) check-run; b=$$?; \
+	  echo "test: lane A (sanitize, then $(TEST_LANE_A)) runs in the background (log: $(BUILD)/lane-a.log); lane B: check, then $(TEST_LANE_B)"; \
+	  ( bash tools/timed.sh check $(MAKE) check-run || exit 1; \
+	    for t in $(TEST_LANE_B); do bash tools/timed.sh $$t $(MAKE) $$t RUN_LIB=$(BUILD)/gravcal.Rcheck || exit 1; done ); b=$$?; \
 	  wait $$lane_a; a=$$?; \
 	  if [ $$a -ne 0 ]; then tail -80 $(BUILD)/lane-a.log; echo "test: lane A failed"; \
 	  else grep -E "ASan/UBSan clean|expectations|^fuzz_|agree|passed under wine" $(BUILD)/lane-a.log; fi; \
@@ -313,13 +315,19 @@ refresh-vignettes: install setup-test
 SITE_ENV := OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2 R_DATATABLE_NUM_THREADS=2 \
             MC_CORES=2 R_PARALLELLY_AVAILABLECORES_FALLBACK=2 \
             GRAVCAL_SHARED_DATA=$(SHARED_DATA)
-site: install setup-test
+# RUN_LIB: the library site and test-slurm run gravcal from (default: make
+# install's $(LIB), installed first); make test's lane B gives them the
+# check's own installation of the tarball ($(BUILD)/gravcal.Rcheck), so that
+# that lane never builds in src/
+RUN_LIB ?=
+USE_LIB = $(abspath $(or $(RUN_LIB),$(LIB)))
+site: $(if $(RUN_LIB),,install) setup-test
 	rm -rf $(BUILD)/site $(BUILD)/site-shots
-	env $(SITE_ENV) R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) -e \
+	env $(SITE_ENV) R_LIBS="$(USE_LIB)$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) -e \
 	  'options(pkgdown.internet = FALSE, Ncpus = 2); pkgdown::build_site(install = FALSE, new_process = FALSE, preview = FALSE)' \
 	  > $(BUILD)/site.log 2>&1 || (tail -60 $(BUILD)/site.log; exit 1)
 	@if grep -n "^Warning\|^Error" $(BUILD)/site.log; then echo "site: pkgdown warned (see $(BUILD)/site.log)"; exit 1; fi
-	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/site-test.R $(BUILD)/site $(BUILD)/site-shots
+	R_LIBS="$(USE_LIB)$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/site-test.R $(BUILD)/site $(BUILD)/site-shots
 
 clean:
 	rm -rf $(BUILD) src/*.o src/*.so gravcal-example.png
@@ -372,9 +380,9 @@ test-Rnext:
 # calibrate_files() through future.batchtools on a real Slurm: starts a
 # single-node Slurm here (root, Debian: slurm-wlm, munge) and runs a cohort
 # as Slurm jobs, checking the table against a sequential run's
-test-slurm: install setup-test
+test-slurm: $(if $(RUN_LIB),,install) setup-test
 	bash tools/slurm-setup.sh
-	R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R
+	R_LIBS="$(USE_LIB)$${R_LIBS:+:$$R_LIBS}" $(RSCRIPT) tools/test-slurm.R
 
 # gravcal on Linux aarch64 with a real arm64 R (tools/arm64-chroot.sh, as
 # root): a Debian 12 arm64 chroot under qemu-user (in
