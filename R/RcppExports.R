@@ -101,6 +101,10 @@ gc_meta_store_gradient <- function(ptr, n_use, sf, ws3, cal, temperature) {
     .Call(`_gravcal_gc_meta_store_gradient`, ptr, n_use, sf, ws3, cal, temperature)
 }
 
+gc_iso_stamps <- function(year, mon, mday, hour, min, sec, isdst, gmtoff) {
+    .Call(`_gravcal_gc_iso_stamps`, year, mon, mday, hour, min, sec, isdst, gmtoff)
+}
+
 gc_ggir_filter <- function(b, a, x, conv_fused, rec_fused) {
     .Call(`_gravcal_gc_ggir_filter`, b, a, x, conv_fused, rec_fused)
 }

@@ -438,6 +438,22 @@ text_round_trip <- function(v) {
   as.numeric(as.character(u))[match(v, u)]
 }
 
+# Times `tt` (seconds since 1970) as GGIR writes M's time stamps,
+# strftime(as.POSIXlt(tt, tz = tz), "%Y-%m-%dT%H:%M:%S%z"): R's conversion
+# to local time, then the text made in C++ (gc_iso_stamps()) wherever it is
+# certainly R's, else by R's own formatter.
+iso_stamps <- function(tt, tz) {
+  lt <- as.POSIXlt(tt, origin = "1970-01-01", tz = tz)
+  u <- unclass(lt)
+  off <- u$gmtoff
+  if (is.null(off) && !(attr(lt, "tzone")[1] %in% c("UTC", "GMT"))) off <- NA
+  s <- if (is.null(off) || is.integer(off)) {
+    gc_iso_stamps(u$year, u$mon, u$mday, u$hour, u$min, u$sec, u$isdst, off)
+  }
+  if (is.null(s)) s <- strftime(lt, format = "%Y-%m-%dT%H:%M:%S%z")
+  s
+}
+
 # GGIR's M from the blocks' values: the columns as GGIR's character
 # matrices hold them (R's text of each number, read back), time stamps in
 # desiredtz.
@@ -457,9 +473,7 @@ meta_result <- function(short, long, asked, metnames, metricnames_long, starttim
   stamp <- function(n, by, min_rows) {
     if (n <= min_rows) return(rep(" ", n))
     t0 <- round(as.numeric(starttime))
-    tt <- seq(t0, t0 + (n - 1) * by, by = by)
-    strftime(as.POSIXlt(tt, origin = "1970-01-01", tz = p$desiredtz),
-             format = "%Y-%m-%dT%H:%M:%S%z")
+    iso_stamps(seq(t0, t0 + (n - 1) * by, by = by), p$desiredtz)
   }
   ms <- data.frame(timestamp = stamp(n_short, ws3, 1), stringsAsFactors = FALSE)
   for (k in seq_along(metnames)) {

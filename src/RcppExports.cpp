@@ -304,6 +304,23 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gc_iso_stamps
+SEXP gc_iso_stamps(const Rcpp::IntegerVector& year, const Rcpp::IntegerVector& mon, const Rcpp::IntegerVector& mday, const Rcpp::IntegerVector& hour, const Rcpp::IntegerVector& min, const Rcpp::NumericVector& sec, const Rcpp::IntegerVector& isdst, SEXP gmtoff);
+RcppExport SEXP _gravcal_gc_iso_stamps(SEXP yearSEXP, SEXP monSEXP, SEXP mdaySEXP, SEXP hourSEXP, SEXP minSEXP, SEXP secSEXP, SEXP isdstSEXP, SEXP gmtoffSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type year(yearSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type mon(monSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type mday(mdaySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type hour(hourSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type min(minSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type sec(secSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type isdst(isdstSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type gmtoff(gmtoffSEXP);
+    rcpp_result_gen = Rcpp::wrap(gc_iso_stamps(year, mon, mday, hour, min, sec, isdst, gmtoff));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gc_ggir_filter
 Rcpp::NumericVector gc_ggir_filter(const Rcpp::NumericVector& b, const Rcpp::NumericVector& a, const Rcpp::NumericVector& x, bool conv_fused, bool rec_fused);
 RcppExport SEXP _gravcal_gc_ggir_filter(SEXP bSEXP, SEXP aSEXP, SEXP xSEXP, SEXP conv_fusedSEXP, SEXP rec_fusedSEXP) {
@@ -562,6 +579,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_gravcal_gc_meta_store_keep", (DL_FUNC) &_gravcal_gc_meta_store_keep, 3},
     {"_gravcal_gc_meta_store_epochs", (DL_FUNC) &_gravcal_gc_meta_store_epochs, 13},
     {"_gravcal_gc_meta_store_gradient", (DL_FUNC) &_gravcal_gc_meta_store_gradient, 6},
+    {"_gravcal_gc_iso_stamps", (DL_FUNC) &_gravcal_gc_iso_stamps, 8},
     {"_gravcal_gc_ggir_filter", (DL_FUNC) &_gravcal_gc_ggir_filter, 5},
     {"_gravcal_gc_ggir_filtered_signal", (DL_FUNC) &_gravcal_gc_ggir_filtered_signal, 8},
     {"_gravcal_gc_fit_icp", (DL_FUNC) &_gravcal_gc_fit_icp, 10},

@@ -506,3 +506,65 @@ Rcpp::NumericMatrix gc_meta_store_gradient(SEXP ptr, double n_use, double sf, do
                                                       "o_x", "o_y", "o_z", "t_x", "t_y", "t_z");
   return out;
 }
+
+// GGIR's time stamps of M (strftime(<POSIXlt>, "%Y-%m-%dT%H:%M:%S%z")) from
+// a POSIXlt's fields, without R's formatter (a tenth of a second for a
+// week's short epochs): the date and time as two-digit fields, the year as
+// four, then the offset from UTC as "+hhmm" or "-hhmm", whole minutes of
+// `gmtoff` (seconds dropped, as the C library's %z drops them). `gmtoff`
+// NULL: an offset of zero (R's "UTC" and "GMT", which carry none). Only
+// where that is certainly what R writes: NULL (R formats) if any element
+// has a year outside 1000-9999, a field NA or out of its range, seconds
+// not whole, an offset NA, or isdst negative (the C library then writes no
+// offset at all).
+// [[Rcpp::export(rng = false)]]
+SEXP gc_iso_stamps(const Rcpp::IntegerVector& year, const Rcpp::IntegerVector& mon,
+                   const Rcpp::IntegerVector& mday, const Rcpp::IntegerVector& hour,
+                   const Rcpp::IntegerVector& min, const Rcpp::NumericVector& sec,
+                   const Rcpp::IntegerVector& isdst, SEXP gmtoff) {
+  const R_xlen_t n = year.size();
+  if (mon.size() != n || mday.size() != n || hour.size() != n || min.size() != n ||
+      sec.size() != n || isdst.size() != n) {
+    Rcpp::stop("the fields of the time stamps differ in length");
+  }
+  const bool zero = Rf_isNull(gmtoff);
+  if (!zero && (TYPEOF(gmtoff) != INTSXP || Rf_xlength(gmtoff) != n)) return R_NilValue;
+  const int* off = zero ? nullptr : INTEGER(gmtoff);
+  auto in = [](int v, int lo, int hi) { return v != NA_INTEGER && v >= lo && v <= hi; };
+  for (R_xlen_t i = 0; i < n; ++i) {
+    const double s = sec[i];
+    if (!in(year[i], 1000 - 1900, 9999 - 1900) || !in(mon[i], 0, 11) || !in(mday[i], 1, 31) ||
+        !in(hour[i], 0, 23) || !in(min[i], 0, 59) || !(s >= 0 && s <= 60) || s != std::floor(s) ||
+        !in(isdst[i], 0, 1) || (off != nullptr && !in(off[i], -86400, 86400))) {
+      return R_NilValue;
+    }
+  }
+  auto two = [](char* p, int v) {
+    p[0] = static_cast<char>('0' + v / 10);
+    p[1] = static_cast<char>('0' + v % 10);
+  };
+  Rcpp::CharacterVector out(n);
+  char b[24];  // "YYYY-mm-ddTHH:MM:SS+hhmm"
+  for (R_xlen_t i = 0; i < n; ++i) {
+    const int y = year[i] + 1900;
+    two(b, y / 100);
+    two(b + 2, y % 100);
+    b[4] = '-';
+    two(b + 5, mon[i] + 1);
+    b[7] = '-';
+    two(b + 8, mday[i]);
+    b[10] = 'T';
+    two(b + 11, hour[i]);
+    b[13] = ':';
+    two(b + 14, min[i]);
+    b[16] = ':';
+    two(b + 17, static_cast<int>(sec[i]));
+    const int o = off == nullptr ? 0 : off[i];
+    const int m = (o < 0 ? -o : o) / 60;  // whole minutes, toward zero
+    b[19] = o < 0 ? '-' : '+';
+    two(b + 20, m / 60);
+    two(b + 22, m % 60);
+    SET_STRING_ELT(out, i, Rf_mkCharLenCE(b, 24, CE_NATIVE));
+  }
+  return out;
+}
