@@ -78,7 +78,8 @@
 #' block of GGIR's starting at a time that exists twice or not at all there).
 #' Metrics:
 #' every `do.*` of
-#' `params_metrics` but `do.brondcounts` (GGIR stops on it too);
+#' `params_metrics` but `do.brondcounts` (GGIR stops on it too); none of
+#' them is an error too, where a recording has a block (GGIR stops there);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
 #' each block's calibrated samples as GGIR calls it (with `actilife_LFE`);
 #' the filtered ones (BFEN, HFEN, HFENplus, LFENMO,

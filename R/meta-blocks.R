@@ -403,6 +403,15 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         LD <- 0
       }
       if (LD >= ws * sf) {
+        if (!length(asked) && !length(neish)) {
+          # GGIR's g.getmeta() reads the first column of the block's metrics
+          # here and stops ("subscript out of bounds"); a file too short
+          # for a block gets its M
+          abort("No metric asked: every `do.*` of `params_metrics` GGIR computes is FALSE, ",
+                "and GGIR's g.getmeta() stops on the first block of such a recording ",
+                "(\"subscript out of bounds\"); gravcal's does too. Ask at least one ",
+                "(GGIR's default: `do.enmo` and `do.anglez`).")
+        }
         use <- meta_myfun_use((floor(LD / (ws2 * sf))) * (ws2 * sf), myfun)
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
         # may not be whole)

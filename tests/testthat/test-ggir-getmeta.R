@@ -466,6 +466,35 @@ test_that("g.getmeta() gives Neishabouri's counts as GGIR does (actilifecounts p
   expect_true(all(is.na(b3$gravcal$metashort[[mf$colnames]])))
 })
 
+test_that("no metric asked: GGIR stops on a recording's first block, and so does gravcal", {
+  # every do.* FALSE: GGIR's g.getmeta() reads the first column of a block's
+  # metrics (accmetrics[[1]]) and stops; found by tools/ggir-sweep.R
+  none <- GGIR::load_params()$params_metrics
+  for (k in grep("^do[.]", names(none), value = TRUE)) none[[k]] <- FALSE
+  f <- meta_recording("cwa", 25, 3, seed = 12)
+  expect_identical(ggir_error("g.getmeta", f, list(none), {
+    I <- meta_quiet(GGIR::g.inspectfile(f))
+    meta_quiet(GGIR::g.getmeta(f, params_metrics = none, inspectfileobject = I, verbose = FALSE))
+  }), "subscript out of bounds")
+  expect_error(gravcal::g.getmeta(f, params_metrics = none, verbose = FALSE),
+               "No metric asked: every `do[.][*]` of `params_metrics`")
+  # with a myfun and no metric GGIR stops the same way (its metrics, not the
+  # function's columns); with Neishabouri's counts alone it does not
+  mf <- meta_myfuns()$per_second
+  expect_identical(ggir_error("g.getmeta", f, list(none, "myfun: meta_myfuns()$per_second"), {
+    I <- meta_quiet(GGIR::g.inspectfile(f))
+    meta_quiet(GGIR::g.getmeta(f, params_metrics = none, myfun = mf, inspectfileobject = I,
+                               verbose = FALSE))
+  }), "subscript out of bounds")
+  expect_error(gravcal::g.getmeta(f, params_metrics = none, myfun = mf, verbose = FALSE),
+               "No metric asked")
+  # a recording too short for a block: GGIR's M (file too short), not an error
+  short <- meta_recording("cwa", 25, 0.5, seed = 12)
+  b <- meta_both(short, list(params_metrics = none))
+  expect_true(b$ggir$filetooshort)
+  expect_same_meta(b)
+})
+
 test_that("a myfun GGIR would stop on is an error naming what is wrong", {
   f <- meta_recording("cwa", 25, 3, seed = 12)
   mf <- meta_myfuns()$per_second
