@@ -78,8 +78,12 @@
 #' block of GGIR's starting at a time that exists twice or not at all there).
 #' Metrics:
 #' every `do.*` of
-#' `params_metrics` but `do.brondcounts` (GGIR stops on it too); none of
-#' them is an error too, where a recording has a block (GGIR stops there);
+#' `params_metrics` but `do.brondcounts` (GGIR stops on it too). Where a
+#' recording has a block, GGIR stops, and so gravcal's g.getmeta() stops, on
+#' none of them, and on part of a group GGIR computes whole: any of
+#' `do.hfx`, `do.hfy`, `do.hfz` without `do.hfen`, one or two axes of
+#' `do.roll_med_acc_*` or of `do.dev_roll_med_acc_*` ([epoch_signals()]
+#' computes those);
 #' `do.neishabouricounts` from the actilifecounts package, called in R on
 #' each block's calibrated samples as GGIR calls it (with `actilife_LFE`);
 #' the filtered ones (BFEN, HFEN, HFENplus, LFENMO,
@@ -142,7 +146,7 @@ g.getmeta <- function(datafile, params_metrics = c(), params_rawdata = c(),
   src <- meta_ahead_take(datafile, p, inspectfileobject) %||%
     meta_open(datafile, p, inspectfileobject)
   on.exit(gc_decoder_close(src$native$ptr), add = TRUE)
-  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun)
+  M <- meta_run(src, p, cal, daylimit, verbose, myfun = myfun, ggir = TRUE)
   # text time in a zone whose offset changes (ad hoc and Axivity csv), and
   # .cwa blocks there: a block of GGIR's that starts at a time that exists
   # twice or not at all there is refused, as by g.calibrate(); an Axivity

@@ -152,6 +152,43 @@ meta_store <- function(src, time) {
 # Rows `i` of a block (a list of equal-length columns).
 meta_rows <- function(d, i) lapply(d, function(v) v[i])
 
+# Why GGIR 3.3-9's g.getmeta() stops on a recording with a block, for the
+# metrics `asked` (meta_metric_table()'s names) and Neishabouri's count
+# columns `neish`, or NULL. Its block reads the first column of
+# g.applymetrics()'s result, which has none without a metric ("subscript
+# out of bounds"); and g.applymetrics() gives HFEN with any of HFX, HFY,
+# HFZ, and all three axes of roll_med_acc and of dev_roll_med_acc with any
+# one, asked or not, while g.getmeta() keeps the asked columns but names
+# them all ("'names' attribute [..] must be the same length as the vector
+# [..]").
+meta_ggir_stops <- function(asked, neish) {
+  if (!length(asked) && !length(neish)) {
+    return(paste0("No metric asked: every `do.*` of `params_metrics` GGIR computes is FALSE, ",
+                  "and GGIR's g.getmeta() stops on the first block of such a recording ",
+                  "(\"subscript out of bounds\"); gravcal's does too. Ask at least one ",
+                  "(GGIR's default: `do.enmo` and `do.anglez`)."))
+  }
+  do <- function(nm) meta_do_name(nm)
+  groups <- list(
+    list(any = c("HFX", "HFY", "HFZ"), gives = "HFEN"),
+    list(any = paste0("roll_med_acc_", c("x", "y", "z")), gives = paste0("roll_med_acc_", c("x", "y", "z"))),
+    list(any = paste0("dev_roll_med_acc_", c("x", "y", "z")),
+         gives = paste0("dev_roll_med_acc_", c("x", "y", "z"))))
+  for (g in groups) {
+    missing <- setdiff(g$gives, asked)
+    if (any(g$any %in% asked) && length(missing)) {
+      return(paste0("`", paste(do(intersect(g$any, asked)), collapse = "`, `"), "` without `",
+                    paste(do(missing), collapse = "`, `"), "`: GGIR's g.applymetrics() computes ",
+                    paste(missing, collapse = ", "), " with ", if (length(g$any) > 1) "any of ",
+                    paste(g$any, collapse = ", "), ", and its g.getmeta() then stops on the ",
+                    "names of its metrics (\"'names' attribute must be the same length as the ",
+                    "vector\"); gravcal's does too. Ask for ",
+                    paste0("`", do(missing), "`", collapse = ", "), " as well (set to TRUE)."))
+    }
+  }
+  NULL
+}
+
 # g.getmeta()'s loop over the blocks of an open native source (or samples
 # in memory), each block held in the core (meta_store()): R decides what
 # GGIR decides per block (the last block, the start, the gap to the carry,
@@ -165,9 +202,11 @@ meta_rows <- function(d, i) lapply(d, function(v) v[i])
 # model), also each short epoch's ENMO gradient with respect to the fit's
 # coefficients, from
 # the raw samples of each block (M$enmo_gradient, a matrix; epoch_signals()
-# only: g.getmeta()'s M never has it).
+# only: g.getmeta()'s M never has it). `ggir`: g.getmeta()'s run, which
+# stops where GGIR's does on the metrics asked (meta_ggir_stops());
+# epoch_signals() computes what it is asked.
 meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NULL,
-                     myfun = NULL) {
+                     myfun = NULL, ggir = FALSE) {
   sf <- src$sf
   ws3 <- p$windowsizes[1]
   ws2 <- p$windowsizes[2]
@@ -403,15 +442,9 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
         LD <- 0
       }
       if (LD >= ws * sf) {
-        if (!length(asked) && !length(neish)) {
-          # GGIR's g.getmeta() reads the first column of the block's metrics
-          # here and stops ("subscript out of bounds"); a file too short
-          # for a block gets its M
-          abort("No metric asked: every `do.*` of `params_metrics` GGIR computes is FALSE, ",
-                "and GGIR's g.getmeta() stops on the first block of such a recording ",
-                "(\"subscript out of bounds\"); gravcal's does too. Ask at least one ",
-                "(GGIR's default: `do.enmo` and `do.anglez`).")
-        }
+        # where GGIR's g.getmeta() stops once it has a block (a file too
+        # short for one gets its M)
+        if (ggir && !is.null(why <- meta_ggir_stops(asked, neish))) abort(why)
         use <- meta_myfun_use((floor(LD / (ws2 * sf))) * (ws2 * sf), myfun)
         # GGIR's data[1:use, ]: the first n_use rows (R's `:` on a use that
         # may not be whole)

@@ -86,8 +86,11 @@ test_that("g.getmeta() gives the same M on one thread and on two; options(gravca
   meta <- function(threads) {
     old <- options(gravcal.threads = threads)
     on.exit(options(old))
+    # (each of GGIR's groups of three axes whole: GGIR stops on a part of one)
     gravcal::g.getmeta(f, chunksize = 0.1, do.anglex = TRUE, do.angley = TRUE,
-                       do.roll_med_acc_y = TRUE, do.dev_roll_med_acc_z = TRUE, do.mad = TRUE,
+                       do.roll_med_acc_x = TRUE, do.roll_med_acc_y = TRUE,
+                       do.roll_med_acc_z = TRUE, do.dev_roll_med_acc_x = TRUE,
+                       do.dev_roll_med_acc_y = TRUE, do.dev_roll_med_acc_z = TRUE, do.mad = TRUE,
                        do.bfen = TRUE, desiredtz = "UTC", verbose = FALSE)
   }
   one <- meta(1)
@@ -104,8 +107,10 @@ test_that("g.getmeta() gives the same M on one thread and on two; options(gravca
   shared <- function(threads) {
     old <- options(gravcal.threads = threads)
     on.exit(options(old))
-    gravcal::g.getmeta(f, chunksize = 0.1, do.anglex = TRUE, do.roll_med_acc_z = TRUE,
-                       do.dev_roll_med_acc_x = TRUE, desiredtz = "UTC", verbose = FALSE)
+    gravcal::g.getmeta(f, chunksize = 0.1, do.anglex = TRUE, do.roll_med_acc_x = TRUE,
+                       do.roll_med_acc_y = TRUE, do.roll_med_acc_z = TRUE,
+                       do.dev_roll_med_acc_x = TRUE, do.dev_roll_med_acc_y = TRUE,
+                       do.dev_roll_med_acc_z = TRUE, desiredtz = "UTC", verbose = FALSE)
   }
   s1 <- shared(1)
   s2 <- shared(2)

@@ -495,6 +495,38 @@ test_that("no metric asked: GGIR stops on a recording's first block, and so does
   expect_same_meta(b)
 })
 
+test_that("part of one of GGIR's groups of metrics: GGIR stops on it, and so does gravcal", {
+  # GGIR's g.applymetrics() gives HFEN with any of HFX, HFY, HFZ, and all
+  # three axes of roll_med_acc (dev_roll_med_acc) with any one; g.getmeta()
+  # keeps the asked columns and names them all, and stops. Found by
+  # tools/ggir-sweep.R (a .gt3x file, roll_med_acc_y and dev_roll_med_acc_y, _z)
+  f <- meta_recording("cwa", 25, 3, seed = 12)
+  parts <- list(hf = list(do.hfx = TRUE),
+                roll = list(do.roll_med_acc_y = TRUE),
+                dev = list(do.dev_roll_med_acc_y = TRUE, do.dev_roll_med_acc_z = TRUE))
+  said <- c(hf = "`do.hfx` without `do.hfen`",
+            roll = "`do.roll_med_acc_y` without `do.roll_med_acc_x`, `do.roll_med_acc_z`",
+            dev = "`do.dev_roll_med_acc_y`, `do.dev_roll_med_acc_z` without `do.dev_roll_med_acc_x`")
+  for (k in names(parts)) {
+    # (the whole list, as meta_both() gives it: GGIR stops elsewhere on one
+    # that lacks entries)
+    pm <- utils::modifyList(GGIR::load_params()$params_metrics, parts[[k]])
+    expect_match(ggir_error("g.getmeta", f, list(pm), {
+      I <- meta_quiet(GGIR::g.inspectfile(f))
+      meta_quiet(GGIR::g.getmeta(f, params_metrics = pm, inspectfileobject = I, verbose = FALSE))
+    }), "'names' attribute \\[[0-9]+\\] must be the same length as the vector", label = k)
+    expect_error(gravcal::g.getmeta(f, params_metrics = pm, verbose = FALSE), said[[k]],
+                 fixed = TRUE, label = k)
+  }
+  # a group asked whole is GGIR's M (HFX with HFEN; the three axes)
+  whole <- list(do.hfx = TRUE, do.hfen = TRUE, do.roll_med_acc_x = TRUE, do.roll_med_acc_y = TRUE,
+                do.roll_med_acc_z = TRUE)
+  expect_same_meta(meta_both(f, list(params_metrics = whole)))
+  # epoch_signals() is not GGIR's drop-in: it computes what it is asked
+  ep <- epoch_signals(f, metrics = c("HFX", "roll_med_acc_y"), se = FALSE)
+  expect_identical(names(ep$short), c("time", "HFX", "roll_med_acc_y"))
+})
+
 test_that("a myfun GGIR would stop on is an error naming what is wrong", {
   f <- meta_recording("cwa", 25, 3, seed = 12)
   mf <- meta_myfuns()$per_second
