@@ -794,6 +794,23 @@ test_that("g.getmeta() is GGIR's on an ActiGraph csv export (start from its head
   expect_identical(b$gravcal$QClog$timegaps_n, c(1L, 0L))
 })
 
+test_that("ActiLife epoch exports (counts, not samples): GGIR's inspection stops, gravcal's g.getmeta() refuses", {
+  # GGIR's own test files: "Epoch Period (hh:mm:ss)" 00:00:15, 00:00:05 and
+  # 00:00:01, no "at N Hz"; before, gravcal read the counts as g (an M of
+  # 2,880 rows for ActiGraph13.csv, NaN in every other row). Found by
+  # tools/ggir-sweep.R
+  for (nm in c("ActiGraph13.csv", "ActiGraph61.csv", "ActiGraph13_timestamps_headers.csv")) {
+    f <- system.file("testfiles", nm, package = "GGIR")
+    expect_true(file.exists(f), label = nm)
+    expect_false(is.na(ggir_error("g.inspectfile", f, list(), {
+      meta_quiet(GGIR::g.inspectfile(f))
+    })), label = paste(nm, "(GGIR's g.inspectfile() stops)"))
+    expect_error(gravcal::g.getmeta(f, verbose = FALSE),
+                 "ActiLife epoch export's header \\(\"Epoch Period \\(hh:mm:ss\\) 00:00:[0-9]+\", no",
+                 label = nm)
+  }
+})
+
 test_that("the date order of an ActiGraph header, by GGIR's rules", {
   top <- function(fmt) make.names(paste("--- date format", fmt, "Filter Normal ---"))
   expect_identical(gravcal:::actigraph_date_order(top("M/d/yyyy")), "mdY")
