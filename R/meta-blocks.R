@@ -168,12 +168,11 @@ meta_ggir_stops <- function(asked, neish) {
                   "(\"subscript out of bounds\"); gravcal's does too. Ask at least one ",
                   "(GGIR's default: `do.enmo` and `do.anglez`)."))
   }
-  do <- function(nm) meta_do_name(nm)
-  groups <- list(
-    list(any = c("HFX", "HFY", "HFZ"), gives = "HFEN"),
-    list(any = paste0("roll_med_acc_", c("x", "y", "z")), gives = paste0("roll_med_acc_", c("x", "y", "z"))),
-    list(any = paste0("dev_roll_med_acc_", c("x", "y", "z")),
-         gives = paste0("dev_roll_med_acc_", c("x", "y", "z"))))
+  do <- meta_do_name
+  axes <- function(base) paste0(base, c("x", "y", "z"))
+  groups <- list(list(any = c("HFX", "HFY", "HFZ"), gives = "HFEN"),
+                 list(any = axes("roll_med_acc_"), gives = axes("roll_med_acc_")),
+                 list(any = axes("dev_roll_med_acc_"), gives = axes("dev_roll_med_acc_")))
   for (g in groups) {
     missing <- setdiff(g$gives, asked)
     if (any(g$any %in% asked) && length(missing)) {
