@@ -200,8 +200,8 @@ meta_open <- function(datafile, p, inspectfileobject) {
   if (!is.null(why)) {
     gc_decoder_close(src$native$ptr)
     abort("\"", basename(datafile), "\" (`datafile`) has ", why, ": GGIR's g.getmeta() ",
-          "gives no result to reproduce there, so gravcal's refuses the file",
-          if (!isTRUE(attr(why, "whole_file"))) " (calibrate() reads the rest of it)", ".")
+          "gives no result to reproduce there, so gravcal's refuses the file (calibrate() ",
+          "reads the rest of it).")
   }
   src
 }

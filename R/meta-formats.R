@@ -30,24 +30,6 @@ actigraph_csv_start <- function(file, p) {
   as.POSIXlt(as.POSIXct(when, format = fmt, tz = ctz), tz = p$desiredtz)
 }
 
-# Why g.getmeta() refuses an ActiGraph csv export, or NULL: an ActiLife
-# epoch export (counts per epoch: its header's "Epoch Period" not 00:00:00,
-# and no "at N Hz" in its first line) holds no samples in g, and GGIR's
-# g.inspectfile() stops on it (GGIR reads such files only as epoch data).
-actigraph_csv_ggir_stops <- function(src) {
-  lines <- tryCatch(readLines(src$path, n = 10, warn = FALSE), error = function(e) character())
-  if (!length(lines) || grepl("at [0-9.,]+ Hz", lines[1])) return(NULL)
-  ep <- grep("Epoch Period (hh:mm:ss)", lines, fixed = TRUE, value = TRUE)
-  if (!length(ep)) return(NULL)
-  clock <- regmatches(ep[1], regexpr("[0-9]+:[0-9]+:[0-9]+", ep[1]))
-  if (!length(clock)) return(NULL)
-  secs <- sum(as.numeric(strsplit(clock, ":", fixed = TRUE)[[1]]) * c(3600, 60, 1))
-  if (!isTRUE(secs > 0)) return(NULL)
-  structure(paste0("an ActiLife epoch export's header (\"Epoch Period (hh:mm:ss) ", clock,
-                   "\", no \"at N Hz\"): counts per ", format(secs), " s epoch, not samples in g, ",
-                   "which GGIR's g.inspectfile() stops on"), whole_file = TRUE)
-}
-
 # The order of day, month and year that an ActiGraph header's "date format"
 # (M/d/yyyy, dd.MM.yy, yyyy-MMM-d, ...; separators read as dots) gives, in
 # strptime letters ("mdY", "dbY", ...), by GGIR's rules: each order tested

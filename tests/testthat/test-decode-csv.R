@@ -95,22 +95,45 @@ read_csv_native <- function(file, ..., format = "actigraph_csv") {
   gravcal:::native_read_all(file, format, options = list(...))
 }
 
-test_that("GGIRread's ActiGraph count exports read as GGIR's fread calls read them", {
+test_that("GGIRread's ActiGraph count exports read as GGIR's fread calls read them (option counts)", {
   for (name in c("ActiGraph13.csv", "ActiGraph13_timestamps_headers.csv", "ActiGraph61.csv")) {
     f <- ggirread_file(name)
     ref <- fread_blocks(f, 300)
-    d <- read_csv_native(f, compat = 1)
+    d <- read_csv_native(f, compat = 1, counts = 1)
     expect_identical(xyz(d), rbind_xyz(ref), label = name)
-    expect_identical(lapply(native_blocks(f, 300), xyz), lapply(ref, xyz), label = name)
+    expect_identical(lapply(native_blocks(f, 300, list(compat = 1, counts = 1)), xyz),
+                     lapply(ref, xyz), label = name)
     expect_identical(attr(d, "report")$skipped, 0)
   }
   # 990 data lines after 10 header lines (wc -l gives 1000)
-  expect_identical(nrow(read_csv_native(ggirread_file("ActiGraph13.csv"))), 990L)
+  expect_identical(nrow(read_csv_native(ggirread_file("ActiGraph13.csv"), counts = 1)), 990L)
+})
+
+test_that("ActiLife epoch exports (counts, not g) are refused by every verb that reads samples", {
+  # GGIR's and GGIRread's test files: "Epoch Period (hh:mm:ss)" 00:00:15,
+  # 00:00:01 and 00:00:05, no "at N Hz"; before, read_recording() gave the
+  # counts as g at 1 / 15 Hz and calibrate() fitted them
+  epoch <- c(ActiGraph13.csv = "00:00:15", ActiGraph13_timestamps_headers.csv = "00:00:01",
+             ActiGraph61.csv = "00:00:05")
+  for (name in names(epoch)) {
+    f <- ggirread_file(name)
+    why <- paste0("an ActiLife epoch export \\(\"Epoch Period \\(hh:mm:ss\\) ", epoch[[name]],
+                  "\" and no \"at N Hz\".*counts per epoch, not samples in g")
+    expect_error(read_recording(f), paste0("`file`.*", why), label = name)
+    expect_error(calibrate(f), paste0("`x`.*", why), label = name)
+    expect_error(epoch_signals(f), why, label = name)
+    expect_error(read_csv_native(f, compat = 1), why, label = name)
+  }
+  # a raw export's header keeps its epoch period 00:00:00: read as before
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  gravcal:::write_actigraph_csv_file(synthetic_samples(300), f, sf = 30)
+  expect_identical(attr(read_recording(f)$data, "sf"), 30)
 })
 
 test_that("compat = 0 takes x, y, z from columns 1:3 when there is no time stamp", {
   f <- ggirread_file("ActiGraph61.csv")
-  d0 <- read_csv_native(f, compat = 0)
+  d0 <- read_csv_native(f, compat = 0, counts = 1)
   ref <- utils::read.csv(f, skip = 10, header = FALSE)
   expect_identical(d0$x, as.numeric(ref[[1]]))
   expect_identical(d0$z, as.numeric(ref[[3]]))

@@ -806,7 +806,7 @@ test_that("ActiLife epoch exports (counts, not samples): GGIR's inspection stops
       meta_quiet(GGIR::g.inspectfile(f))
     })), label = paste(nm, "(GGIR's g.inspectfile() stops)"))
     expect_error(gravcal::g.getmeta(f, verbose = FALSE),
-                 "ActiLife epoch export's header \\(\"Epoch Period \\(hh:mm:ss\\) 00:00:[0-9]+\", no",
+                 "ActiLife epoch export \\(\"Epoch Period \\(hh:mm:ss\\) 00:00:[0-9]+\" and no",
                  label = nm)
   }
 })

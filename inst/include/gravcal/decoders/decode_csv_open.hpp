@@ -55,6 +55,7 @@ class CsvOpener {
       : lines_(lines), times_(times), dt_(times.date_times()), layout_(layout), info_(info),
         error_(error), want_actigraph_(format == "actigraph_csv"), compat_(compat) {
     sf_option_ = opts.num("sf", 0);
+    opts_counts_ = opts.num("counts", 0);
     // an Axivity csv export (time stamp, x, y, z) is read by the same layout
     // options (R/formats.R gives them)
     adhoc_ = format == "adhoc_csv" || format == "axivity_csv";
@@ -144,7 +145,10 @@ class CsvOpener {
       const char* p = v.data();
       double secs = 0;
       int fd = 0;
-      if (csv_text::parse_clock(p, v.data() + v.size(), secs, fd)) epoch_ = secs;
+      if (csv_text::parse_clock(p, v.data() + v.size(), secs, fd)) {
+        epoch_ = secs;
+        epoch_clock_ = v;
+      }
     }
   }
 
@@ -173,6 +177,15 @@ class CsvOpener {
       int fd = 0;
       const std::string s = start_date_ + " " + start_clock_;
       if (dt_.parse(s.data(), s.data() + s.size(), t, fd)) info_.start_time = t;
+    }
+    // An ActiLife epoch export: counts per epoch, not samples in g (GGIR's
+    // g.inspectfile() stops on it, wanting "at N Hz"). Refused unless the
+    // option `counts` asks for the values as they are (its tests read GGIR's
+    // own count files as GGIR's reader does).
+    if (epoch_ > 0 && !(header_sf_ > 0) && !(opts_counts_ > 0)) {
+      return fail("an ActiLife epoch export (\"Epoch Period (hh:mm:ss) " + epoch_clock_ +
+                  "\" and no \"at N Hz\" in the first line): counts per epoch, not samples in g; "
+                  "export the raw samples instead (ActiLife's raw csv, or the .gt3x file)");
     }
     if (!learn_actigraph_layout()) return false;
     return choose_sf(header_sf_ > 0 ? header_sf_ : (epoch_ > 0 ? 1 / epoch_ : 0));
@@ -437,7 +450,8 @@ class CsvOpener {
   bool compat_;
   double sf_option_ = 0;
   // header
-  double header_sf_ = 0, epoch_ = 0;
+  double header_sf_ = 0, epoch_ = 0, opts_counts_ = 0;
+  std::string epoch_clock_;  // the header's epoch period as written
   std::string date_format_, start_date_, start_clock_;
   // ad hoc csv (format "adhoc_csv"): its layout, from options
   bool adhoc_ = false;
