@@ -5,11 +5,19 @@
 # columns (numeric ones hold what GGIR's text will be read back as; text
 # ones, a myfun's, hold GGIR's text) and `count`; a row past a column's end
 # is GGIR's blank, " " (NA once read as a number).
+#
+# Each column is its written values (`cols`) and the blocks' writes not yet
+# laid into it (`puts`: list(at, v) in the order written), laid in when the
+# column is read (sheet_flat()): a week's columns grown block by block
+# would copy every earlier block at each write, garbage that R's collector
+# leaves in the process while the block store is held (tens of MB with
+# every metric).
 
 sheet_new <- function(numeric = character(0), text = character(0)) {
   cols <- c(stats::setNames(rep(list(numeric(0)), length(numeric)), numeric),
             stats::setNames(rep(list(character(0)), length(text)), text))
-  list(cols = cols, count = 1)
+  list(cols = cols, puts = stats::setNames(rep(list(list()), length(cols)), names(cols)),
+       count = 1)
 }
 
 sheet_blank <- function(col, n) if (is.character(col)) rep(" ", n) else rep(NA_real_, n)
@@ -30,12 +38,31 @@ sheet_put <- function(sh, values) {
   for (nm in names(values)) {
     v <- values[[nm]]
     if (!length(v)) next
-    end <- sh$count + length(v) - 1
-    col <- sheet_extend(if (is.null(sh$cols[[nm]])) numeric(0) else sh$cols[[nm]], end)
-    col[sh$count:end] <- v
-    sh$cols[[nm]] <- col
+    if (is.null(sh$cols[[nm]])) sh$cols[[nm]] <- numeric(0)
+    sh$puts[[nm]] <- c(sh$puts[[nm]], list(list(at = sh$count, v = v)))
   }
   sh
+}
+
+# Column `nm` with its writes laid in, as writing each in turn would leave
+# it: extended with blanks of the column's type at each write, a text write
+# into a numeric column turning it (and the blanks after it) into text.
+# Where no write changes the column's type, it is extended once.
+sheet_flat <- function(sh, nm) {
+  col <- sh$cols[[nm]]
+  puts <- sh$puts[[nm]]
+  if (!length(puts)) return(col)
+  same_type <- is.character(col) ||
+    all(vapply(puts, function(w) is.numeric(w$v) || is.logical(w$v), TRUE))
+  if (same_type) {
+    col <- sheet_extend(col, max(vapply(puts, function(w) w$at + length(w$v) - 1, 0)))
+  }
+  for (w in puts) {
+    end <- w$at + length(w$v) - 1
+    if (!same_type) col <- sheet_extend(col, end)
+    col[w$at:end] <- w$v
+  }
+  col
 }
 
 sheet_advance <- function(sh, n) {
@@ -58,6 +85,8 @@ sheet_impute <- function(sh, gap_index, gapsize, set) {
       gapsize <- gapsize[-drop]
     }
   }
+  for (nm in names(sh$cols)) sh$cols[[nm]] <- sheet_flat(sh, nm)
+  sh$puts[] <- list(list())
   n <- max(c(lengths(sh$cols), gap_index))
   sh$cols <- lapply(sh$cols, sheet_extend, n)
   for (nm in names(set)) sh$cols[[nm]][gap_index] <- set[[nm]]
@@ -71,5 +100,5 @@ sheet_impute <- function(sh, gap_index, gapsize, set) {
 
 # The rows written, 1 to count - 1 (GGIR's cut), of column `nm`.
 sheet_column <- function(sh, nm) {
-  sheet_extend(sh$cols[[nm]], sh$count - 1)[seq_len(sh$count - 1)]
+  sheet_extend(sheet_flat(sh, nm), sh$count - 1)[seq_len(sh$count - 1)]
 }
