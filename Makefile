@@ -43,6 +43,10 @@ TARBALL := gravcal_$(VERSION).tar.gz
 # for make test's steps and the test targets only: bench/'s contenders run
 # as users run them.
 TEST_TUNABLES := glibc.malloc.hugetlb=1
+# what every test run's R gets in its environment: the shared data, the
+# cache of GGIR's results, testthat's off-CRAN tests, the tunable
+TEST_ENV := GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
+            GLIBC_TUNABLES=$(TEST_TUNABLES)
 
 # R CMD check on a machine without general network access: skip the parts
 # that must reach servers other than CRAN (current-time lookup) and CRAN's
@@ -50,9 +54,7 @@ TEST_TUNABLES := glibc.malloc.hugetlb=1
 # expect_snapshot() only off CRAN, and the snapshots of every error message
 # and printed fit are part of the suite.
 CHECK_ENV := _R_CHECK_FUTURE_FILE_TIMESTAMPS_=FALSE _R_CHECK_SYSTEM_CLOCK_=FALSE \
-             _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE \
-             GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true \
-             GLIBC_TUNABLES=$(TEST_TUNABLES)
+             _R_CHECK_CRAN_INCOMING_REMOTE_=FALSE $(TEST_ENV)
 
 
 # (test-slurm: a single-node Slurm, see below)
@@ -138,7 +140,7 @@ test: setup-test
 # a few minutes
 quick: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
+	  $(TEST_ENV) \
 	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/run-tests.R
 
 # every cached GGIR result recomputed and compared with the cache (and the
@@ -147,7 +149,7 @@ quick: install setup-test
 # Not part of make test; run it before resolving and after a GGIR upgrade.
 test-ggir-cache: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
+	  $(TEST_ENV) \
 	  GRAVCAL_GGIR_CACHE_MODE=verify $(RSCRIPT) ../../tools/run-tests.R
 
 # the time (wall and CPU) of each test file and of the slowest tests, into
@@ -156,13 +158,13 @@ test-ggir-cache: install setup-test
 PROFILE_OUT ?= bench/results/test-profile.md
 profile-tests: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
+	  $(TEST_ENV) \
 	  $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_OUT))
 
 PROFILE_QUICK_OUT ?= bench/results/test-profile-quick.md
 profile-quick: install setup-test
 	cd tests/testthat && R_LIBS="$(abspath $(LIB))$${R_LIBS:+:$$R_LIBS}" \
-	  GRAVCAL_SHARED_DATA=$(SHARED_DATA) GRAVCAL_GGIR_CACHE=$(GGIR_CACHE) NOT_CRAN=true GLIBC_TUNABLES=$(TEST_TUNABLES) \
+	  $(TEST_ENV) \
 	  GRAVCAL_TEST_TIER=quick $(RSCRIPT) ../../tools/profile-tests.R $(abspath $(PROFILE_QUICK_OUT))
 
 # the header-only core alone, without R, with -Wall -Wextra -Werror: unit
