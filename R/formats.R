@@ -268,6 +268,7 @@ recording_formats <- list(
       options
     },
     ggir_block_qclog = function(src, from) cwa_qclog(src, from),
+    ggir_read_stops = function(src, part) cwa_ggir_stops(src),
     label = "an Axivity .cwa file", unit = "block", own_rate = TRUE,
     # 512-byte blocks of 80 samples (GGIR's count, whatever the packing)
     block_units = function(sf, chunksize, part) round(12 * 3600 * sf / 80 * chunksize),

@@ -57,8 +57,10 @@
 #' (its `g.inspectfile()` stops), is refused as GGIR refuses it, the error naming
 #' the `rmc.*` parameters that read it as an ad hoc csv file (GGIR's advice). The other formats are read by gravcal's own decoders, which give what GGIR's
 #' readers give (GGIRread's resampling of `.cwa` included), block by block
-#' as GGIR reads them, in bounded memory; a damaged file keeps its good
-#' samples where GGIR's readers stop. `reader = "reference"` in `...` reads
+#' as GGIR reads them, in bounded memory. Where GGIR's reader stops on a
+#' damaged `.cwa` or GENEActiv file (and loses the block of its reading that
+#' holds the damage), this function stops too, saying where; `calibrate()`
+#' keeps the good samples of such a file. `reader = "reference"` in `...` reads
 #' through GGIR's readers themselves (GGIRread, read.gt3x, data.table).
 #'
 #' @section GGIR's parameters:

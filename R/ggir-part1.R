@@ -33,8 +33,14 @@
 #' was read so); where GGIR stops on such a file, or its time stamps are
 #' not defined where it reads them, gravcal's stops too, saying why.
 #'
-#' Formats: Axivity `.cwa`, GENEActiv `.bin`, ActiGraph `.gt3x` and csv
-#' exports (their time gaps and idle-sleep zeros filled as GGIR fills them; a
+#' Formats: Axivity `.cwa` (`QClog` GGIRread's log of the blocks it skips
+#' or imputes: bad checksums, breaks in the sequence, a rate more than 5 %
+#' off, an hour skipped or repeated at a change of `desiredtz`'s offset;
+#' where GGIR's reader stops instead, on a zeroed block, more than 20 bad
+#' blocks in a row or a gap of over 3 days, GGIR loses the whole block of its
+#' reading that holds it, which gravcal does not reproduce: an error says
+#' where), GENEActiv `.bin`, ActiGraph `.gt3x` and csv exports
+#' (their time gaps and idle-sleep zeros filled as GGIR fills them; a
 #' gap over GGIR's limit, 90 minutes or 6 long epochs, filled up to the next
 #' long epoch and the rest imputed as whole epochs, non-wear, as GGIR 3.3-9
 #' does on R 4.3 or later, which reads the gap's time of day in the session's

@@ -582,13 +582,6 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
             "(M$QClog logs them).", call. = FALSE)
   }
   if (!is.null(fe$ggir_damage_warning)) fe$ggir_damage_warning(src)
-  if (!is.null(fe$ggir_block_qclog) && counter("qclog_not_reproduced") > 0) {
-    warning("\"", basename(src$filename), "\": ", counter("qclog_not_reproduced"),
-            " place", if (counter("qclog_not_reproduced") != 1) "s", " where GGIR's reader stops ",
-            "(damage it does not skip, a gap over 3 days or more than 20 bad ",
-            unit_name(src$format, 2), " in a row); M$QClog does not log ",
-            "what GGIR's reader would have logged there.", call. = FALSE)
-  }
   M <- meta_result(short, long, cols, metnames, metricnames_long, starttime, wday, wdayname,
                    filetooshort, filecorrupt, p, ws3, ws2, QClog, myfun)
   if (!is.null(gradient)) {

@@ -169,6 +169,28 @@ parmay_ggir_stops <- function(src) {
   NULL
 }
 
+# Where GGIR's reader of .cwa files (GGIRread's readAxivity()) stops on a
+# damaged file instead of skipping the damage, from the decoder's counts so
+# far: a block that is not a data packet (not "AX", or not 508 bytes long:
+# a zeroed block, at the file's end too), more than 20 bad blocks in a
+# row, a time gap of over 3 days to impute. readAxivity() then fails for
+# the whole of the call that meets it, so GGIR's g.calibrate() and
+# g.getmeta() lose that block of their reading and every one after it
+# (GGIR's g.getmeta() marks a first block's loss as a corrupt file), which
+# gravcal does not reproduce: why, or NULL.
+cwa_ggir_stops <- function(src) {
+  rep <- src$report()
+  k <- rep$counters
+  n <- if ("qclog_not_reproduced" %in% names(k)) k[["qclog_not_reproduced"]] else 0
+  if (n == 0) return(NULL)
+  first <- grep("^bad_header|^bad_content|in a row|gap over 3 days", rep$notes, value = TRUE)
+  paste0(n, " place", if (n != 1) "s", " where GGIR's reader (readAxivity()) stops instead of ",
+         "skipping the damage (a block that is not a data packet, such as a zeroed one, more ",
+         "than 20 bad blocks in a row, or a time gap of over 3 days",
+         if (length(first)) paste0("; the first: ", first[1]),
+         "), and GGIR's reading loses the whole of its block that holds it")
+}
+
 # Where GGIR's reading of a damaged GENEActiv .bin file (GGIRread's
 # readGENEActiv(), whose reading of damaged pages the native decoder follows
 # in GGIR's mode: decode_geneactiv.hpp) stops, or goes where the decoder

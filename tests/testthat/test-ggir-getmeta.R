@@ -194,6 +194,46 @@ test_that("a damaged .cwa recording: M is GGIR's, readAxivity's log of the damag
   unlink(c(f, g))
 })
 
+test_that("a .cwa file GGIR's reader stops on (zeroed blocks): GGIR loses its block, gravcal's drop-ins refuse", {
+  # readAxivity() stops (not "AX") on a zeroed block, in a window or in its
+  # search for the file's last good block, and GGIR's reading loses the
+  # whole block of it that holds it: this 10 h file is one block of
+  # g.getmeta()'s (M: a corrupt file) and of g.calibrate()'s (no hour
+  # used). Before, gravcal's drop-ins read on, gave every row and warned of
+  # the QClog only. Found by a random damage sweep (stop 68)
+  f <- meta_recording("cwa", 25, 10, seed = 41)
+  b <- readBin(f, raw(), file.size(f))
+  nb <- (length(b) - 1024) / 512
+  mid <- b
+  mid[1024 + 512 * 6000 + 1:512] <- as.raw(0)  # 8 h in
+  cases <- list(`a zeroed block` = mid, `three zeroed blocks appended` = c(b, raw(3 * 512)))
+  for (nm in names(cases)) {
+    g <- tempfile(fileext = ".cwa")
+    writeBin(cases[[nm]], g)
+    G <- ggir_cached("g.getmeta", g, list(), {
+      meta_quiet(GGIR::g.getmeta(g, inspectfileobject = meta_quiet(GGIR::g.inspectfile(g)),
+                                 verbose = FALSE))
+    })
+    expect_true(G$filecorrupt && G$filetooshort && is.null(G$metashort), label = paste(nm, "(GGIR's M)"))
+    C <- ggir_cached("g.calibrate", g, list(), {
+      meta_quiet(GGIR::g.calibrate(g, inspectfileobject = meta_quiet(GGIR::g.inspectfile(g)),
+                                   verbose = FALSE))
+    })
+    expect_identical(C$nhoursused, 0)  # GGIR's calibration read nothing
+    why <- "GGIR's reader \\(readAxivity\\(\\)\\) stops instead of skipping the damage"
+    expect_error(meta_quiet(gravcal::g.getmeta(g, verbose = FALSE)),
+                 paste0(why, ".*bad_header in block ", if (grepl("appended", nm)) nb else 6000,
+                        ".*GGIR's g.getmeta\\(\\) gives no result there"), label = nm)
+    expect_error(meta_quiet(gravcal::g.calibrate(g, verbose = FALSE)),
+                 paste0(why, ".*GGIR's g.calibrate\\(\\) gives no result there"), label = nm)
+    # gravcal's own verb reads past it (the block skipped)
+    fit <- calibrate(g, method = "ggir")
+    expect_identical(fit$input$report$skipped, if (grepl("appended", nm)) 3 else 1, label = nm)
+    unlink(g)
+  }
+  unlink(f)
+})
+
 # A GENEActiv recording's lines (meta_recording(): `hours` at 30 Hz), and
 # a .bin file of them with CRLF line ends, as the device writes them.
 ga_meta_lines <- function(hours = 3) {
