@@ -237,6 +237,7 @@ recording_formats <- list(
     },
     label = "an ActiGraph .gt3x file", unit = "record", own_rate = TRUE,
     local_clock = "sample", ggir_timegaps = TRUE,
+    ggir_read_stops = function(src, part) gt3x_ggir_stops(src),
     ggir_inspect = function(file, tz) ggir_inspect_gt3x(file, tz, decoder = "gt3x"),
     block_units = function(sf, chunksize, part) (12 * 3600) * chunksize,  # seconds
     decoder = "gt3x",

@@ -191,6 +191,18 @@ cwa_ggir_stops <- function(src) {
          "), and GGIR's reading loses the whole of its block that holds it")
 }
 
+# Where GGIR's reader of .gt3x files (read.gt3x, which opens the zip
+# archive by its central directory) cannot open a damaged one, which the
+# native decoder reads from its entries' local headers (a file cut short,
+# or its directory damaged): GGIR's g.getmeta() marks the file corrupt and
+# gives no M, its g.calibrate() no hour. Why, or NULL.
+gt3x_ggir_stops <- function(src) {
+  k <- src$report()$counters
+  if (!isTRUE(k["zip_directory_damaged"] > 0)) return(NULL)
+  paste0("a zip archive whose central directory is missing or damaged (the file cut ",
+         "short, for example), which GGIR's reader (read.gt3x) cannot open")
+}
+
 # Where GGIR's reading of a damaged GENEActiv .bin file (GGIRread's
 # readGENEActiv(), whose reading of damaged pages the native decoder follows
 # in GGIR's mode: decode_geneactiv.hpp) stops, or goes where the decoder

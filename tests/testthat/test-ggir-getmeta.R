@@ -234,6 +234,35 @@ test_that("a .cwa file GGIR's reader stops on (zeroed blocks): GGIR loses its bl
   unlink(f)
 })
 
+test_that("a .gt3x file cut short (no zip directory): GGIR's reader cannot open it, gravcal's drop-ins refuse", {
+  # read.gt3x opens the archive by its central directory, at the file's
+  # end: GGIR's M is a corrupt file's. gravcal's decoder reads the entries
+  # from their local headers; before, its g.getmeta() gave 3 h of M and its
+  # g.calibrate() coefficients, no warning. Found by a random damage sweep
+  # (stop 68)
+  f <- meta_recording("gt3x", 30, 5, seed = 43)
+  g <- tempfile(fileext = ".gt3x")
+  writeBin(readBin(f, raw(), file.size(f))[seq_len(round(0.6 * file.size(f)))], g)
+  G <- ggir_cached("g.getmeta", g, list(), {
+    meta_quiet(GGIR::g.getmeta(g, inspectfileobject = meta_quiet(GGIR::g.inspectfile(g)),
+                               verbose = FALSE))
+  })
+  expect_true(G$filecorrupt && is.null(G$metashort))
+  C <- ggir_cached("g.calibrate", g, list(), {
+    meta_quiet(GGIR::g.calibrate(g, inspectfileobject = meta_quiet(GGIR::g.inspectfile(g)),
+                                 verbose = FALSE))
+  })
+  expect_null(C)  # GGIR's inspection gets no rate ("File info could not be extracted")
+  why <- "a zip archive whose central directory is missing or damaged.*read.gt3x\\) cannot open"
+  expect_error(meta_quiet(gravcal::g.getmeta(g, verbose = FALSE)), why)
+  expect_error(meta_quiet(gravcal::g.calibrate(g, verbose = FALSE)), why)
+  # gravcal's own reader keeps what the local headers give, and says so
+  r <- read_recording(g)
+  expect_gt(nrow(r$data), 30 * 3600)
+  expect_true(attr(r$data, "report")$truncated)
+  unlink(c(f, g))
+})
+
 # A GENEActiv recording's lines (meta_recording(): `hours` at 30 Hz), and
 # a .bin file of them with CRLF line ends, as the device writes them.
 ga_meta_lines <- function(hours = 3) {
