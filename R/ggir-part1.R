@@ -31,7 +31,10 @@
 #' garbled temperature or rate, a line missing, a last page cut short) is
 #' read as GGIRread reads it, so M is GGIR's there too (a warning says what
 #' was read so); where GGIR stops on such a file, or its time stamps are
-#' not defined where it reads them, gravcal's stops too, saying why.
+#' not defined where it reads them, gravcal's stops too, saying why. A
+#' `.gt3x` file cut short (which GGIR's reader cannot open) or with damaged
+#' records in `log.bin` (which it does not read as gravcal's decoder skips
+#' them) is refused, the error saying why.
 #'
 #' Formats: Axivity `.cwa` (`QClog` GGIRread's log of the blocks it skips
 #' or imputes: bad checksums, breaks in the sequence, a rate more than 5 %

@@ -566,8 +566,9 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   imputed <- counter("imputed_spans")
   if (is.null(fe$ggir_qclog) && is.null(fe$ggir_block_qclog) &&
       (imputed > 0 || isTRUE(rep$skipped > 0))) {
-    # (csv lines and .gt3x records the decoder skips; GENEActiv pages are
-    # read as GGIR's reader reads them, none skipped: ggir_damage_warning)
+    # (csv lines the decoder skips; .gt3x records skipped are refused,
+    # gt3x_ggir_stops(); GENEActiv pages are read as GGIR's reader reads
+    # them, none skipped: ggir_damage_warning)
     warning("\"", basename(src$filename), "\": ", rep$skipped, " damaged ",
             unit_name(src$format, rep$skipped), " skipped, ", imputed, " span",
             if (imputed != 1) "s", " imputed (damage, or time stamps that jump); GGIR's reader ",

@@ -191,16 +191,30 @@ cwa_ggir_stops <- function(src) {
          "), and GGIR's reading loses the whole of its block that holds it")
 }
 
-# Where GGIR's reader of .gt3x files (read.gt3x, which opens the zip
-# archive by its central directory) cannot open a damaged one, which the
-# native decoder reads from its entries' local headers (a file cut short,
-# or its directory damaged): GGIR's g.getmeta() marks the file corrupt and
-# gives no M, its g.calibrate() no hour. Why, or NULL.
+# Where GGIR's reader of .gt3x files (read.gt3x) gives what gravcal does
+# not reproduce: a damaged archive it cannot open (it finds the entries by
+# the zip's central directory; the native decoder reads them from their
+# local headers when that is cut short or damaged), where GGIR's
+# g.getmeta() marks the file corrupt and its g.calibrate() gives NULL; or
+# damaged records in log.bin, which the decoder skips. Why, or NULL.
 gt3x_ggir_stops <- function(src) {
-  k <- src$report()$counters
-  if (!isTRUE(k["zip_directory_damaged"] > 0)) return(NULL)
-  paste0("a zip archive whose central directory is missing or damaged (the file cut ",
-         "short, for example), which GGIR's reader (read.gt3x) cannot open")
+  rep <- src$report()
+  k <- rep$counters
+  if (isTRUE(k["zip_directory_damaged"] > 0)) {
+    return(paste0("a zip archive whose central directory is missing or damaged (the file ",
+                  "cut short, for example), which GGIR's reader (read.gt3x) cannot open"))
+  }
+  if (isTRUE(rep$skipped > 0)) {
+    # GGIR's reader does not skip them alike: its g.calibrate() gave other
+    # coefficients, its g.getmeta() other values or (R 4.2) an error
+    # ("'origin' must be supplied"), on a damage sweep's files (stop 68)
+    first <- grep("^bad_|^long_", rep$notes, value = TRUE)
+    return(paste0(rep$skipped, " damaged record", if (rep$skipped != 1) "s",
+                  " in log.bin (", if (length(first)) first[1] else "bad checksums or separators",
+                  ") that gravcal's decoder skips and GGIR's reader (read.gt3x) does not ",
+                  "read alike"))
+  }
+  NULL
 }
 
 # Where GGIR's reading of a damaged GENEActiv .bin file (GGIRread's

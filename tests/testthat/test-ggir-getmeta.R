@@ -234,7 +234,7 @@ test_that("a .cwa file GGIR's reader stops on (zeroed blocks): GGIR loses its bl
   unlink(f)
 })
 
-test_that("a .gt3x file cut short (no zip directory): GGIR's reader cannot open it, gravcal's drop-ins refuse", {
+test_that("a damaged .gt3x file (cut short, damaged records): gravcal's drop-ins refuse", {
   # read.gt3x opens the archive by its central directory, at the file's
   # end: GGIR's M is a corrupt file's. gravcal's decoder reads the entries
   # from their local headers; before, its g.getmeta() gave 3 h of M and its
@@ -260,6 +260,17 @@ test_that("a .gt3x file cut short (no zip directory): GGIR's reader cannot open 
   r <- read_recording(g)
   expect_gt(nrow(r$data), 30 * 3600)
   expect_true(attr(r$data, "report")$truncated)
+  # damaged records in log.bin (8 bytes of its deflated stream overwritten
+  # half way): the decoder skips them, GGIR's reader does not read them
+  # alike (on the damage sweep's files GGIR's g.calibrate() gave other
+  # coefficients, silently, and its g.getmeta() other values or an error)
+  b <- readBin(f, raw(), file.size(f))
+  b[round(0.5 * length(b)) + 0:7] <- as.raw(1:8)
+  writeBin(b, g)
+  expect_gt(attr(read_recording(g)$data, "report")$skipped, 0)
+  why <- "damaged records in log.bin \\(bad_checksum.*GGIR's reader \\(read.gt3x\\) does not read alike"
+  expect_error(meta_quiet(gravcal::g.getmeta(g, verbose = FALSE)), why)
+  expect_error(meta_quiet(gravcal::g.calibrate(g, verbose = FALSE)), why)
   unlink(c(f, g))
 })
 
