@@ -112,6 +112,7 @@ recording_formats <- list(
     ggir_codes = "3 2", ggir_decimal = TRUE, fread_rule = TRUE,
     empty_why = "it has a header but no data lines",
     ggir_start = function(file, p) actigraph_csv_start(file, p),
+    ggir_read_stops = function(src, part) actigraph_csv_ggir_stops(src, part),
     ext = c(csv = ".csv (ActiGraph or x,y,z columns)", csv.gz = ".csv.gz"),
     detect = function(file) is_actigraph_csv(file),
     label = "an ActiGraph csv export", unit = "line",

@@ -60,7 +60,8 @@
 #' as GGIR reads them, in bounded memory. Where GGIR's reader stops on a
 #' damaged `.cwa` or GENEActiv file (and loses the block of its reading that
 #' holds the damage), or cannot open a `.gt3x` file cut short (or reads its
-#' damaged records otherwise), this function stops too, saying where; `calibrate()`
+#' damaged records otherwise) or an ActiGraph csv export's damaged lines, this
+#' function stops too, saying where; `calibrate()`
 #' keeps the good samples of such a file. `reader = "reference"` in `...` reads
 #' through GGIR's readers themselves (GGIRread, read.gt3x, data.table).
 #'

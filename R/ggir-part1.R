@@ -34,7 +34,9 @@
 #' not defined where it reads them, gravcal's stops too, saying why. A
 #' `.gt3x` file cut short (which GGIR's reader cannot open) or with damaged
 #' records in `log.bin` (which it does not read as gravcal's decoder skips
-#' them) is refused, the error saying why.
+#' them) is refused, the error saying why; so is an ActiGraph csv export with
+#' damaged lines (fields missing or extra, a value or a time stamp that is
+#' not one), which GGIR's reader does not read as gravcal's decoder does.
 #'
 #' Formats: Axivity `.cwa` (`QClog` GGIRread's log of the blocks it skips
 #' or imputes: bad checksums, breaks in the sequence, a rate more than 5 %

@@ -191,6 +191,28 @@ cwa_ggir_stops <- function(src) {
          "), and GGIR's reading loses the whole of its block that holds it")
 }
 
+# Damaged lines in an ActiGraph csv export (fields missing or extra, a
+# value or a time stamp that is not one) that the decoder skips or mends,
+# where GGIR's reader (data.table's fread()) does not read them alike: on a
+# damage sweep's files (stop 68) GGIR's g.calibrate() gave other
+# coefficients, silently, and its g.getmeta() other values. A file cut
+# short inside its last line is read alike (that line dropped), and so
+# are unreadable time stamps where only the samples count (`part`
+# "calibrate"; "getmeta" reads the time). Why, or NULL.
+actigraph_csv_ggir_stops <- function(src, part) {
+  rep <- src$report()
+  k <- rep$counters
+  damage <- c("long_lines", "short_lines", "non_numeric_lines",
+              if (part == "getmeta") "bad_timestamps")
+  n <- sum(vapply(damage, function(nm) if (nm %in% names(k)) k[[nm]] else 0, 0))
+  if (n == 0) return(NULL)
+  first <- grep("too many fields|too few fields|not a number|unreadable time stamp", rep$notes,
+                value = TRUE)
+  paste0(n, " damaged line", if (n != 1) "s", if (length(first)) paste0(" (", first[1], ")"),
+         ", which gravcal's decoder skips or mends and GGIR's reader (fread()) does not ",
+         "read alike")
+}
+
 # Where GGIR's reader of .gt3x files (read.gt3x) gives what gravcal does
 # not reproduce: a damaged archive it cannot open (it finds the entries by
 # the zip's central directory; the native decoder reads them from their

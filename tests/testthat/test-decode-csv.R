@@ -122,6 +122,7 @@ test_that("ActiLife epoch exports (counts, not g) are refused by every verb that
     expect_error(read_recording(f), paste0("`file`.*", why), label = name)
     expect_error(calibrate(f), paste0("`x`.*", why), label = name)
     expect_error(epoch_signals(f), why, label = name)
+    expect_error(g.calibrate(f, verbose = FALSE), paste0("`datafile`.*", why), label = name)
     expect_error(read_csv_native(f, compat = 1), why, label = name)
   }
   # a raw export's header keeps its epoch period 00:00:00: read as before

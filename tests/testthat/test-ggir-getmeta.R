@@ -274,6 +274,42 @@ test_that("a damaged .gt3x file (cut short, damaged records): gravcal's drop-ins
   unlink(c(f, g))
 })
 
+test_that("an ActiGraph csv export with damaged lines: gravcal's drop-ins refuse where GGIR reads otherwise", {
+  # 3 h at 20 Hz. A line with a field too many, or too few, is skipped by
+  # gravcal's decoder, not alike by GGIR's fread(): on the damage sweep's
+  # files GGIR's g.calibrate() gave other coefficients, silently. An
+  # unreadable time stamp changes only what g.getmeta() reads; a file cut
+  # inside its last line is read alike by both. Found by a damage sweep
+  # (stop 68)
+  f <- tempfile(fileext = ".csv")
+  rec <- simulate_recording(hours = 3, sf = 20, seed = 47,
+                            start = as.POSIXct("2024-03-04 09:07:23", tz = "UTC"))
+  write_recording(rec[, c("x", "y", "z")], f, sf = 20, format = "actigraph_csv",
+                  start = "2024-03-04 09:07:23")
+  l <- readLines(f)
+  put <- function(lines) {
+    g <- tempfile(fileext = ".csv")
+    writeLines(lines, g)
+    g
+  }
+  extra <- l
+  extra[120011] <- paste0(extra[120011], ",0.5")
+  g <- put(extra)
+  why <- "1 damaged line \\(line 120011 .*too many fields.*GGIR's reader \\(fread\\(\\)\\) does not read alike"
+  expect_error(meta_quiet(gravcal::g.getmeta(g, verbose = FALSE)), why)
+  expect_error(meta_quiet(gravcal::g.calibrate(g, verbose = FALSE)), why)
+  stamp <- l
+  stamp[60011] <- sub("^[^,]*", "3/x/2024 17:27:23.000", stamp[60011])
+  g2 <- put(stamp)
+  expect_error(meta_quiet(gravcal::g.getmeta(g2, verbose = FALSE)), "unreadable time stamp")
+  expect_same_as_ggir(run_both(g2))
+  cut <- tempfile(fileext = ".csv")
+  b <- readBin(f, raw(), file.size(f))
+  writeBin(b[seq_len(round(0.7 * length(b)))], cut)
+  expect_same_meta(meta_both(cut), clock = TRUE)
+  unlink(c(f, g, g2, cut))
+})
+
 # A GENEActiv recording's lines (meta_recording(): `hours` at 30 Hz), and
 # a .bin file of them with CRLF line ends, as the device writes them.
 ga_meta_lines <- function(hours = 3) {
