@@ -1,5 +1,6 @@
 # Usage: Rscript tools/ggir-sweep.R [n] [seed]
 #   (with gravcal installed: R_LIBS=<gravcal's library> Rscript tools/ggir-sweep.R 40 1)
+#   SWEEP_TARGET=calibrate Rscript tools/ggir-sweep.R 40 1: g.calibrate() instead
 #
 # A randomized differential test ("parameter sweep") of gravcal::g.getmeta()
 # against GGIR::g.getmeta() (GGIR 3.3-9): n random cases (default 5; seed
@@ -51,6 +52,26 @@
 #   SWEEP_DEADLINE  a UTC time ("2026-12-02 02:00:00"): no case starts after it
 #   SWEEP_THREADS   options(gravcal.threads) for gravcal (default: gravcal's own)
 #
+#   SWEEP_TARGET    getmeta (default) or calibrate (below)
+#
+# SWEEP_TARGET=calibrate: the same sweep of gravcal::g.calibrate() against
+# GGIR::g.calibrate(), both called as GGIR's g.part1() calls it
+# (GGIR::g.inspectfile(f, desiredtz =, params_rawdata =, configtz =), then
+# g.calibrate(f, params_rawdata =, params_general =, params_cleaning =,
+# inspectfileobject = I, verbose = FALSE); gravcal sometimes without I),
+# every element of the result but bsc_qc (GGIR's wall clock and memory)
+# compared with identical(), as expect_same_as_ggir() does. The files: the
+# same pool, plus one ad hoc csv recording (written by write_adhoc_csv():
+# random unit, header, time column, temperature unit, sometimes a gap),
+# read with its rmc.* list. The parameters (draw_args_calibrate()): the
+# ones GGIR's g.calibrate() and g.readaccfile() read (chunksize, spherecrit,
+# minloadcrit, printsummary, interpolationType, frequency_tol, desiredtz,
+# configtz; rmc.noise, rmc.check4timegaps, rmc.doresample for ad hoc csv)
+# and, sometimes, ones GGIR takes and leaves alone there (windowsizes,
+# dynrange, do.cal, backup.cal.coef, minimumFileSizeMB, imputeTimegaps,
+# rmc.noise for a device file, dayborder, params_cleaning's), which gravcal
+# must take and leave alone too.
+#
 # The file can also be source()d (nothing runs then) to rebuild a synthetic
 # recording from its recipe: make_synthetic(recipe, file).
 
@@ -79,6 +100,13 @@ make_synthetic <- function(recipe, file) {
   }
   # 41 samples at 7.9 g: clipping
   rec$x[round(0.8 * n) + 0:40] <- 7.9
+  if (r$format == "adhoc_csv") {
+    drop <- if (!is.null(r$gap)) round(r$gap * n) + seq_len(120 * r$sf) - 1L else integer()
+    rmc <- gravcal:::write_adhoc_csv(rec, file, sf = r$sf, header = r$header, unit = r$unit,
+                                     time = r$time, temp_unit = r$temp_unit,
+                                     sf_header = r$sf_header, start = r$start, drop = drop)
+    return(structure(file, rmc = rmc))
+  }
   # formats without a temperature channel (write_recording() would warn)
   if (r$format %in% c("gt3x", "actigraph_csv")) rec$temperature <- NULL
   rec <- rec[, intersect(c("x", "y", "z", "temperature"), names(rec))]
@@ -98,7 +126,8 @@ draw_recipe <- function(format, seed) {
                gt3x = sample(c(20, 30, 40, 50, 60, 80, 100), 1),
                actigraph_csv = sample(c(20, 25, 30), 1),
                movisens = 64,
-               parmay = sample(c(20, 25, 50, 100), 1))
+               parmay = sample(c(20, 25, 50, 100), 1),
+               adhoc_csv = sample(c(10, 20, 25, 30), 1))
   hours <- if (sf >= 60) sample(26:32, 1) else sample(26:40, 1)
   starts <- c(plain = "2024-03-04 09:07:23",
               eu_spring = "2024-03-30 21:11:00",     # Europe: 31 March 01:00 UTC
@@ -110,8 +139,18 @@ draw_recipe <- function(format, seed) {
   if (format == "cwa" && stats::runif(1) < 0.5) start <- paste0(start, ".37")
   a <- stats::runif(1, 0.1, 0.4)
   b <- stats::runif(1, 0.5, 0.7)
-  list(format = format, sf = sf, hours = hours, seed = seed, start = unname(start),
-       rests = list(round(c(a, a + 0.07), 3), round(c(b, b + 0.03), 3)))
+  r <- list(format = format, sf = sf, hours = hours, seed = seed, start = unname(start),
+            rests = list(round(c(a, a + 0.07), 3), round(c(b, b + 0.03), 3)))
+  if (format == "adhoc_csv") {
+    r$unit <- sample(c("g", "mg", "bit"), 1)
+    r$time <- sample(c("none", "UNIXsec", "UNIXmsec", "POSIX", "character"), 1)
+    r$header <- if (stats::runif(1) < 0.5) c("device,sim", "serial,S1") else character()
+    r$sf_header <- stats::runif(1) < 0.3
+    r$temp_unit <- sample(c("C", "K", "F"), 1)
+    # a 2-minute gap (samples left out) for rmc.check4timegaps
+    if (r$time != "none" && stats::runif(1) < 0.5) r$gap <- round(stats::runif(1, 0.75, 0.95), 3)
+  }
+  r
 }
 
 # The real files: GGIRread's, GGIR's and read.gt3x's test files that are raw
@@ -192,6 +231,24 @@ draw_args <- function(defaults, sf) {
       pm$n <- sample(1:4, 1)
     }
   }
+  rg <- draw_rawdata_general()
+  pc <- draw_cleaning()
+  args <- list(params_metrics = pm, params_rawdata = rg$pr, params_general = rg$pg,
+               params_cleaning = pc)
+  args <- args[lengths(args) > 0]
+  if (stats::runif(1) < 0.4) {
+    args$offset <- sample(-500:500, 3) / 10000
+    args$scale <- sample(9500:10500, 3) / 10000
+    if (stats::runif(1) < 0.5) {
+      args$tempoffset <- sample(-500:500, 3) / 1e5
+      args$meantempcal <- sample(1800:3000, 1) / 100
+    }
+  }
+  args
+}
+
+# chunksize, dynrange, windowsizes, desiredtz and configtz: list(pr, pg)
+draw_rawdata_general <- function() {
   pr <- list()
   ch <- sample(c(0.2, 0.5, 1), 1)
   if (ch != 1) pr$chunksize <- ch
@@ -208,25 +265,56 @@ draw_args <- function(defaults, sf) {
   } else if (u < 0.6) {
     pg$configtz <- sample(setdiff(zones, c("", tz)), 1)
   }
+  list(pr = pr, pg = pg)
+}
+
+draw_cleaning <- function() {
   pc <- list()
   # ("2023" is GGIR 3.3-9's default)
   if (stats::runif(1) < 0.5) pc$nonwear_approach <- "2013"
-  args <- list(params_metrics = pm, params_rawdata = pr, params_general = pg,
-               params_cleaning = pc)
-  args <- args[lengths(args) > 0]
-  if (stats::runif(1) < 0.4) {
-    args$offset <- sample(-500:500, 3) / 10000
-    args$scale <- sample(9500:10500, 3) / 10000
-    if (stats::runif(1) < 0.5) {
-      args$tempoffset <- sample(-500:500, 3) / 1e5
-      args$meantempcal <- sample(1800:3000, 1) / 100
-    }
-  }
-  args
+  pc
 }
 
-complete_args <- function(args, defaults) {
-  for (k in c("metrics", "rawdata", "general", "cleaning")) {
+# One g.calibrate() case's arguments (SWEEP_TARGET=calibrate): the common
+# draws above, then the parameters GGIR's g.calibrate() and g.readaccfile()
+# read, sometimes ones it leaves alone; `rmc`: the ad hoc csv file's rmc.*
+# list (NULL for other files).
+draw_args_calibrate <- function(defaults, sf, rmc = NULL) {
+  rg <- draw_rawdata_general()
+  pr <- rg$pr
+  pg <- rg$pg
+  pc <- draw_cleaning()
+  if (stats::runif(1) < 0.2) pr$chunksize <- sample(c(0.1, 0.3, 0.8), 1)
+  if (stats::runif(1) < 0.5) pr$spherecrit <- sample(c(0.1, 0.2, 0.4, 0.5, 0.7, 0.9), 1)
+  if (stats::runif(1) < 0.6) pr$minloadcrit <- sample(c(1, 6, 12, 20, 24, 30, 48, 72), 1)
+  if (stats::runif(1) < 0.2) pr$printsummary <- TRUE
+  if (stats::runif(1) < 0.3) pr$interpolationType <- 2
+  if (stats::runif(1) < 0.25) pr$frequency_tol <- sample(c(0, 0.05, 0.2, 0.5, 1), 1)
+  # taken by GGIR, no effect on its g.calibrate()
+  if (stats::runif(1) < 0.15) pr$do.cal <- FALSE
+  if (stats::runif(1) < 0.15) pr$backup.cal.coef <- "/nonexistent/calibration.csv"
+  if (stats::runif(1) < 0.15) pr$minimumFileSizeMB <- 0
+  if (stats::runif(1) < 0.15) pr$imputeTimegaps <- FALSE
+  if (stats::runif(1) < 0.15) pr$nonwear_range_threshold <- 100
+  if (stats::runif(1) < 0.15) pg$dayborder <- 4
+  if (stats::runif(1) < 0.15) pc$includedaycrit <- 10
+  if (stats::runif(1) < 0.15) pc$hrs.del.start <- 1
+  if (!is.null(rmc)) {
+    pr <- c(pr, rmc)
+    pr$rmc.noise <- sample(c(0.01, 0.011, 0.013, 13), 1)
+    if (!is.null(rmc$rmc.col.time)) {
+      if (stats::runif(1) < 0.4) pr$rmc.check4timegaps <- TRUE
+      if (stats::runif(1) < 0.3) pr$rmc.doresample <- TRUE
+    }
+  } else if (stats::runif(1) < 0.15) {
+    pr$rmc.noise <- 0.01
+  }
+  args <- list(params_rawdata = pr, params_general = pg, params_cleaning = pc)
+  args[lengths(args) > 0]
+}
+
+complete_args <- function(args, defaults, lists = c("metrics", "rawdata", "general", "cleaning")) {
+  for (k in lists) {
     nm <- paste0("params_", k)
     args[[nm]] <- utils::modifyList(defaults[[nm]], args[[nm]] %||% list())
   }
@@ -240,6 +328,9 @@ compact <- function(x) paste(deparse(x, width.cutoff = 500L), collapse = " ")
 # expr's value, its printed output dropped, its warnings collected, its
 # error caught: list(value, error = message or NULL, warnings, seconds)
 run_quiet <- function(expr) {
+  # (GGIR's readers set options(warn = -1) and may stop before resetting it)
+  op <- options(warn = getOption("warn"))
+  on.exit(options(op), add = TRUE)
   warns <- character()
   t0 <- proc.time()[["elapsed"]]
   value <- NULL
@@ -326,7 +417,8 @@ diff_element <- function(nm, R, G) {
 }
 
 # M of both compared as expect_same_meta() compares them: a list of the
-# differing elements (empty: identical).
+# differing elements (empty: identical). (g.calibrate()'s lists too: they
+# have no QClog; bsc_qc is left out as expect_same_as_ggir() leaves it.)
 compare_meta <- function(R, G) {
   if (!identical(names(G), names(R))) {
     return(list(list(element = "(names of M)", column = NA, row = NA,
@@ -354,9 +446,48 @@ named_param <- function(msg, pnames) {
   if (length(hit)) paste(unique(hit), collapse = ",") else NA_character_
 }
 
+# What the sweep compares (SWEEP_TARGET): the function, GGIR's parameter
+# lists it takes, the g.inspectfile() call that gives GGIR's
+# inspectfileobject (code run with the file `f` and the completed
+# arguments `a`), a one-line summary of an identical result.
+sweep_targets <- list(
+  getmeta = list(
+    fun = "g.getmeta", lists = c("metrics", "rawdata", "general", "cleaning"),
+    inspect = "GGIR::g.inspectfile(f, params_rawdata = a$params_rawdata, params_general = a$params_general)",
+    summary = function(v) sprintf("metashort %d x %d, metalong %d x %d",
+                                  NROW(v$metashort), NCOL(v$metashort),
+                                  NROW(v$metalong), NCOL(v$metalong))),
+  calibrate = list(
+    # (as GGIR's g.part1() calls g.inspectfile())
+    fun = "g.calibrate", lists = c("rawdata", "general", "cleaning"),
+    inspect = paste("GGIR::g.inspectfile(f, desiredtz = a$params_general[[\"desiredtz\"]],",
+                    "params_rawdata = a$params_rawdata, configtz = a$params_general[[\"configtz\"]])"),
+    summary = function(v) sprintf("npoints %s, nhoursused %s, use.temp %s: %s",
+                                  paste(v$npoints, collapse = ","), paste(format(v$nhoursused), collapse = ","),
+                                  paste(v$use.temp, collapse = ","), paste(v$QCmessage, collapse = " "))))
+
+sweep_target <- function() {
+  name <- Sys.getenv("SWEEP_TARGET", "getmeta")
+  if (!name %in% names(sweep_targets)) {
+    stop("ggir-sweep: SWEEP_TARGET must be one of ", paste(names(sweep_targets), collapse = ", "))
+  }
+  sweep_targets[[name]]
+}
+
+# The code of the three calls of a case (I, R, G), run by run_case() and
+# written into repro_code().
+call_code <- function(target, give_inspect) {
+  list(I = target$inspect,
+       R = paste0("do.call(GGIR::", target$fun, ", c(list(datafile = f, inspectfileobject = I, ",
+                  "verbose = FALSE), a))"),
+       G = paste0("do.call(gravcal::", target$fun, ", c(list(datafile = f, ",
+                  if (give_inspect) "inspectfileobject = I, ", "verbose = FALSE), a))"))
+}
+
 # R code that reruns a case: `build` is the code that rebuilds the file
 # (a synthetic recording, from its recipe; NULL for a real file).
-repro_code <- function(path, args, give_inspect, build) {
+repro_code <- function(path, args, give_inspect, build, target = sweep_targets$getmeta) {
+  code <- call_code(target, give_inspect)
   c(if (!is.null(build)) c(
       "source(\"tools/ggir-sweep.R\")  # its functions; nothing runs",
       paste0("f <- ", deparse(path), "  # kept with SWEEP_FILES, else rebuild it:"),
@@ -364,27 +495,28 @@ repro_code <- function(path, args, give_inspect, build) {
     if (is.null(build)) paste0("f <- ", deparse(path)),
     paste0("a <- ", compact(args)),
     "d <- GGIR::load_params()",
-    "for (k in paste0(\"params_\", c(\"metrics\", \"rawdata\", \"general\", \"cleaning\"))) a[[k]] <- utils::modifyList(d[[k]], if (is.null(a[[k]])) list() else a[[k]])",
-    "I <- GGIR::g.inspectfile(f, params_rawdata = a$params_rawdata, params_general = a$params_general)",
-    "R <- do.call(GGIR::g.getmeta, c(list(datafile = f, inspectfileobject = I, verbose = FALSE), a))",
-    paste0("G <- do.call(gravcal::g.getmeta, c(list(datafile = f, ",
-           if (give_inspect) "inspectfileobject = I, ", "verbose = FALSE), a))"))
+    paste0("for (k in paste0(\"params_\", ", compact(target$lists), ")) a[[k]] <- ",
+           "utils::modifyList(d[[k]], if (is.null(a[[k]])) list() else a[[k]])"),
+    paste0("I <- ", code$I), paste0("R <- ", code$R), paste0("G <- ", code$G))
 }
 
 run_case <- function(id, file, args, give_inspect, defaults, pnames, recipe = NULL,
-                     build = NULL) {
-  full <- complete_args(args, defaults)
-  ins <- run_quiet(GGIR::g.inspectfile(file, params_rawdata = full$params_rawdata,
-                                       params_general = full$params_general))
+                     build = NULL, target = sweep_targets$getmeta) {
+  full <- complete_args(args, defaults, target$lists)
+  code <- call_code(target, give_inspect)
+  env <- new.env()
+  env$f <- file
+  env$a <- full
+  ins <- run_quiet(eval(str2lang(code$I), env))
+  env$I <- ins$value
   gg <- if (is.null(ins$error)) {
-    run_quiet(do.call(GGIR::g.getmeta, c(list(datafile = file, inspectfileobject = ins$value,
-                                              verbose = FALSE), full)))
+    run_quiet(eval(str2lang(code$R), env))
   } else {
     list(value = NULL, error = paste("g.inspectfile():", ins$error), warnings = ins$warnings,
          seconds = 0)
   }
-  gi <- if (give_inspect && is.null(ins$error)) list(inspectfileobject = ins$value)
-  gc <- run_quiet(do.call(gravcal::g.getmeta, c(list(datafile = file, verbose = FALSE), gi, full)))
+  if (give_inspect && !is.null(ins$error)) code$G <- call_code(target, FALSE)$G
+  gc <- run_quiet(eval(str2lang(code$G), env))
   diffs <- list()
   refused <- if (!is.null(gc$error)) named_param(gc$error, pnames) else NA_character_
   if (is.null(gg$error) && is.null(gc$error)) {
@@ -398,9 +530,7 @@ run_case <- function(id, file, args, give_inspect, defaults, pnames, recipe = NU
     outcome <- "only GGIR errors"
   }
   detail <- switch(outcome,
-    identical = sprintf("metashort %d x %d, metalong %d x %d",
-                        NROW(gg$value$metashort), NCOL(gg$value$metashort),
-                        NROW(gg$value$metalong), NCOL(gg$value$metalong)),
+    identical = target$summary(gg$value),
     differs = paste(vapply(diffs, function(d) {
       sprintf("%s[%s, %s]: GGIR %s, gravcal %s (%s)", d$element, d$row, d$column,
               d$ggir, d$gravcal, d$note)
@@ -416,7 +546,7 @@ run_case <- function(id, file, args, give_inspect, defaults, pnames, recipe = NU
        diffs = diffs, ggir_error = gg$error, gravcal_error = gc$error,
        ggir_warnings = gg$warnings, gravcal_warnings = gc$warnings,
        seconds_inspect = ins$seconds, seconds_ggir = gg$seconds, seconds_gravcal = gc$seconds,
-       repro = repro_code(file, args, give_inspect, build), time = format(Sys.time(), tz = "UTC"))
+       repro = repro_code(file, args, give_inspect && is.null(ins$error), build, target), time = format(Sys.time(), tz = "UTC"))
 }
 
 md_cell <- function(x, max = 600) {
@@ -427,19 +557,30 @@ md_cell <- function(x, max = 600) {
 
 # ---- main --------------------------------------------------------------------
 
-main <- function() {
+# A sweep's settings: n and seed from the command line, SWEEP_OUT (default
+# `out`), SWEEP_DEADLINE, SWEEP_THREADS (set as options(gravcal.threads)).
+sweep_settings <- function(n, out) {
   a <- commandArgs(TRUE)
-  n <- if (length(a) >= 1) as.integer(a[1]) else 5L
-  seed <- if (length(a) >= 2) as.integer(a[2]) else 1L
-  out <- Sys.getenv("SWEEP_OUT", "/tmp/sweep-results")
   deadline <- Sys.getenv("SWEEP_DEADLINE", "")
-  deadline <- if (nzchar(deadline)) as.POSIXct(deadline, tz = "UTC") else NULL
   if (nzchar(Sys.getenv("SWEEP_THREADS"))) options(gravcal.threads = as.integer(Sys.getenv("SWEEP_THREADS")))
+  list(n = if (length(a) >= 1) as.integer(a[1]) else n,
+       seed = if (length(a) >= 2) as.integer(a[2]) else 1L,
+       out = Sys.getenv("SWEEP_OUT", out),
+       deadline = if (nzchar(deadline)) as.POSIXct(deadline, tz = "UTC"))
+}
+
+main <- function() {
+  st <- sweep_settings(5L, "/tmp/sweep-results")
+  n <- st$n
+  seed <- st$seed
+  out <- st$out
+  deadline <- st$deadline
   folder <- Sys.getenv("SWEEP_FILES", "")
   keep <- nzchar(folder)
   if (!keep) folder <- file.path(tempdir(), "ggir-sweep")
   dir.create(folder, showWarnings = FALSE, recursive = TRUE)
   if (!keep) on.exit(unlink(folder, recursive = TRUE), add = TRUE)
+  target <- sweep_target()
   suppressMessages(library(gravcal))
   if (!requireNamespace("GGIR", quietly = TRUE)) stop("ggir-sweep: needs GGIR")
   defaults <- GGIR::load_params()
@@ -449,16 +590,20 @@ main <- function() {
   # the files: synthetic ones (one per format, written once) and real ones,
   # each with its sampling rate (for the filters' hb)
   pool <- list()
-  for (fm in c("cwa", "geneactiv", "gt3x", "actigraph_csv", "movisens", "parmay")) {
+  formats <- c("cwa", "geneactiv", "gt3x", "actigraph_csv", "movisens", "parmay",
+               if (target$fun == "g.calibrate") "adhoc_csv")
+  for (fm in formats) {
     if (fm == "movisens" && !requireNamespace("unisensR", quietly = TRUE)) next
     r <- draw_recipe(fm, seed = sample(1e4, 1))
     ext <- c(cwa = ".cwa", geneactiv = ".bin", gt3x = ".gt3x", actigraph_csv = ".csv",
-             movisens = "", parmay = ".bin")[[fm]]
+             movisens = "", parmay = ".bin", adhoc_csv = ".csv")[[fm]]
     name <- sprintf("syn-s%d-%s-%gHz-%dh%s", seed, fm, r$sf, r$hours, ext)
     t0 <- proc.time()[["elapsed"]]
     path <- make_synthetic(r, file.path(folder, name))
     cat(sprintf("wrote %s (start %s) in %.1f s\n", name, r$start, proc.time()[["elapsed"]] - t0))
-    pool[[length(pool) + 1]] <- list(path = path, sf = r$sf, recipe = r, synthetic = TRUE,
+    rmc <- attr(path, "rmc")
+    path <- as.vector(path)
+    pool[[length(pool) + 1]] <- list(path = path, sf = r$sf, recipe = r, synthetic = TRUE, rmc = rmc,
                                      build = paste0("make_synthetic(", compact(r), ", ",
                                                     deparse(file.path(folder, name)), ")"))
   }
@@ -475,8 +620,9 @@ main <- function() {
   }
   synth <- vapply(pool, function(p) p$synthetic, TRUE)
 
-  writeLines(c(sprintf("# g.getmeta(): gravcal against GGIR %s, random parameters (tools/ggir-sweep.R %d %d)",
-                       utils::packageVersion("GGIR"), n, seed), "",
+  writeLines(c(sprintf("# %s(): gravcal against GGIR %s, random parameters (%stools/ggir-sweep.R %d %d)",
+                       target$fun, utils::packageVersion("GGIR"),
+                       if (target$fun == "g.calibrate") "SWEEP_TARGET=calibrate " else "", n, seed), "",
                sprintf("R %s, gravcal %s, started %s UTC.", getRversion(),
                        utils::packageVersion("gravcal"), format(Sys.time(), tz = "UTC")), "",
                "| case | file | parameters (non-default) | outcome | detail | GGIR s | gravcal s |",
@@ -490,10 +636,14 @@ main <- function() {
     # half the cases on a synthetic recording (several GGIR blocks), half on a real file
     k <- if (stats::runif(1) < 0.5) which(synth) else which(!synth)
     p <- pool[[if (length(k) == 1) k else sample(k, 1)]]
-    args <- draw_args(defaults, p$sf)
+    args <- if (target$fun == "g.calibrate") {
+      draw_args_calibrate(defaults, p$sf, p$rmc)
+    } else {
+      draw_args(defaults, p$sf)
+    }
     give_inspect <- stats::runif(1) < 0.3
     id <- sprintf("s%d-%03d", seed, i)
-    r <- run_case(id, p$path, args, give_inspect, defaults, pnames, p$recipe, p$build)
+    r <- run_case(id, p$path, args, give_inspect, defaults, pnames, p$recipe, p$build, target)
     results[[length(results) + 1]] <- r
     saveRDS(results, paste0(out, ".rds"))
     shown <- compact(c(args, if (give_inspect) list(gravcal_gets_inspectfileobject = TRUE)))
