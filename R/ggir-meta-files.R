@@ -216,12 +216,12 @@ g.part1 <- function(datadir = c(), metadatadir = c(), f0 = 1, f1 = c(), myfun = 
   # GGIR on 4 or more cores runs files in parallel and lowers chunksize
   # with the number of metrics: so that M is the one GGIR writes here
   pr[["chunksize"]] <- part1_parallel_chunksize(pm, pr, pg, f0, f1)
-  done <- part1_done(basic)
+  done <- part1_done(basic, fnames)
   out <- list()
   todo <- integer(0)
   for (i in f0:f1) {
     meta <- file.path(basic, part1_meta_name(fnames[i], fnames[1]))
-    if (!isTRUE(pg[["overwrite"]]) && fnames[i] %in% done) {
+    if (!isTRUE(pg[["overwrite"]]) && done[i]) {
       out[[length(out) + 1]] <- part1_row(fnames[i], "exists",
                                           "meta file exists (overwrite = FALSE)", meta)
       next
@@ -340,11 +340,22 @@ part1_files <- function(datadir, filelist) {
   list(fnames = basename(datadir), fnamesfull = datadir)
 }
 
-# The names of the recordings whose meta file is in `basic` (meta_<name>.RData).
-part1_done <- function(basic) {
+# Whether GGIR's part 1 (overwrite = FALSE) takes the recordings `fnames`
+# as done by the files in `basic`, by its reading of the names, which split
+# at patterns ("." any character): each file's name before the first match
+# of ".RData", its part between the first "meta_" and the next (NA without
+# one, "" for "meta_meta_..."), cut at every match of ".csv"; a recording
+# is done where its name before the first ".csv" match, then before the
+# first ".RD", is one of those pieces. So "s_csv.cwa" is done when
+# "meta_s_csv.bin.RData" is there, and "meta_a.cwa" never is.
+part1_done <- function(basic, fnames) {
+  first <- function(x, split) vapply(strsplit(x, split), function(p) p[1], "")
   f <- dir(basic)
-  f <- f[startsWith(f, "meta_")]
-  sub("[.]RData$", "", substring(f, 6))
+  if (!length(f)) return(rep(FALSE, length(fnames)))
+  pieces <- unlist(strsplit(vapply(strsplit(first(f, ".RData"), "meta_"),
+                                   function(p) p[2], ""), ".csv"))
+  own <- first(first(fnames, ".csv"), "[.]RD")
+  vapply(own, function(x) any(pieces == x, na.rm = TRUE), TRUE, USE.NAMES = FALSE)
 }
 
 # The meta file's name for the recording named `fname` (GGIR: .RData added
@@ -384,13 +395,15 @@ part1_default_cal <- function() {
 }
 
 # The coefficient file's row for the recording `fname` as GGIR reads it
-# into C (data.table::fread(); names "meta_<file>.RData" stand for
-# "<file>"); NULL when it has none.
+# into C (data.table::fread(); a name with "meta_" in it, split there, stands
+# for its second piece before the first match of the pattern ".RData": so
+# "meta_meta_a.cwa.RData" for "", never a recording); NULL when it has none.
 part1_retrieve <- function(C, file, fname) {
   d <- data.table::fread(file, data.table = FALSE)
-  nm <- as.character(d$filename)
-  meta <- grepl("meta_", nm, fixed = TRUE)
-  nm[meta] <- sub("[.]RData.*$", "", sub("^.*?meta_", "", nm[meta]))
+  nm <- vapply(as.character(d$filename), function(x) {
+    p <- strsplit(x, "meta_")[[1]]
+    if (length(p) > 1) strsplit(p[2], ".RData")[[1]][1] else x
+  }, "", USE.NAMES = FALSE)
   r <- which(nm == fname)[1]
   if (is.na(r)) return(NULL)
   col <- function(names) which(colnames(d) %in% names)
@@ -526,18 +539,26 @@ part1_save <- function(names, env, file) {
 # iso8601chartime2POSIX(), in desiredtz); M gains `nonwear` (NA for the
 # recorded short epochs, 0 for the added ones), as in GGIR. Returns
 # list(M, log = list(short =, long =) or NULL).
-part1_expand_tail <- function(M, end_hour, dayborder, tz, fname) {
-  if (!NROW(M$metashort) || !NROW(M$metalong)) {
-    abort("`recordingEndSleepHour`: \"", fname, "\" has no epochs to expand ",
-          "(too short or unreadable); GGIR's part 1 stops on it too.")
-  }
+#
+# A recording without epochs (too short, or unreadable): GGIR starts from
+# times of now (Sys.time()), which the last epochs' zero-length times leave
+# as they are, so it writes the file without expansion unless it runs
+# between recordingEndSleepHour and the day border (desiredtz's clock),
+# where it stops on the rows it does not have. So does this (`now`: the
+# time it runs).
+part1_expand_tail <- function(M, end_hour, dayborder, tz, fname, now = Sys.time()) {
+  empty <- !NROW(M$metashort) || !NROW(M$metalong)
   ws3 <- M$windowsizes[1]
   ws2 <- M$windowsizes[2]
-  last <- c(long = as.character(M$metalong$timestamp[nrow(M$metalong)]),
-            short = as.character(M$metashort$timestamp[nrow(M$metashort)]))
   # as POSIXct times without a zone of their own (GGIR fills such a vector)
   last_ts <- .POSIXct(c(0, 0))
-  for (k in 1:2) last_ts[k] <- GGIR::iso8601chartime2POSIX(x = last[[k]], tz = tz)
+  if (empty) {
+    last_ts[1:2] <- now
+  } else {
+    last <- c(long = as.character(M$metalong$timestamp[nrow(M$metalong)]),
+              short = as.character(M$metashort$timestamp[nrow(M$metashort)]))
+    for (k in 1:2) last_ts[k] <- GGIR::iso8601chartime2POSIX(x = last[[k]], tz = tz)
+  }
   last_ts <- list(long = last_ts[1], short = last_ts[2])
   refhour <- 24 + dayborder
   to_border <- vapply(last_ts, function(t) {
@@ -548,6 +569,13 @@ part1_expand_tail <- function(M, end_hour, dayborder, tz, fname) {
   }, 0)
   if (to_border[["long"]] > (refhour - (end_hour - dayborder)) * 3600) {
     return(list(M = M, log = NULL))
+  }
+  if (empty) {
+    abort("`recordingEndSleepHour`: \"", fname, "\" has no epochs to expand (too short or ",
+          "unreadable), and GGIR's part 1 run now (after ", end_hour, ":00 in `desiredtz`, ",
+          "before the day border) stops on such a file, taking the time of now for its ",
+          "last epoch; at other times of day it writes the file without expansion, as ",
+          "gravcal's does.")
   }
   to_border <- to_border + 8 * 3600
   n_long <- ceiling(to_border[["long"]] / ws2) + 1

@@ -480,10 +480,12 @@ meta_result <- function(short, long, asked, metnames, metricnames_long, starttim
   bsc_qc <- data.frame(time = format(Sys.time()), size = memory_in_use_mb(),
                        stringsAsFactors = FALSE)
   if (filecorrupt || filetooshort) {
+    # (no block made: GGIR's bsc_qc as it starts, no row)
     return(invisible(list(filecorrupt = filecorrupt, filetooshort = TRUE,
                           NFilePagesSkipped = 0, metalong = c(), metashort = c(),
                           wday = c(), wdayname = c(), windowsizes = c(),
-                          bsc_qc = bsc_qc, QClog = QClog)))
+                          bsc_qc = data.frame(time = c(), size = c(), stringsAsFactors = FALSE),
+                          QClog = QClog)))
   }
   n_short <- short$count - 1
   stamp <- function(n, by, min_rows) {

@@ -19,7 +19,7 @@ myfun_needed <- c("FUN", "parameters", "expected_sample_rate", "expected_unit", 
 # stops), and outputtype, which GGIR's g.getmeta() reads without checking
 # (it stops on its absence in the middle of the first block).
 meta_myfun_check <- function(myfun, ws3) {
-  bad <- function(...) abort("`myfun`: ", ..., call. = FALSE)
+  bad <- function(...) abort("`myfun`: ", ...)
   if (!is.list(myfun)) bad("must be a list (GGIR's external function object), not ",
                            describe(myfun), ".")
   extra <- setdiff(names(myfun), myfun_known)

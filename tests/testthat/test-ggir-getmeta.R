@@ -310,6 +310,18 @@ test_that("an ActiGraph csv export with damaged lines: gravcal's drop-ins refuse
   unlink(c(f, g, g2, cut))
 })
 
+test_that("a file too short for a block: M's bsc_qc is GGIR's, without a row", {
+  # GGIR's bsc_qc gains a row with each block it makes; a file too short
+  # for one has none. Before, gravcal's had one (found by
+  # tools/ggir-sweep-part1.R, stop 68)
+  skip_if_not_installed("GGIRread")
+  f <- system.file("testfiles", "ax3_testfile.cwa", package = "GGIRread")
+  b <- meta_both(f)
+  expect_true(b$ggir$filetooshort)
+  expect_same_meta(b)
+  expect_identical(b$gravcal$bsc_qc, b$ggir$bsc_qc)
+})
+
 # A GENEActiv recording's lines (meta_recording(): `hours` at 30 Hz), and
 # a .bin file of them with CRLF line ends, as the device writes them.
 ga_meta_lines <- function(hours = 3) {

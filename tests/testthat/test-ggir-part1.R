@@ -398,6 +398,58 @@ test_that("g.part1() is GGIR's with recordingEndSleepHour (M's tail expanded)", 
   expect_true("nonwear" %in% names(obj$M))
 })
 
+test_that("recordingEndSleepHour on a recording without epochs: GGIR's outcome at the time it runs", {
+  # GGIR 3.3-9's g.part1() takes the last epochs' times into times of now
+  # (Sys.time()); a recording without epochs (too short, unreadable) leaves
+  # them so: it expands (and stops on the rows it does not have) only when
+  # run between recordingEndSleepHour and the day border in desiredtz's
+  # clock, and writes M as it is otherwise. Before, gravcal stopped at any
+  # time. Found by tools/ggir-sweep-part1.R (stop 68), where GGIR wrote the
+  # file at 04:xx UTC with recordingEndSleepHour 20
+  M <- list(metashort = NULL, metalong = NULL, windowsizes = NULL)
+  at <- function(h) as.POSIXct(sprintf("2026-12-02 %02d:30:00", h), tz = "UTC")
+  for (h in c(0, 4, 12, 19)) {
+    r <- gravcal:::part1_expand_tail(M, 20, 0, "UTC", "a.cwa", now = at(h))
+    expect_identical(r, list(M = M, log = NULL), label = paste("at", h))
+  }
+  for (h in c(20, 23)) {
+    expect_error(gravcal:::part1_expand_tail(M, 20, 0, "UTC", "a.cwa", now = at(h)),
+                 "no epochs to expand.*run now \\(after 20:00", label = paste("at", h))
+  }
+  # the clock is desiredtz's: 19:30 UTC is 20:30 in Amsterdam (winter)
+  expect_error(gravcal:::part1_expand_tail(M, 20, 0, "Europe/Amsterdam", "a.cwa", now = at(19)),
+               "no epochs to expand")
+})
+
+test_that("overwrite = FALSE and backup.cal.coef find a recording's name as GGIR's part 1 does", {
+  # GGIR 3.3-9 splits the names at patterns ("." any character): a meta
+  # file's name before ".RData", its piece after "meta_", cut at ".csv";
+  # a recording's own name before ".csv", then ".RD". So "s_csv.cwa" is
+  # done by "meta_s_csv.bin.RData" (both "s"), and a recording named
+  # "meta_a.cwa" never is (its meta file "meta_meta_a.cwa.RData" reads as
+  # ""). Found by tools/ggir-sweep-part1.R (stop 68), against GGIR's
+  # g.part1(): before, gravcal wrote s_csv.cwa's meta file and skipped
+  # meta_a.cwa's, where GGIR does the opposite
+  basic <- tempfile("basic-")
+  dir.create(basic)
+  file.create(file.path(basic, c("meta_s_csv.bin.RData", "meta_meta_a.cwa.RData",
+                                 "meta_b.cwa.RData", "notes.txt")))
+  done <- gravcal:::part1_done(basic, c("s_csv.cwa", "meta_a.cwa", "b.cwa", "c.cwa", "s_csv.bin"))
+  expect_identical(done, c(TRUE, FALSE, TRUE, FALSE, TRUE))
+  expect_identical(gravcal:::part1_done(tempfile(), "a.cwa"), FALSE)
+  # backup.cal.coef: a row named "meta_meta_a.cwa.RData" is no recording's
+  csv <- tempfile(fileext = ".csv")
+  utils::write.csv(data.frame(filename = c("meta_meta_a.cwa.RData", "meta_b.cwa.RData", "c.cwa"),
+                              scale.x = c(0.99, 0.98, 0.97), scale.y = 1, scale.z = 1,
+                              offset.x = 0, offset.y = 0, offset.z = 0),
+                   csv, row.names = FALSE)
+  C <- list()
+  expect_null(gravcal:::part1_retrieve(C, csv, "meta_a.cwa"))
+  expect_identical(gravcal:::part1_retrieve(C, csv, "b.cwa")$scale, c(0.98, 1, 1))
+  expect_identical(gravcal:::part1_retrieve(C, csv, "c.cwa")$scale, c(0.97, 1, 1))
+  unlink(c(basic, csv), recursive = TRUE)
+})
+
 # A folder of one ad hoc csv file (GGIR's rmc.* files) of 8 hours at 10 Hz,
 # in mg with UNIX seconds and temperature, after two free header lines
 # (write_adhoc_csv()); its rmc.* list in p1_state$adhoc_rmc. Made once a
