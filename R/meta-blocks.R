@@ -230,8 +230,8 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   # block, give GGIR's QClog
   impute <- isTRUE(src$getmeta_timegaps)
   counters <- function() {
-    k <- src$report()$counters
-    g <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+    k <- src$report()
+    g <- function(nm) report_count(k, nm)
     c(read = g("timegap_rows_read"), gaps = g("timegaps_imputed"), rows = g("timegap_rows"),
       over = g("timegaps_over_limit"), longest = g("timegap_longest_rows"),
       missing = g("clock_time_missing"), exceeded = g("clock_table_exceeded"),
@@ -240,8 +240,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   before <- if (impute) counters()
   na_times <- function() {
     if (!isTRUE(fe$rmc) || is.null(src$report)) return(FALSE)
-    k <- src$report()$counters
-    "time_not_existing" %in% names(k) && k[["time_not_existing"]] > 0
+    report_count(src$report(), "time_not_existing") > 0
   }
   last_read <- NA_real_  # the last time stamp of the block before
   # (the store g.part1() made, its first block read beside g.calibrate()'s
@@ -562,7 +561,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
   rep <- if (!is.null(src$report)) src$report() else list()
   # (a format whose reader's log is M$QClog keeps its damaged units as
   # GGIR's reader keeps them, and logs them there)
-  counter <- function(nm) if (nm %in% names(rep$counters)) unname(rep$counters[nm]) else 0
+  counter <- function(nm) report_count(rep, nm)
   imputed <- counter("imputed_spans")
   if (is.null(fe$ggir_qclog) && is.null(fe$ggir_block_qclog) &&
       (imputed > 0 || isTRUE(rep$skipped > 0))) {
@@ -598,8 +597,7 @@ meta_run <- function(src, p, cal, daylimit, verbose, model = NULL, gradient = NU
 meta_undefined_time <- function(src, times) {
   # (NaN, or NA once the zone's shift has been applied)
   if (!anyNA(times) || is.null(src$native) || is.null(src$report)) return(FALSE)
-  k <- src$report()$counters
-  "ggir_time_undefined" %in% names(k) && k[["ggir_time_undefined"]] > 0
+  report_count(src$report(), "ggir_time_undefined") > 0
 }
 
 # A block's time stamps, from a decoder that reads the file's clock as UTC,

@@ -141,6 +141,13 @@ cwa_qclog <- function(src, from) {
              imputed = log$imputed[k] == 1)
 }
 
+# The sum of a decoder report's counters named `nm` (list(counters =) from
+# src$report(), or its counters), 0 for those it does not have.
+report_count <- function(rep, nm) {
+  k <- if (is.list(rep)) rep$counters else rep
+  sum(vapply(nm, function(x) if (x %in% names(k)) unname(k[[x]]) else 0, 0))
+}
+
 # Why GGIR's reader of Parmay Matrix files (GGIRread's readParmayMatrix())
 # gives no result to reproduce where gravcal's decoder reads on, or NULL:
 # a packet too short for its header (at the file's end, a file cut inside
@@ -149,8 +156,7 @@ cwa_qclog <- function(src, from) {
 # packet.
 parmay_ggir_stops <- function(src) {
   rep <- src$report()
-  k <- rep$counters
-  short <- if ("short_packet" %in% names(k)) k[["short_packet"]] else 0
+  short <- report_count(rep, "short_packet")
   if (short == 1 && isTRUE(rep$truncated)) {
     return("a packet cut inside its header at its end (GGIR's reader fails on it)")
   }
@@ -158,7 +164,7 @@ parmay_ggir_stops <- function(src) {
     return(paste0("a packet too short for its header within it (GGIR's reader takes the next ",
                   "packet's bytes for its own)"))
   }
-  if (isTRUE(k["bad_packet_counts"] > 0)) {
+  if (report_count(rep, "bad_packet_counts") > 0) {
     return("a packet with a negative sample count (GGIR's reader fails on it)")
   }
   declared <- parmay_declared(src$path)
@@ -180,8 +186,7 @@ parmay_ggir_stops <- function(src) {
 # gravcal does not reproduce: why, or NULL.
 cwa_ggir_stops <- function(src) {
   rep <- src$report()
-  k <- rep$counters
-  n <- if ("qclog_not_reproduced" %in% names(k)) k[["qclog_not_reproduced"]] else 0
+  n <- report_count(rep, "qclog_not_reproduced")
   if (n == 0) return(NULL)
   first <- grep("^bad_header|^bad_content|in a row|gap over 3 days", rep$notes, value = TRUE)
   paste0(n, " place", if (n != 1) "s", " where GGIR's reader (readAxivity()) stops instead of ",
@@ -201,10 +206,9 @@ cwa_ggir_stops <- function(src) {
 # "calibrate"; "getmeta" reads the time). Why, or NULL.
 actigraph_csv_ggir_stops <- function(src, part) {
   rep <- src$report()
-  k <- rep$counters
   damage <- c("long_lines", "short_lines", "non_numeric_lines",
               if (part == "getmeta") "bad_timestamps")
-  n <- sum(vapply(damage, function(nm) if (nm %in% names(k)) k[[nm]] else 0, 0))
+  n <- report_count(rep, damage)
   if (n == 0) return(NULL)
   first <- grep("too many fields|too few fields|not a number|unreadable time stamp", rep$notes,
                 value = TRUE)
@@ -221,8 +225,7 @@ actigraph_csv_ggir_stops <- function(src, part) {
 # damaged records in log.bin, which the decoder skips. Why, or NULL.
 gt3x_ggir_stops <- function(src) {
   rep <- src$report()
-  k <- rep$counters
-  if (isTRUE(k["zip_directory_damaged"] > 0)) {
+  if (report_count(rep, "zip_directory_damaged") > 0) {
     return(paste0("a zip archive whose central directory is missing or damaged (the file ",
                   "cut short, for example), which GGIR's reader (read.gt3x) cannot open"))
   }
@@ -247,8 +250,8 @@ gt3x_ggir_stops <- function(src) {
 # stamps are checked in meta_run()) or "calibrate" (time stamps matter only
 # where GGIR resamples the blocks by them: a rate that is not whole).
 geneactiv_ggir_stops <- function(src, part) {
-  k <- src$report()$counters
-  n <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+  rep <- src$report()
+  n <- function(nm) report_count(rep, nm)
   if (n("ggir_not_reproduced") > 0) {
     return(paste0("a page line longer than 8192 characters that GGIR's reader reads on ",
                   "(gravcal's decoder keeps lines to that length)"))
@@ -278,8 +281,7 @@ geneactiv_ggir_stops <- function(src, part) {
 # last page cut short.
 geneactiv_damage_warning <- function(src) {
   rep <- src$report()
-  k <- rep$counters
-  n <- function(nm) if (nm %in% names(k)) k[[nm]] else 0
+  n <- function(nm) report_count(rep, nm)
   damaged <- n("damaged_hex") + n("damaged_page_header")
   what <- c(
     if (damaged > 0) {

@@ -542,12 +542,7 @@ main <- function() {
     cat(sprintf("%s %-20s GGIR %6.1f s gravcal %5.1f s  %s\n", spec$id, r$outcome,
                 r$seconds_ggir, r$seconds_gravcal, substr(r$detail, 1, 200)))
   }
-  tab <- table(vapply(results, function(r) r$outcome, ""))
-  summary <- paste(sprintf("%s: %d", names(tab), as.integer(tab)), collapse = ", ")
-  cat(sprintf("\n%d cases: %s\n", length(results), summary))
-  cat("\n", sprintf("%d cases: %s.", length(results), summary), "\n", sep = "",
-      file = paste0(out, ".md"), append = TRUE)
-  invisible(results)
+  sw$sweep_summary(results, out)
 }
 
 if (sys.nframe() == 0L) main()

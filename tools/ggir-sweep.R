@@ -569,6 +569,16 @@ sweep_settings <- function(n, out) {
        deadline = if (nzchar(deadline)) as.POSIXct(deadline, tz = "UTC"))
 }
 
+# The count of each outcome, printed and appended to <out>.md; the results.
+sweep_summary <- function(results, out) {
+  tab <- table(vapply(results, function(r) r$outcome, ""))
+  summary <- paste(sprintf("%s: %d", names(tab), as.integer(tab)), collapse = ", ")
+  cat(sprintf("\n%d cases: %s\n", length(results), summary))
+  cat("\n", sprintf("%d cases: %s.", length(results), summary), "\n", sep = "",
+      file = paste0(out, ".md"), append = TRUE)
+  invisible(results)
+}
+
 main <- function() {
   st <- sweep_settings(5L, "/tmp/sweep-results")
   n <- st$n
@@ -654,12 +664,7 @@ main <- function() {
                 r$outcome, r$seconds_ggir + r$seconds_inspect, r$seconds_gravcal,
                 substr(r$detail, 1, 150)))
   }
-  tab <- table(vapply(results, function(r) r$outcome, ""))
-  summary <- paste(sprintf("%s: %d", names(tab), as.integer(tab)), collapse = ", ")
-  cat(sprintf("\n%d cases: %s\n", length(results), summary))
-  cat("\n", sprintf("%d cases: %s.", length(results), summary), "\n", sep = "",
-      file = paste0(out, ".md"), append = TRUE)
-  invisible(results)
+  sweep_summary(results, out)
 }
 
 if (sys.nframe() == 0L) main()
